@@ -6,13 +6,25 @@ use irpol::optics::RefractiveIndex;
 use irpol::pbrdf::{Direction, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
 
 fn paper_paint(shadowing: Shadowing) -> Pbrdf {
-    Pbrdf::new(SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 }, shadowing, RefractiveIndex::new(1.2, 0.2), 0.0)
-        .unwrap()
+    Pbrdf::new(
+        SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
+        shadowing,
+        RefractiveIndex::new(1.2, 0.2),
+        0.0,
+    )
+    .unwrap()
 }
 
 fn mueller(c: &mut Criterion) {
-    let (incident, scattered) = (Direction::from_angles(1.0, 0.0), Direction::from_angles(0.9, 2.8));
-    for shadowing in [Shadowing::None, Shadowing::TorranceSparrow, Shadowing::Smith] {
+    let (incident, scattered) = (
+        Direction::from_angles(1.0, 0.0),
+        Direction::from_angles(0.9, 2.8),
+    );
+    for shadowing in [
+        Shadowing::None,
+        Shadowing::TorranceSparrow,
+        Shadowing::Smith,
+    ] {
         let model = paper_paint(shadowing);
         c.bench_function(&format!("mueller_4x4_cauchy_{}", shadowing.name()), |b| {
             b.iter(|| model.mueller(black_box(&incident), black_box(&scattered)))
@@ -30,7 +42,9 @@ fn emissivity(c: &mut Criterion) {
     group.sample_size(20);
     for shadowing in [Shadowing::None, Shadowing::Smith] {
         let model = paper_paint(shadowing);
-        group.bench_function(shadowing.name(), |b| b.iter(|| model.emissivity_table(black_box(&thetas), &quadrature)));
+        group.bench_function(shadowing.name(), |b| {
+            b.iter(|| model.emissivity_table(black_box(&thetas), &quadrature))
+        });
     }
     group.finish();
 }

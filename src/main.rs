@@ -2,7 +2,9 @@
 //! non-zero exit, never a panic.
 
 use clap::{Args, Parser, Subcommand};
-use irpol::commands::evaluate::{read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv};
+use irpol::commands::evaluate::{
+    read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
+};
 use irpol::commands::{parse_sweep, ModelArgs};
 use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
 use std::io::Write;
@@ -10,7 +12,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "irpol", version, about = "Infrared polarimetry: fit polarimetric BRDFs and simulate LWIR Stokes imagery")]
+#[command(
+    name = "irpol",
+    version,
+    about = "Infrared polarimetry: fit polarimetric BRDFs and simulate LWIR Stokes imagery"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -118,13 +124,23 @@ fn main() -> ExitCode {
 
 fn run(command: Command) -> anyhow::Result<()> {
     match command {
-        Command::Eval { model, geometry, theta_i, theta_r, phi_i, phi_r } => {
+        Command::Eval {
+            model,
+            geometry,
+            theta_i,
+            theta_r,
+            phi_i,
+            phi_r,
+        } => {
             let model = model.model_args().build()?;
             let table = match (geometry, theta_i, theta_r) {
                 (Some(path), _, _) => read_geometry_csv(&path)?,
-                (None, Some(ti), Some(tr)) => {
-                    sweep_table(&parse_sweep(&ti, "theta-i")?, phi_i, &parse_sweep(&tr, "theta-r")?, phi_r)?
-                }
+                (None, Some(ti), Some(tr)) => sweep_table(
+                    &parse_sweep(&ti, "theta-i")?,
+                    phi_i,
+                    &parse_sweep(&tr, "theta-r")?,
+                    phi_r,
+                )?,
                 _ => anyhow::bail!("give --geometry FILE.csv, or --theta-i and --theta-r"),
             };
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
@@ -146,7 +162,11 @@ fn run(command: Command) -> anyhow::Result<()> {
             }
         }
         Command::Figure { which, out } => {
-            let figure = if which == "paper-fig2" { PaperFigure::Fig2 } else { PaperFigure::Fig3 };
+            let figure = if which == "paper-fig2" {
+                PaperFigure::Fig2
+            } else {
+                PaperFigure::Fig3
+            };
             for path in write_paper_figure(figure, &out)? {
                 println!("wrote {}", path.display());
             }
@@ -173,7 +193,10 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
             irpol::pbrdf::SlopeDistribution::Cauchy { q, .. } => format!("{q:.3}"),
             irpol::pbrdf::SlopeDistribution::Gaussian { .. } => "—".into(),
         };
-        let chi2 = m.fit.as_ref().map_or("—".into(), |f| format!("{:.3}", f.reduced_chi2));
+        let chi2 = m
+            .fit
+            .as_ref()
+            .map_or("—".into(), |f| format!("{:.3}", f.reduced_chi2));
         println!(
             "{:<18} {:<9} {:<17} {:>7.3} {:>6.3} {:>6} {:>6.3} {:>6.3} {:>7.4} {:>8}",
             m.name,

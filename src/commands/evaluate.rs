@@ -34,8 +34,12 @@ pub struct GeometryTable {
 }
 
 pub fn read_geometry_csv(path: &Path) -> anyhow::Result<GeometryTable> {
-    let file = std::fs::File::open(path).with_context(|| format!("{}: cannot open", path.display()))?;
-    let mut reader = csv::ReaderBuilder::new().comment(Some(b'#')).trim(csv::Trim::All).from_reader(file);
+    let file =
+        std::fs::File::open(path).with_context(|| format!("{}: cannot open", path.display()))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .from_reader(file);
     let headers: Vec<String> = reader
         .headers()
         .with_context(|| format!("{}:1:1: cannot read the header", path.display()))?
@@ -44,7 +48,13 @@ pub fn read_geometry_csv(path: &Path) -> anyhow::Result<GeometryTable> {
         .collect();
     let column = |name: &str| headers.iter().position(|h| h == name);
     let required = |name: &str| {
-        column(name).ok_or_else(|| anyhow::anyhow!("{}:1:1: missing column '{name}' (have: {})", path.display(), headers.join(",")))
+        column(name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "{}:1:1: missing column '{name}' (have: {})",
+                path.display(),
+                headers.join(",")
+            )
+        })
     };
     let (ti, tr) = (required("theta_i_deg")?, required("theta_r_deg")?);
     let (pi, pr) = (column("phi_i_deg"), column("phi_r_deg"));
@@ -54,9 +64,17 @@ pub fn read_geometry_csv(path: &Path) -> anyhow::Result<GeometryTable> {
         let line = record.position().map_or(0, |p| p.line());
         let field = |index: usize| -> anyhow::Result<f64> {
             let text = &record[index];
-            text.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
-                anyhow::anyhow!("{}:{line}:{}: {} = '{text}' is not a finite number", path.display(), index + 1, headers[index])
-            })
+            text.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "{}:{line}:{}: {} = '{text}' is not a finite number",
+                        path.display(),
+                        index + 1,
+                        headers[index]
+                    )
+                })
         };
         let geometry = Geometry {
             theta_i_deg: field(ti)?,
@@ -64,7 +82,9 @@ pub fn read_geometry_csv(path: &Path) -> anyhow::Result<GeometryTable> {
             theta_r_deg: field(tr)?,
             phi_r_deg: pr.map(field).transpose()?.unwrap_or(180.0),
         };
-        geometry.directions().map_err(|e| anyhow::anyhow!("{}:{line}: {e}", path.display()))?;
+        geometry
+            .directions()
+            .map_err(|e| anyhow::anyhow!("{}:{line}: {e}", path.display()))?;
         rows.push((record.iter().map(str::to_owned).collect(), geometry));
     }
     if rows.is_empty() {
@@ -74,7 +94,11 @@ pub fn read_geometry_csv(path: &Path) -> anyhow::Result<GeometryTable> {
 }
 
 /// Writes the table's rows with the 16 Mueller elements (sr⁻¹, psps) appended.
-pub fn write_mueller_csv(model: &Pbrdf, table: &GeometryTable, out: &mut impl Write) -> anyhow::Result<()> {
+pub fn write_mueller_csv(
+    model: &Pbrdf,
+    table: &GeometryTable,
+    out: &mut impl Write,
+) -> anyhow::Result<()> {
     writeln!(out, "{},{MUELLER_HEADER}", table.headers.join(","))?;
     for (fields, geometry) in &table.rows {
         let (incident, scattered) = geometry.directions()?;
@@ -86,14 +110,34 @@ pub fn write_mueller_csv(model: &Pbrdf, table: &GeometryTable, out: &mut impl Wr
 }
 
 /// A sweep as a geometry table (every combination of the given angles).
-pub fn sweep_table(theta_i: &[f64], phi_i: f64, theta_r: &[f64], phi_r: f64) -> anyhow::Result<GeometryTable> {
-    let headers = ["theta_i_deg", "phi_i_deg", "theta_r_deg", "phi_r_deg"].map(str::to_owned).to_vec();
+pub fn sweep_table(
+    theta_i: &[f64],
+    phi_i: f64,
+    theta_r: &[f64],
+    phi_r: f64,
+) -> anyhow::Result<GeometryTable> {
+    let headers = ["theta_i_deg", "phi_i_deg", "theta_r_deg", "phi_r_deg"]
+        .map(str::to_owned)
+        .to_vec();
     let mut rows = Vec::new();
     for &ti in theta_i {
         for &tr in theta_r {
-            let geometry = Geometry { theta_i_deg: ti, phi_i_deg: phi_i, theta_r_deg: tr, phi_r_deg: phi_r };
+            let geometry = Geometry {
+                theta_i_deg: ti,
+                phi_i_deg: phi_i,
+                theta_r_deg: tr,
+                phi_r_deg: phi_r,
+            };
             geometry.directions()?;
-            rows.push((vec![ti.to_string(), phi_i.to_string(), tr.to_string(), phi_r.to_string()], geometry));
+            rows.push((
+                vec![
+                    ti.to_string(),
+                    phi_i.to_string(),
+                    tr.to_string(),
+                    phi_r.to_string(),
+                ],
+                geometry,
+            ));
         }
     }
     Ok(GeometryTable { headers, rows })
@@ -101,7 +145,11 @@ pub fn sweep_table(theta_i: &[f64], phi_i: f64, theta_r: &[f64], phi_r: f64) -> 
 
 /// Writes theta_deg,e0,e1,e2,e3 and returns the angles where the hemispherical reflectance
 /// exceeds 1 (ε0 < 0), which the caller must report.
-pub fn write_emissivity_csv(model: &Pbrdf, thetas_deg: &[f64], out: &mut impl Write) -> anyhow::Result<Vec<f64>> {
+pub fn write_emissivity_csv(
+    model: &Pbrdf,
+    thetas_deg: &[f64],
+    out: &mut impl Write,
+) -> anyhow::Result<Vec<f64>> {
     for &theta in thetas_deg {
         Direction::from_degrees_checked("theta", theta, 0.0)?;
     }

@@ -32,7 +32,9 @@ impl ModelArgs {
         };
         if let Some(path) = &self.material {
             if self.sigma.is_some() || self.q.is_some() || self.n.is_some() || self.k.is_some() {
-                anyhow::bail!("give either --material or model parameters (--sigma --q --n --k), not both");
+                anyhow::bail!(
+                    "give either --material or model parameters (--sigma --q --n --k), not both"
+                );
             }
             let mut spec = Material::load(path)?.model;
             if let Some(shadowing) = shadowing {
@@ -43,7 +45,10 @@ impl ModelArgs {
         let missing = |flag: &str| anyhow::anyhow!("missing --{flag} (or give --material FILE)");
         let sigma = self.sigma.ok_or_else(|| missing("sigma"))?;
         let distribution = match self.distribution.as_deref().unwrap_or("cauchy") {
-            "cauchy" => SlopeDistribution::Cauchy { sigma, q: self.q.ok_or_else(|| missing("q"))? },
+            "cauchy" => SlopeDistribution::Cauchy {
+                sigma,
+                q: self.q.ok_or_else(|| missing("q"))?,
+            },
             "gaussian" => {
                 if self.q.is_some() {
                     anyhow::bail!("--q applies to the cauchy distribution only");
@@ -52,8 +57,16 @@ impl ModelArgs {
             }
             other => anyhow::bail!("unknown distribution '{other}': use cauchy or gaussian"),
         };
-        let index = RefractiveIndex::new(self.n.ok_or_else(|| missing("n"))?, self.k.ok_or_else(|| missing("k"))?);
-        Ok(Pbrdf::new(distribution, shadowing.unwrap_or_default(), index, self.rho.unwrap_or(0.0))?)
+        let index = RefractiveIndex::new(
+            self.n.ok_or_else(|| missing("n"))?,
+            self.k.ok_or_else(|| missing("k"))?,
+        );
+        Ok(Pbrdf::new(
+            distribution,
+            shadowing.unwrap_or_default(),
+            index,
+            self.rho.unwrap_or(0.0),
+        )?)
     }
 }
 
@@ -61,7 +74,10 @@ impl ModelArgs {
 pub fn parse_sweep(text: &str, name: &str) -> anyhow::Result<Vec<f64>> {
     let parts: Vec<&str> = text.split(':').collect();
     let number = |s: &str| -> anyhow::Result<f64> {
-        let value: f64 = s.trim().parse().map_err(|_| anyhow::anyhow!("--{name}: '{s}' is not a number"))?;
+        let value: f64 = s
+            .trim()
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--{name}: '{s}' is not a number"))?;
         if value.is_finite() {
             Ok(value)
         } else {
@@ -73,7 +89,9 @@ pub fn parse_sweep(text: &str, name: &str) -> anyhow::Result<Vec<f64>> {
         [start, stop, step] => {
             let (start, stop, step) = (number(start)?, number(stop)?, number(step)?);
             if step <= 0.0 || stop < start {
-                anyhow::bail!("--{name}: need STEP > 0 and STOP ≥ START in START:STOP:STEP, got '{text}'");
+                anyhow::bail!(
+                    "--{name}: need STEP > 0 and STOP ≥ START in START:STOP:STEP, got '{text}'"
+                );
             }
             let count = ((stop - start) / step + 1e-9).floor() as usize + 1;
             if count > 1_000_000 {
@@ -91,7 +109,10 @@ mod tests {
 
     #[test]
     fn sweeps_parse_and_refuse_nonsense() {
-        assert_eq!(parse_sweep("0:10:5", "theta").unwrap(), vec![0.0, 5.0, 10.0]);
+        assert_eq!(
+            parse_sweep("0:10:5", "theta").unwrap(),
+            vec![0.0, 5.0, 10.0]
+        );
         assert_eq!(parse_sweep("0:89:1", "theta").unwrap().len(), 90);
         assert_eq!(parse_sweep("42", "theta").unwrap(), vec![42.0]);
         for bad in ["0:10:0", "10:0:1", "a:1:1", "1:2", "nan", "0:1e9:1e-3"] {
@@ -101,7 +122,12 @@ mod tests {
 
     #[test]
     fn model_args_need_all_parameters_and_refuse_mixing() {
-        let mut args = ModelArgs { sigma: Some(0.1), q: Some(1.8), n: Some(1.2), ..Default::default() };
+        let mut args = ModelArgs {
+            sigma: Some(0.1),
+            q: Some(1.8),
+            n: Some(1.2),
+            ..Default::default()
+        };
         assert!(args.build().unwrap_err().to_string().contains("--k"));
         args.k = Some(0.2);
         assert!(args.build().is_ok());

@@ -25,9 +25,15 @@ pub fn register_fonts() {
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {
     #[error("{path}: cannot draw the figure: {message}")]
-    Draw { path: std::path::PathBuf, message: String },
+    Draw {
+        path: std::path::PathBuf,
+        message: String,
+    },
     #[error("{path}: cannot write: {source}")]
-    Write { path: std::path::PathBuf, source: std::io::Error },
+    Write {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
     #[error(transparent)]
     Model(#[from] crate::pbrdf::ModelError),
 }

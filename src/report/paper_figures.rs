@@ -28,8 +28,14 @@ impl PaperFigure {
     /// (legend label, σ, q) of each curve.
     fn curves(&self) -> Vec<(String, f64, f64)> {
         match self {
-            PaperFigure::Fig2 => [1.5, 1.8, 2.5].iter().map(|&q| (format!("q = {q}"), 0.1, q)).collect(),
-            PaperFigure::Fig3 => [0.1, 0.2, 0.3].iter().map(|&s| (format!("σ = {s}"), s, 1.8)).collect(),
+            PaperFigure::Fig2 => [1.5, 1.8, 2.5]
+                .iter()
+                .map(|&q| (format!("q = {q}"), 0.1, q))
+                .collect(),
+            PaperFigure::Fig3 => [0.1, 0.2, 0.3]
+                .iter()
+                .map(|&s| (format!("σ = {s}"), s, 1.8))
+                .collect(),
         }
     }
 
@@ -45,7 +51,11 @@ impl PaperFigure {
 /// negative toward the source (φ_r = φ_i).
 fn in_plane_f00(model: &Pbrdf, theta_i_deg: f64, detector_deg: f64) -> f64 {
     let incident = Direction::from_angles(theta_i_deg.to_radians(), 0.0);
-    let phi_r = if detector_deg >= 0.0 { std::f64::consts::PI } else { 0.0 };
+    let phi_r = if detector_deg >= 0.0 {
+        std::f64::consts::PI
+    } else {
+        0.0
+    };
     let scattered = Direction::from_angles(detector_deg.abs().to_radians(), phi_r);
     model.first_column(&incident, &scattered)[0]
 }
@@ -57,7 +67,12 @@ pub fn figure_data(figure: PaperFigure) -> Result<Vec<(String, Vec<(f64, f64)>)>
         .curves()
         .into_iter()
         .map(|(label, sigma, q)| {
-            let model = Pbrdf::new(SlopeDistribution::Cauchy { sigma, q }, Shadowing::None, index, 0.0)?;
+            let model = Pbrdf::new(
+                SlopeDistribution::Cauchy { sigma, q },
+                Shadowing::None,
+                index,
+                0.0,
+            )?;
             let points = (-890..=890)
                 .step_by(5)
                 .map(|tenth| {
@@ -71,7 +86,10 @@ pub fn figure_data(figure: PaperFigure) -> Result<Vec<(String, Vec<(f64, f64)>)>
 }
 
 /// Writes `<out>/<stem>.png` and `.svg`; returns their paths.
-pub fn write_paper_figure(figure: PaperFigure, out_dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
+pub fn write_paper_figure(
+    figure: PaperFigure,
+    out_dir: &Path,
+) -> Result<Vec<PathBuf>, ReportError> {
     let curves = figure_data(figure)?;
     let png = out_dir.join(format!("{}.png", figure.file_stem()));
     let svg = out_dir.join(format!("{}.svg", figure.file_stem()));
@@ -92,9 +110,14 @@ pub fn write_paper_figure(figure: PaperFigure, out_dir: &Path) -> Result<Vec<Pat
         draw_curves(&root, figure.title(), &curves).map_err(|e| draw_error(&svg, &e))?;
     }
     let png_bytes = encode_png(&rgb, width, height).map_err(|e| draw_error(&png, &e))?;
-    write_atomically(&png, &png_bytes).map_err(|source| ReportError::Write { path: png.clone(), source })?;
-    write_atomically(&svg, svg_text.as_bytes())
-        .map_err(|source| ReportError::Write { path: svg.clone(), source })?;
+    write_atomically(&png, &png_bytes).map_err(|source| ReportError::Write {
+        path: png.clone(),
+        source,
+    })?;
+    write_atomically(&svg, svg_text.as_bytes()).map_err(|source| ReportError::Write {
+        path: svg.clone(),
+        source,
+    })?;
     Ok(vec![png, svg])
 }
 
@@ -118,7 +141,10 @@ fn draw_curves<DB: DrawingBackend>(
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     register_fonts();
     root.fill(&WHITE)?;
-    let max = curves.iter().flat_map(|(_, p)| p.iter().map(|&(_, f)| f)).fold(0.0f64, f64::max);
+    let max = curves
+        .iter()
+        .flat_map(|(_, p)| p.iter().map(|&(_, f)| f))
+        .fold(0.0f64, f64::max);
     let min = (max * 1e-5).max(1e-6);
     let mut chart = ChartBuilder::on(root)
         .caption(title, (FONT, 26))
@@ -134,7 +160,11 @@ fn draw_curves<DB: DrawingBackend>(
         .axis_desc_style((FONT, 20))
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()?;
-    let colors = [RGBColor(31, 119, 180), RGBColor(214, 39, 40), RGBColor(44, 160, 44)];
+    let colors = [
+        RGBColor(31, 119, 180),
+        RGBColor(214, 39, 40),
+        RGBColor(44, 160, 44),
+    ];
     for ((label, points), color) in curves.iter().zip(colors) {
         chart
             .draw_series(LineSeries::new(
@@ -142,7 +172,9 @@ fn draw_curves<DB: DrawingBackend>(
                 color.stroke_width(3),
             ))?
             .label(label.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(3)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(3))
+            });
     }
     chart
         .configure_series_labels()
@@ -162,7 +194,11 @@ mod tests {
     fn lower_q_puts_more_energy_in_the_wings_and_peaks_at_specular() {
         let data = figure_data(PaperFigure::Fig2).unwrap();
         let at = |curve: &[(f64, f64)], zenith: f64| {
-            curve.iter().find(|&&(x, _)| (x - zenith).abs() < 1e-9).unwrap().1
+            curve
+                .iter()
+                .find(|&&(x, _)| (x - zenith).abs() < 1e-9)
+                .unwrap()
+                .1
         };
         let (q15, q25) = (&data[0].1, &data[2].1);
         // Heavier tails (smaller q): lower specular peak, higher far wing.
@@ -175,7 +211,9 @@ mod tests {
         );
         for ((_, curve), q) in data.iter().zip([1.5, 1.8, 2.5]) {
             let a = 2.0 * 0.1 * 0.1;
-            let expect = (q - 1.0) / (std::f64::consts::PI * a) * 0.5 * (rs.norm_sqr() + rp.norm_sqr()) / (4.0 * 0.25);
+            let expect =
+                (q - 1.0) / (std::f64::consts::PI * a) * 0.5 * (rs.norm_sqr() + rp.norm_sqr())
+                    / (4.0 * 0.25);
             assert!((at(curve, 60.0) / expect - 1.0).abs() < 1e-12, "q={q}");
         }
     }
