@@ -60,8 +60,11 @@ fn in_plane_f00(model: &Pbrdf, theta_i_deg: f64, detector_deg: f64) -> f64 {
     model.first_column(&incident, &scattered)[0]
 }
 
-/// The curves as (label, [(detector zenith °, f00 sr⁻¹)]).
-pub fn figure_data(figure: PaperFigure) -> Result<Vec<(String, Vec<(f64, f64)>)>, ReportError> {
+/// A labelled curve of (detector zenith °, f00 sr⁻¹).
+pub type Curve = (String, Vec<(f64, f64)>);
+
+/// The figure's curves.
+pub fn figure_data(figure: PaperFigure) -> Result<Vec<Curve>, ReportError> {
     let index = RefractiveIndex::new(1.2, 0.2);
     figure
         .curves()
@@ -137,7 +140,7 @@ pub fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, image:
 fn draw_curves<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
-    curves: &[(String, Vec<(f64, f64)>)],
+    curves: &[Curve],
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     register_fonts();
     root.fill(&WHITE)?;
