@@ -14,7 +14,10 @@ mod style;
 mod table;
 
 pub use data::{DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00};
-use table::{format_angle, format_plain};
+use table::format_angle;
+pub(crate) use table::{
+    format_plain, format_with_uncertainty, is_free, lookup, parameters, preference, sha_prefix,
+};
 
 use super::paper_figures::encode_png;
 use super::{register_fonts, ReportError, FONT};
@@ -466,4 +469,39 @@ fn draw_dolp<DB: DrawingBackend>(
             compact: false,
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn report_files_are_named_by_a_plain_material_name() {
+        assert_eq!(report_stem("gloss paint-2").unwrap(), "gloss paint-2");
+        for bad in ["", ".", "..", "../etc", "a/b", "a\\b", ".hidden"] {
+            let message = report_stem(bad).unwrap_err().to_string();
+            assert!(message.contains("plain file name"), "{bad}: {message}");
+        }
+    }
+
+    #[test]
+    fn the_source_is_looked_for_as_recorded_then_beside_the_library() {
+        let fits = Path::new("/project/fits/paint.toml");
+        assert_eq!(
+            source_candidates(fits, Path::new("measurements/paint.csv")),
+            [
+                PathBuf::from("measurements/paint.csv"),
+                PathBuf::from("/project/measurements/paint.csv")
+            ]
+        );
+        assert_eq!(
+            source_candidates(fits, Path::new("/data/paint.csv")),
+            [PathBuf::from("/data/paint.csv")]
+        );
+        // fits/paint.toml relative to the working directory: both readings coincide.
+        assert_eq!(
+            source_candidates(Path::new("fits/paint.toml"), Path::new("m/p.csv")),
+            [PathBuf::from("m/p.csv")]
+        );
+    }
 }

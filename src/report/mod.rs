@@ -3,6 +3,7 @@
 //! without any system fonts.
 
 pub mod fit_report;
+pub mod index;
 pub mod paper_figures;
 
 use std::sync::Once;

@@ -47,7 +47,7 @@ pub struct PointView {
     /// φ_r − φ_i in [0°, 360°).
     pub relative_azimuth: f64,
     /// θ_r signed by hemisphere: + when the detector is on the forward (specular) half,
-    /// cos(φ_r − φ_i) < 0. Equals `signed_zenith` in the plane.
+    /// 90° ≤ φ_r − φ_i ≤ 270°. Equals `signed_zenith` in the plane.
     pub forward_zenith: f64,
     /// The measured elements by Mueller index r*4 + c.
     pub readings: [Option<Reading>; 16],
@@ -130,8 +130,8 @@ impl ReportData {
             let scattered = checked_direction("theta_r_deg", p.theta_r_deg, p.phi_r_deg)?;
             let relative_azimuth = (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0);
             let signed_zenith = in_plane_zenith(p.theta_r_deg, relative_azimuth);
-            let forward_zenith = signed_zenith.unwrap_or_else(|| {
-                if relative_azimuth.to_radians().cos() < 0.0 {
+            let forward_zenith = signed_zenith.unwrap_or({
+                if (90.0..=270.0).contains(&relative_azimuth) {
                     p.theta_r_deg
                 } else {
                     -p.theta_r_deg
@@ -382,5 +382,242 @@ fn emissivity_curves(
         chosen: chosen.pbrdf.emissivity_table(&radians, &quadrature),
         alternative: alternative.map(|a| a.pbrdf.emissivity_table(&radians, &quadrature)),
         theta_deg,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::{AlternativeFit, ModelSpec};
+    use crate::measure::MeasurementPoint;
+    use crate::pbrdf::{Shadowing, SlopeDistribution};
+    use std::collections::BTreeMap;
+
+    fn spec(distribution: SlopeDistribution) -> ModelSpec {
+        ModelSpec {
+            distribution,
+            shadowing: Shadowing::Smith,
+            n: 1.5,
+            k: 0.1,
+            rho_d: 0.01,
+            wavelength_um: 10.0,
+        }
+    }
+
+    fn material(with_alternative: bool) -> Material {
+        let model = spec(SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 });
+        let fit = with_alternative.then(|| crate::material::FitRecord {
+            source: "x.csv".into(),
+            source_sha256: String::new(),
+            points: 0,
+            elements: vec![],
+            free_parameters: vec![],
+            optimizer: "nm".into(),
+            seed: 0,
+            settings: BTreeMap::new(),
+            iterations: 0,
+            evaluations: 0,
+            cost: 1.0,
+            reduced_chi2: 1.0,
+            degrees_of_freedom: 1,
+            aic: 0.0,
+            bic: 0.0,
+            termination: String::new(),
+            rmse: BTreeMap::new(),
+            uncertainty: BTreeMap::new(),
+            correlation: vec![],
+            undetermined: vec![],
+            alternative: Some(AlternativeFit {
+                model: spec(SlopeDistribution::Gaussian { sigma: 0.15 }),
+                cost: 2.0,
+                reduced_chi2: 2.0,
+                aic: 1.0,
+                bic: 1.0,
+            }),
+            convergence: vec![],
+            global_iterations: 0,
+        });
+        Material {
+            name: "test".into(),
+            tool_version: "test".into(),
+            model,
+            fit,
+        }
+    }
+
+    /// A set of m00 and m10 at the given (θ_i, φ_i, θ_r, φ_r), valued by `value(m)`.
+    fn set_of(
+        geometry: &[(f64, f64, f64, f64)],
+        value: impl Fn(&Mueller) -> [f64; 2],
+        uncertainties: [Option<f64>; 2],
+    ) -> MeasurementSet {
+        let model = material(false).pbrdf().unwrap();
+        let points = geometry
+            .iter()
+            .enumerate()
+            .map(|(i, &(ti, pi, tr, pr))| {
+                let m = model.mueller(
+                    &Direction::from_angles(ti.to_radians(), pi.to_radians()),
+                    &Direction::from_angles(tr.to_radians(), pr.to_radians()),
+                );
+                MeasurementPoint {
+                    theta_i_deg: ti,
+                    phi_i_deg: pi,
+                    theta_r_deg: tr,
+                    phi_r_deg: pr,
+                    values: value(&m).to_vec(),
+                    uncertainties: uncertainties.to_vec(),
+                    line: i as u64 + 2,
+                }
+            })
+            .collect();
+        MeasurementSet {
+            source: "x.csv".into(),
+            sha256: String::new(),
+            material: "test".into(),
+            wavelength_um: 10.0,
+            metadata: BTreeMap::new(),
+            elements: vec![0, 4],
+            points,
+        }
+    }
+
+    fn exact(m: &Mueller) -> [f64; 2] {
+        [m[(0, 0)], m[(1, 0)]]
+    }
+
+    #[test]
+    fn points_are_placed_in_the_plane_on_rings_or_in_a_raster() {
+        let geometry = [
+            (60.0, 0.0, 30.0, 180.0), // specular side of the plane
+            (60.0, 10.0, 30.0, 10.0), // toward the source (φ_r = φ_i)
+            (60.0, 0.0, 0.0, 90.0),   // detector at the normal: in every plane
+            (60.0, 0.0, 45.0, 30.0),  // a ring spanning 120°
+            (60.0, 0.0, 45.0, 90.0),
+            (60.0, 0.0, 45.0, 150.0),
+            (60.0, 0.0, 45.0, 180.0), // its in-plane member
+            (60.0, 0.0, 58.0, 175.0), // a raster of 10° around specular: no ring
+            (60.0, 0.0, 58.0, 185.0),
+            (20.0, 0.0, 45.0, 200.0), // another incidence angle
+        ];
+        let set = set_of(&geometry, exact, [None, None]);
+        let data = ReportData::new(&material(false), &set).unwrap();
+        assert_eq!(data.incidences, [20.0, 60.0]);
+        let signed: Vec<Option<f64>> = data.points.iter().map(|p| p.signed_zenith).collect();
+        assert_eq!(
+            signed,
+            [
+                Some(30.0),
+                Some(-30.0),
+                Some(0.0),
+                None,
+                None,
+                None,
+                Some(45.0),
+                None,
+                None,
+                None
+            ]
+        );
+        let forward: Vec<f64> = data.points.iter().map(|p| p.forward_zenith).collect();
+        assert_eq!(
+            forward[3..6],
+            [-45.0, 45.0, 45.0],
+            "90° ≤ φr−φi ≤ 270° is forward"
+        );
+        assert_eq!(data.rings.len(), 1);
+        assert_eq!(
+            (data.rings[0].incidence, data.rings[0].theta_r_deg),
+            (1, 45.0)
+        );
+        let on_ring: Vec<bool> = data.points.iter().map(|p| p.ring == Some(0)).collect();
+        assert_eq!(
+            on_ring,
+            [false, false, false, true, true, true, true, false, false, false]
+        );
+        assert_eq!(data.off_ring_points(), 3);
+        // Only θi = 60° has in-plane points, so only it gets an in-plane model sweep.
+        assert!(data.in_plane[0].is_none() && data.in_plane[1].is_some());
+    }
+
+    #[test]
+    fn residuals_are_data_minus_model_over_sigma() {
+        let geometry = [(40.0, 0.0, 40.0, 180.0), (40.0, 0.0, 20.0, 0.0)];
+        let exact_set = set_of(&geometry, exact, [None, None]);
+        let data = ReportData::new(&material(false), &exact_set).unwrap();
+        assert_eq!(data.residuals.len(), 4);
+        assert!(data.residuals.iter().all(|r| r.value.abs() < 1e-12));
+
+        // Without u_ columns: σ(m00) = 3 % and σ(m10) = 1 % of the measured m00 (the fit's noise
+        // model), so a reading 3 % high is 1/1.03 σ off.
+        let shifted = set_of(
+            &geometry,
+            |m| [1.03 * m[(0, 0)], m[(1, 0)] - 0.02 * m[(0, 0)]],
+            [None, None],
+        );
+        let data = ReportData::new(&material(false), &shifted).unwrap();
+        let values: Vec<f64> = data.residuals.iter().map(|r| r.value).collect();
+        let (up, down) = (1.0 / 1.03, -2.0 / 1.03);
+        for (got, want) in values.iter().zip([up, down, up, down]) {
+            assert!((got - want).abs() < 1e-9, "{values:?}");
+        }
+        // With them, the file's σ is used as is.
+        let with_u = set_of(
+            &geometry,
+            |m| [m[(0, 0)] + 0.004, m[(1, 0)]],
+            [Some(0.002), Some(1.0)],
+        );
+        let data = ReportData::new(&material(false), &with_u).unwrap();
+        assert!((data.residuals[0].value - 2.0).abs() < 1e-9);
+        assert_eq!(data.residuals[0].forward_zenith, 40.0);
+        assert_eq!(data.residuals[2].forward_zenith, -20.0);
+    }
+
+    #[test]
+    fn sweeps_and_emissivity_are_the_models_own_values() {
+        let set = set_of(&[(30.0, 0.0, 30.0, 180.0)], exact, [None, None]);
+        let material = material(true);
+        let data = ReportData::new(&material, &set).unwrap();
+        let sweep = data.in_plane[0].as_ref().unwrap();
+        let specular = sweep
+            .x
+            .iter()
+            .position(|&x| (x - 30.0).abs() < 1e-9)
+            .unwrap();
+        let at = |model: &Pbrdf| {
+            model.mueller(
+                &Direction::from_angles(30f64.to_radians(), 0.0),
+                &Direction::from_angles(30f64.to_radians(), std::f64::consts::PI),
+            )
+        };
+        assert_eq!(sweep.chosen[specular], at(&material.pbrdf().unwrap()));
+        let alternative = material.fit.as_ref().unwrap().alternative.as_ref().unwrap();
+        assert_eq!(
+            sweep.alternative.as_ref().unwrap()[specular],
+            at(&alternative.model.pbrdf().unwrap())
+        );
+        assert_eq!(data.alternative_label.as_deref(), Some("gaussian"));
+        // Toward the source the detector sits at φ_r = φ_i: the retro direction at −30°.
+        let retro = sweep
+            .x
+            .iter()
+            .position(|&x| (x + 30.0).abs() < 1e-9)
+            .unwrap();
+        let expected = material.pbrdf().unwrap().mueller(
+            &Direction::from_angles(30f64.to_radians(), 0.0),
+            &Direction::from_angles(30f64.to_radians(), 0.0),
+        );
+        assert_eq!(sweep.chosen[retro], expected);
+
+        let e = &data.emissivity;
+        assert_eq!(e.theta_deg.first(), Some(&0.0));
+        assert_eq!(e.theta_deg.last(), Some(&88.0));
+        let direct = material
+            .pbrdf()
+            .unwrap()
+            .emissivity(60f64.to_radians(), &HemisphereQuadrature::default());
+        assert_eq!(e.chosen[30], direct);
+        // Isotropic surface: emission is p-polarized (ε1 < 0) away from the normal.
+        assert!(e.chosen[1..].iter().all(|s| s[1] < 0.0 && s[0] < 1.0));
     }
 }

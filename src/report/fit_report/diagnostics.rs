@@ -473,3 +473,27 @@ pub fn draw_emissivity<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) -
 fn floor_to(value: f64, step: f64) -> f64 {
     (value / step).floor() * step
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn histogram_bins_are_quarter_sigma_and_count_the_overflow() {
+        let (counts, outside) = histogram(&[-5.0, -0.1, 0.0, 0.1, 0.26, 4.99, 5.0, -7.0, f64::NAN]);
+        assert_eq!(counts.len(), 40);
+        assert_eq!(counts[0], 1, "−5 opens the first bin");
+        assert_eq!(
+            (counts[19], counts[20], counts[21], counts[39]),
+            (1, 2, 1, 1)
+        );
+        assert_eq!(outside, 3, "5.0, −7 and NaN");
+        assert_eq!(counts.iter().sum::<usize>() + outside, 9);
+    }
+
+    #[test]
+    fn element_classes_split_intensity_linear_and_circular() {
+        let classes: Vec<usize> = (0..16).map(element_class).collect();
+        assert_eq!(classes, [0, 1, 1, 2, 1, 1, 1, 2, 1, 1, 1, 2, 2, 2, 2, 2]);
+    }
+}

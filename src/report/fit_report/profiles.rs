@@ -429,3 +429,107 @@ fn draw_series<DB: DrawingBackend, Y: Ranged<ValueType = f64> + ValueFormatter<f
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::fit_report::data::Reading;
+
+    fn point(readings: &[(usize, f64, f64)]) -> PointView {
+        let mut all = [None; 16];
+        for &(e, value, sigma) in readings {
+            all[e] = Some(Reading { value, sigma });
+        }
+        PointView {
+            incidence: 0,
+            signed_zenith: Some(10.0),
+            ring: None,
+            relative_azimuth: 180.0,
+            forward_zenith: 10.0,
+            readings: all,
+            model: Mueller::zeros(),
+        }
+    }
+
+    #[test]
+    fn quantities_of_measurements_and_models() {
+        let p = point(&[(0, 0.5, 0.015), (4, 0.15, 0.005), (8, -0.2, 0.005)]);
+        assert_eq!(Quantity::M00.of_point(&p), Some((0.5, Some(0.015))));
+        let (ratio, sigma) = Quantity::Ratio(4).of_point(&p).unwrap();
+        assert!((ratio - 0.3).abs() < 1e-15);
+        // σ(m10/m00) = √(σ10² + (ratio σ00)²)/m00 = √(0.005² + 0.0045²)/0.5
+        assert!((sigma.unwrap() - 0.0134536240470737).abs() < 1e-12);
+        let (dolp, none) = Quantity::Dolp.of_point(&p).unwrap();
+        assert!(
+            (dolp - 0.5).abs() < 1e-15 && none.is_none(),
+            "√(0.15² + 0.2²)/0.5"
+        );
+        assert_eq!(Quantity::Ratio(5).of_point(&p), None, "m11 not measured");
+
+        let mut m = Mueller::zeros();
+        m[(0, 0)] = 2.0;
+        m[(1, 0)] = -1.2;
+        m[(2, 0)] = 1.6;
+        m[(2, 2)] = -1.0;
+        assert_eq!(Quantity::Dolp.of_model(&m), Some(1.0));
+        assert_eq!(Quantity::Ratio(10).of_model(&m), Some(-0.5));
+        assert_eq!(Quantity::Ratio(10).of_model(&Mueller::zeros()), None);
+        assert_eq!(Quantity::Ratio(6).label(), "m12/m00");
+    }
+
+    #[test]
+    fn log_axis_holds_data_error_bars_and_model_over_two_decades() {
+        let series = ProfileSeries {
+            color: BLACK,
+            marker: Marker::FilledCircle,
+            points: vec![
+                ProfilePoint {
+                    x: 0.0,
+                    value: 0.2,
+                    sigma: Some(0.3),
+                    model: Some(0.25),
+                },
+                ProfilePoint {
+                    x: 5.0,
+                    value: 0.1,
+                    sigma: Some(0.01),
+                    model: Some(0.01),
+                },
+            ],
+            chosen: vec![(0.0, 1e-12), (5.0, 100.0)],
+            alternative: None,
+        };
+        let YAxis::Log { low, high } = log_axis(std::slice::from_ref(&series)).unwrap() else {
+            panic!("log axis expected")
+        };
+        // Data top 0.5, model bottom 0.01 (the error bar below 0 is ignored), 1.5× margins;
+        // curves outside the measured geometry do not stretch the axis.
+        assert!((high - 0.75).abs() < 1e-12 && (low - 0.01 / 1.5).abs() < 1e-15);
+        let narrow = ProfileSeries {
+            points: vec![series.points[1]],
+            ..series
+        };
+        let YAxis::Log { low, high } = log_axis(&[narrow]).unwrap() else {
+            panic!("log axis expected")
+        };
+        assert!(((high / low).log10() - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn degree_axes_label_angles_at_multiples_that_fit() {
+        use plotters::coord::ranged1d::BoldPoints;
+        let wide = Domain::InPlane.axis(1200);
+        assert_eq!(wide.key_points(BoldPoints(20)).len(), 13, "every 15°");
+        let narrow = Domain::Rings.axis(300);
+        assert_eq!(
+            narrow.key_points(BoldPoints(20)),
+            [0.0, 90.0, 180.0, 270.0, 360.0]
+        );
+        assert_eq!(
+            narrow.key_points(100usize).len(),
+            13,
+            "light lines every 30°"
+        );
+        assert_eq!(wide.map(&0.0, (100, 300)), 200);
+    }
+}

@@ -275,13 +275,6 @@ impl YAxis {
         }
     }
 
-    fn unscaled(&self, t: f64) -> f64 {
-        match self {
-            YAxis::Log { .. } => t.exp(),
-            YAxis::Linear { .. } => t,
-        }
-    }
-
     /// Splits a polyline into the pieces inside the axis range, ending each piece on the
     /// boundary where it leaves (interpolated in the axis' own scale). Plotters would otherwise
     /// squash out-of-range points onto the frame.
@@ -293,18 +286,19 @@ impl YAxis {
             let (ta, tb) = (self.scaled(a.1), self.scaled(b.1));
             let a_inside = self.contains(a.1);
             let outside = if a_inside { tb } else { ta };
-            let edge = if outside > t_high { t_high } else { t_low };
+            let (edge, t_edge) = if outside > t_high {
+                (high, t_high)
+            } else {
+                (low, t_low)
+            };
             let fraction = if ta.is_finite() && tb.is_finite() && ta != tb {
-                ((edge - ta) / (tb - ta)).clamp(0.0, 1.0)
+                ((t_edge - ta) / (tb - ta)).clamp(0.0, 1.0)
             } else if a_inside {
                 0.0
             } else {
                 1.0
             };
-            (
-                a.0 + fraction * (b.0 - a.0),
-                self.unscaled(edge).clamp(low, high),
-            )
+            (a.0 + fraction * (b.0 - a.0), edge)
         };
         let mut pieces = Vec::new();
         let mut current: Vec<(f64, f64)> = Vec::new();
@@ -338,5 +332,56 @@ pub fn log_tick(value: &f64) -> String {
         format!("{value:.decimals$}")
     } else {
         format!("{value:.0e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_are_cut_at_the_axis_range_not_squashed_onto_it() {
+        let linear = YAxis::Linear {
+            low: 0.0,
+            high: 1.0,
+        };
+        let pieces = linear.clip(&[(0.0, 0.5), (1.0, 1.5), (2.0, 2.5), (3.0, 0.5), (4.0, 0.25)]);
+        // Leaves at y = 1 halfway to x = 1; re-enters 3/4 of the way from x = 2 (2.5 → 0.5).
+        assert_eq!(
+            pieces,
+            vec![
+                vec![(0.0, 0.5), (0.5, 1.0)],
+                vec![(2.75, 1.0), (3.0, 0.5), (4.0, 0.25)]
+            ]
+        );
+        // A log axis interpolates geometrically; zero (log −∞) ends a piece at its last point.
+        let log = YAxis::Log {
+            low: 1e-3,
+            high: 1.0,
+        };
+        let pieces = log.clip(&[
+            (0.0, 1e-2),
+            (1.0, 1e-4),
+            (2.0, 0.0),
+            (3.0, 1e-2),
+            (4.0, 0.1),
+        ]);
+        assert_eq!(pieces.len(), 2);
+        let (x, y) = pieces[0][1];
+        assert!(
+            (x - 0.5).abs() < 1e-12 && (y - 1e-3).abs() < 1e-15,
+            "{pieces:?}"
+        );
+        assert_eq!(pieces[1], vec![(3.0, 1e-3), (3.0, 1e-2), (4.0, 0.1)]);
+        assert!(log.clip(&[(0.0, 5.0), (1.0, 7.0)]).is_empty());
+    }
+
+    #[test]
+    fn log_ticks_are_decimals_within_reason() {
+        let labels: Vec<String> = [1e-4, 1e-3, 0.01, 1.0, 100.0, 1e4]
+            .iter()
+            .map(log_tick)
+            .collect();
+        assert_eq!(labels, ["1e-4", "0.001", "0.01", "1", "100", "1e4"]);
     }
 }

@@ -390,3 +390,125 @@ fn wrap<DB: DrawingBackend>(
     lines.push(current);
     Ok(lines)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::AlternativeFit;
+    use crate::pbrdf::Shadowing;
+    use std::collections::BTreeMap;
+
+    #[test]
+    fn values_are_rounded_to_their_uncertainty() {
+        let cases = [
+            ((0.100_34, Some(0.0012)), ("0.1003", Some("0.0012"))),
+            ((1.812_3, Some(0.034)), ("1.812", Some("0.034"))),
+            ((123.4, Some(12.0)), ("123", Some("12"))),
+            ((0.02, Some(0.0)), ("0.02000", None)),
+            ((2.5e-5, None), ("2.500e-5", None)),
+        ];
+        for ((value, sigma), (text, sigma_text)) in cases {
+            let (got, got_sigma) = format_with_uncertainty(value, sigma);
+            assert_eq!((got.as_str(), got_sigma.as_deref()), (text, sigma_text));
+        }
+        assert_eq!(format_plain(0.0), "0");
+        assert_eq!(format_plain(9.925), "9.925");
+        assert_eq!(format_angle(20.0), "20");
+        assert_eq!(format_angle(62.5), "62.5");
+        assert_eq!(sha_prefix(&"ab".repeat(32)), format!("{}…", "ab".repeat(8)));
+    }
+
+    fn material(aic: f64, alternative_aic: f64) -> Material {
+        let model = ModelSpec {
+            distribution: SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
+            shadowing: Shadowing::Smith,
+            n: 1.2,
+            k: 0.2,
+            rho_d: 0.0,
+            wavelength_um: 9.925,
+        };
+        Material {
+            name: "m".into(),
+            tool_version: "t".into(),
+            fit: Some(FitRecord {
+                source: "m.csv".into(),
+                source_sha256: "0".repeat(64),
+                points: 10,
+                elements: vec!["m00".into(), "m10".into()],
+                free_parameters: vec!["sigma".into(), "q".into(), "rho".into()],
+                optimizer: "ga+nm".into(),
+                seed: 1,
+                settings: BTreeMap::new(),
+                iterations: 3,
+                evaluations: 30,
+                cost: 18.0,
+                reduced_chi2: 1.06,
+                degrees_of_freedom: 17,
+                aic,
+                bic: aic + 3.0,
+                termination: "converged".into(),
+                rmse: BTreeMap::new(),
+                uncertainty: BTreeMap::from([("sigma".into(), 0.0012), ("rho".into(), 0.001)]),
+                correlation: vec![
+                    vec![1.0, -0.95, 0.1],
+                    vec![-0.95, 1.0, 0.2],
+                    vec![0.1, 0.2, 1.0],
+                ],
+                undetermined: vec!["q".into()],
+                alternative: Some(AlternativeFit {
+                    model: ModelSpec {
+                        distribution: SlopeDistribution::Gaussian { sigma: 0.09 },
+                        ..model.clone()
+                    },
+                    cost: 30.0,
+                    reduced_chi2: 1.6,
+                    aic: alternative_aic,
+                    bic: alternative_aic + 3.0,
+                }),
+                convergence: vec![],
+                global_iterations: 0,
+            }),
+            model,
+        }
+    }
+
+    #[test]
+    fn the_lower_aic_is_preferred_unless_within_two() {
+        assert_eq!(
+            preference(&material(24.0, 36.5)).unwrap(),
+            "cauchy preferred: ΔAIC = 12.5, ΔBIC = 12.5 (gaussian − cauchy)"
+        );
+        assert!(preference(&material(40.0, 36.0))
+            .unwrap()
+            .starts_with("gaussian preferred: ΔAIC = -4.0"));
+        assert!(preference(&material(24.0, 25.0))
+            .unwrap()
+            .contains("|ΔAIC| = 1.0 < 2 does not distinguish"));
+    }
+
+    #[test]
+    fn table_rows_show_uncertainties_fixed_and_undetermined_parameters() {
+        let rows = table_rows(&material(24.0, 36.5));
+        let cells = |symbol: &str| {
+            rows.iter()
+                .find_map(|row| match row {
+                    Row::Cells(cells, tone) if cells[0] == symbol => Some((cells.clone(), *tone)),
+                    _ => None,
+                })
+                .unwrap()
+        };
+        assert_eq!(cells("σ").0, ["σ", "0.1000", "± 0.0012", "0.09000"]);
+        assert_eq!(cells("q").1, Tone::Warning, "q is undetermined");
+        assert_eq!(cells("q").0[2], "± ? undetermined");
+        assert_eq!(cells("n").0[1..3], ["1.200", "fixed"]);
+        assert_eq!(
+            cells("ρd").0[1..3],
+            ["0.0000", "± 0.0010"],
+            "`rho` names ρ_d"
+        );
+        assert!(rows.contains(&Row::Text(
+            "strongest correlation ρ(σ, q) = -0.950".into(),
+            Tone::Normal
+        )));
+    }
+}
