@@ -13,7 +13,6 @@ mod profiles;
 mod style;
 mod table;
 
-pub use data::{DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00};
 use table::format_angle;
 pub(crate) use table::{
     format_plain, format_with_uncertainty, is_free, lookup, parameters, preference, sha_prefix,
@@ -216,14 +215,13 @@ fn draw_header<DB: DrawingBackend>(
 ) -> DrawResult<DB> {
     let model = &material.model;
     let title = format!(
-        "Fit report: {}   —   {} slopes, {} shadowing, λ = {} µm, {} points × {} Mueller elements from {}",
+        "Fit report: {}   —   {} slopes, {} shadowing, λ = {} µm, {} points × {} Mueller elements",
         material.name,
         model.distribution.name(),
         model.shadowing.name(),
         format_plain(set.wavelength_um),
         set.points.len(),
         set.elements.len(),
-        set.source.display()
     );
     let title_style = (FONT, TITLE_SIZE, FontStyle::Bold)
         .into_font()
