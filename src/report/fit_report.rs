@@ -115,44 +115,46 @@ fn source_candidates(material_path: &Path, source: &Path) -> Vec<PathBuf> {
 }
 
 /// Finds the fit's source CSV and checks it is byte-for-byte the file that was fitted; returns
-/// its path and bytes.
+/// its path and bytes. Of several candidates the first with the recorded hash wins (a same-named
+/// file elsewhere is not the source); if none has it, the first existing one is reported changed.
 pub(crate) fn verified_source(
     material_path: &Path,
     fit: &FitRecord,
 ) -> Result<(PathBuf, Vec<u8>), ReportError> {
     let candidates = source_candidates(material_path, &fit.source);
-    let Some(csv) = candidates.iter().find(|p| p.is_file()).cloned() else {
-        return Err(ReportError::SourceMissing {
-            material: material_path.to_owned(),
-            csv: fit.source.clone(),
-            tried: candidates
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-        });
-    };
-    let bytes = std::fs::read(&csv).map_err(|e| MeasureError {
-        file: csv.clone(),
-        line: 1,
-        column: 1,
-        kind: MeasureErrorKind::Unreadable {
-            reason: e.to_string(),
-        },
-    })?;
-    let actual: String = Sha256::digest(&bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    if !actual.eq_ignore_ascii_case(fit.source_sha256.trim()) {
-        return Err(ReportError::SourceChanged {
-            csv,
+    let mut first_changed = None;
+    for csv in candidates.iter().filter(|p| p.is_file()) {
+        let bytes = std::fs::read(csv).map_err(|e| MeasureError {
+            file: csv.clone(),
+            line: 1,
+            column: 1,
+            kind: MeasureErrorKind::Unreadable {
+                reason: e.to_string(),
+            },
+        })?;
+        let actual: String = Sha256::digest(&bytes)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        if actual.eq_ignore_ascii_case(fit.source_sha256.trim()) {
+            return Ok((csv.clone(), bytes));
+        }
+        first_changed.get_or_insert(ReportError::SourceChanged {
+            csv: csv.clone(),
             actual,
             recorded: fit.source_sha256.clone(),
             material: material_path.to_owned(),
         });
     }
-    Ok((csv, bytes))
+    Err(first_changed.unwrap_or_else(|| ReportError::SourceMissing {
+        material: material_path.to_owned(),
+        csv: fit.source.clone(),
+        tried: candidates
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+    }))
 }
 
 /// The material name as a file stem: a plain name, no folders.
