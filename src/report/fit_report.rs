@@ -12,6 +12,8 @@ mod diagnostics;
 mod profiles;
 mod style;
 mod table;
+#[cfg(test)]
+mod test_records;
 
 use table::format_angle;
 pub(crate) use table::{

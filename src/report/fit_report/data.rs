@@ -391,6 +391,7 @@ mod tests {
     use crate::material::{AlternativeFit, ModelSpec};
     use crate::measure::MeasurementPoint;
     use crate::pbrdf::{Shadowing, SlopeDistribution};
+    use crate::report::fit_report::test_records::fit_record;
     use std::collections::BTreeMap;
 
     fn spec(distribution: SlopeDistribution) -> ModelSpec {
@@ -406,36 +407,15 @@ mod tests {
 
     fn material(with_alternative: bool) -> Material {
         let model = spec(SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 });
-        let fit = with_alternative.then(|| crate::material::FitRecord {
-            source: "x.csv".into(),
-            source_sha256: String::new(),
-            points: 0,
-            elements: vec![],
-            free_parameters: vec![],
-            optimizer: "nm".into(),
-            seed: 0,
-            settings: BTreeMap::new(),
-            iterations: 0,
-            evaluations: 0,
-            cost: 1.0,
-            reduced_chi2: 1.0,
-            degrees_of_freedom: 1,
-            aic: 0.0,
-            bic: 0.0,
-            termination: String::new(),
-            rmse: BTreeMap::new(),
-            uncertainty: BTreeMap::new(),
-            correlation: vec![],
-            undetermined: vec![],
-            alternative: Some(AlternativeFit {
+        let fit = with_alternative.then(|| {
+            let alternative = AlternativeFit {
                 model: spec(SlopeDistribution::Gaussian { sigma: 0.15 }),
                 cost: 2.0,
                 reduced_chi2: 2.0,
                 aic: 1.0,
                 bic: 1.0,
-            }),
-            convergence: vec![],
-            global_iterations: 0,
+            };
+            fit_record(serde_json::json!({ "alternative": alternative }))
         });
         Material {
             name: "test".into(),

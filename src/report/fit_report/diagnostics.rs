@@ -257,7 +257,9 @@ pub fn draw_convergence<DB: DrawingBackend>(
     let dof = fit.degrees_of_freedom as f64;
     let low = costs.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
     let high = costs.iter().map(|c| c.1).fold(0.0, f64::max);
-    let show_dof = dof > 0.0 && dof > low / 100.0;
+    // χ² ≈ degrees of freedom marks a fit at the noise level; a robust cost Σρ(r) has no such mark.
+    let robust = super::table::robust_loss(fit);
+    let show_dof = robust.is_none() && dof > 0.0 && dof > low / 100.0;
     let (low, high) = (low.min(if show_dof { dof } else { low }) / 1.6, high * 1.6);
     let last = (fit.convergence.len() - 1) as f64;
     let mut chart = chart_builder(area, caption)
@@ -269,7 +271,10 @@ pub fn draw_convergence<DB: DrawingBackend>(
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&log_tick)
         .x_desc("step: GA generation, then local-stage iteration")
-        .y_desc("best cost χ² = Σ ((data − model)/σ)²")
+        .y_desc(match robust {
+            Some(loss) => format!("best cost Σρ(r), {loss} loss, r = (data − model)/σ"),
+            None => "best cost χ² = Σ ((data − model)/σ)²".to_owned(),
+        })
         .label_style((FONT, TICK_SIZE))
         .axis_desc_style((FONT, AXIS_DESC_SIZE))
         .light_line_style(RGBColor(235, 235, 235))
@@ -339,7 +344,11 @@ pub fn draw_convergence<DB: DrawingBackend>(
         ));
     }
     entries.push(LegendEntry::line(
-        format!("final χ² = {}", super::table::format_plain(fit.cost)),
+        format!(
+            "final {} = {}",
+            if robust.is_some() { "cost" } else { "χ²" },
+            super::table::format_plain(fit.cost)
+        ),
         WHITE,
         LineKind::Solid,
     ));

@@ -113,6 +113,15 @@ pub fn preference(material: &Material) -> Option<String> {
     })
 }
 
+/// The robust loss the fit minimized, if not plain least squares (`settings.robust_loss`, as the
+/// fit engine records it); then its cost is Σρ(r), not χ².
+pub fn robust_loss(fit: &FitRecord) -> Option<&str> {
+    fit.settings
+        .get("robust_loss")
+        .map(String::as_str)
+        .filter(|loss| *loss != "none")
+}
+
 pub fn sha_prefix(sha: &str) -> String {
     let prefix: String = sha.chars().take(SHA_PREFIX).collect();
     if sha.chars().count() > SHA_PREFIX {
@@ -192,13 +201,17 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
     };
 
     rows.push(Row::Heading("Fit quality".into()));
+    let cost_label = match robust_loss(fit) {
+        Some(loss) => format!("cost, {loss}"),
+        None => "cost χ²".to_owned(),
+    };
     let quality: [(&str, f64, Option<f64>); 4] = [
         (
             "reduced χ²",
             fit.reduced_chi2,
             alternative.map(|a| a.reduced_chi2),
         ),
-        ("cost χ²", fit.cost, alternative.map(|a| a.cost)),
+        (cost_label.as_str(), fit.cost, alternative.map(|a| a.cost)),
         ("AIC", fit.aic, alternative.map(|a| a.aic)),
         ("BIC", fit.bic, alternative.map(|a| a.bic)),
     ];
@@ -392,7 +405,8 @@ mod tests {
     use super::*;
     use crate::material::AlternativeFit;
     use crate::pbrdf::Shadowing;
-    use std::collections::BTreeMap;
+    use crate::report::fit_report::test_records::fit_record;
+    use serde_json::json;
 
     #[test]
     fn values_are_rounded_to_their_uncertainty() {
@@ -426,32 +440,22 @@ mod tests {
         Material {
             name: "m".into(),
             tool_version: "t".into(),
-            fit: Some(FitRecord {
-                source: "m.csv".into(),
-                source_sha256: "0".repeat(64),
-                points: 10,
-                elements: vec!["m00".into(), "m10".into()],
-                free_parameters: vec!["sigma".into(), "q".into(), "rho".into()],
-                optimizer: "ga+nm".into(),
-                seed: 1,
-                settings: BTreeMap::new(),
-                iterations: 3,
-                evaluations: 30,
-                cost: 18.0,
-                reduced_chi2: 1.06,
-                degrees_of_freedom: 17,
-                aic,
-                bic: aic + 3.0,
-                termination: "converged".into(),
-                rmse: BTreeMap::new(),
-                uncertainty: BTreeMap::from([("sigma".into(), 0.0012), ("rho".into(), 0.001)]),
-                correlation: vec![
-                    vec![1.0, -0.95, 0.1],
-                    vec![-0.95, 1.0, 0.2],
-                    vec![0.1, 0.2, 1.0],
-                ],
-                undetermined: vec!["q".into()],
-                alternative: Some(AlternativeFit {
+            fit: Some(fit_record(json!({
+                "source": "m.csv",
+                "source_sha256": "0".repeat(64),
+                "points": 10,
+                "elements": ["m00", "m10"],
+                "free_parameters": ["sigma", "q", "rho"],
+                "optimizer": "ga+nm",
+                "cost": 18.0,
+                "reduced_chi2": 1.06,
+                "degrees_of_freedom": 17,
+                "aic": aic,
+                "bic": aic + 3.0,
+                "uncertainty": { "sigma": 0.0012, "rho": 0.001 },
+                "correlation": [[1.0, -0.95, 0.1], [-0.95, 1.0, 0.2], [0.1, 0.2, 1.0]],
+                "undetermined": ["q"],
+                "alternative": AlternativeFit {
                     model: ModelSpec {
                         distribution: SlopeDistribution::Gaussian { sigma: 0.09 },
                         ..model.clone()
@@ -460,10 +464,8 @@ mod tests {
                     reduced_chi2: 1.6,
                     aic: alternative_aic,
                     bic: alternative_aic + 3.0,
-                }),
-                convergence: vec![],
-                global_iterations: 0,
-            }),
+                },
+            }))),
             model,
         }
     }
@@ -506,5 +508,20 @@ mod tests {
             "strongest correlation ρ(σ, q) = -0.950".into(),
             Tone::Normal
         )));
+        assert_eq!(cells("cost χ²").0[1], "18.00");
+    }
+
+    #[test]
+    fn a_robust_cost_is_not_called_chi_squared() {
+        let mut m = material(24.0, 36.5);
+        let fit = m.fit.as_mut().unwrap();
+        fit.settings.insert("robust_loss".into(), "none".into());
+        assert_eq!(robust_loss(fit), None);
+        fit.settings
+            .insert("robust_loss".into(), "huber(1.5)".into());
+        assert_eq!(robust_loss(fit), Some("huber(1.5)"));
+        let rows = table_rows(&m);
+        assert!(rows.iter().any(|row| matches!(row,
+            Row::Cells(cells, _) if cells[0] == "cost, huber(1.5)" && cells[1] == "18.00")));
     }
 }
