@@ -86,7 +86,12 @@ def draw_params(rng: np.random.Generator, groups_per_combo: int, corners_first: 
                 else:
                     sigma = float(rng.uniform(0.05, 0.5))
                     q = float(rng.uniform(1.6, 4.0)) if dist == "cauchy" else 0.0
-                n, k = INDICES[int(rng.integers(len(INDICES)))]
+                if corners_first:
+                    # every (distribution, shadowing) pair sees every index, paired differently
+                    offset = 2 * sb.SHADOWINGS.index(shadowing) + sb.DISTRIBUTIONS.index(dist)
+                    n, k = INDICES[(g + offset) % len(INDICES)]
+                else:
+                    n, k = INDICES[int(rng.integers(len(INDICES)))]
                 wl = WAVELENGTHS[int(rng.integers(len(WAVELENGTHS)))]
                 out.append(sb.SurfaceParams(dist, sigma, q, n, k, shadowing, wl))
     return out
