@@ -5,7 +5,7 @@
 use super::distribution::PreparedDistribution;
 use super::geometry::{frame_rotation, Direction};
 use super::{ModelError, Shadowing, SlopeDistribution};
-use crate::optics::{fresnel_amplitudes, Mueller, RefractiveIndex, Stokes};
+use crate::optics::{FresnelFractions, Mueller, RefractiveIndex, Stokes};
 use nalgebra::Vector3;
 use num_complex::Complex64;
 use std::f64::consts::FRAC_1_PI;
@@ -23,11 +23,13 @@ pub struct Pbrdf {
 }
 
 /// What one facet reflection contributes: the specular scale P G/(4 cosθ cosθ_i cosθ_r) and the
-/// Fresnel coefficients at the local incidence angle.
+/// Fresnel terms at the local incidence angle.
 struct FacetReflection {
     scale: f64,
-    r_s: Complex64,
-    r_p: Complex64,
+    /// |r_s|², |r_p|² and r_s* r_p.
+    rs2: f64,
+    rp2: f64,
+    cross: Complex64,
     /// unit(ω_i × h) up to length: the facet s axis (h × k_in), ⊥ to both propagation directions.
     facet_s: Vector3<f64>,
 }
@@ -120,11 +122,13 @@ impl Pbrdf {
                 .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta),
         };
         let scale = pdf * g / (4.0 * cos_theta * cos_i * cos_r);
-        let (r_s, r_p) = fresnel_amplitudes(cos_beta, self.permittivity);
+        let (rs2, rp2, cross) =
+            FresnelFractions::new(cos_beta, self.permittivity).reflectances_and_cross();
         Some(FacetReflection {
             scale,
-            r_s,
-            r_p,
+            rs2,
+            rp2,
+            cross,
             facet_s: w_i.cross(&sum),
         })
     }
@@ -176,10 +180,8 @@ impl Pbrdf {
             frame_rotation(&facet.facet_s, &(-incident.azimuthal_axis), &k_in)
         };
         let (cr, sr) = Self::scattered_rotation(&facet.facet_s, scattered);
-        let (rs2, rp2) = (facet.r_s.norm_sqr(), facet.r_p.norm_sqr());
-        let (a, b) = (0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2));
-        let cross = facet.r_s.conj() * facet.r_p;
-        let (c, s) = (cross.re, cross.im);
+        let (a, b) = (0.5 * (facet.rs2 + facet.rp2), 0.5 * (facet.rs2 - facet.rp2));
+        let (c, s) = (facet.cross.re, facet.cross.im);
         // L(−η_r) F_fres L(η_i) multiplied out (DESIGN §1.3).
         let mut m = Mueller::new(
             a,
@@ -211,9 +213,8 @@ impl Pbrdf {
             return Stokes::zeros();
         };
         let (cr, sr) = Self::scattered_rotation(&facet.facet_s, scattered);
-        let (rs2, rp2) = (facet.r_s.norm_sqr(), facet.r_p.norm_sqr());
-        let a = 0.5 * (rs2 + rp2) * facet.scale;
-        let b = 0.5 * (rs2 - rp2) * facet.scale;
+        let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
+        let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
         Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
     }
 }
