@@ -82,13 +82,24 @@ impl Pbrdf {
         &self.prepared
     }
 
+    /// The factor of the shadowing G that depends on one direction only, for a direction with
+    /// cos θ = `cos_theta`: Smith's G1(θ) = 1/(1+Λ(θ)) (DESIGN §1.3); 1 for `none` and
+    /// `torrance-sparrow`. The Cauchy Λ needs an incomplete beta function (~0.2 µs), so a caller
+    /// that evaluates many direction pairs sharing few zenith angles (a fit) computes it once per
+    /// angle and passes it to [`Pbrdf::mueller_with_masking`].
+    pub fn masking(&self, cos_theta: f64) -> f64 {
+        self.shadowing.masking(&self.prepared, cos_theta)
+    }
+
     /// Geometry, distribution, shadowing and Fresnel part shared by the full and fast paths;
-    /// `None` when either direction is at or below the horizon.
+    /// `None` when either direction is at or below the horizon. `masking` holds the
+    /// [`Pbrdf::masking`] factors of ω_i and ω_r, or `None` to compute them here.
     #[inline]
     fn facet_reflection(
         &self,
         incident: &Direction,
         scattered: &Direction,
+        masking: Option<[f64; 2]>,
     ) -> Option<FacetReflection> {
         let (w_i, w_r) = (&incident.vector, &scattered.vector);
         let (cos_i, cos_r) = (w_i.z, w_r.z);
@@ -102,9 +113,14 @@ impl Pbrdf {
         let cos_beta = 0.5 * sum_norm;
         let cos_theta = sum.z / sum_norm;
         let pdf = self.prepared.facet_pdf(cos_theta);
-        let g = self
-            .shadowing
-            .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta);
+        let g = match masking {
+            Some(masking) => self
+                .shadowing
+                .factor_with_masking(cos_theta, cos_i, cos_r, cos_beta, masking),
+            None => self
+                .shadowing
+                .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta),
+        };
         let scale = pdf * g / (4.0 * cos_theta * cos_i * cos_r);
         let (rs2, rp2, cross) =
             FresnelFractions::new(cos_beta, self.permittivity).reflectances_and_cross();
@@ -131,7 +147,29 @@ impl Pbrdf {
     /// The full 4×4 Mueller BRDF (sr⁻¹) from `incident` (ω_i, toward the source) to `scattered`
     /// (ω_r, toward the viewer), in the psps frames of both (DESIGN §1.3). Zero below the horizon.
     pub fn mueller(&self, incident: &Direction, scattered: &Direction) -> Mueller {
-        let Some(facet) = self.facet_reflection(incident, scattered) else {
+        self.mueller_from(incident, scattered, None)
+    }
+
+    /// [`Pbrdf::mueller`] with the per-direction shadowing factors supplied by the caller:
+    /// `masking_i` = `self.masking(cos θ_i)`, `masking_r` = `self.masking(cos θ_r)`.
+    pub fn mueller_with_masking(
+        &self,
+        incident: &Direction,
+        scattered: &Direction,
+        masking_i: f64,
+        masking_r: f64,
+    ) -> Mueller {
+        self.mueller_from(incident, scattered, Some([masking_i, masking_r]))
+    }
+
+    #[inline]
+    fn mueller_from(
+        &self,
+        incident: &Direction,
+        scattered: &Direction,
+        masking: Option<[f64; 2]>,
+    ) -> Mueller {
+        let Some(facet) = self.facet_reflection(incident, scattered, masking) else {
             return Mueller::zeros();
         };
         // Incident frame: k_in = −ω_i, s = −ê_φ(ω_i); the facet s axis h × k_in = ω_i × h.
@@ -171,7 +209,7 @@ impl Pbrdf {
     /// thermal scenes need. Skips the incident-frame rotation: (A, cos2η_r B, sin2η_r B, 0).
     #[inline]
     pub fn first_column(&self, incident: &Direction, scattered: &Direction) -> Stokes {
-        let Some(facet) = self.facet_reflection(incident, scattered) else {
+        let Some(facet) = self.facet_reflection(incident, scattered, None) else {
             return Stokes::zeros();
         };
         let (cr, sr) = Self::scattered_rotation(&facet.facet_s, scattered);
