@@ -283,4 +283,14 @@ impl Pbrdf {
         }
         Ok(e)
     }
+
+    /// Directional-hemispherical reflectance ρ(θ) = ∫ F_00(ω_i→ω) cosθ_i dΩ_i = 1 − ε0(θ)
+    /// (reciprocity makes incidence and emission directions interchangeable).
+    pub fn directional_hemispherical_reflectance(
+        &self,
+        theta: f64,
+        quadrature: &HemisphereQuadrature,
+    ) -> f64 {
+        self.reflected_stokes(&Direction::from_angles(theta, 0.0), |_| 1.0, quadrature)[0]
+    }
 }
