@@ -1,9 +1,10 @@
-//! A measurement prepared for fast repeated model evaluation: directions built once, the
-//! per-direction shadowing factors shared between points with the same zenith angle, and one
-//! standard deviation per observation (the weights of the least-squares objective).
+//! A measurement prepared for fast repeated model evaluation: the model-independent scattering
+//! geometry of every point built once, the per-direction shadowing factors shared between points
+//! with the same zenith angle, and one standard deviation per observation (the weights of the
+//! least-squares objective).
 
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
-use crate::pbrdf::Direction;
+use crate::pbrdf::{Direction, ScatteringGeometry};
 
 use super::FitError;
 
@@ -26,11 +27,11 @@ pub enum ErrorSource {
     DefaultModel,
 }
 
-/// One measured geometry with its zenith angles' positions in [`MeasurementData::zenith_cosines`].
+/// One measured geometry, and its zenith angles' positions in
+/// [`MeasurementData::zenith_cosines`].
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PreparedGeometry {
-    pub incident: Direction,
-    pub scattered: Direction,
+    pub scattering: ScatteringGeometry,
     pub incident_zenith: usize,
     pub scattered_zenith: usize,
 }
@@ -98,11 +99,12 @@ impl MeasurementData {
             let scattered =
                 Direction::from_degrees_checked("theta_r_deg", point.theta_r_deg, point.phi_r_deg)
                     .map_err(|e| at_line(e.to_string()))?;
+            let scattering = ScatteringGeometry::new(&incident, &scattered)
+                .ok_or_else(|| at_line("a direction lies on the horizon".into()))?;
             geometry.push(PreparedGeometry {
-                incident,
-                scattered,
-                incident_zenith: zenith_index(incident.cos_theta()),
-                scattered_zenith: zenith_index(scattered.cos_theta()),
+                scattering,
+                incident_zenith: zenith_index(scattering.cos_incident()),
+                scattered_zenith: zenith_index(scattering.cos_scattered()),
             });
             let m00 = point.values[0];
             for (column, (&value, uncertainty)) in

@@ -190,7 +190,7 @@ mod tests {
             assert!((a - b).abs() < 1e-12);
         }
         // Any z maps inside the box, and the bounds are reached exactly at z = ±π/2.
-        for z in [-10.0, -1.5707963267948966, 0.3, 7.0] {
+        for z in [-10.0, -std::f64::consts::FRAC_PI_2, 0.3, 7.0] {
             for (i, v) in map.bounded(&[z, z, z]).iter().enumerate() {
                 assert!((lower[i]..=upper[i]).contains(v));
             }

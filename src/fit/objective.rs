@@ -67,9 +67,8 @@ impl<'a> Objective<'a> {
             .collect();
         let width = self.data.elements.len();
         for (point, g) in self.data.geometry.iter().enumerate() {
-            let m = pbrdf.mueller_with_masking(
-                &g.incident,
-                &g.scattered,
+            let m = pbrdf.mueller_for_geometry(
+                &g.scattering,
                 masking[g.incident_zenith],
                 masking[g.scattered_zenith],
             );
@@ -137,7 +136,14 @@ impl<'a> Objective<'a> {
             self.data
                 .geometry
                 .iter()
-                .map(|g| pbrdf.mueller(&g.incident, &g.scattered))
+                .map(|g| {
+                    let s = &g.scattering;
+                    let masking = [
+                        pbrdf.masking(s.cos_incident()),
+                        pbrdf.masking(s.cos_scattered()),
+                    ];
+                    pbrdf.mueller_for_geometry(s, masking[0], masking[1])
+                })
                 .collect(),
         )
     }

@@ -142,8 +142,10 @@ mod tests {
 
     #[test]
     fn free_parameters_default_to_everything_not_fixed() {
-        let mut options = FitOptions::default();
-        options.fixed = parse_parameter_values("k=0.1, rho=0").unwrap();
+        let mut options = FitOptions {
+            fixed: parse_parameter_values("k=0.1, rho=0").unwrap(),
+            ..FitOptions::default()
+        };
         assert_eq!(
             options.free_parameters().unwrap(),
             vec![Parameter::Sigma, Parameter::Q, Parameter::N]

@@ -95,6 +95,7 @@ fn fit_record(
     comparison: Option<&ModelComparison>,
 ) -> FitRecord {
     let uncertainty = &chosen.uncertainty;
+    let (convergence, global_iterations) = chosen.history.best_cost_trace();
     FitRecord {
         source: set.source.clone(),
         source_sha256: set.sha256.clone(),
@@ -134,6 +135,8 @@ fn fit_record(
             aic: other.aic,
             bic: other.bic,
         }),
+        convergence,
+        global_iterations,
     }
 }
 

@@ -115,6 +115,27 @@ impl ConvergenceHistory {
     pub fn evaluations(&self) -> u64 {
         self.stages.iter().map(|s| s.evaluations).sum()
     }
+    /// The best cost so far after every recorded step of every stage, in run order (restarts
+    /// included, so the curve never rises), and how many leading entries belong to the
+    /// global (GA) stage.
+    pub fn best_cost_trace(&self) -> (Vec<f64>, usize) {
+        let mut best = f64::INFINITY;
+        let mut trace = Vec::new();
+        for stage in &self.stages {
+            for &cost in &stage.best_cost {
+                best = best.min(cost);
+                trace.push(best);
+            }
+        }
+        let global = self
+            .stages
+            .iter()
+            .take_while(|s| s.stage == Stage::Ga)
+            .map(|s| s.best_cost.len())
+            .sum();
+        (trace, global)
+    }
+
     /// Termination reason of the last stage.
     pub fn termination(&self) -> String {
         self.stages

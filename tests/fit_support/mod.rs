@@ -99,3 +99,45 @@ pub fn synthetic_set(
         points,
     }
 }
+
+/// The set as a measurement CSV (DESIGN §2.1), with u_ columns when `with_uncertainties`.
+pub fn to_csv(set: &MeasurementSet, with_uncertainties: bool) -> String {
+    use irpol::measure::MUELLER_ELEMENT_NAMES;
+    let mut text = format!(
+        "# material: {}\n# wavelength_um: {}\n# mueller_convention: psps\n",
+        set.material, set.wavelength_um
+    );
+    let mut header = vec!["theta_i_deg", "phi_i_deg", "theta_r_deg", "phi_r_deg"]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>();
+    header.extend(
+        set.elements
+            .iter()
+            .map(|&e| MUELLER_ELEMENT_NAMES[e].to_owned()),
+    );
+    if with_uncertainties {
+        header.extend(
+            set.elements
+                .iter()
+                .map(|&e| format!("u_{}", MUELLER_ELEMENT_NAMES[e])),
+        );
+    }
+    text += &header.join(",");
+    text.push('\n');
+    for p in &set.points {
+        let mut row = vec![
+            p.theta_i_deg.to_string(),
+            p.phi_i_deg.to_string(),
+            p.theta_r_deg.to_string(),
+            p.phi_r_deg.to_string(),
+        ];
+        row.extend(p.values.iter().map(|v| format!("{v:e}")));
+        if with_uncertainties {
+            row.extend(p.uncertainties.iter().map(|u| format!("{:e}", u.unwrap())));
+        }
+        text += &row.join(",");
+        text.push('\n');
+    }
+    text
+}
