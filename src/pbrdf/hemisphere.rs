@@ -163,6 +163,8 @@ impl Pbrdf {
         );
 
         let mut sum = Stokes::zeros();
+        // The scattered direction's shadowing factor is the same for every facet.
+        let masking_r = self.masking(cos_r);
         let mut add_facet = |u: f64, delta: f64, weight: f64| {
             let (sin_d, cos_d) = delta.sin_cos();
             let sec_h = (1.0 + u * u).sqrt();
@@ -173,9 +175,13 @@ impl Pbrdf {
             if cos_i <= 0.0 {
                 return; // rounding at the horizon cut
             }
-            let g = self
-                .shadowing()
-                .factor(distribution, 1.0 / sec_h, cos_i, cos_r, cos_beta);
+            let g = self.shadowing().factor_with_masking(
+                1.0 / sec_h,
+                cos_i,
+                cos_r,
+                cos_beta,
+                [self.masking(cos_i), masking_r],
+            );
             let fresnel = FresnelFractions::new(cos_beta, permittivity);
             let rs2 = fresnel.s_num.norm_sqr() / fresnel.s_den.norm_sqr();
             let rp2 = fresnel.p_num.norm_sqr() / fresnel.p_den.norm_sqr();
