@@ -7,6 +7,12 @@ use super::genetic::GeneticAlgorithm;
 use super::objective::{BoxCost, Objective};
 use super::stages::{Stage, StageHistory};
 use argmin::core::{Error, Executor, State};
+use std::collections::HashMap;
+
+/// Cost evaluations counted by argmin's `Problem` wrapper.
+pub(crate) fn cost_count(counts: &HashMap<&'static str, u64>) -> u64 {
+    counts.get("cost_count").copied().unwrap_or(0)
+}
 
 /// Settings of the genetic stage.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,7 +60,6 @@ pub(crate) fn genetic(
     initial: Vec<Vec<f64>>,
 ) -> Result<(Vec<f64>, StageHistory), Error> {
     let space = objective.space();
-    let evaluations_before = objective.evaluations();
     let solver = GeneticAlgorithm::new(space.lower().to_vec(), space.upper().to_vec())?
         .with_seed(seed)
         .with_population_size(settings.population)?
@@ -76,7 +81,7 @@ pub(crate) fn genetic(
         stage: Stage::Ga,
         best_cost: result.solver().history().to_vec(),
         iterations: state.get_iter(),
-        evaluations: objective.evaluations() - evaluations_before,
+        evaluations: cost_count(&result.problem().counts),
         termination: state
             .get_termination_reason()
             .map(|r| r.to_string())

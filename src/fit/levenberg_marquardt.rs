@@ -22,14 +22,14 @@ pub struct LevenbergMarquardtSettings {
 impl Default for LevenbergMarquardtSettings {
     fn default() -> Self {
         LevenbergMarquardtSettings {
-            relative_tolerance: 1e-12,
+            relative_tolerance: 1e-10,
             max_iterations: 200,
         }
     }
 }
 
 /// Residuals (whose squares sum to the cost) at search coordinates `s`.
-fn residuals(objective: &Objective, s: &[f64]) -> Option<DVector<f64>> {
+pub(crate) fn residuals(objective: &Objective, s: &[f64]) -> Option<DVector<f64>> {
     let mut r = DVector::zeros(objective.observations());
     objective
         .residuals_at(&objective.space().values(s), r.as_mut_slice())
@@ -65,7 +65,6 @@ pub(crate) fn levenberg_marquardt(
     start: &[f64],
     settings: &LevenbergMarquardtSettings,
 ) -> (Vec<f64>, StageHistory) {
-    let evaluations_before = objective.evaluations();
     let space = objective.space();
     let (lower, upper) = (space.lower(), space.upper());
     let mut s: Vec<f64> = start
@@ -80,9 +79,10 @@ pub(crate) fn levenberg_marquardt(
         evaluations: 0,
         termination: String::new(),
     };
+    // One residual vector per trial point, one per Jacobian column.
+    let columns = s.len() as u64;
     let finish = |history: &mut StageHistory, reason: &str| {
         history.termination = reason.to_owned();
-        history.evaluations = objective.evaluations() - evaluations_before;
     };
     let Some(mut r) = residuals(objective, &s) else {
         finish(&mut history, "invalid starting point");
@@ -90,12 +90,14 @@ pub(crate) fn levenberg_marquardt(
     };
     let mut cost = r.norm_squared();
     history.best_cost.push(cost);
+    history.evaluations = 1;
     let (mut lambda, mut nu) = (1e-3, 2.0);
     let mut jacobian = None;
     for _ in 0..settings.max_iterations {
         history.iterations += 1;
         if jacobian.is_none() {
             jacobian = search_jacobian(objective, &s, &r);
+            history.evaluations += columns;
         }
         let Some(j) = &jacobian else {
             finish(&mut history, "the Jacobian could not be evaluated");
@@ -136,6 +138,7 @@ pub(crate) fn levenberg_marquardt(
         // Gain ratio: actual decrease over the decrease the linear model predicts.
         let predicted = -(2.0 * g.dot(&delta) + (j * &delta).norm_squared());
         let trial_residuals = residuals(objective, &trial);
+        history.evaluations += 1;
         let trial_cost = trial_residuals
             .as_ref()
             .map_or(f64::INFINITY, |r| r.norm_squared());

@@ -3,6 +3,7 @@
 //! valid model and the simplex can settle exactly on a bound. A collapsed simplex is restarted
 //! around its best vertex until a restart no longer improves the cost.
 
+use super::global::cost_count;
 use super::objective::Objective;
 use super::stages::{Stage, StageHistory};
 use argmin::core::observers::{Observe, ObserverMode};
@@ -113,14 +114,13 @@ pub(crate) fn nelder_mead(
 ) -> Result<(Vec<f64>, StageHistory), Error> {
     let space = objective.space();
     let map = SineMap::new(space.lower(), space.upper());
-    let evaluations_before = objective.evaluations();
     let mut best_z = map.unbounded(start);
     let mut best_cost = objective.cost(start);
     let mut history = StageHistory {
         stage: Stage::Nm,
         best_cost: vec![best_cost],
         iterations: 0,
-        evaluations: 0,
+        evaluations: 1,
         termination: String::new(),
     };
     for run in 0..=settings.restarts {
@@ -139,6 +139,7 @@ pub(crate) fn nelder_mead(
             .run()?;
         let state = result.state();
         history.iterations += state.get_iter();
+        history.evaluations += cost_count(&result.problem().counts);
         history.termination = state
             .get_termination_reason()
             .map(|r| r.to_string())
@@ -160,7 +161,6 @@ pub(crate) fn nelder_mead(
             break;
         }
     }
-    history.evaluations = objective.evaluations() - evaluations_before;
     Ok((map.bounded(&best_z), history))
 }
 

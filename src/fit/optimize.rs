@@ -6,6 +6,7 @@ use super::nelder_mead::{nelder_mead, NelderMeadSettings};
 use super::objective::Objective;
 use super::parameters::Parameter;
 use super::stages::{ConvergenceHistory, Optimizer, Stage};
+use rayon::prelude::*;
 
 /// Settings of every stage (the defaults suit the 3–5 parameter fits of issue 3).
 #[derive(Clone, Debug, PartialEq)]
@@ -185,10 +186,26 @@ fn escape(
             })
             .collect(),
     };
+    // The restarts are independent: run them in parallel, then merge in start order so that
+    // the result and the history do not depend on the thread count.
+    let runs = starts
+        .into_par_iter()
+        .map(|mut trial| {
+            let mut trial_history = ConvergenceHistory::default();
+            run_stages(
+                objective,
+                local,
+                &mut trial,
+                seed,
+                settings,
+                &mut trial_history,
+            )?;
+            Ok((objective.cost(&trial), trial, trial_history))
+        })
+        .collect::<Result<Vec<_>, (Stage, argmin::core::Error)>>()?;
     let mut best_cost = objective.cost(point);
-    for mut trial in starts {
-        run_stages(objective, local, &mut trial, seed, settings, history)?;
-        let cost = objective.cost(&trial);
+    for (cost, trial, trial_history) in runs {
+        history.stages.extend(trial_history.stages);
         if cost < best_cost {
             best_cost = cost;
             *point = trial;

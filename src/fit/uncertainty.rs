@@ -4,9 +4,9 @@
 //!
 //! A parameter is *undetermined* when the data carry no information on it (its Jacobian column
 //! vanishes, e.g. k = 0 without circular elements, or JᵀJ is singular along it), when it is
-//! almost perfectly correlated with another one (|ρ| > 0.999), or when its 1-σ error exceeds half
-//! its value (not judged for a parameter resting on a bound, where the value is not a
-//! measurement of the scale: ρ_d = 0 ± 0.0002 is well determined).
+//! almost perfectly correlated with another one (|ρ| > 0.999), or when its 1-σ error exceeds
+//! both half its value and 1 % of its search interval. The second condition keeps a value that
+//! is consistent with zero but tightly bounded (ρ_d = 0.00001 ± 0.00002) determined.
 
 use super::objective::Objective;
 use super::parameters::{value_per_coordinate, Parameter, ParameterValues};
@@ -15,8 +15,11 @@ use rayon::prelude::*;
 
 /// Correlation beyond which two parameters count as not separately determined.
 pub const DEGENERATE_CORRELATION: f64 = 0.999;
-/// Relative 1-σ error beyond which a parameter counts as undetermined.
+/// Relative 1-σ error beyond which a parameter counts as undetermined (if its error also exceeds
+/// [`UNDETERMINED_RANGE_FRACTION`] of its search interval).
 pub const UNDETERMINED_RELATIVE_ERROR: f64 = 0.5;
+/// See [`UNDETERMINED_RELATIVE_ERROR`].
+pub const UNDETERMINED_RANGE_FRACTION: f64 = 0.01;
 /// A search coordinate within this fraction of its box width from a bound rests on it (the
 /// sine-mapped Nelder–Mead approaches a bound without reaching it exactly).
 const AT_BOUND: f64 = 1e-6;
@@ -144,9 +147,10 @@ pub(crate) fn estimate(objective: &Objective, search: &[f64], reduced_chi2: f64)
             .iter()
             .enumerate()
             .any(|(j, rho)| j != i && rho.abs() > DEGENERATE_CORRELATION);
-        let value = values.get(parameter);
-        let vague = !uncertainty.at_bound.contains(&parameter)
-            && uncertainty.errors[i] > UNDETERMINED_RELATIVE_ERROR * value.abs();
+        let error = uncertainty.errors[i];
+        let interval = space.bounds().get(parameter);
+        let vague = error > UNDETERMINED_RELATIVE_ERROR * values.get(parameter).abs()
+            && error > UNDETERMINED_RANGE_FRACTION * (interval.upper - interval.lower);
         if !uncertainty.errors[i].is_finite() || degenerate || vague {
             uncertainty.undetermined.push(parameter);
         }

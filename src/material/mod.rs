@@ -79,8 +79,8 @@ pub struct FitRecord {
     pub uncertainty: BTreeMap<String, f64>,
     /// Correlation matrix of the free parameters, in `free_parameters` order.
     pub correlation: Vec<Vec<f64>>,
-    /// Free parameters the data do not determine (no sensitivity, |ρ| > 0.999, or relative
-    /// uncertainty > 50 % away from a bound).
+    /// Free parameters the data do not determine (no sensitivity, |ρ| > 0.999, or a 1-σ error
+    /// above both 50 % of the value and 1 % of the search interval).
     #[serde(default)]
     pub undetermined: Vec<String>,
     /// Free parameters resting on a bound of their search interval (e.g. ρ_d = 0).
