@@ -420,10 +420,20 @@ def normalize_name(name: str) -> str:
     return "rho_d" if name in ("rho", "rho_d") else name
 
 
+def _fit_takes_reports(irpol: str) -> bool:
+    """Whether this irpol build has `fit --reports` (DESIGN §4); earlier builds write no reports."""
+    try:
+        help_text = subprocess.run([irpol, "fit", "--help"], capture_output=True, text=True, timeout=60).stdout
+    except (OSError, subprocess.TimeoutExpired) as e:
+        raise SetupError(f"{irpol} fit --help: {e}") from e
+    return "--reports" in help_text
+
+
 def run_irpol_fit(irpol: str, csv_path: str, extra: list[str] | None = None, timeout: float = 1800) -> IrpolFit:
     """`irpol fit CSV --out TMP --reports TMP2` (wall clock timed); returns the parsed material TOML."""
     with tempfile.TemporaryDirectory(prefix="xcheck_fits_") as out, tempfile.TemporaryDirectory(prefix="xcheck_reports_") as rep:
-        cmd = [irpol, "fit", csv_path, "--out", out, "--reports", rep, *(extra or [])]
+        cmd = [irpol, "fit", csv_path, "--out", out, *(["--reports", rep] if _fit_takes_reports(irpol) else []),
+               *(extra or [])]
         t0 = time.perf_counter()
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)

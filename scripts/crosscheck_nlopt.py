@@ -219,16 +219,18 @@ def compare(m: cc.Measurement, fast: cc.FastModel, fit: cc.IrpolFit, free: list[
 
 def print_tables(outcomes: list[FileOutcome]) -> None:
     print()
-    print(f"{'material':<16}{'dist':<9}{'irpol cost':>12}{'recomputed':>12}{'NM cost':>12}{'CRS2+NM cost':>14}"
-          f"{'irpol s':>9}{'nlopt s':>9}{'nlopt/irpol':>12}{'NM evals':>9}{'CRS evals':>10}  verdict")
+    print(f"{'material':<16}{'dist':<9}{'irpol cost':>15}{'recomputed':>15}{'NM cost':>15}{'CRS2+NM cost':>15}"
+          f"{'irpol/best-1':>13}{'irpol s':>9}{'nlopt s':>9}{'nlopt/irpol':>12}{'NM evals':>9}{'CRS evals':>10}  verdict")
     for o in outcomes:
-        ic = f"{float(o.irpol.fit['cost']):.6g}" if o.irpol else "-"
-        rc = f"{o.recomputed:.6g}" if o.recomputed is not None else "-"
+        best = min(o.nm.cost, o.crs.cost)
+        ic = f"{float(o.irpol.fit['cost']):.10g}" if o.irpol else "-"
+        rc = f"{o.recomputed:.10g}" if o.recomputed is not None else "-"
+        rel = f"{float(o.irpol.fit['cost']) / best - 1:.1e}" if o.irpol else "-"
         iw = f"{o.irpol.wall_seconds:.2f}" if o.irpol else "-"
         ratio = f"{o.crs.seconds / o.irpol.wall_seconds:.2f}" if o.irpol else "-"
         verdict = "-" if not o.irpol else ("PASS" if not o.failures else "FAIL")
-        print(f"{o.name:<16}{o.distribution:<9}{ic:>12}{rc:>12}{o.nm.cost:>12.6g}{o.crs.cost:>14.6g}"
-              f"{iw:>9}{o.crs.seconds:>9.2f}{ratio:>12}{o.nm.evaluations:>9}{o.crs.evaluations:>10}  {verdict}")
+        print(f"{o.name:<16}{o.distribution:<9}{ic:>15}{rc:>15}{o.nm.cost:>15.10g}{o.crs.cost:>15.10g}"
+              f"{rel:>13}{iw:>9}{o.crs.seconds:>9.2f}{ratio:>12}{o.nm.evaluations:>9}{o.crs.evaluations:>10}  {verdict}")
     print()
     print(f"{'material':<16}{'param':<7}{'irpol':>13}{'1-sigma':>11}{'NM':>13}{'CRS2+NM':>13}{'|diff|/sigma':>14}")
     for o in outcomes:
@@ -236,7 +238,7 @@ def print_tables(outcomes: list[FileOutcome]) -> None:
         for p in o.nm.params:
             iv = o.irpol.value(p) if o.irpol else None
             s = o.irpol.uncertainty(p) if o.irpol else None
-            z = f"{abs(iv - best.params[p]) / s:.3f}" if (iv is not None and s) else "-"
+            z = f"{abs(iv - best.params[p]) / s:.1e}" if (iv is not None and s) else "-"
             print(f"{o.name:<16}{p:<7}{(f'{iv:.6g}' if iv is not None else '-'):>13}"
                   f"{(f'{s:.3g}' if s else '-'):>11}{o.nm.params[p]:>13.6g}{o.crs.params[p]:>13.6g}{z:>14}")
 
