@@ -24,7 +24,10 @@ PASS for a file when all of
   * irpol's cost <= min(NM, CRS2+NM) * (1 + 1e-3);
   * every free parameter agrees with the best NLopt result within max(2 sigma_irpol, 1e-6 max(1, |p|)),
     sigma_irpol being irpol's reported 1-sigma ([fit.uncertainty]); the floor only matters if irpol
-    reports no or a zero uncertainty.
+    reports no or a zero uncertainty;
+  * when irpol fitted both distributions and kept one ([fit.alternative]), the other one's cost is
+    also <= NLopt's best for that distribution (both runs) * (1 + 1e-3), so that the AIC choice
+    compares two converged fits.
 Exit status 0 when every file passes, 1 when one fails, 2 on setup problems (no irpol binary, an
 unreadable file, a model check failing).
 """
@@ -158,6 +161,7 @@ class FileOutcome:
     crs: NloptResult
     failures: list[str]
     model_check: str
+    alternative: tuple[str, float, float] | None = None  # distribution, irpol cost, nlopt best cost
 
 
 def irpol_vector(fit: cc.IrpolFit) -> np.ndarray:
@@ -183,10 +187,30 @@ def check_file(path: str, irpol: str | None, distribution: str, seed: int, crs_m
     crs = fit_crs2_nm(fast, free, seed, crs_maxeval)
     failures: list[str] = []
     recomputed = None
+    alternative = None
     if fit is not None:
         failures += compare(m, fast, fit, free, nm, crs)
         recomputed = fast.chi2(irpol_vector(fit))
-    return FileOutcome(m.name, distribution, fit, recomputed, nm, crs, failures, model_check)
+        alternative = check_alternative(m, fit, seed, crs_maxeval, failures)
+    return FileOutcome(m.name, distribution, fit, recomputed, nm, crs, failures, model_check, alternative)
+
+
+def check_alternative(m: cc.Measurement, fit: cc.IrpolFit, seed: int, crs_maxeval: int,
+                      failures: list[str]) -> tuple[str, float, float] | None:
+    """irpol keeps the distribution with the lower AIC; that choice is only sound if the other
+    family was fitted as well. Refits it (both NLopt runs) and requires the same cost tolerance."""
+    alt = fit.fit.get("alternative")
+    if not alt:
+        return None
+    distribution = alt["model"]["distribution"]
+    fast = cc.FastModel(m, distribution)
+    free = cc.free_parameters(distribution)
+    best = min(fit_nm(fast, free).cost, fit_crs2_nm(fast, free, seed, crs_maxeval).cost)
+    cost = float(alt["cost"])
+    if cost > best * (1 + COST_TOLERANCE):
+        failures.append(f"irpol's {distribution} alternative cost {cost:.6g} > nlopt's best {best:.6g} "
+                        f"x (1 + {COST_TOLERANCE:g}): the model choice compares against an unconverged fit")
+    return distribution, cost, best
 
 
 def compare(m: cc.Measurement, fast: cc.FastModel, fit: cc.IrpolFit, free: list[str],
@@ -241,6 +265,13 @@ def print_tables(outcomes: list[FileOutcome]) -> None:
             z = f"{abs(iv - best.params[p]) / s:.1e}" if (iv is not None and s) else "-"
             print(f"{o.name:<16}{p:<7}{(f'{iv:.6g}' if iv is not None else '-'):>13}"
                   f"{(f'{s:.3g}' if s else '-'):>11}{o.nm.params[p]:>13.6g}{o.crs.params[p]:>13.6g}{z:>14}")
+    alternatives = [o for o in outcomes if o.alternative]
+    if alternatives:
+        print()
+        print(f"{'material':<16}{'alternative':<13}{'irpol cost':>15}{'nlopt best':>15}{'irpol/best-1':>13}")
+        for o in alternatives:
+            d, cost, best = o.alternative
+            print(f"{o.name:<16}{d:<13}{cost:>15.10g}{best:>15.10g}{cost / best - 1:>13.1e}")
 
 
 def main(argv=None) -> int:
