@@ -11,6 +11,8 @@ use irpol::fit::{
     FitOutcome, Optimizer, RobustLoss,
 };
 use irpol::pbrdf::Shadowing;
+use irpol::report::fit_report::{rebuild_report, write_fit_report};
+use irpol::report::index::write_library_index;
 use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -85,7 +87,7 @@ enum Command {
         #[arg(long, default_value = "ga+lm")]
         optimizer: String,
         /// Seed of the genetic stage.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = FitOptions::default().seed)]
         seed: u64,
         /// Robust loss on normalized residuals: huber or cauchy, optionally with a scale (huber:2).
         #[arg(long)]
@@ -93,6 +95,16 @@ enum Command {
         /// Library folder for the material TOMLs.
         #[arg(long, default_value = "fits")]
         out: PathBuf,
+        /// Folder for the fit reports (PNG, SVG) and index.html.
+        #[arg(long, default_value = "reports")]
+        reports: PathBuf,
+    },
+    /// Rebuilds a material's fit report from its library entry and source CSV.
+    Report {
+        /// The material TOML.
+        material: PathBuf,
+        #[arg(long, default_value = "reports")]
+        reports: PathBuf,
     },
     /// A table of the materials in a library folder.
     Library {
@@ -216,6 +228,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             seed,
             robust,
             out,
+            reports,
         } => {
             let options = fit_options(
                 distribution,
@@ -226,7 +239,21 @@ fn run(command: Command) -> anyhow::Result<()> {
                 seed,
                 robust,
             )?;
-            fit_and_summarize(&inputs, &options, &out)?;
+            let outcomes = fit_and_summarize(&inputs, &options, &out)?;
+            write_reports(&outcomes, &out, &reports)?;
+        }
+        Command::Report { material, reports } => {
+            for path in rebuild_report(&material, &reports)? {
+                println!("wrote {}", path.display());
+            }
+            let library = material
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            println!(
+                "wrote {}",
+                write_library_index(library, &reports)?.display()
+            );
         }
         Command::Library { dir } => print_library(&dir)?,
         Command::Demo => demo()?,
@@ -304,6 +331,23 @@ fn fit_and_summarize(
     Ok(outcomes)
 }
 
+/// A report per fitted material and the library's index page.
+fn write_reports(
+    outcomes: &[FitOutcome],
+    fits_dir: &Path,
+    reports_dir: &Path,
+) -> anyhow::Result<()> {
+    for outcome in outcomes {
+        let paths = write_fit_report(&outcome.material, &outcome.measurement, reports_dir)?;
+        println!("  report {}", paths[0].display());
+    }
+    println!(
+        "  index  {}",
+        write_library_index(fits_dir, reports_dir)?.display()
+    );
+    Ok(())
+}
+
 fn print_library(dir: &Path) -> anyhow::Result<()> {
     let materials = irpol::material::list_library(dir)?;
     if materials.is_empty() {
@@ -342,8 +386,18 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
 }
 
 fn demo() -> anyhow::Result<()> {
-    let reports = PathBuf::from("reports");
-    println!("irpol demo: the paper's model figures (fitting and rendering steps are added as they land)");
+    let (measurements, fits, reports) = (
+        PathBuf::from("measurements"),
+        PathBuf::from("fits"),
+        PathBuf::from("reports"),
+    );
+    println!(
+        "irpol demo: fit the shipped measurements in {}",
+        measurements.display()
+    );
+    let outcomes = fit_and_summarize(&[measurements], &FitOptions::default(), &fits)?;
+    write_reports(&outcomes, &fits, &reports)?;
+    println!("the paper's model figures:");
     for figure in [PaperFigure::Fig2, PaperFigure::Fig3] {
         for path in write_paper_figure(figure, &reports)? {
             println!("  wrote {}", path.display());

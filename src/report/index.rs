@@ -268,6 +268,7 @@ fn material_section(html: &mut String, reports_dir: &Path, path: &Path, material
                     "optimizer",
                     format!("{} (seed {}), {}", fit.optimizer, fit.seed, fit.termination),
                 ),
+                ("fitted by", material.tool_version.clone()),
             ];
             if let Some(alt) = &fit.alternative {
                 rows.push((

@@ -207,6 +207,8 @@ pub fn fitted_material(name: &str, set: &MeasurementSet, source: &Path) -> Mater
             }),
             convergence,
             global_iterations: 40,
+            at_bound: Vec::new(),
+            model_choice: None,
         }),
     }
 }

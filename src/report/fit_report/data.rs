@@ -436,6 +436,8 @@ mod tests {
             }),
             convergence: vec![],
             global_iterations: 0,
+            at_bound: Vec::new(),
+            model_choice: None,
         });
         Material {
             name: "test".into(),

@@ -3,8 +3,8 @@
 
 use super::data::{ReportData, Residual};
 use super::style::{
-    draw_legend_column, draw_note, log_tick, DrawResult, LegendEntry, LineKind, Marker,
-    AXIS_DESC_SIZE, CAPTION_SIZE, GREY, LEGEND_SIZE, TICK_SIZE,
+    draw_legend_column, draw_legend_top_right, draw_note, log_tick, DrawResult, LegendEntry,
+    LineKind, Marker, AXIS_DESC_SIZE, CAPTION_SIZE, GREY, LEGEND_SIZE, TICK_SIZE,
 };
 use crate::material::FitRecord;
 use crate::report::FONT;
@@ -126,13 +126,7 @@ pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
             LineKind::Solid,
         ));
     }
-    let (x, y) = chart.plotting_area().get_pixel_range();
-    let legend_origin = (
-        x.end - area.get_base_pixel().0 - 260,
-        y.start - area.get_base_pixel().1 + 6,
-    );
-    draw_legend_column(area, &entries, legend_origin)?;
-    Ok(())
+    draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 8)
 }
 
 /// Bins of the residual histogram: 0.25σ wide over ±5σ.
@@ -228,8 +222,7 @@ pub fn draw_histogram<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
             LineKind::Solid,
         ));
     }
-    let (_, y) = chart.plotting_area().get_pixel_range();
-    let (x, _) = chart.plotting_area().get_pixel_range();
+    let (x, y) = chart.plotting_area().get_pixel_range();
     draw_legend_column(
         area,
         &entries,
@@ -350,15 +343,7 @@ pub fn draw_convergence<DB: DrawingBackend>(
         WHITE,
         LineKind::Solid,
     ));
-    let (x, y) = chart.plotting_area().get_pixel_range();
-    let base = area.get_base_pixel();
-    let legend_width = 300;
-    draw_legend_column(
-        area,
-        &entries,
-        (x.end - base.0 - legend_width - 6, y.start - base.1 + 40),
-    )?;
-    Ok(())
+    draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 40)
 }
 
 /// ε0 (left axis) and −ε1 (right axis) against emission angle for both models.

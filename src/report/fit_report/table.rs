@@ -230,38 +230,34 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
     }
 
     rows.push(Row::Heading("Data and optimizer".into()));
+    let rmse = fit
+        .rmse
+        .get("m00")
+        .map(|r| format!(", RMSE m00 = {} sr⁻¹", format_plain(*r)))
+        .unwrap_or_default();
     rows.push(Row::Text(
         format!(
-            "{} points × {} elements ({}), {} degrees of freedom{}",
+            "{} points × {} elements ({}), {} dof{rmse}",
             fit.points,
             fit.elements.len(),
             element_span(&fit.elements),
             fit.degrees_of_freedom,
-            fit.rmse
-                .get("m00")
-                .map(|r| format!(", RMSE m00 = {} sr⁻¹", format_plain(*r)))
-                .unwrap_or_default()
         ),
         Tone::Normal,
     ));
     let local = fit.convergence.len().saturating_sub(fit.global_iterations);
     rows.push(Row::Text(
         format!(
-            "{}, seed {}: {} generations + {} local iterations, {} evaluations",
-            fit.optimizer, fit.seed, fit.global_iterations, local, fit.evaluations
+            "{}, seed {}: {} generations + {} local iterations, {} evaluations; {}",
+            fit.optimizer, fit.seed, fit.global_iterations, local, fit.evaluations, fit.termination
         ),
         Tone::Normal,
     ));
     rows.push(Row::Text(
-        format!("termination: {}", fit.termination),
-        Tone::Normal,
-    ));
-    rows.push(Row::Text(
         format!(
-            "source {}, sha256 {}; {}",
+            "source {} (sha256 {})",
             fit.source.display(),
-            sha_prefix(&fit.source_sha256),
-            material.tool_version
+            sha_prefix(&fit.source_sha256)
         ),
         Tone::Muted,
     ));
@@ -323,14 +319,14 @@ pub fn draw_table<DB: DrawingBackend>(
         &caption,
         (width as i32 / 2, 12),
     )?;
-    let size = LEGEND_SIZE + 1;
-    let line = size + 7;
+    let size = LEGEND_SIZE;
+    let line = size + 8;
     let mut y = 50;
     for row in table_rows(material) {
         match row {
             Row::Heading(text) => {
                 y += 4;
-                let style = (FONT, size + 1, FontStyle::Bold).into_font().color(&BLACK);
+                let style = (FONT, size + 2, FontStyle::Bold).into_font().color(&BLACK);
                 area.draw_text(&text, &style.into_text_style(area), (left, y))?;
                 area.draw(&PathElement::new(
                     vec![(left, y + line - 3), (right, y + line - 3)],
@@ -467,6 +463,8 @@ mod tests {
                 }),
                 convergence: vec![],
                 global_iterations: 0,
+                at_bound: Vec::new(),
+                model_choice: None,
             }),
             model,
         }
