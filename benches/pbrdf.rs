@@ -33,6 +33,16 @@ fn mueller(c: &mut Criterion) {
             b.iter(|| model.first_column(black_box(&incident), black_box(&scattered)))
         });
     }
+    let gaussian = Pbrdf::new(
+        SlopeDistribution::Gaussian { sigma: 0.1 },
+        Shadowing::None,
+        RefractiveIndex::new(1.2, 0.2),
+        0.0,
+    )
+    .unwrap();
+    c.bench_function("mueller_4x4_gaussian_none", |b| {
+        b.iter(|| gaussian.mueller(black_box(&incident), black_box(&scattered)))
+    });
 }
 
 fn emissivity(c: &mut Criterion) {

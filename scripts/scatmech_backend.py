@@ -21,7 +21,7 @@ Maps the irpol model of DESIGN §1.3 onto SCATMECH's `Shadowed_Facet_BRDF_Model`
   Lambda(mu) = (1/mu) int_mu^inf (m - mu) p1(m) dm with p1 the one-dimensional marginal slope density
   (not with the closed forms of DESIGN §1.3, which the numpy port uses), and the table holds the exact
   evaluation angles as nodes, so SCATMECH's linear table interpolation returns node values and adds no
-  error (see `smith_table_interpolation_error` for what a plain grid would cost).
+  error (`scatmech_reference.py --measure-table-interpolation` shows what a plain grid would cost).
 """
 
 from __future__ import annotations
@@ -240,17 +240,3 @@ class ScatmechSurface:
         for idx in np.ndindex(ti.shape):
             out[idx] = self.mueller_scatmech_angles(float(ti[idx]), float(tr[idx]), float(ps[idx]))
         return out
-
-
-def smith_table_interpolation_error(params: SurfaceParams, grid_points: int, samples: int, seed: int = 1):
-    """Largest |G1_interp - G1| over random angles for a uniform theta grid of `grid_points` nodes,
-    as SCATMECH's linear table interpolation would return it (relative to G1)."""
-    rng = np.random.default_rng(seed)
-    table = SmithTable(params, tempfile.gettempdir())
-    grid = np.linspace(0.0, math.pi / 2, grid_points)[:-1]
-    g_grid = np.array([table.g1(float(t)) for t in grid] + [0.0])
-    grid = np.append(grid, math.pi / 2)
-    th = rng.uniform(0.0, math.radians(89.0), samples)
-    exact = np.array([table.g1(float(t)) for t in th])
-    interp = np.interp(th, grid, g_grid)
-    return float(np.max(np.abs(interp - exact) / exact))

@@ -144,17 +144,18 @@ fn draw_curves<DB: DrawingBackend>(
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     register_fonts();
     root.fill(&WHITE)?;
-    let max = curves
-        .iter()
-        .flat_map(|(_, p)| p.iter().map(|&(_, f)| f))
-        .fold(0.0f64, f64::max);
-    let min = (max * 1e-5).max(1e-6);
+    let values = || curves.iter().flat_map(|(_, p)| p.iter().map(|&(_, f)| f));
+    let max = values().fold(0.0f64, f64::max);
+    // Whole decades from the smallest positive value, so no curve is clipped into a false floor.
+    let smallest = values().filter(|&f| f > 0.0).fold(max, f64::min);
+    let min = 10f64.powf(smallest.log10().floor());
+    let top = 10f64.powf(max.log10().ceil());
     let mut chart = ChartBuilder::on(root)
         .caption(title, (FONT, 26))
         .margin(20)
         .x_label_area_size(55)
         .y_label_area_size(90)
-        .build_cartesian_2d(-90.0..90.0, (min..max * 2.0).log_scale())?;
+        .build_cartesian_2d(-90.0..90.0, (min..top).log_scale())?;
     chart
         .configure_mesh()
         .x_desc("detector zenith θ_r (°), + specular side, − toward the source; θ_i = 60°")
@@ -172,7 +173,7 @@ fn draw_curves<DB: DrawingBackend>(
         chart
             .draw_series(LineSeries::new(
                 points.iter().map(|&(x, y)| (x, y.max(min))),
-                color.stroke_width(3),
+                color.stroke_width(2),
             ))?
             .label(label.clone())
             .legend(move |(x, y)| {
