@@ -17,7 +17,8 @@ mod test_records;
 
 use table::format_angle;
 pub(crate) use table::{
-    format_plain, format_with_uncertainty, is_free, lookup, parameters, preference, sha_prefix,
+    at_bound, format_plain, format_with_uncertainty, is_free, lookup, parameters, preference,
+    sha_prefix,
 };
 
 use super::paper_figures::encode_png;

@@ -32,15 +32,17 @@ pub enum Row {
 }
 
 /// `value ± sigma` rounded to the uncertainty's second significant digit; without a usable
-/// uncertainty, four significant digits.
+/// uncertainty, four significant digits. An exact zero (a parameter on its bound) stays "0".
 pub fn format_with_uncertainty(value: f64, sigma: Option<f64>) -> (String, Option<String>) {
     match sigma.filter(|s| s.is_finite() && *s > 0.0) {
         Some(sigma) => {
             let decimals = (1 - sigma.log10().floor() as i32).clamp(0, 10) as usize;
-            (
-                format!("{value:.decimals$}"),
-                Some(format!("{sigma:.decimals$}")),
-            )
+            let value = if value == 0.0 {
+                "0".to_owned()
+            } else {
+                format!("{value:.decimals$}")
+            };
+            (value, Some(format!("{sigma:.decimals$}")))
         }
         None => (format_plain(value), None),
     }
@@ -82,6 +84,13 @@ pub fn parameters(model: &ModelSpec) -> Vec<(&'static str, &'static str, Option<
 /// A fit map entry under the parameter's name, accepting `rho` for `rho_d` (DESIGN §4 spelling).
 pub fn lookup<'a, T>(map: impl Fn(&str) -> Option<&'a T>, name: &str) -> Option<&'a T> {
     map(name).or_else(|| (name == "rho_d").then(|| map("rho")).flatten())
+}
+
+/// Whether the fit left parameter `name` on a bound of its search interval.
+pub fn at_bound(fit: &FitRecord, name: &str) -> bool {
+    fit.at_bound
+        .iter()
+        .any(|p| p == name || (name == "rho_d" && p == "rho"))
 }
 
 pub fn is_free(fit: &FitRecord, name: &str) -> bool {
@@ -181,6 +190,11 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
                 } else {
                     Tone::Normal
                 };
+                let text = if at_bound(fit, name) {
+                    format!("{text} †")
+                } else {
+                    text
+                };
                 (text, sigma_text, tone)
             }
             Some(_) => (format_plain(value), "fixed".into(), Tone::Muted),
@@ -239,6 +253,13 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
                 fit.undetermined.join(", ")
             ),
             Tone::Warning,
+        ));
+    }
+    if !fit.at_bound.is_empty() {
+        let names: Vec<&str> = fit.at_bound.iter().map(|n| symbol(n)).collect();
+        rows.push(Row::Text(
+            format!("† at a bound of its search interval: {}", names.join(", ")),
+            Tone::Muted,
         ));
     }
 
@@ -455,6 +476,7 @@ mod tests {
                 "uncertainty": { "sigma": 0.0012, "rho": 0.001 },
                 "correlation": [[1.0, -0.95, 0.1], [-0.95, 1.0, 0.2], [0.1, 0.2, 1.0]],
                 "undetermined": ["q"],
+                "at_bound": ["rho_d"],
                 "alternative": AlternativeFit {
                     model: ModelSpec {
                         distribution: SlopeDistribution::Gaussian { sigma: 0.09 },
@@ -499,11 +521,11 @@ mod tests {
         assert_eq!(cells("q").1, Tone::Warning, "q is undetermined");
         assert_eq!(cells("q").0[2], "± ? undetermined");
         assert_eq!(cells("n").0[1..3], ["1.200", "fixed"]);
-        assert_eq!(
-            cells("ρd").0[1..3],
-            ["0.0000", "± 0.0010"],
-            "`rho` names ρ_d"
-        );
+        assert_eq!(cells("ρd").0[1..3], ["0 †", "± 0.0010"], "`rho` names ρ_d");
+        assert!(rows.contains(&Row::Text(
+            "† at a bound of its search interval: ρd".into(),
+            Tone::Muted
+        )));
         assert!(rows.contains(&Row::Text(
             "strongest correlation ρ(σ, q) = -0.950".into(),
             Tone::Normal
