@@ -3,20 +3,13 @@
 //! deviation and normalized residual, and the chosen and competing models evaluated along each
 //! plane and ring and as polarized emissivity (DESIGN §1.3–1.4).
 
+use crate::fit::MeasurementData;
 use crate::material::Material;
 use crate::measure::MeasurementSet;
 use crate::optics::{Mueller, Stokes};
 use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
 
 use super::super::ReportError;
-
-/// The fit's default noise model where a file has no `u_` column: 3 % of m00 on m00 and 1 % of m00
-/// on every other element (a rotating-retarder polarimeter), floored at 1e-6 of the largest m00 so
-/// that a zero reading keeps a finite weight. Mirrors `fit::data` so that report residuals are the
-/// ones the optimizer minimized.
-pub const DEFAULT_M00_RELATIVE_ERROR: f64 = 0.03;
-pub const DEFAULT_OTHER_ERROR_PER_M00: f64 = 0.01;
-const DEFAULT_ERROR_FLOOR: f64 = 1e-6;
 
 /// Two angles are the same goniometer setting when they agree to a microdegree.
 const SAME_ANGLE_DEG: f64 = 1e-6;
@@ -121,11 +114,13 @@ impl ReportData {
         };
 
         let incidences = distinct_sorted(set.points.iter().map(|p| p.theta_i_deg));
-        let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
-        let floor = DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE);
+        // The standard deviations the fit weighted by (the file's u_ columns or the fit's default
+        // noise model), so that report residuals are the ones the optimizer minimized.
+        let weights = MeasurementData::new(set)?;
+        let elements_per_point = set.elements.len();
 
         let mut points = Vec::with_capacity(set.points.len());
-        for p in &set.points {
+        for (point, p) in set.points.iter().enumerate() {
             let incident = checked_direction("theta_i_deg", p.theta_i_deg, p.phi_i_deg)?;
             let scattered = checked_direction("theta_r_deg", p.theta_r_deg, p.phi_r_deg)?;
             let relative_azimuth = (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0);
@@ -140,11 +135,7 @@ impl ReportData {
             let mut readings = [None; 16];
             for (column, &element) in set.elements.iter().enumerate() {
                 let value = p.values[column];
-                let sigma = p.uncertainties[column].unwrap_or(if element == 0 {
-                    (DEFAULT_M00_RELATIVE_ERROR * p.values[0]).max(floor)
-                } else {
-                    (DEFAULT_OTHER_ERROR_PER_M00 * p.values[0]).max(floor)
-                });
+                let (_, sigma) = weights.observation(point * elements_per_point + column);
                 readings[element] = Some(Reading { value, sigma });
             }
             points.push(PointView {
