@@ -1,1 +1,258 @@
-//! (module material)
+//! The material library: one TOML file per material (DESIGN §2.2) holding the pBRDF model, how it
+//! was fitted, and its uncertainties. Written atomically; read by `render` and `report`.
+
+use crate::optics::RefractiveIndex;
+use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum MaterialError {
+    #[error("{path}: cannot read the material file: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: not a valid material TOML: {message}")]
+    Parse { path: PathBuf, message: String },
+    #[error("{path}: the model is invalid: {source}")]
+    Model { path: PathBuf, source: ModelError },
+    #[error("material '{name}' is not in the library {dir} (no {dir}/{name}.toml)")]
+    NotFound { name: String, dir: PathBuf },
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// The pBRDF parameters of a material (DESIGN §1.3) at one wavelength.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelSpec {
+    #[serde(flatten)]
+    pub distribution: SlopeDistribution,
+    pub shadowing: Shadowing,
+    pub n: f64,
+    pub k: f64,
+    #[serde(default)]
+    pub rho_d: f64,
+    pub wavelength_um: f64,
+}
+
+impl ModelSpec {
+    pub fn pbrdf(&self) -> Result<Pbrdf, ModelError> {
+        Pbrdf::new(
+            self.distribution,
+            self.shadowing,
+            RefractiveIndex::new(self.n, self.k),
+            self.rho_d,
+        )
+    }
+}
+
+/// How a material was fitted (DESIGN §2.2): provenance, optimizer, quality and uncertainties.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FitRecord {
+    /// The measurement file, as given to `irpol fit`, and the SHA-256 of its bytes.
+    pub source: PathBuf,
+    pub source_sha256: String,
+    pub points: usize,
+    /// Mueller elements used, e.g. ["m00", "m01", …].
+    pub elements: Vec<String>,
+    pub free_parameters: Vec<String>,
+    pub optimizer: String,
+    pub seed: u64,
+    pub settings: BTreeMap<String, String>,
+    pub iterations: u64,
+    pub evaluations: u64,
+    pub cost: f64,
+    pub reduced_chi2: f64,
+    pub degrees_of_freedom: usize,
+    pub aic: f64,
+    pub bic: f64,
+    pub termination: String,
+    /// Root-mean-square residual per Mueller element (sr⁻¹).
+    pub rmse: BTreeMap<String, f64>,
+    /// 1-σ uncertainty per free parameter (scaled by the reduced χ²).
+    pub uncertainty: BTreeMap<String, f64>,
+    /// Correlation matrix of the free parameters, in `free_parameters` order.
+    pub correlation: Vec<Vec<f64>>,
+    /// Free parameters the data do not determine (relative uncertainty > 50 % or |ρ| > 0.999).
+    #[serde(default)]
+    pub undetermined: Vec<String>,
+    /// The competing slope distribution's best fit, for model comparison.
+    pub alternative: Option<AlternativeFit>,
+}
+
+/// The other distribution's best fit on the same data (model comparison by AIC/BIC).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AlternativeFit {
+    pub model: ModelSpec,
+    pub cost: f64,
+    pub reduced_chi2: f64,
+    pub aic: f64,
+    pub bic: f64,
+}
+
+/// One entry of the material library.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    pub name: String,
+    pub tool_version: String,
+    pub model: ModelSpec,
+    pub fit: Option<FitRecord>,
+}
+
+impl Material {
+    pub fn load(path: &Path) -> Result<Material, MaterialError> {
+        let text = std::fs::read_to_string(path).map_err(|source| MaterialError::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        let material: Material = toml::from_str(&text).map_err(|e| MaterialError::Parse {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        material
+            .model
+            .pbrdf()
+            .map_err(|source| MaterialError::Model {
+                path: path.to_owned(),
+                source,
+            })?;
+        Ok(material)
+    }
+
+    pub fn pbrdf(&self) -> Result<Pbrdf, ModelError> {
+        self.model.pbrdf()
+    }
+
+    /// Writes the TOML atomically: a temporary file in the same folder, then a rename, so a failed
+    /// run never leaves a half-written library entry.
+    pub fn save(&self, path: &Path) -> Result<(), MaterialError> {
+        let text = toml::to_string_pretty(self).map_err(|e| MaterialError::Write {
+            path: path.to_owned(),
+            source: std::io::Error::other(e),
+        })?;
+        write_atomically(path, text.as_bytes()).map_err(|source| MaterialError::Write {
+            path: path.to_owned(),
+            source,
+        })
+    }
+}
+
+/// The file of material `name` in the library folder `dir`.
+pub fn find_material(dir: &Path, name: &str) -> Result<PathBuf, MaterialError> {
+    let path = dir.join(format!("{name}.toml"));
+    if path.is_file() {
+        Ok(path)
+    } else {
+        Err(MaterialError::NotFound {
+            name: name.to_owned(),
+            dir: dir.to_owned(),
+        })
+    }
+}
+
+/// Every material in a library folder, sorted by file name.
+pub fn list_library(dir: &Path) -> Result<Vec<(PathBuf, Material)>, MaterialError> {
+    let entries = std::fs::read_dir(dir).map_err(|source| MaterialError::Read {
+        path: dir.to_owned(),
+        source,
+    })?;
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    paths
+        .into_iter()
+        .map(|p| Material::load(&p).map(|m| (p, m)))
+        .collect()
+}
+
+/// Writes `bytes` to `path` through a temporary sibling and a rename (atomic on one filesystem).
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)?;
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let temp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut file = std::fs::File::create(&temp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        std::fs::rename(&temp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&temp);
+    }
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Material {
+        Material {
+            name: "paper_paint".into(),
+            tool_version: "irpol test".into(),
+            model: ModelSpec {
+                distribution: SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
+                shadowing: Shadowing::Smith,
+                n: 1.2,
+                k: 0.2,
+                rho_d: 0.0,
+                wavelength_um: 9.925,
+            },
+            fit: None,
+        }
+    }
+
+    #[test]
+    fn material_round_trips_through_toml() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("paper_paint.toml");
+        sample().save(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            text.contains("distribution = \"cauchy\"") && text.contains("shadowing = \"smith\""),
+            "{text}"
+        );
+        assert_eq!(Material::load(&path).unwrap(), sample());
+        assert_eq!(find_material(dir.path(), "paper_paint").unwrap(), path);
+        assert!(find_material(dir.path(), "nope")
+            .unwrap_err()
+            .to_string()
+            .contains("'nope'"));
+        assert_eq!(list_library(dir.path()).unwrap().len(), 1);
+    }
+
+    #[test]
+    fn invalid_model_in_a_library_file_is_reported_with_its_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.toml");
+        let text = toml::to_string(&sample())
+            .unwrap()
+            .replace("q = 1.8", "q = 0.5");
+        std::fs::write(&path, text).unwrap();
+        let message = Material::load(&path).unwrap_err().to_string();
+        assert!(
+            message.contains("bad.toml") && message.contains("q = 0.5"),
+            "{message}"
+        );
+        std::fs::write(&path, "name = 3").unwrap();
+        assert!(Material::load(&path)
+            .unwrap_err()
+            .to_string()
+            .contains("not a valid material"));
+    }
+}

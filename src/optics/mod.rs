@@ -1,1 +1,12 @@
-//! (module optics)
+//! Optics primitives: Fresnel coefficients of an absorbing medium, Jones/Mueller/Stokes algebra in
+//! the SCATMECH "psps" convention, and Planck band radiance. Nothing here knows about microfacets.
+
+mod fresnel;
+mod planck;
+mod polarization;
+
+pub use fresnel::{fresnel_amplitudes, RefractiveIndex};
+pub use planck::{Band, OpticsError};
+pub use polarization::{
+    fresnel_mueller, jones_to_mueller, rotate_stokes, stokes_rotator, Mueller, Stokes,
+};

@@ -1,1 +1,18 @@
-//! (module pbrdf)
+//! The polarimetric microfacet BRDF of DESIGN §1.3 (Priest–Germer with the Wellems/Cauchy slope
+//! distribution, as in Ma et al. 2009 eqs. 1–7), its polarized emissivity by Kirchhoff's law
+//! (eqs. 8–9) and the hemispherical reflection integrals that both the emissivity and the scene
+//! renderer use.
+
+mod distribution;
+mod error;
+mod geometry;
+mod hemisphere;
+mod model;
+mod shadowing;
+
+pub use distribution::SlopeDistribution;
+pub use error::ModelError;
+pub use geometry::Direction;
+pub use hemisphere::HemisphereQuadrature;
+pub use model::Pbrdf;
+pub use shadowing::Shadowing;

@@ -1,0 +1,292 @@
+//! Facet slope distributions (DESIGN §1.2) and their Smith Λ functions (DESIGN §1.3).
+
+use super::ModelError;
+use serde::{Deserialize, Serialize};
+use statrs::function::{beta::beta_reg, erf::erfc, gamma::ln_gamma};
+use std::f64::consts::PI;
+
+/// Distribution of facet slopes m = tan θ, normalized over the hemisphere (∫ P(θ) dΩ = 1).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "distribution", rename_all = "lowercase")]
+pub enum SlopeDistribution {
+    /// Cauchy / Student-t (Wellems 2006; Ma et al. eq. 3), a = 2σ², q > 1:
+    /// P(θ) = (q−1) a^(q−1) / (π cos³θ (tan²θ + a)^q). q = 2 is GGX with α = √2σ; q → ∞ Gaussian.
+    Cauchy { sigma: f64, q: f64 },
+    /// Gaussian slopes (Priest–Germer, Torrance–Sparrow): P(θ) = exp(−tan²θ/(2σ²)) / (2πσ² cos³θ).
+    /// SCATMECH's slope parameter s and Beckmann's α equal √2σ.
+    Gaussian { sigma: f64 },
+}
+
+impl SlopeDistribution {
+    pub fn sigma(&self) -> f64 {
+        match *self {
+            SlopeDistribution::Cauchy { sigma, .. } | SlopeDistribution::Gaussian { sigma } => {
+                sigma
+            }
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            SlopeDistribution::Cauchy { .. } => "cauchy",
+            SlopeDistribution::Gaussian { .. } => "gaussian",
+        }
+    }
+
+    pub fn validate(&self) -> Result<(), ModelError> {
+        let sigma = self.sigma();
+        if !(sigma.is_finite() && sigma > 0.0) {
+            return Err(ModelError::Sigma(sigma));
+        }
+        if let SlopeDistribution::Cauchy { q, .. } = *self {
+            if !(q.is_finite() && q > 1.0) {
+                return Err(ModelError::Q(q));
+            }
+        }
+        Ok(())
+    }
+
+    /// Precomputes the normalization and Smith constants; call only on a validated distribution.
+    pub(crate) fn prepare(&self) -> PreparedDistribution {
+        match *self {
+            SlopeDistribution::Cauchy { sigma, q } => {
+                let a = 2.0 * sigma * sigma;
+                PreparedDistribution::Cauchy {
+                    a,
+                    q,
+                    norm: (q - 1.0) * a.powf(q - 1.0) / PI,
+                    // Γ(q−½)/(Γ(q−1)√π); only meaningful (and only used) for q > 3/2.
+                    smith_prefactor: if q > 1.5 {
+                        (ln_gamma(q - 0.5) - ln_gamma(q - 1.0)).exp() / PI.sqrt()
+                    } else {
+                        f64::NAN
+                    },
+                }
+            }
+            SlopeDistribution::Gaussian { sigma } => PreparedDistribution::Gaussian {
+                inv_two_sigma2: 0.5 / (sigma * sigma),
+                norm: 1.0 / (2.0 * PI * sigma * sigma),
+                inv_sqrt2_sigma: 1.0 / (2.0f64.sqrt() * sigma),
+            },
+        }
+    }
+}
+
+/// A validated distribution with its constants computed once.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum PreparedDistribution {
+    Cauchy {
+        a: f64,
+        q: f64,
+        norm: f64,
+        smith_prefactor: f64,
+    },
+    Gaussian {
+        inv_two_sigma2: f64,
+        norm: f64,
+        inv_sqrt2_sigma: f64,
+    },
+}
+
+impl PreparedDistribution {
+    /// Slope-space density p(m) at |m|² = `slope2` (∫ p d²m = 1).
+    #[inline]
+    pub(crate) fn slope_pdf(&self, slope2: f64) -> f64 {
+        match *self {
+            PreparedDistribution::Cauchy { a, q, norm, .. } => norm * (slope2 + a).powf(-q),
+            PreparedDistribution::Gaussian {
+                inv_two_sigma2,
+                norm,
+                ..
+            } => norm * (-slope2 * inv_two_sigma2).exp(),
+        }
+    }
+
+    /// Facet-normal density per solid angle P(θ) = p(tan θ)/cos³θ (paper eq. 3).
+    #[inline]
+    pub(crate) fn facet_pdf(&self, cos_theta: f64) -> f64 {
+        let cos2 = cos_theta * cos_theta;
+        let tan2 = (1.0 - cos2) / cos2;
+        self.slope_pdf(tan2) / (cos2 * cos_theta)
+    }
+
+    /// Smith Λ(θ) for a direction at zenith angle θ, μ = cot θ (DESIGN §1.3).
+    pub(crate) fn smith_lambda(&self, cos_theta: f64) -> f64 {
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        if sin_theta == 0.0 {
+            return 0.0;
+        }
+        let mu = cos_theta / sin_theta;
+        match *self {
+            PreparedDistribution::Gaussian {
+                inv_sqrt2_sigma, ..
+            } => {
+                let x = mu * inv_sqrt2_sigma;
+                if x > 26.0 {
+                    return 0.0; // erfc(26) < 1e-295: Λ underflows
+                }
+                // ½(erf x − 1) + e^(−x²)/(2√π x), with erfc to keep absolute accuracy at large x.
+                0.5 * ((-x * x).exp() / (PI.sqrt() * x) - erfc(x))
+            }
+            PreparedDistribution::Cauchy {
+                a,
+                q,
+                smith_prefactor,
+                ..
+            } => {
+                let mu2 = mu * mu;
+                smith_prefactor * a.sqrt() / ((2.0 * q - 3.0) * mu) * (1.0 + mu2 / a).powf(1.5 - q)
+                    - 0.5 * beta_reg(q - 1.0, 0.5, a / (a + mu2))
+            }
+        }
+    }
+
+    /// A slope scale of the distribution (≈ σ), for laying out quadrature panels.
+    pub(crate) fn slope_scale(&self) -> f64 {
+        match *self {
+            PreparedDistribution::Cauchy { a, .. } => (0.5 * a).sqrt(),
+            PreparedDistribution::Gaussian { inv_two_sigma2, .. } => (0.5 / inv_two_sigma2).sqrt(),
+        }
+    }
+
+    /// Slope magnitude beyond which the distribution holds < 1e-17 of its mass (∞ for the
+    /// heavy-tailed Cauchy, whose tail matters at grazing angles).
+    pub(crate) fn slope_cutoff(&self) -> f64 {
+        match *self {
+            PreparedDistribution::Cauchy { .. } => f64::INFINITY,
+            // Mass beyond u is exp(−u²/(2σ²)); e^−40 ≈ 4e-18.
+            PreparedDistribution::Gaussian { inv_two_sigma2, .. } => (40.0 / inv_two_sigma2).sqrt(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gauss_quad::legendre::GaussLegendre;
+
+    fn gl(n: usize) -> GaussLegendre {
+        GaussLegendre::new(n.try_into().unwrap())
+    }
+
+    /// ∫ p(m) d²m over the plane by polar quadrature with u = s/(1−s) on [0, 1).
+    fn total_mass(dist: &PreparedDistribution) -> f64 {
+        let rule = gl(400);
+        2.0 * PI
+            * rule.integrate(0.0, 1.0, |s| {
+                let u = s / (1.0 - s);
+                dist.slope_pdf(u * u) * u / ((1.0 - s) * (1.0 - s))
+            })
+    }
+
+    #[test]
+    fn distributions_are_normalized() {
+        for dist in [
+            SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
+            SlopeDistribution::Cauchy { sigma: 0.3, q: 4.0 },
+            SlopeDistribution::Gaussian { sigma: 0.2 },
+        ] {
+            let mass = total_mass(&dist.prepare());
+            assert!((mass - 1.0).abs() < 1e-6, "{dist:?}: {mass}");
+        }
+    }
+
+    #[test]
+    fn cauchy_with_q_2_is_ggx() {
+        // GGX D(h) = α² / (π cos⁴θ (α² + tan²θ)²) with α = √2σ, and D = P / cosθ.
+        let sigma = 0.23;
+        let alpha2 = 2.0 * sigma * sigma;
+        let dist = SlopeDistribution::Cauchy { sigma, q: 2.0 }.prepare();
+        for deg in [0.0f64, 10.0, 35.0, 70.0] {
+            let c = deg.to_radians().cos();
+            let tan2 = (1.0 - c * c) / (c * c);
+            let ggx = alpha2 / (PI * c.powi(4) * (alpha2 + tan2).powi(2));
+            assert!((dist.facet_pdf(c) / c / ggx - 1.0).abs() < 1e-13);
+        }
+    }
+
+    /// ∫_0^∞ f by Gauss–Legendre on panels doubling in width from scale/16 (heavy tails welcome).
+    fn integrate_to_infinity(f: impl Fn(f64) -> f64, scale: f64) -> f64 {
+        let rule = gl(16);
+        let (mut start, mut width, mut total) = (0.0, scale / 16.0, 0.0);
+        for _ in 0..60 {
+            total += rule.integrate(start, start + width, &f);
+            start += width;
+            width *= 2.0;
+        }
+        total
+    }
+
+    /// Smith Λ from its definition, Λ(μ) = (1/μ) ∫_μ^∞ (x − μ) p_x(x) dx, with the marginal slope
+    /// density p_x(x) = ∫ p(x, y) dy computed numerically too.
+    fn lambda_by_quadrature(dist: &PreparedDistribution, mu: f64) -> f64 {
+        let scale = dist.slope_scale();
+        let marginal =
+            |x: f64| 2.0 * integrate_to_infinity(|y| dist.slope_pdf(x * x + y * y), scale);
+        integrate_to_infinity(|t| t * marginal(mu + t), scale) / mu
+    }
+
+    #[test]
+    fn smith_lambda_matches_its_definition() {
+        for dist in [
+            SlopeDistribution::Gaussian { sigma: 0.25 },
+            SlopeDistribution::Cauchy { sigma: 0.2, q: 2.0 },
+            SlopeDistribution::Cauchy {
+                sigma: 0.15,
+                q: 1.8,
+            },
+            SlopeDistribution::Cauchy { sigma: 0.3, q: 3.5 },
+        ] {
+            let prepared = dist.prepare();
+            for deg in [20.0f64, 60.0, 80.0, 88.0] {
+                let c = deg.to_radians().cos();
+                let mu = c / (1.0 - c * c).sqrt();
+                let closed = prepared.smith_lambda(c);
+                let numeric = lambda_by_quadrature(&prepared, mu);
+                assert!(
+                    (closed - numeric).abs() < 1e-9 * numeric + 1e-15,
+                    "{dist:?} θ={deg}: closed {closed} numeric {numeric}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn cauchy_q2_lambda_has_the_ggx_closed_form() {
+        let sigma = 0.2;
+        let dist = SlopeDistribution::Cauchy { sigma, q: 2.0 }.prepare();
+        for deg in [5.0f64, 45.0, 85.0] {
+            let theta = deg.to_radians();
+            let expect = 0.5 * ((1.0 + 2.0 * sigma * sigma * theta.tan().powi(2)).sqrt() - 1.0);
+            assert!((dist.smith_lambda(theta.cos()) - expect).abs() < 1e-13);
+        }
+        assert_eq!(dist.smith_lambda(1.0), 0.0);
+    }
+
+    #[test]
+    fn invalid_parameters_are_refused() {
+        assert_eq!(
+            SlopeDistribution::Gaussian { sigma: 0.0 }.validate(),
+            Err(ModelError::Sigma(0.0))
+        );
+        assert!(SlopeDistribution::Gaussian { sigma: f64::NAN }
+            .validate()
+            .is_err());
+        assert_eq!(
+            SlopeDistribution::Cauchy { sigma: 0.1, q: 1.0 }.validate(),
+            Err(ModelError::Q(1.0))
+        );
+        assert!(SlopeDistribution::Cauchy {
+            sigma: -0.1,
+            q: 2.0
+        }
+        .validate()
+        .is_err());
+        assert!(SlopeDistribution::Cauchy {
+            sigma: 0.1,
+            q: f64::INFINITY
+        }
+        .validate()
+        .is_err());
+    }
+}

@@ -1,0 +1,181 @@
+//! The polarized microfacet BRDF (DESIGN §1.3; Ma et al. eqs. 4–7, Priest & Germer 2000):
+//! F(ω_i→ω_r) = P(θ) G M(β, η_i, η_r) / (4 cosθ cosθ_i cosθ_r) + (ρ_d/π) diag(1,0,0,0),
+//! M = L(−η_r) F_fres(β) L(η_i).
+
+use super::distribution::PreparedDistribution;
+use super::geometry::{frame_rotation, Direction};
+use super::{ModelError, Shadowing, SlopeDistribution};
+use crate::optics::{fresnel_amplitudes, Mueller, RefractiveIndex, Stokes};
+use nalgebra::Vector3;
+use num_complex::Complex64;
+use std::f64::consts::FRAC_1_PI;
+
+/// A validated pBRDF model. Construct with [`Pbrdf::new`]; the parameters are read-only so that
+/// the constants derived from them stay consistent.
+#[derive(Clone, Debug)]
+pub struct Pbrdf {
+    distribution: SlopeDistribution,
+    shadowing: Shadowing,
+    index: RefractiveIndex,
+    rho_d: f64,
+    prepared: PreparedDistribution,
+    permittivity: Complex64,
+}
+
+/// What one facet reflection contributes: the specular scale P G/(4 cosθ cosθ_i cosθ_r) and the
+/// Fresnel coefficients at the local incidence angle.
+struct FacetReflection {
+    scale: f64,
+    r_s: Complex64,
+    r_p: Complex64,
+    /// unit(ω_i × h) up to length: the facet s axis (h × k_in), ⊥ to both propagation directions.
+    facet_s: Vector3<f64>,
+}
+
+impl Pbrdf {
+    pub fn new(
+        distribution: SlopeDistribution,
+        shadowing: Shadowing,
+        index: RefractiveIndex,
+        rho_d: f64,
+    ) -> Result<Pbrdf, ModelError> {
+        distribution.validate()?;
+        if let (SlopeDistribution::Cauchy { q, .. }, Shadowing::Smith) = (distribution, shadowing) {
+            if q <= 1.5 {
+                return Err(ModelError::SmithNeedsQ(q));
+            }
+        }
+        if !(index.n.is_finite() && index.n > 0.0) {
+            return Err(ModelError::RealIndex(index.n));
+        }
+        if !(index.k.is_finite() && index.k >= 0.0) {
+            return Err(ModelError::ExtinctionIndex(index.k));
+        }
+        if !(rho_d.is_finite() && (0.0..=1.0).contains(&rho_d)) {
+            return Err(ModelError::Diffuse(rho_d));
+        }
+        Ok(Pbrdf {
+            distribution,
+            shadowing,
+            index,
+            rho_d,
+            prepared: distribution.prepare(),
+            permittivity: index.permittivity(),
+        })
+    }
+
+    pub fn distribution(&self) -> SlopeDistribution {
+        self.distribution
+    }
+    pub fn shadowing(&self) -> Shadowing {
+        self.shadowing
+    }
+    pub fn index(&self) -> RefractiveIndex {
+        self.index
+    }
+    pub fn rho_d(&self) -> f64 {
+        self.rho_d
+    }
+    pub(crate) fn prepared_distribution(&self) -> &PreparedDistribution {
+        &self.prepared
+    }
+
+    /// Geometry, distribution, shadowing and Fresnel part shared by the full and fast paths;
+    /// `None` when either direction is at or below the horizon.
+    #[inline]
+    fn facet_reflection(
+        &self,
+        incident: &Direction,
+        scattered: &Direction,
+    ) -> Option<FacetReflection> {
+        let (w_i, w_r) = (&incident.vector, &scattered.vector);
+        let (cos_i, cos_r) = (w_i.z, w_r.z);
+        if cos_i <= 0.0 || cos_r <= 0.0 {
+            return None;
+        }
+        // Half vector h = (ω_i + ω_r)/|ω_i + ω_r|; cos β = h·ω_i = |ω_i + ω_r|/2 (paper eqs. 1–2 in
+        // vector form, regular at θ = 0 and β = 0).
+        let sum = w_i + w_r;
+        let sum_norm = sum.norm();
+        let cos_beta = 0.5 * sum_norm;
+        let cos_theta = sum.z / sum_norm;
+        let pdf = self.prepared.facet_pdf(cos_theta);
+        let g = self
+            .shadowing
+            .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta);
+        let scale = pdf * g / (4.0 * cos_theta * cos_i * cos_r);
+        let (r_s, r_p) = fresnel_amplitudes(cos_beta, self.permittivity);
+        Some(FacetReflection {
+            scale,
+            r_s,
+            r_p,
+            facet_s: w_i.cross(&sum),
+        })
+    }
+
+    /// cos 2η_r, sin 2η_r of the facet frame against the psps frame of the scattered light.
+    /// At exact retroreflection (h ∥ ω_i) the facet plane is undefined and any facet s axis gives
+    /// the same matrix; take the scattered light's own s axis.
+    #[inline]
+    fn scattered_rotation(facet_s: &Vector3<f64>, scattered: &Direction) -> (f64, f64) {
+        if facet_s.norm_squared() < 1e-30 {
+            return (1.0, 0.0);
+        }
+        frame_rotation(facet_s, &scattered.outgoing_s_axis(), &scattered.vector)
+    }
+
+    /// The full 4×4 Mueller BRDF (sr⁻¹) from `incident` (ω_i, toward the source) to `scattered`
+    /// (ω_r, toward the viewer), in the psps frames of both (DESIGN §1.3). Zero below the horizon.
+    pub fn mueller(&self, incident: &Direction, scattered: &Direction) -> Mueller {
+        let Some(facet) = self.facet_reflection(incident, scattered) else {
+            return Mueller::zeros();
+        };
+        // Incident frame: k_in = −ω_i, s = −ê_φ(ω_i); the facet s axis h × k_in = ω_i × h.
+        let (ci, si) = if facet.facet_s.norm_squared() < 1e-30 {
+            (1.0, 0.0)
+        } else {
+            let k_in = -incident.vector;
+            frame_rotation(&facet.facet_s, &(-incident.azimuthal_axis), &k_in)
+        };
+        let (cr, sr) = Self::scattered_rotation(&facet.facet_s, scattered);
+        let (rs2, rp2) = (facet.r_s.norm_sqr(), facet.r_p.norm_sqr());
+        let (a, b) = (0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2));
+        let cross = facet.r_s.conj() * facet.r_p;
+        let (c, s) = (cross.re, cross.im);
+        // L(−η_r) F_fres L(η_i) multiplied out (DESIGN §1.3).
+        let mut m = Mueller::new(
+            a,
+            b * ci,
+            b * si,
+            0.0,
+            cr * b,
+            cr * a * ci + sr * c * si,
+            cr * a * si - sr * c * ci,
+            sr * s,
+            sr * b,
+            sr * a * ci - cr * c * si,
+            sr * a * si + cr * c * ci,
+            -cr * s,
+            0.0,
+            -s * si,
+            s * ci,
+            c,
+        ) * facet.scale;
+        m[(0, 0)] += self.rho_d * FRAC_1_PI;
+        m
+    }
+
+    /// First column F_j0 (sr⁻¹): the Stokes BRDF for unpolarized illumination, the only part that
+    /// thermal scenes need. Skips the incident-frame rotation: (A, cos2η_r B, sin2η_r B, 0).
+    #[inline]
+    pub fn first_column(&self, incident: &Direction, scattered: &Direction) -> Stokes {
+        let Some(facet) = self.facet_reflection(incident, scattered) else {
+            return Stokes::zeros();
+        };
+        let (cr, sr) = Self::scattered_rotation(&facet.facet_s, scattered);
+        let (rs2, rp2) = (facet.r_s.norm_sqr(), facet.r_p.norm_sqr());
+        let a = 0.5 * (rs2 + rp2) * facet.scale;
+        let b = 0.5 * (rs2 - rp2) * facet.scale;
+        Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
+    }
+}

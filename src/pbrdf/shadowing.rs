@@ -1,0 +1,58 @@
+//! Shadowing/masking functions G (the paper's g(k_np); DESIGN §1.3).
+
+use super::distribution::PreparedDistribution;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Shadowing {
+    /// G = 1 (the paper's model; not energy conserving at grazing angles).
+    #[default]
+    None,
+    /// V-groove: G = min(1, 2cosθ cosθ_i/cosβ, 2cosθ cosθ_r/cosβ).
+    TorranceSparrow,
+    /// Uncorrelated Smith: G = G1(θ_i) G1(θ_r), G1 = 1/(1+Λ) with the distribution's own Λ.
+    Smith,
+}
+
+impl Shadowing {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Shadowing::None => "none",
+            Shadowing::TorranceSparrow => "torrance-sparrow",
+            Shadowing::Smith => "smith",
+        }
+    }
+
+    pub fn parse(text: &str) -> Option<Shadowing> {
+        match text {
+            "none" => Some(Shadowing::None),
+            "torrance-sparrow" => Some(Shadowing::TorranceSparrow),
+            "smith" => Some(Shadowing::Smith),
+            _ => None,
+        }
+    }
+
+    /// G for facet tilt θ, incidence θ_i, reflection θ_r and local incidence β (all as cosines).
+    #[inline]
+    pub(crate) fn factor(
+        &self,
+        distribution: &PreparedDistribution,
+        cos_theta: f64,
+        cos_i: f64,
+        cos_r: f64,
+        cos_beta: f64,
+    ) -> f64 {
+        match self {
+            Shadowing::None => 1.0,
+            Shadowing::TorranceSparrow => {
+                let scale = 2.0 * cos_theta / cos_beta;
+                1.0f64.min(scale * cos_i).min(scale * cos_r)
+            }
+            Shadowing::Smith => {
+                1.0 / ((1.0 + distribution.smith_lambda(cos_i))
+                    * (1.0 + distribution.smith_lambda(cos_r)))
+            }
+        }
+    }
+}
