@@ -66,6 +66,47 @@ impl Environment {
     pub fn ground_radiance(&self) -> f64 {
         self.ground
     }
+
+    /// The radiance as a branch-free piecewise-linear function of u ∈ [−1, 1] on `cells` equal
+    /// cells (even, so the horizon u = 0 is a cell boundary and the sky/ground jump is exact).
+    pub fn sine_table(&self, cells: usize) -> SineTable {
+        let cells = cells.max(2) & !1;
+        let h = 2.0 / cells as f64;
+        let pieces = (0..cells)
+            .map(|i| {
+                let u0 = -1.0 + i as f64 * h;
+                if u0 < -0.5 * h {
+                    [self.ground, 0.0]
+                } else {
+                    let (a, b) = (self.radiance_at_sine(u0), self.radiance_at_sine(u0 + h));
+                    // Value at u0 and slope per unit u within the cell.
+                    [a, (b - a) / h]
+                }
+            })
+            .collect();
+        SineTable {
+            inv_h: 1.0 / h,
+            h,
+            pieces,
+        }
+    }
+}
+
+/// [`Environment::sine_table`]: per cell, the radiance at its left end and its slope.
+pub struct SineTable {
+    inv_h: f64,
+    h: f64,
+    pieces: Vec<[f64; 2]>,
+}
+
+impl SineTable {
+    #[inline]
+    pub fn radiance(&self, u: f64) -> f64 {
+        let x = (u + 1.0) * self.inv_h;
+        let i = (x.max(0.0) as usize).min(self.pieces.len() - 1);
+        let [a, slope] = self.pieces[i];
+        a + slope * (u + 1.0 - i as f64 * self.h)
+    }
 }
 
 /// Sky radiance as a function of u = sin(elevation).
@@ -215,6 +256,27 @@ mod tests {
         assert!((env.radiance_at_sine(u) - 0.9375 * air).abs() < 1e-6 * air);
         assert!((env.radiance_at_sine(1e-6) - air).abs() < 1e-9 * air);
         assert!((env.radiance_at_sine(-0.2) - band.radiance(288.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sine_table_keeps_the_horizon_jump() {
+        let band = Band::lwir();
+        let env = Environment::new(
+            &config(
+                SkyConfig::Window {
+                    zenith_emissivity: 0.75,
+                },
+                300.0,
+                1.0,
+            ),
+            &band,
+        )
+        .unwrap();
+        let table = env.sine_table(2048);
+        for u in [-1.0, -0.3, -1e-9, 0.0, 1e-9, 0.01, 0.2, 0.7, 1.0] {
+            let exact = env.radiance_at_sine(u);
+            assert!((table.radiance(u) - exact).abs() < 1e-6 * exact, "{u}");
+        }
     }
 
     #[test]
