@@ -4,6 +4,7 @@
 //! Data flows one way: CSV → [`measure::MeasurementSet`] → [`fit`] → [`material::Material`] →
 //! [`scene`] → [`render`]. The physics lives in [`optics`] and [`pbrdf`]; everything else calls it.
 
+pub mod commands;
 pub mod fit;
 pub mod material;
 pub mod measure;

@@ -1,1 +1,226 @@
-fn main() {}
+//! The `irpol` command line: parse, call the library, print. Errors are one clear line and a
+//! non-zero exit, never a panic.
+
+use clap::{Args, Parser, Subcommand};
+use irpol::commands::evaluate::{
+    read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
+};
+use irpol::commands::{parse_sweep, ModelArgs};
+use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "irpol",
+    version,
+    about = "Infrared polarimetry: fit polarimetric BRDFs and simulate LWIR Stokes imagery"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Mueller BRDF (m00…m33, sr⁻¹, psps frames) of a model at given geometries, as CSV on stdout.
+    Eval {
+        #[command(flatten)]
+        model: ModelFlags,
+        /// CSV with theta_i_deg, theta_r_deg [, phi_i_deg (0), phi_r_deg (180), other columns kept].
+        #[arg(long, conflicts_with_all = ["theta_i", "theta_r"])]
+        geometry: Option<PathBuf>,
+        /// Incidence zenith (°), a value or START:STOP:STEP.
+        #[arg(long)]
+        theta_i: Option<String>,
+        /// Detector zenith (°), a value or START:STOP:STEP.
+        #[arg(long)]
+        theta_r: Option<String>,
+        /// Incidence azimuth (°).
+        #[arg(long, default_value_t = 0.0)]
+        phi_i: f64,
+        /// Detector azimuth (°); 180 is the specular plane.
+        #[arg(long, default_value_t = 180.0)]
+        phi_r: f64,
+    },
+    /// Polarized emissivity ε0…ε3 against emission angle, as CSV on stdout.
+    Emissivity {
+        #[command(flatten)]
+        model: ModelFlags,
+        /// Emission zenith (°), a value or START:STOP:STEP.
+        #[arg(long, default_value = "0:89:1")]
+        theta: String,
+    },
+    /// The paper's figures (Ma et al. 2009 Figs. 2 and 3) as PNG and SVG.
+    Figure {
+        #[arg(value_parser = ["paper-fig2", "paper-fig3"])]
+        which: String,
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
+    /// A table of the materials in a library folder.
+    Library {
+        #[arg(long, default_value = "fits")]
+        dir: PathBuf,
+    },
+    /// Runs the main job on shipped defaults and prints where everything went.
+    Demo,
+}
+
+#[derive(Args)]
+struct ModelFlags {
+    /// A material TOML from the library (instead of the parameters below).
+    #[arg(long)]
+    material: Option<PathBuf>,
+    /// Slope distribution: cauchy or gaussian.
+    #[arg(long)]
+    distribution: Option<String>,
+    /// Slope parameter σ (rms slope per axis for the Gaussian; a = 2σ² for the Cauchy).
+    #[arg(long, allow_negative_numbers = true)]
+    sigma: Option<f64>,
+    /// Cauchy exponent q (> 1).
+    #[arg(long, allow_negative_numbers = true)]
+    q: Option<f64>,
+    /// Real part of the refractive index.
+    #[arg(long, allow_negative_numbers = true)]
+    n: Option<f64>,
+    /// Extinction coefficient (≥ 0).
+    #[arg(long, allow_negative_numbers = true)]
+    k: Option<f64>,
+    /// Diffuse (unpolarized) reflectance ρ_d.
+    #[arg(long, allow_negative_numbers = true)]
+    rho: Option<f64>,
+    /// Shadowing: none, torrance-sparrow or smith.
+    #[arg(long)]
+    shadowing: Option<String>,
+}
+
+impl ModelFlags {
+    fn model_args(&self) -> ModelArgs {
+        ModelArgs {
+            material: self.material.clone(),
+            distribution: self.distribution.clone(),
+            sigma: self.sigma,
+            q: self.q,
+            n: self.n,
+            k: self.k,
+            rho: self.rho,
+            shadowing: self.shadowing.clone(),
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("irpol: error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(command: Command) -> anyhow::Result<()> {
+    match command {
+        Command::Eval {
+            model,
+            geometry,
+            theta_i,
+            theta_r,
+            phi_i,
+            phi_r,
+        } => {
+            let model = model.model_args().build()?;
+            let table = match (geometry, theta_i, theta_r) {
+                (Some(path), _, _) => read_geometry_csv(&path)?,
+                (None, Some(ti), Some(tr)) => sweep_table(
+                    &parse_sweep(&ti, "theta-i")?,
+                    phi_i,
+                    &parse_sweep(&tr, "theta-r")?,
+                    phi_r,
+                )?,
+                _ => anyhow::bail!("give --geometry FILE.csv, or --theta-i and --theta-r"),
+            };
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            write_mueller_csv(&model, &table, &mut out)?;
+            out.flush()?;
+        }
+        Command::Emissivity { model, theta } => {
+            let model = model.model_args().build()?;
+            let thetas = parse_sweep(&theta, "theta")?;
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            let excess = write_emissivity_csv(&model, &thetas, &mut out)?;
+            out.flush()?;
+            if !excess.is_empty() {
+                eprintln!(
+                    "irpol: warning: hemispherical reflectance exceeds 1 (ε0 < 0) at θ = {:?}°: this model \
+                     does not conserve energy there; values are reported unclamped (use --shadowing smith)",
+                    excess
+                );
+            }
+        }
+        Command::Figure { which, out } => {
+            let figure = if which == "paper-fig2" {
+                PaperFigure::Fig2
+            } else {
+                PaperFigure::Fig3
+            };
+            for path in write_paper_figure(figure, &out)? {
+                println!("wrote {}", path.display());
+            }
+        }
+        Command::Library { dir } => print_library(&dir)?,
+        Command::Demo => demo()?,
+    }
+    Ok(())
+}
+
+fn print_library(dir: &Path) -> anyhow::Result<()> {
+    let materials = irpol::material::list_library(dir)?;
+    if materials.is_empty() {
+        println!("no materials in {}", dir.display());
+        return Ok(());
+    }
+    println!(
+        "{:<18} {:<9} {:<17} {:>7} {:>6} {:>6} {:>6} {:>6} {:>7} {:>8}",
+        "material", "dist", "shadowing", "λ µm", "σ", "q", "n", "k", "ρ_d", "χ²_red"
+    );
+    for (_, m) in materials {
+        let s = &m.model;
+        let q = match s.distribution {
+            irpol::pbrdf::SlopeDistribution::Cauchy { q, .. } => format!("{q:.3}"),
+            irpol::pbrdf::SlopeDistribution::Gaussian { .. } => "—".into(),
+        };
+        let chi2 = m
+            .fit
+            .as_ref()
+            .map_or("—".into(), |f| format!("{:.3}", f.reduced_chi2));
+        println!(
+            "{:<18} {:<9} {:<17} {:>7.3} {:>6.3} {:>6} {:>6.3} {:>6.3} {:>7.4} {:>8}",
+            m.name,
+            s.distribution.name(),
+            s.shadowing.name(),
+            s.wavelength_um,
+            s.distribution.sigma(),
+            q,
+            s.n,
+            s.k,
+            s.rho_d,
+            chi2
+        );
+    }
+    Ok(())
+}
+
+fn demo() -> anyhow::Result<()> {
+    let reports = PathBuf::from("reports");
+    println!("irpol demo: the paper's model figures (fitting and rendering steps are added as they land)");
+    for figure in [PaperFigure::Fig2, PaperFigure::Fig3] {
+        for path in write_paper_figure(figure, &reports)? {
+            println!("  wrote {}", path.display());
+        }
+    }
+    Ok(())
+}

@@ -331,6 +331,30 @@ fn smith_conserves_energy_and_excess_reflectance_is_reported() {
             }
         }
     }
+    // ρ_d lowers ε0 by exactly ρ_d (DESIGN §1.4), and ρ(θ) = 1 − ε0(θ).
+    let smooth = model(
+        SlopeDistribution::Gaussian { sigma: 0.1 },
+        Shadowing::Smith,
+        1.5,
+        0.1,
+        0.0,
+    );
+    let diffuse = model(
+        SlopeDistribution::Gaussian { sigma: 0.1 },
+        Shadowing::Smith,
+        1.5,
+        0.1,
+        0.04,
+    );
+    for theta in [0.0f64, 50.0, 85.0] {
+        let (a, b) = (
+            smooth.emissivity(theta.to_radians(), &quad),
+            diffuse.emissivity(theta.to_radians(), &quad),
+        );
+        assert!((a[0] - b[0] - 0.04).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-15);
+        let rho = diffuse.directional_hemispherical_reflectance(theta.to_radians(), &quad);
+        assert!((rho - (1.0 - b[0])).abs() < 1e-15);
+    }
     let bare = model(
         SlopeDistribution::Cauchy { sigma: 0.5, q: 1.6 },
         Shadowing::None,

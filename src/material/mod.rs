@@ -84,6 +84,12 @@ pub struct FitRecord {
     pub undetermined: Vec<String>,
     /// The competing slope distribution's best fit, for model comparison.
     pub alternative: Option<AlternativeFit>,
+    /// Best cost after each global-stage generation, then after each local-stage iteration (for the
+    /// report's convergence plot); the first `global_iterations` entries are the global stage.
+    #[serde(default)]
+    pub convergence: Vec<f64>,
+    #[serde(default)]
+    pub global_iterations: usize,
 }
 
 /// The other distribution's best fit on the same data (model comparison by AIC/BIC).

@@ -1,1 +1,85 @@
-//! (module measure)
+//! Measurement ingestion (DESIGN §2.1): SOC-style Mueller-matrix BRDF CSV files into a validated
+//! [`MeasurementSet`], the input of the fit. Anything ambiguous is refused with a
+//! `file:line:column: what is wrong` [`MeasureError`]; nothing here writes.
+//!
+//! A file holds one material at one wavelength (a fit is per wavelength):
+//! ```text
+//! # material: gloss_paint
+//! # wavelength_um: 9.925
+//! # mueller_convention: psps
+//! theta_i_deg,phi_i_deg,theta_r_deg,phi_r_deg,m00,m01,u_m00
+//! 60,0,55,180,1.92e-01,-3.1e-02,2e-03
+//! ```
+//! Required columns: theta_i_deg, theta_r_deg, m00. Optional: phi_i_deg (default 0°),
+//! phi_r_deg (default 180°), wavelength_um (else the `# wavelength_um:` header; both must agree),
+//! any of m01…m33, and absolute 1-σ uncertainties u_m00…u_m33 for any subset of the elements
+//! present. Mueller elements are BRDF values in sr⁻¹ in SCATMECH's psps convention (DESIGN §1.3),
+//! not normalized by m00.
+
+mod columns;
+mod csv_reader;
+mod error;
+mod fields;
+mod files;
+mod metadata;
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+pub use csv_reader::{parse_measurement_csv, read_measurement_csv};
+pub use error::{Delimiter, MeasureError, MeasureErrorKind};
+pub use files::collect_measurement_files;
+
+/// Column names of the 16 Mueller elements; element (r, c) has index r*4 + c (row-major).
+pub const MUELLER_ELEMENT_NAMES: [&str; 16] = [
+    "m00", "m01", "m02", "m03", "m10", "m11", "m12", "m13", "m20", "m21", "m22", "m23", "m30",
+    "m31", "m32", "m33",
+];
+
+/// Row-major index r*4 + c of a Mueller element name such as `"m12"` (→ 6).
+pub fn mueller_index(name: &str) -> Option<usize> {
+    MUELLER_ELEMENT_NAMES.iter().position(|&m| m == name)
+}
+
+/// One measured geometry: the Mueller elements of [`MeasurementSet::elements`] at (θ_i, φ_i) →
+/// (θ_r, φ_r), directions pointing away from the surface (DESIGN §1.1).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasurementPoint {
+    /// Incidence zenith angle, degrees, in [0, 90).
+    pub theta_i_deg: f64,
+    /// Incidence azimuth, degrees (0 when the file has no phi_i_deg column).
+    pub phi_i_deg: f64,
+    /// Receiver zenith angle, degrees, in [0, 90).
+    pub theta_r_deg: f64,
+    /// Receiver azimuth, degrees (180, the specular side, when the file has no phi_r_deg column).
+    pub phi_r_deg: f64,
+    /// Mueller-matrix BRDF elements, sr⁻¹, aligned with [`MeasurementSet::elements`]; values[0]
+    /// is m00 ≥ 0.
+    pub values: Vec<f64>,
+    /// Absolute 1-σ uncertainties, sr⁻¹ (> 0), aligned with [`MeasurementSet::elements`]:
+    /// `Some` for each element that has a `u_` column, `None` for the others. Which elements
+    /// have one is the same for every point of a set, because it is decided by the header row.
+    pub uncertainties: Vec<Option<f64>>,
+    /// 1-based line of the row in the file, for messages.
+    pub line: u64,
+}
+
+/// A validated measurement file: one material at one wavelength.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasurementSet {
+    /// The path as given by the caller.
+    pub source: PathBuf,
+    /// Lower-case hex SHA-256 of the file's bytes (fit provenance, DESIGN §2.2).
+    pub sha256: String,
+    /// The `# material:` header, else the file stem.
+    pub material: String,
+    /// Wavelength, µm: the `# wavelength_um:` header, else the wavelength_um column (one value
+    /// per file).
+    pub wavelength_um: f64,
+    /// All `# key: value` header lines, material / wavelength_um / mueller_convention included.
+    pub metadata: BTreeMap<String, String>,
+    /// Mueller indices (r*4 + c) present in the file, ascending, so m00 (0) is always first.
+    pub elements: Vec<usize>,
+    /// The data rows in file order; never empty.
+    pub points: Vec<MeasurementPoint>,
+}

@@ -23,21 +23,75 @@ impl RefractiveIndex {
     }
 }
 
-/// Amplitude reflection coefficients (r_s, r_p) at local incidence angle β, given cos β and the
-/// substrate permittivity ε (DESIGN §1.3):
-/// r_s = (cosβ − √(ε − sin²β)) / (cosβ + √(ε − sin²β)),
-/// r_p = (ε cosβ − √(ε − sin²β)) / (ε cosβ + √(ε − sin²β)).
+/// The numerators and denominators of the Fresnel amplitude coefficients at local incidence angle
+/// β, for permittivity ε (DESIGN §1.3), with w = √(ε − sin²β):
+/// r_s = (cosβ − w)/(cosβ + w), r_p = (ε cosβ − w)/(ε cosβ + w).
 ///
 /// With k ≥ 0, Im(ε − sin²β) = 2nk ≥ 0, so the principal square root has Re ≥ 0 and Im ≥ 0: the
 /// transmitted wave decays into the substrate, which is the physical branch for metals too.
+/// Kept as fractions so that the Mueller coefficients need no complex division.
+#[derive(Clone, Copy, Debug)]
+pub struct FresnelFractions {
+    pub s_num: Complex64,
+    pub s_den: Complex64,
+    pub p_num: Complex64,
+    pub p_den: Complex64,
+}
+
+impl FresnelFractions {
+    #[inline]
+    pub fn new(cos_beta: f64, permittivity: Complex64) -> Self {
+        let sin2 = 1.0 - cos_beta * cos_beta;
+        let w = principal_sqrt(permittivity - sin2);
+        let eps_cos = permittivity * cos_beta;
+        FresnelFractions {
+            s_num: cos_beta - w,
+            s_den: cos_beta + w,
+            p_num: eps_cos - w,
+            p_den: eps_cos + w,
+        }
+    }
+
+    /// (r_s, r_p).
+    pub fn amplitudes(&self) -> (Complex64, Complex64) {
+        (self.s_num / self.s_den, self.p_num / self.p_den)
+    }
+
+    /// (|r_s|², |r_p|², r_s* r_p): what the Mueller matrix of the reflection needs.
+    #[inline]
+    pub fn reflectances_and_cross(&self) -> (f64, f64, Complex64) {
+        let (s_den2, p_den2) = (self.s_den.norm_sqr(), self.p_den.norm_sqr());
+        let rs2 = self.s_num.norm_sqr() / s_den2;
+        let rp2 = self.p_num.norm_sqr() / p_den2;
+        // r_s* r_p = (s_num* p_num)(s_den p_den*) / (|s_den|² |p_den|²)
+        let cross =
+            self.s_num.conj() * self.p_num * (self.s_den * self.p_den.conj()) / (s_den2 * p_den2);
+        (rs2, rp2, cross)
+    }
+}
+
+/// Principal square root (Re ≥ 0) in algebraic form. num-complex's `sqrt` goes through the polar
+/// form (atan2, hypot, sin, cos) and costs about four times as much; this is on the hot path of
+/// every BRDF evaluation.
 #[inline]
+fn principal_sqrt(z: Complex64) -> Complex64 {
+    // |z| without hypot's overflow guard: here |z| ≤ |ε| + 1, far from overflow, and hypot is slow.
+    let modulus = (z.re * z.re + z.im * z.im).sqrt();
+    if z.re >= 0.0 {
+        let t = (0.5 * (modulus + z.re)).sqrt();
+        if t == 0.0 {
+            return Complex64::new(0.0, 0.0);
+        }
+        Complex64::new(t, 0.5 * z.im / t)
+    } else {
+        let t = (0.5 * (modulus - z.re)).sqrt();
+        Complex64::new(0.5 * z.im.abs() / t, t.copysign(z.im))
+    }
+}
+
+/// Amplitude reflection coefficients (r_s, r_p) at local incidence cos β (see [`FresnelFractions`]).
 pub fn fresnel_amplitudes(cos_beta: f64, permittivity: Complex64) -> (Complex64, Complex64) {
-    let sin2 = 1.0 - cos_beta * cos_beta;
-    let root = (permittivity - sin2).sqrt();
-    let r_s = (cos_beta - root) / (cos_beta + root);
-    let eps_cos = permittivity * cos_beta;
-    let r_p = (eps_cos - root) / (eps_cos + root);
-    (r_s, r_p)
+    FresnelFractions::new(cos_beta, permittivity).amplitudes()
 }
 
 #[cfg(test)]
@@ -72,6 +126,37 @@ mod tests {
             (rs - 0.1479289940828402).abs() < 1e-12,
             "R_s at Brewster = {rs}"
         );
+    }
+
+    #[test]
+    fn reflectances_and_cross_term_match_the_amplitudes() {
+        let eps = RefractiveIndex::new(10.0, 30.0).permittivity();
+        for deg in [0.0f64, 33.0, 71.0, 89.0] {
+            let fractions = FresnelFractions::new(deg.to_radians().cos(), eps);
+            let (rs, rp) = fractions.amplitudes();
+            let (rs2, rp2, cross) = fractions.reflectances_and_cross();
+            assert!((rs2 - rs.norm_sqr()).abs() < 1e-15 && (rp2 - rp.norm_sqr()).abs() < 1e-15);
+            assert!((cross - rs.conj() * rp).norm() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn principal_sqrt_matches_num_complex() {
+        for &(re, im) in &[
+            (2.0, 0.5),
+            (-3.0, 0.2),
+            (-3.0, -0.2),
+            (0.0, 1.0),
+            (4.0, 0.0),
+            (-4.0, 0.0),
+            (3600.0, 1200.0), // a metal's ε − sin²β; |z| stays far from under/overflow
+        ] {
+            let z = Complex64::new(re, im);
+            assert!(
+                (principal_sqrt(z) - z.sqrt()).norm() <= 1e-15 * z.norm().sqrt(),
+                "{z}"
+            );
+        }
     }
 
     #[test]

@@ -18,7 +18,7 @@
 
 use super::geometry::Direction;
 use super::{ModelError, Pbrdf};
-use crate::optics::{fresnel_amplitudes, Stokes};
+use crate::optics::{FresnelFractions, Stokes};
 use gauss_quad::legendre::GaussLegendre;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -176,8 +176,9 @@ impl Pbrdf {
             let g = self
                 .shadowing()
                 .factor(distribution, 1.0 / sec_h, cos_i, cos_r, cos_beta);
-            let (r_s, r_p) = fresnel_amplitudes(cos_beta, permittivity);
-            let (rs2, rp2) = (r_s.norm_sqr(), r_p.norm_sqr());
+            let fresnel = FresnelFractions::new(cos_beta, permittivity);
+            let rs2 = fresnel.s_num.norm_sqr() / fresnel.s_den.norm_sqr();
+            let rp2 = fresnel.p_num.norm_sqr() / fresnel.p_den.norm_sqr();
             // Facet s axis ω_i × h against the psps frame of ω_r (η_r of DESIGN §1.3).
             let facet_s = w_i.cross(&h);
             let (c, s) = (facet_s.dot(&s_axis), facet_s.dot(&p_axis));
@@ -281,5 +282,15 @@ impl Pbrdf {
             });
         }
         Ok(e)
+    }
+
+    /// Directional-hemispherical reflectance ρ(θ) = ∫ F_00(ω_i→ω) cosθ_i dΩ_i = 1 − ε0(θ)
+    /// (reciprocity makes incidence and emission directions interchangeable).
+    pub fn directional_hemispherical_reflectance(
+        &self,
+        theta: f64,
+        quadrature: &HemisphereQuadrature,
+    ) -> f64 {
+        self.reflected_stokes(&Direction::from_angles(theta, 0.0), |_| 1.0, quadrature)[0]
     }
 }

@@ -5,7 +5,7 @@
 use super::distribution::PreparedDistribution;
 use super::geometry::{frame_rotation, Direction};
 use super::{ModelError, Shadowing, SlopeDistribution};
-use crate::optics::{fresnel_amplitudes, Mueller, RefractiveIndex, Stokes};
+use crate::optics::{FresnelFractions, Mueller, RefractiveIndex, Stokes};
 use nalgebra::Vector3;
 use num_complex::Complex64;
 use std::f64::consts::FRAC_1_PI;
@@ -23,11 +23,13 @@ pub struct Pbrdf {
 }
 
 /// What one facet reflection contributes: the specular scale P G/(4 cosθ cosθ_i cosθ_r) and the
-/// Fresnel coefficients at the local incidence angle.
+/// Fresnel terms at the local incidence angle.
 struct FacetReflection {
     scale: f64,
-    r_s: Complex64,
-    r_p: Complex64,
+    /// |r_s|², |r_p|² and r_s* r_p.
+    rs2: f64,
+    rp2: f64,
+    cross: Complex64,
     /// unit(ω_i × h) up to length: the facet s axis (h × k_in), ⊥ to both propagation directions.
     facet_s: Vector3<f64>,
 }
@@ -80,13 +82,24 @@ impl Pbrdf {
         &self.prepared
     }
 
+    /// The factor of the shadowing G that depends on one direction only, for a direction with
+    /// cos θ = `cos_theta`: Smith's G1(θ) = 1/(1+Λ(θ)) (DESIGN §1.3); 1 for `none` and
+    /// `torrance-sparrow`. The Cauchy Λ needs an incomplete beta function (~0.2 µs), so a caller
+    /// that evaluates many direction pairs sharing few zenith angles (a fit) computes it once per
+    /// angle and passes it to [`Pbrdf::mueller_with_masking`].
+    pub fn masking(&self, cos_theta: f64) -> f64 {
+        self.shadowing.masking(&self.prepared, cos_theta)
+    }
+
     /// Geometry, distribution, shadowing and Fresnel part shared by the full and fast paths;
-    /// `None` when either direction is at or below the horizon.
+    /// `None` when either direction is at or below the horizon. `masking` holds the
+    /// [`Pbrdf::masking`] factors of ω_i and ω_r, or `None` to compute them here.
     #[inline]
     fn facet_reflection(
         &self,
         incident: &Direction,
         scattered: &Direction,
+        masking: Option<[f64; 2]>,
     ) -> Option<FacetReflection> {
         let (w_i, w_r) = (&incident.vector, &scattered.vector);
         let (cos_i, cos_r) = (w_i.z, w_r.z);
@@ -100,15 +113,22 @@ impl Pbrdf {
         let cos_beta = 0.5 * sum_norm;
         let cos_theta = sum.z / sum_norm;
         let pdf = self.prepared.facet_pdf(cos_theta);
-        let g = self
-            .shadowing
-            .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta);
+        let g = match masking {
+            Some(masking) => self
+                .shadowing
+                .factor_with_masking(cos_theta, cos_i, cos_r, cos_beta, masking),
+            None => self
+                .shadowing
+                .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta),
+        };
         let scale = pdf * g / (4.0 * cos_theta * cos_i * cos_r);
-        let (r_s, r_p) = fresnel_amplitudes(cos_beta, self.permittivity);
+        let (rs2, rp2, cross) =
+            FresnelFractions::new(cos_beta, self.permittivity).reflectances_and_cross();
         Some(FacetReflection {
             scale,
-            r_s,
-            r_p,
+            rs2,
+            rp2,
+            cross,
             facet_s: w_i.cross(&sum),
         })
     }
@@ -127,7 +147,29 @@ impl Pbrdf {
     /// The full 4×4 Mueller BRDF (sr⁻¹) from `incident` (ω_i, toward the source) to `scattered`
     /// (ω_r, toward the viewer), in the psps frames of both (DESIGN §1.3). Zero below the horizon.
     pub fn mueller(&self, incident: &Direction, scattered: &Direction) -> Mueller {
-        let Some(facet) = self.facet_reflection(incident, scattered) else {
+        self.mueller_from(incident, scattered, None)
+    }
+
+    /// [`Pbrdf::mueller`] with the per-direction shadowing factors supplied by the caller:
+    /// `masking_i` = `self.masking(cos θ_i)`, `masking_r` = `self.masking(cos θ_r)`.
+    pub fn mueller_with_masking(
+        &self,
+        incident: &Direction,
+        scattered: &Direction,
+        masking_i: f64,
+        masking_r: f64,
+    ) -> Mueller {
+        self.mueller_from(incident, scattered, Some([masking_i, masking_r]))
+    }
+
+    #[inline]
+    fn mueller_from(
+        &self,
+        incident: &Direction,
+        scattered: &Direction,
+        masking: Option<[f64; 2]>,
+    ) -> Mueller {
+        let Some(facet) = self.facet_reflection(incident, scattered, masking) else {
             return Mueller::zeros();
         };
         // Incident frame: k_in = −ω_i, s = −ê_φ(ω_i); the facet s axis h × k_in = ω_i × h.
@@ -138,10 +180,8 @@ impl Pbrdf {
             frame_rotation(&facet.facet_s, &(-incident.azimuthal_axis), &k_in)
         };
         let (cr, sr) = Self::scattered_rotation(&facet.facet_s, scattered);
-        let (rs2, rp2) = (facet.r_s.norm_sqr(), facet.r_p.norm_sqr());
-        let (a, b) = (0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2));
-        let cross = facet.r_s.conj() * facet.r_p;
-        let (c, s) = (cross.re, cross.im);
+        let (a, b) = (0.5 * (facet.rs2 + facet.rp2), 0.5 * (facet.rs2 - facet.rp2));
+        let (c, s) = (facet.cross.re, facet.cross.im);
         // L(−η_r) F_fres L(η_i) multiplied out (DESIGN §1.3).
         let mut m = Mueller::new(
             a,
@@ -169,13 +209,12 @@ impl Pbrdf {
     /// thermal scenes need. Skips the incident-frame rotation: (A, cos2η_r B, sin2η_r B, 0).
     #[inline]
     pub fn first_column(&self, incident: &Direction, scattered: &Direction) -> Stokes {
-        let Some(facet) = self.facet_reflection(incident, scattered) else {
+        let Some(facet) = self.facet_reflection(incident, scattered, None) else {
             return Stokes::zeros();
         };
         let (cr, sr) = Self::scattered_rotation(&facet.facet_s, scattered);
-        let (rs2, rp2) = (facet.r_s.norm_sqr(), facet.r_p.norm_sqr());
-        let a = 0.5 * (rs2 + rp2) * facet.scale;
-        let b = 0.5 * (rs2 - rp2) * facet.scale;
+        let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
+        let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
         Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
     }
 }

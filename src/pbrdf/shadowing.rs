@@ -43,16 +43,41 @@ impl Shadowing {
         cos_r: f64,
         cos_beta: f64,
     ) -> f64 {
+        let masking = [
+            self.masking(distribution, cos_i),
+            self.masking(distribution, cos_r),
+        ];
+        self.factor_with_masking(cos_theta, cos_i, cos_r, cos_beta, masking)
+    }
+
+    /// The part of G that depends on one direction only: Smith's G1(θ) = 1/(1+Λ(θ)); 1 for the
+    /// other kinds, whose G couples both directions through the facet.
+    #[inline]
+    pub(crate) fn masking(&self, distribution: &PreparedDistribution, cos_theta: f64) -> f64 {
+        match self {
+            Shadowing::Smith => 1.0 / (1.0 + distribution.smith_lambda(cos_theta)),
+            Shadowing::None | Shadowing::TorranceSparrow => 1.0,
+        }
+    }
+
+    /// G given the per-direction factors [`Shadowing::masking`] of ω_i and ω_r (precomputed by a
+    /// caller that evaluates many direction pairs sharing zenith angles).
+    #[inline]
+    pub(crate) fn factor_with_masking(
+        &self,
+        cos_theta: f64,
+        cos_i: f64,
+        cos_r: f64,
+        cos_beta: f64,
+        [masking_i, masking_r]: [f64; 2],
+    ) -> f64 {
         match self {
             Shadowing::None => 1.0,
             Shadowing::TorranceSparrow => {
                 let scale = 2.0 * cos_theta / cos_beta;
                 1.0f64.min(scale * cos_i).min(scale * cos_r)
             }
-            Shadowing::Smith => {
-                1.0 / ((1.0 + distribution.smith_lambda(cos_i))
-                    * (1.0 + distribution.smith_lambda(cos_r)))
-            }
+            Shadowing::Smith => masking_i * masking_r,
         }
     }
 }

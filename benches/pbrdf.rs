@@ -1,0 +1,63 @@
+//! Speed of the physics core: one full 4×4 Mueller evaluation, the first-column fast path, and an
+//! emissivity table 0°–89° in 1° steps at the default (1e-5) accuracy.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use irpol::optics::RefractiveIndex;
+use irpol::pbrdf::{Direction, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
+
+fn paper_paint(shadowing: Shadowing) -> Pbrdf {
+    Pbrdf::new(
+        SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
+        shadowing,
+        RefractiveIndex::new(1.2, 0.2),
+        0.0,
+    )
+    .unwrap()
+}
+
+fn mueller(c: &mut Criterion) {
+    let (incident, scattered) = (
+        Direction::from_angles(1.0, 0.0),
+        Direction::from_angles(0.9, 2.8),
+    );
+    for shadowing in [
+        Shadowing::None,
+        Shadowing::TorranceSparrow,
+        Shadowing::Smith,
+    ] {
+        let model = paper_paint(shadowing);
+        c.bench_function(&format!("mueller_4x4_cauchy_{}", shadowing.name()), |b| {
+            b.iter(|| model.mueller(black_box(&incident), black_box(&scattered)))
+        });
+        c.bench_function(&format!("first_column_cauchy_{}", shadowing.name()), |b| {
+            b.iter(|| model.first_column(black_box(&incident), black_box(&scattered)))
+        });
+    }
+    let gaussian = Pbrdf::new(
+        SlopeDistribution::Gaussian { sigma: 0.1 },
+        Shadowing::None,
+        RefractiveIndex::new(1.2, 0.2),
+        0.0,
+    )
+    .unwrap();
+    c.bench_function("mueller_4x4_gaussian_none", |b| {
+        b.iter(|| gaussian.mueller(black_box(&incident), black_box(&scattered)))
+    });
+}
+
+fn emissivity(c: &mut Criterion) {
+    let thetas: Vec<f64> = (0..90).map(|t| (t as f64).to_radians()).collect();
+    let quadrature = HemisphereQuadrature::default();
+    let mut group = c.benchmark_group("emissivity_table_0_89");
+    group.sample_size(20);
+    for shadowing in [Shadowing::None, Shadowing::Smith] {
+        let model = paper_paint(shadowing);
+        group.bench_function(shadowing.name(), |b| {
+            b.iter(|| model.emissivity_table(black_box(&thetas), &quadrature))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, mueller, emissivity);
+criterion_main!(benches);

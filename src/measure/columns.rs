@@ -1,0 +1,257 @@
+//! The header row of a measurement CSV: which quantity each column holds (DESIGN §2.1).
+//! Required: theta_i_deg, theta_r_deg, m00. Optional: phi_i_deg, phi_r_deg, wavelength_um, any of
+//! m01…m33 and their uncertainties u_m00…u_m33. Names are case-sensitive.
+
+use super::error::{shown, Delimiter, MeasureErrorKind, Refusal};
+use super::fields::Field;
+use super::MUELLER_ELEMENT_NAMES;
+
+const THETA_I: &str = "theta_i_deg";
+const PHI_I: &str = "phi_i_deg";
+const THETA_R: &str = "theta_r_deg";
+const PHI_R: &str = "phi_r_deg";
+const WAVELENGTH: &str = "wavelength_um";
+const UNCERTAINTY_PREFIX: &str = "u_";
+
+/// What one column of the file holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Quantity {
+    ThetaI,
+    PhiI,
+    ThetaR,
+    PhiR,
+    Wavelength,
+    /// Mueller element, row-major index r*4+c.
+    Element(usize),
+    /// Absolute 1-σ uncertainty of a Mueller element, sr⁻¹.
+    Uncertainty(usize),
+}
+
+impl Quantity {
+    fn from_name(name: &str) -> Option<Self> {
+        match name {
+            THETA_I => Some(Self::ThetaI),
+            PHI_I => Some(Self::PhiI),
+            THETA_R => Some(Self::ThetaR),
+            PHI_R => Some(Self::PhiR),
+            WAVELENGTH => Some(Self::Wavelength),
+            _ => match name.strip_prefix(UNCERTAINTY_PREFIX) {
+                Some(element) => super::mueller_index(element).map(Self::Uncertainty),
+                None => super::mueller_index(name).map(Self::Element),
+            },
+        }
+    }
+}
+
+/// The columns of a file, in file order, and the Mueller elements they hold.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Layout {
+    pub quantities: Vec<Quantity>,
+    /// Column names as written, for messages.
+    pub names: Vec<String>,
+    /// Mueller indices present, ascending (so m00 is first).
+    pub elements: Vec<usize>,
+}
+
+impl Layout {
+    pub(crate) fn has(&self, quantity: Quantity) -> bool {
+        self.quantities.contains(&quantity)
+    }
+
+    /// Position of Mueller element `index` within [`Layout::elements`].
+    pub(crate) fn slot(&self, index: usize) -> Option<usize> {
+        self.elements.iter().position(|&e| e == index)
+    }
+}
+
+/// Reads the header row (1-based line `line`) from its fields.
+pub(crate) fn parse_header_row(line: u64, fields: &[Field<'_>]) -> Result<Layout, Refusal> {
+    let mut quantities = Vec::with_capacity(fields.len());
+    let mut names = Vec::with_capacity(fields.len());
+    for field in fields {
+        let name = field.text.as_ref();
+        if !field.quoted {
+            if let Some(refusal) = wrong_delimiter(line, field) {
+                return Err(refusal);
+            }
+        }
+        if name.is_empty() {
+            return Err(Refusal::new(
+                line,
+                field.column,
+                MeasureErrorKind::EmptyColumnName,
+            ));
+        }
+        let Some(quantity) = Quantity::from_name(name) else {
+            return Err(Refusal::new(
+                line,
+                field.column,
+                MeasureErrorKind::UnknownColumn {
+                    name: shown(name),
+                    hint: unknown_column_hint(name),
+                },
+            ));
+        };
+        if let Some(first) = quantities.iter().position(|&q| q == quantity) {
+            return Err(Refusal::new(
+                line,
+                field.column,
+                MeasureErrorKind::DuplicateColumn {
+                    name: name.to_string(),
+                    first_column: fields[first].column,
+                },
+            ));
+        }
+        quantities.push(quantity);
+        names.push(name.to_string());
+    }
+    for (quantity, name) in [
+        (Quantity::ThetaI, THETA_I),
+        (Quantity::ThetaR, THETA_R),
+        (Quantity::Element(0), MUELLER_ELEMENT_NAMES[0]),
+    ] {
+        if !quantities.contains(&quantity) {
+            return Err(Refusal::new(
+                line,
+                1,
+                MeasureErrorKind::MissingColumn {
+                    name: name.to_string(),
+                },
+            ));
+        }
+    }
+    for (field, quantity) in fields.iter().zip(&quantities) {
+        if let Quantity::Uncertainty(index) = *quantity {
+            if !quantities.contains(&Quantity::Element(index)) {
+                return Err(Refusal::new(
+                    line,
+                    field.column,
+                    MeasureErrorKind::UncertaintyWithoutElement {
+                        name: field.text.to_string(),
+                        element: MUELLER_ELEMENT_NAMES[index].to_string(),
+                    },
+                ));
+            }
+        }
+    }
+    let mut elements: Vec<usize> = quantities
+        .iter()
+        .filter_map(|q| match q {
+            Quantity::Element(index) => Some(*index),
+            _ => None,
+        })
+        .collect();
+    elements.sort_unstable();
+    Ok(Layout {
+        quantities,
+        names,
+        elements,
+    })
+}
+
+/// A refusal if an unquoted field holds a ';', tab or '|': the file is separated by that
+/// character (a European spreadsheet export, a TSV), not by ','.
+pub(crate) fn wrong_delimiter(line: u64, field: &Field<'_>) -> Option<Refusal> {
+    field
+        .text
+        .chars()
+        .enumerate()
+        .find_map(|(offset, c)| Delimiter::from_char(c).map(|found| (offset, found)))
+        .map(|(offset, found)| {
+            Refusal::new(
+                line,
+                field.column + offset as u64,
+                MeasureErrorKind::WrongDelimiter { found },
+            )
+        })
+}
+
+/// A hint that turns a near miss into a one-edit fix.
+fn unknown_column_hint(name: &str) -> String {
+    let geometry = [THETA_I, PHI_I, THETA_R, PHI_R, WAVELENGTH];
+    let all_names = geometry.into_iter().map(str::to_string).chain(
+        MUELLER_ELEMENT_NAMES
+            .iter()
+            .flat_map(|m| [m.to_string(), format!("{UNCERTAINTY_PREFIX}{m}")]),
+    );
+    for known in all_names {
+        if known.eq_ignore_ascii_case(name) {
+            return format!(" (column names are case-sensitive: did you mean '{known}'?)");
+        }
+    }
+    // A geometry name without its unit suffix or with another unit: theta_i, wavelength_nm.
+    let without_unit = |n: &str| n.rsplit_once('_').map_or(n.to_string(), |(s, _)| s.into());
+    for known in geometry {
+        if without_unit(known) == name || without_unit(known) == without_unit(name) {
+            return format!(" (did you mean '{known}'? angles are in degrees, wavelengths in µm)");
+        }
+    }
+    let element = name.strip_prefix(UNCERTAINTY_PREFIX).unwrap_or(name);
+    if element.starts_with('m') {
+        return " (Mueller elements are m00…m33: row then column, each 0–3)".to_string();
+    }
+    format!(
+        " (expected {THETA_I}, {PHI_I}, {THETA_R}, {PHI_R}, {WAVELENGTH}, m00…m33, u_m00…u_m33)"
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fields::split_fields;
+    use super::*;
+
+    fn layout(header: &str) -> Result<Layout, Refusal> {
+        parse_header_row(4, &split_fields(header).unwrap())
+    }
+
+    #[test]
+    fn columns_map_to_quantities_and_elements_are_sorted() {
+        let layout = layout("m11, theta_i_deg ,theta_r_deg,m00,u_m11,wavelength_um,m01").unwrap();
+        assert_eq!(layout.elements, vec![0, 1, 5]);
+        assert_eq!(layout.quantities[0], Quantity::Element(5));
+        assert_eq!(layout.quantities[4], Quantity::Uncertainty(5));
+        assert_eq!(layout.names[1], "theta_i_deg");
+        assert_eq!(layout.slot(5), Some(2));
+        assert!(layout.has(Quantity::Wavelength));
+        assert!(!layout.has(Quantity::PhiI));
+    }
+
+    #[test]
+    fn header_problems_point_at_the_column() {
+        let at = |header: &str| {
+            let refusal = layout(header).unwrap_err();
+            (refusal.line, refusal.column, refusal.kind.to_string())
+        };
+        assert_eq!(
+            at("theta_i_deg,theta_r_deg,M00"),
+            (
+                4,
+                25,
+                "unknown column 'M00' (column names are case-sensitive: did you mean 'm00'?)"
+                    .into()
+            )
+        );
+        assert_eq!(
+            at("theta_i,theta_r_deg,m00").2,
+            "unknown column 'theta_i' (did you mean 'theta_i_deg'? angles are in degrees, wavelengths in µm)"
+        );
+        assert!(at("theta_i_deg,theta_r_deg,m00,wavelength_nm")
+            .2
+            .contains("did you mean 'wavelength_um'?"));
+        assert!(at("theta_i_deg,theta_r_deg,m00,m40").2.contains("m00…m33"));
+        assert_eq!(at("theta_i_deg,theta_r_deg,m00,m00").1, 29);
+        assert_eq!(
+            at("theta_i_deg,m00").2,
+            "missing required column 'theta_r_deg'"
+        );
+        assert_eq!(
+            at("theta_i_deg,theta_r_deg,m00,u_m12").2,
+            "column 'u_m12' is the uncertainty of 'm12', but there is no 'm12' column"
+        );
+        assert_eq!(at("theta_i_deg;theta_r_deg;m00").1, 12);
+        assert_eq!(
+            at("theta_i_deg,,m00").2,
+            "empty column name (a doubled or trailing ',' in the header row)"
+        );
+    }
+}

@@ -1,0 +1,451 @@
+//! Reading a measurement CSV into a [`MeasurementSet`] (DESIGN §2.1), refusing anything that is
+//! not unambiguous with a `file:line:column` message. The reader never writes.
+//!
+//! Order of checks: UTF-8, then all `# key: value` metadata (wherever it stands), then the
+//! header row (the first line that is neither blank nor `#`), then the data rows top to bottom,
+//! fields left to right. The first problem found is reported.
+
+use std::path::Path;
+
+use sha2::{Digest, Sha256};
+
+use super::columns::{parse_header_row, wrong_delimiter, Layout, Quantity};
+use super::error::{shown, MeasureError, MeasureErrorKind, Refusal};
+use super::fields::{split_fields, Field};
+use super::metadata::{split_metadata_line, HeaderWavelength, Metadata};
+use super::{MeasurementPoint, MeasurementSet};
+
+/// Default azimuths when the columns are absent: the plane of incidence, with the receiver on
+/// the specular side (φ_r = φ_i + 180°, DESIGN §1.1).
+const DEFAULT_PHI_I_DEG: f64 = 0.0;
+const DEFAULT_PHI_R_DEG: f64 = 180.0;
+
+/// Two wavelengths are the same when they agree to 1 ppm: tighter than any monochromator, looser
+/// than the digits a file writer may drop between a header and a column.
+const WAVELENGTH_RELATIVE_TOLERANCE: f64 = 1e-6;
+
+/// Reads and validates one measurement CSV. `path` is quoted as given in every message.
+pub fn read_measurement_csv(path: &Path) -> Result<MeasurementSet, MeasureError> {
+    let whole_file = |kind| Refusal::new(1, 1, kind).in_file(path);
+    match std::fs::metadata(path) {
+        Ok(meta) if meta.is_dir() => return Err(whole_file(MeasureErrorKind::IsDirectory)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(whole_file(MeasureErrorKind::NotFound))
+        }
+        _ => {}
+    }
+    let bytes = std::fs::read(path).map_err(|e| {
+        whole_file(MeasureErrorKind::Unreadable {
+            reason: e.to_string(),
+        })
+    })?;
+    parse_measurement_csv(path, &bytes)
+}
+
+/// Parses the bytes of a measurement CSV; `source` names it in messages and in the result.
+/// [`read_measurement_csv`] is this plus reading the file.
+pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementSet, MeasureError> {
+    let sha256 = hex(&Sha256::digest(bytes));
+    let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
+    let parsed = parse_text(text).map_err(|r| r.in_file(source))?;
+    let material = match parsed.metadata.material {
+        Some(material) => material,
+        None => source
+            .file_stem()
+            .map(|stem| stem.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+    };
+    Ok(MeasurementSet {
+        source: source.to_path_buf(),
+        sha256,
+        material,
+        wavelength_um: parsed.wavelength_um,
+        metadata: parsed.metadata.entries,
+        elements: parsed.layout.elements,
+        points: parsed.points,
+    })
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The text of the file without a leading byte-order mark (spreadsheets write one).
+fn decode_utf8(bytes: &[u8]) -> Result<&str, Refusal> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        // The valid prefix is UTF-8 by construction, so the lossy decode is exact.
+        let before = String::from_utf8_lossy(&bytes[..e.valid_up_to()]);
+        let (last_line, line_number) = text_lines(without_bom(&before))
+            .zip(1..)
+            .last()
+            .unwrap_or(("", 1));
+        let byte = bytes[e.valid_up_to()];
+        Refusal::new(
+            line_number,
+            last_column(last_line),
+            MeasureErrorKind::InvalidUtf8 { byte },
+        )
+    })?;
+    Ok(without_bom(text))
+}
+
+fn without_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
+}
+
+/// The column just after the end of `line`.
+fn last_column(line: &str) -> u64 {
+    line.chars().count() as u64 + 1
+}
+
+/// The lines of a text without their terminators: "\r\n", "\n", or a bare "\r" (old Mac
+/// spreadsheet exports) each end a line.
+fn text_lines(text: &str) -> impl Iterator<Item = &str> {
+    text.split('\n')
+        .flat_map(|line| line.strip_suffix('\r').unwrap_or(line).split('\r'))
+}
+
+struct ParsedText {
+    metadata: Metadata,
+    layout: Layout,
+    wavelength_um: f64,
+    points: Vec<MeasurementPoint>,
+}
+
+/// A line of the file, numbered from 1, without its terminator.
+type NumberedLine<'a> = (u64, &'a str);
+
+fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
+    let lines: Vec<NumberedLine<'_>> = text_lines(text)
+        .zip(1..)
+        .map(|(line, number)| (number, line))
+        .filter(|(_, line)| !line.trim().is_empty())
+        .collect();
+    if lines.is_empty() {
+        return Err(Refusal::new(1, 1, MeasureErrorKind::EmptyFile));
+    }
+    let is_hash_line = |line: &str| line.trim_start().starts_with('#');
+
+    let mut metadata = Metadata::default();
+    for &(number, line) in lines.iter().filter(|(_, line)| is_hash_line(line)) {
+        if let Some((key, value, column)) = split_metadata_line(line) {
+            metadata.add(number, key, value, column)?;
+        }
+    }
+
+    let mut content = lines.iter().filter(|(_, line)| !is_hash_line(line));
+    let &(header_line, header) = content
+        .next()
+        .ok_or_else(|| Refusal::new(1, 1, MeasureErrorKind::NoHeader))?;
+    let header_fields = fields_of(header_line, header)?;
+    let layout = parse_header_row(header_line, &header_fields)?;
+
+    let mut wavelength = match (&metadata.wavelength, layout.has(Quantity::Wavelength)) {
+        (Some(header), _) => WavelengthCheck::AgainstHeader(header.clone()),
+        (None, true) => WavelengthCheck::AgainstFirstRow(None),
+        (None, false) => return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength)),
+    };
+    let points = content
+        .map(|&(number, line)| parse_row(number, line, &layout, &mut wavelength))
+        .collect::<Result<Vec<_>, _>>()?;
+    if points.is_empty() {
+        return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
+    }
+    let wavelength_um = match wavelength {
+        WavelengthCheck::AgainstHeader(header) => header.um,
+        // With a wavelength column and at least one row, the first row has set it.
+        WavelengthCheck::AgainstFirstRow(first) => first
+            .map(|f| f.um)
+            .ok_or_else(|| Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows))?,
+    };
+    Ok(ParsedText {
+        metadata,
+        layout,
+        wavelength_um,
+        points,
+    })
+}
+
+fn fields_of(line_number: u64, line: &str) -> Result<Vec<Field<'_>>, Refusal> {
+    split_fields(line).map_err(|(column, kind)| Refusal::new(line_number, column, kind))
+}
+
+/// How each row's wavelength_um is checked: a fit is per wavelength (DESIGN §2.1), so every row
+/// must agree with the header, or, without a header, with the first row.
+enum WavelengthCheck {
+    AgainstHeader(HeaderWavelength),
+    AgainstFirstRow(Option<HeaderWavelength>),
+}
+
+impl WavelengthCheck {
+    fn check(&mut self, line: u64, column: u64, um: f64, text: &str) -> Result<(), Refusal> {
+        let same = |a: f64, b: f64| (a - b).abs() <= WAVELENGTH_RELATIVE_TOLERANCE * a.max(b);
+        match self {
+            Self::AgainstHeader(header) if !same(header.um, um) => Err(Refusal::new(
+                line,
+                column,
+                MeasureErrorKind::WavelengthDisagrees {
+                    value: shown(text),
+                    header: shown(&header.text),
+                    header_line: header.line,
+                },
+            )),
+            Self::AgainstFirstRow(Some(first)) if !same(first.um, um) => Err(Refusal::new(
+                line,
+                column,
+                MeasureErrorKind::MixedWavelengths {
+                    value: shown(text),
+                    first: shown(&first.text),
+                    first_line: first.line,
+                },
+            )),
+            Self::AgainstFirstRow(first @ None) => {
+                *first = Some(HeaderWavelength {
+                    um,
+                    text: text.to_string(),
+                    line,
+                });
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+fn parse_row(
+    line_number: u64,
+    line: &str,
+    layout: &Layout,
+    wavelength: &mut WavelengthCheck,
+) -> Result<MeasurementPoint, Refusal> {
+    let fields = fields_of(line_number, line)?;
+    if let Some(refusal) = fields
+        .iter()
+        .filter(|f| !f.quoted)
+        .find_map(|f| wrong_delimiter(line_number, f))
+    {
+        return Err(refusal);
+    }
+    let expected = layout.quantities.len();
+    if fields.len() != expected {
+        // Point at the first extra field, or at the end of a short row.
+        let column = match fields.get(expected) {
+            Some(extra) => extra.column,
+            None => last_column(line),
+        };
+        return Err(Refusal::new(
+            line_number,
+            column,
+            MeasureErrorKind::FieldCount {
+                found: fields.len(),
+                expected,
+            },
+        ));
+    }
+
+    let mut point = MeasurementPoint {
+        theta_i_deg: f64::NAN,
+        phi_i_deg: DEFAULT_PHI_I_DEG,
+        theta_r_deg: f64::NAN,
+        phi_r_deg: DEFAULT_PHI_R_DEG,
+        values: vec![f64::NAN; layout.elements.len()],
+        uncertainties: vec![None; layout.elements.len()],
+        line: line_number,
+    };
+    for ((field, &quantity), name) in fields.iter().zip(&layout.quantities).zip(&layout.names) {
+        let refuse = |kind| Err(Refusal::new(line_number, field.column, kind));
+        let text = field.text.as_ref();
+        let value = match parse_number(name, text) {
+            Ok(value) => value,
+            Err(kind) => return refuse(kind),
+        };
+        match quantity {
+            Quantity::ThetaI | Quantity::ThetaR => {
+                // Zenith angles of directions above the surface; 90° is grazing and leaves the
+                // BRDF's 1/cosθ undefined (DESIGN §1.3).
+                if !(0.0..90.0).contains(&value) {
+                    return refuse(MeasureErrorKind::ThetaOutOfRange {
+                        column: name.clone(),
+                        value: shown(text),
+                    });
+                }
+                if quantity == Quantity::ThetaI {
+                    point.theta_i_deg = value;
+                } else {
+                    point.theta_r_deg = value;
+                }
+            }
+            Quantity::PhiI => point.phi_i_deg = value,
+            Quantity::PhiR => point.phi_r_deg = value,
+            Quantity::Wavelength => {
+                if value <= 0.0 {
+                    return refuse(MeasureErrorKind::NonPositiveWavelength { value: shown(text) });
+                }
+                wavelength.check(line_number, field.column, value, text)?;
+            }
+            Quantity::Element(index) => {
+                if index == 0 && value < 0.0 {
+                    return refuse(MeasureErrorKind::NegativeM00 { value: shown(text) });
+                }
+                if let Some(slot) = layout.slot(index) {
+                    point.values[slot] = value;
+                }
+            }
+            Quantity::Uncertainty(index) => {
+                if value <= 0.0 {
+                    return refuse(MeasureErrorKind::NonPositiveUncertainty {
+                        column: name.clone(),
+                        value: shown(text),
+                    });
+                }
+                if let Some(slot) = layout.slot(index) {
+                    point.uncertainties[slot] = Some(value);
+                }
+            }
+        }
+    }
+    Ok(point)
+}
+
+/// A finite number, or why the field is not one.
+fn parse_number(column: &str, text: &str) -> Result<f64, MeasureErrorKind> {
+    if text.is_empty() {
+        return Err(MeasureErrorKind::EmptyField {
+            column: column.to_string(),
+        });
+    }
+    match text.parse::<f64>() {
+        Ok(value) if value.is_finite() => Ok(value),
+        // Rust parses "NaN", "inf" and overflowing literals such as 1e999 as non-finite.
+        Ok(_) => Err(MeasureErrorKind::NotFinite {
+            column: column.to_string(),
+            value: shown(text),
+        }),
+        Err(_) => Err(MeasureErrorKind::NotANumber {
+            column: column.to_string(),
+            value: shown(text),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<MeasurementSet, MeasureError> {
+        parse_measurement_csv(Path::new("mem/sample.csv"), text.as_bytes())
+    }
+
+    fn message(text: &str) -> String {
+        parse(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn defaults_apply_and_material_falls_back_to_the_stem() {
+        let set =
+            parse("# wavelength_um: 10.6\ntheta_i_deg,theta_r_deg,m00\n30,40,0.05\n").unwrap();
+        assert_eq!(set.material, "sample");
+        assert_eq!(set.wavelength_um, 10.6);
+        assert_eq!(set.elements, vec![0]);
+        let p = &set.points[0];
+        assert_eq!(
+            (p.theta_i_deg, p.phi_i_deg, p.theta_r_deg, p.phi_r_deg),
+            (30.0, 0.0, 40.0, 180.0)
+        );
+        assert_eq!(
+            (p.values.clone(), p.uncertainties.clone(), p.line),
+            (vec![0.05], vec![None], 3)
+        );
+    }
+
+    #[test]
+    fn values_follow_the_sorted_elements_whatever_the_column_order() {
+        let set = parse(
+            "m22,u_m00,m00,theta_r_deg,theta_i_deg,wavelength_um\n-0.04,0.001,0.05,30,30,9.925\n",
+        )
+        .unwrap();
+        assert_eq!(set.elements, vec![0, 10]);
+        assert_eq!(set.points[0].values, vec![0.05, -0.04]);
+        assert_eq!(set.points[0].uncertainties, vec![Some(0.001), None]);
+        assert_eq!(set.wavelength_um, 9.925);
+    }
+
+    #[test]
+    fn sha256_is_of_the_raw_bytes() {
+        // SHA-256 of the 53 bytes below, computed independently with coreutils `sha256sum`.
+        let text = "# wavelength_um: 1\ntheta_i_deg,theta_r_deg,m00\n0,0,1\n";
+        let set = parse(text).unwrap();
+        assert_eq!(
+            set.sha256,
+            "83cd091616bdf72952f4e76fc25a5c8ec17daa0dcccce9de5326952ac9ff886b"
+        );
+        let other = parse(&text.replace("0,0,1", "0,0,2")).unwrap();
+        assert_ne!(set.sha256, other.sha256);
+    }
+
+    #[test]
+    fn wavelengths_agree_within_one_ppm() {
+        let header = "# wavelength_um: 9.925\ntheta_i_deg,theta_r_deg,m00,wavelength_um\n";
+        assert!(parse(&format!("{header}0,0,1,9.92500001\n")).is_ok());
+        assert_eq!(
+            message(&format!("{header}0,0,1,9.926\n")),
+            "mem/sample.csv:3:7: column 'wavelength_um': 9.926 disagrees with the header \
+             '# wavelength_um: 9.925' (line 1)"
+        );
+        let no_header = "theta_i_deg,theta_r_deg,m00,wavelength_um\n0,0,1,10\n1,1,1,10.6\n";
+        assert_eq!(
+            message(no_header),
+            "mem/sample.csv:3:7: column 'wavelength_um': 10.6 differs from 10 on line 2; \
+             a fit is per wavelength, so give one file per wavelength"
+        );
+    }
+
+    #[test]
+    fn utf8_errors_point_at_the_byte() {
+        let bytes = b"# a: b\nthe\xffta_i_deg";
+        let err = parse_measurement_csv(Path::new("x.csv"), bytes).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "x.csv:2:4: invalid UTF-8 (byte 0xFF): a measurement CSV must be UTF-8 text"
+        );
+    }
+
+    #[test]
+    fn bare_carriage_returns_end_lines() {
+        let set = parse("# wavelength_um: 8\rtheta_i_deg,theta_r_deg,m00\r10,20,0.5\r\r11,21,0.4")
+            .unwrap();
+        assert_eq!(set.points[1].line, 5);
+        assert_eq!(
+            message("# wavelength_um: 8\r\ntheta_i_deg,theta_r_deg,m00\r10,20,-0.5"),
+            "mem/sample.csv:3:7: column 'm00': -0.5 is negative, but m00 (the unpolarized BRDF, sr⁻¹) is ≥ 0"
+        );
+        let err = parse_measurement_csv(Path::new("x.csv"), b"\xef\xbb\xbfab\rc\xc3").unwrap_err();
+        assert_eq!((err.line, err.column), (2, 2));
+    }
+
+    #[test]
+    fn bom_crlf_and_quoted_names_are_accepted() {
+        let text = "\u{feff}\"theta_i_deg\",\"theta_r_deg\",\"m00\"\r\n# wavelength_um: 8\r\n10,20,0.5\r\n";
+        let set = parse(text).unwrap();
+        assert_eq!(set.points[0].values, vec![0.5]);
+        assert_eq!(set.wavelength_um, 8.0);
+    }
+
+    #[test]
+    fn numbers_are_finite_decimal_literals() {
+        assert_eq!(parse_number("m00", "1e-3"), Ok(1e-3));
+        assert_eq!(parse_number("m00", "+.5"), Ok(0.5));
+        for bad in ["NaN", "inf", "-infinity", "1e999"] {
+            assert!(matches!(
+                parse_number("m00", bad),
+                Err(MeasureErrorKind::NotFinite { .. })
+            ));
+        }
+        for bad in ["0x10", "1,5", "1.2.3", "one", "1_000"] {
+            assert!(matches!(
+                parse_number("m00", bad),
+                Err(MeasureErrorKind::NotANumber { .. })
+            ));
+        }
+    }
+}

@@ -1,0 +1,191 @@
+//! Errors of measurement ingestion (DESIGN §2.1): every refusal names the file, the 1-based line
+//! and the 1-based character column of the offending field, then says what is wrong, so that
+//! `irpol fit` can print it as one line (`file:line:column: what is wrong`).
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// A refused measurement input. Displays exactly as `file:line:column: what is wrong`, with the
+/// file as the caller gave it. Whole-file problems point at line 1 column 1 (or at the header
+/// row when they concern the columns).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}:{}:{}: {}", .file.display(), .line, .column, .kind)]
+pub struct MeasureError {
+    /// The path as given by the caller (not canonicalized).
+    pub file: PathBuf,
+    /// 1-based line number.
+    pub line: u64,
+    /// 1-based character (not byte) column of the start of the offending field.
+    pub column: u64,
+    /// What is wrong.
+    pub kind: MeasureErrorKind,
+}
+
+/// The reason a measurement input is refused. Values are quoted as they appear in the file
+/// (trimmed), so the message can be matched against the file by eye.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeasureErrorKind {
+    // --- the path itself ---
+    #[error("no such file or directory")]
+    NotFound,
+    #[error("is a directory, expected a CSV file")]
+    IsDirectory,
+    #[error("cannot read: {reason}")]
+    Unreadable { reason: String },
+    #[error("the folder holds no *.csv files")]
+    NoCsvInFolder,
+
+    // --- whole-file structure ---
+    #[error("invalid UTF-8 (byte 0x{byte:02X}): a measurement CSV must be UTF-8 text")]
+    InvalidUtf8 { byte: u8 },
+    #[error("the file is empty")]
+    EmptyFile,
+    #[error("no header row: the file holds only comments and metadata")]
+    NoHeader,
+    #[error("a header row but no data rows")]
+    NoDataRows,
+
+    // --- field splitting ---
+    #[error("fields are separated by {found}, expected ','")]
+    WrongDelimiter { found: Delimiter },
+    #[error("quoted field has no closing '\"'")]
+    UnterminatedQuote,
+    #[error("unexpected text after the closing '\"' of a quoted field")]
+    TextAfterQuote,
+
+    // --- `# key: value` metadata ---
+    #[error("header '{key}' given twice (first on line {first_line})")]
+    DuplicateHeaderKey { key: String, first_line: u64 },
+    #[error("header '{key}' has no value")]
+    EmptyHeaderValue { key: String },
+    #[error("header 'wavelength_um': '{value}' is not a positive number of micrometres")]
+    BadHeaderWavelength { value: String },
+    #[error("header 'mueller_convention': '{value}' is not supported; irpol uses 'psps' (SCATMECH's Stokes convention)")]
+    UnsupportedConvention { value: String },
+    #[error("header 'material': '{name}' cannot name a file ({reason})")]
+    BadMaterialName { name: String, reason: String },
+
+    // --- the header row ---
+    #[error("empty column name (a doubled or trailing ',' in the header row)")]
+    EmptyColumnName,
+    #[error("unknown column '{name}'{hint}")]
+    UnknownColumn { name: String, hint: String },
+    #[error("duplicate column '{name}' (already column {first_column} of the header row)")]
+    DuplicateColumn { name: String, first_column: u64 },
+    #[error("missing required column '{name}'")]
+    MissingColumn { name: String },
+    #[error(
+        "column '{name}' is the uncertainty of '{element}', but there is no '{element}' column"
+    )]
+    UncertaintyWithoutElement { name: String, element: String },
+    #[error(
+        "no wavelength: add a 'wavelength_um' column or a '# wavelength_um: <micrometres>' header line"
+    )]
+    NoWavelength,
+
+    // --- data rows ---
+    #[error("the row has {found} fields, the header row has {expected}")]
+    FieldCount { found: usize, expected: usize },
+    #[error("column '{column}' is empty, expected a number")]
+    EmptyField { column: String },
+    #[error("column '{column}': '{value}' is not a number")]
+    NotANumber { column: String, value: String },
+    #[error("column '{column}': '{value}' is not a finite number")]
+    NotFinite { column: String, value: String },
+    #[error("column '{column}': {value} is outside [0°, 90°) (zenith angles of the hemisphere above the surface)")]
+    ThetaOutOfRange { column: String, value: String },
+    #[error("column 'm00': {value} is negative, but m00 (the unpolarized BRDF, sr⁻¹) is ≥ 0")]
+    NegativeM00 { value: String },
+    #[error("column '{column}': {value} is not a positive uncertainty")]
+    NonPositiveUncertainty { column: String, value: String },
+    #[error("column 'wavelength_um': {value} is not a positive wavelength")]
+    NonPositiveWavelength { value: String },
+    #[error(
+        "column 'wavelength_um': {value} disagrees with the header '# wavelength_um: {header}' (line {header_line})"
+    )]
+    WavelengthDisagrees {
+        value: String,
+        header: String,
+        header_line: u64,
+    },
+    #[error(
+        "column 'wavelength_um': {value} differs from {first} on line {first_line}; a fit is per wavelength, so give one file per wavelength"
+    )]
+    MixedWavelengths {
+        value: String,
+        first: String,
+        first_line: u64,
+    },
+}
+
+/// A field separator found where ',' was expected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Delimiter {
+    Semicolon,
+    Tab,
+    Pipe,
+}
+
+impl Delimiter {
+    /// The separator a character would be, if it is one of the common non-comma ones.
+    pub(crate) fn from_char(c: char) -> Option<Self> {
+        match c {
+            ';' => Some(Self::Semicolon),
+            '\t' => Some(Self::Tab),
+            '|' => Some(Self::Pipe),
+            _ => None,
+        }
+    }
+}
+
+impl fmt::Display for Delimiter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Semicolon => "';'",
+            Self::Tab => "tabs",
+            Self::Pipe => "'|'",
+        })
+    }
+}
+
+/// A refusal located in the file but not yet tied to a path; the reader attaches the path.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Refusal {
+    pub line: u64,
+    pub column: u64,
+    pub kind: MeasureErrorKind,
+}
+
+impl Refusal {
+    pub(crate) fn new(line: u64, column: u64, kind: MeasureErrorKind) -> Self {
+        Self { line, column, kind }
+    }
+
+    pub(crate) fn in_file(self, file: &std::path::Path) -> MeasureError {
+        MeasureError {
+            file: file.to_path_buf(),
+            line: self.line,
+            column: self.column,
+            kind: self.kind,
+        }
+    }
+}
+
+/// A file's text as it may be quoted in a message: control characters escaped (so a stray
+/// carriage return or NUL is visible) and long values cut, so one message stays one short line.
+pub(crate) fn shown(text: &str) -> String {
+    const MAX_CHARS: usize = 40;
+    let mut out = String::new();
+    for (i, c) in text.chars().enumerate() {
+        if i == MAX_CHARS {
+            out.push('…');
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}

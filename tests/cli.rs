@@ -1,0 +1,245 @@
+//! The `irpol` binary end to end: outputs that carry physics, and clear one-line errors (no panics)
+//! for bad input.
+
+use std::process::Command;
+
+fn irpol(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .args(args)
+        .output()
+        .expect("run irpol");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn column(csv: &str, name: &str) -> Vec<f64> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let index = header.iter().position(|h| *h == name).unwrap();
+    lines
+        .map(|l| l.split(',').nth(index).unwrap().parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn eval_reproduces_the_scatmech_reference_through_a_geometry_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let geometry = dir.path().join("geometry.csv");
+    std::fs::write(
+        &geometry,
+        "label,theta_i_deg,phi_i_deg,theta_r_deg,phi_r_deg\nspec,30,0,30,180\noop,10,0,70,90\n",
+    )
+    .unwrap();
+    let sigma = (0.3 / 2f64.sqrt()).to_string();
+    let (ok, stdout, stderr) = irpol(&[
+        "eval",
+        "--distribution",
+        "gaussian",
+        "--sigma",
+        &sigma,
+        "--n",
+        "1.5",
+        "--k",
+        "0.1",
+        "--geometry",
+        geometry.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.starts_with("label,theta_i_deg,phi_i_deg,theta_r_deg,phi_r_deg,m00,"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("\nspec,30,0,30,180,"),
+        "extra columns are passed through: {stdout}"
+    );
+    let m00 = column(&stdout, "m00");
+    assert!(
+        (m00[0] / 5.08136012e-02 - 1.0).abs() < 1e-8
+            && (m00[1] / 8.50772992e-04 - 1.0).abs() < 1e-8
+    );
+    let m20 = column(&stdout, "m20");
+    assert!((m20[1] / 1.65370386e-04 - 1.0).abs() < 1e-7);
+}
+
+#[test]
+fn emissivity_table_has_the_smooth_limit_and_reports_excess_reflectance() {
+    let (ok, stdout, _) = irpol(&[
+        "emissivity",
+        "--sigma",
+        "1e-4",
+        "--q",
+        "4",
+        "--n",
+        "1.5",
+        "--k",
+        "0.1",
+        "--shadowing",
+        "smith",
+        "--theta",
+        "60",
+    ]);
+    assert!(ok);
+    let (e0, e1) = (column(&stdout, "e0")[0], column(&stdout, "e1")[0]);
+    assert!(
+        (e0 - 0.908286).abs() < 2e-6 && (e1 + 0.089534).abs() < 2e-6,
+        "{stdout}"
+    );
+    let (ok, stdout, stderr) = irpol(&[
+        "emissivity",
+        "--sigma",
+        "0.5",
+        "--q",
+        "1.6",
+        "--n",
+        "10",
+        "--k",
+        "60",
+        "--theta",
+        "85:89:2",
+    ]);
+    assert!(
+        ok && stderr.contains("exceeds 1") && stderr.contains("89"),
+        "{stderr}"
+    );
+    assert!(
+        column(&stdout, "e0").iter().all(|&e| e < 0.0),
+        "reported unclamped: {stdout}"
+    );
+}
+
+#[test]
+fn bad_input_gives_one_clear_line_and_a_failure_exit() {
+    let dir = tempfile::tempdir().unwrap();
+    let geometry = dir.path().join("g.csv");
+    std::fs::write(&geometry, "theta_i_deg,theta_r_deg\n30,30\n95,10\n").unwrap();
+    let g = geometry.to_str().unwrap();
+    let base = [
+        "eval", "--sigma", "0.1", "--q", "1.8", "--n", "1.2", "--k", "0.2",
+    ];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            [&base[..], &["--geometry", g]].concat(),
+            "g.csv:3: theta_i_deg = 95° is invalid",
+        ),
+        (
+            [&base[..], &["--geometry", "/nonexistent.csv"]].concat(),
+            "/nonexistent.csv: cannot open",
+        ),
+        (
+            vec![
+                "eval",
+                "--sigma",
+                "-0.1",
+                "--q",
+                "1.8",
+                "--n",
+                "1.2",
+                "--k",
+                "0.2",
+                "--theta-i",
+                "0",
+                "--theta-r",
+                "0",
+            ],
+            "σ = -0.1",
+        ),
+        (
+            vec![
+                "eval",
+                "--sigma",
+                "0.1",
+                "--q",
+                "1.2",
+                "--n",
+                "1.2",
+                "--k",
+                "0.2",
+                "--shadowing",
+                "smith",
+                "--theta-i",
+                "0",
+                "--theta-r",
+                "0",
+            ],
+            "q > 1.5",
+        ),
+        (
+            vec![
+                "eval",
+                "--sigma",
+                "0.1",
+                "--q",
+                "1.8",
+                "--n",
+                "1.2",
+                "--k",
+                "-1",
+                "--theta-i",
+                "0",
+                "--theta-r",
+                "0",
+            ],
+            "k = -1",
+        ),
+        (
+            vec![
+                "eval",
+                "--sigma",
+                "0.1",
+                "--q",
+                "1.8",
+                "--n",
+                "1.2",
+                "--k",
+                "0.2",
+                "--theta-i",
+                "NaN",
+                "--theta-r",
+                "0",
+            ],
+            "not finite",
+        ),
+        (
+            vec![
+                "eval",
+                "--sigma",
+                "0.1",
+                "--q",
+                "1.8",
+                "--n",
+                "1.2",
+                "--k",
+                "0.2",
+                "--theta-i",
+                "10",
+                "--theta-r",
+                "0:100:10",
+            ],
+            "theta_r_deg = 90° is invalid",
+        ),
+        (
+            vec!["emissivity", "--material", "/no/such.toml"],
+            "/no/such.toml: cannot read",
+        ),
+        (
+            vec!["emissivity", "--sigma", "0.1", "--n", "1", "--k", "0"],
+            "missing --q",
+        ),
+    ];
+    for (args, needle) in cases {
+        let (ok, stdout, stderr) = irpol(&args);
+        assert!(!ok, "{args:?} succeeded: {stdout}");
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: {stderr:?} lacks {needle:?}"
+        );
+        assert!(
+            !stderr.contains("panicked") && stderr.lines().count() == 1,
+            "{args:?}: {stderr}"
+        );
+    }
+}
