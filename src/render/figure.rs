@@ -6,25 +6,15 @@
 
 use super::colormap::{cyclic, ColorMap, DIVERGING, MASKED, SEQUENTIAL, THERMAL};
 use super::shading::dolp_aop;
+use super::tables::TemperatureLookup;
 use super::{StokesImage, BACKGROUND};
+use crate::report::{register_fonts, FONT};
 use crate::scene::Scene;
 use image::ImageEncoder;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::FontStyle;
 use std::io;
-
-const FONT: &str = "sans-serif";
-
-fn register_fonts() {
-    static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| {
-        // The bytes are a valid TrueType font shipped by the dejavu crate; failure would leave
-        // plotters without glyphs, which its draw calls then report as errors.
-        let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
-        let _ = plotters::style::register_font(FONT, FontStyle::Bold, dejavu::sans::bold());
-    });
-}
 
 /// How a panel's colour bar is drawn: its colours bottom to top and labelled ticks.
 enum Bar {
@@ -54,8 +44,8 @@ pub struct Previews {
 
 impl Previews {
     pub fn new(scene: &Scene, image: &StokesImage) -> Previews {
-        let object = |i: usize| image.object[i] != BACKGROUND;
-        let any_object = image.object.iter().any(|&o| o != BACKGROUND);
+        let object = |i: usize| image.surface[i] != BACKGROUND;
+        let any_object = image.surface.iter().any(|&o| o != BACKGROUND);
         let pick = |f: &dyn Fn([f64; 3]) -> f64| -> Vec<f64> {
             image
                 .stokes
@@ -405,33 +395,5 @@ fn widen(lo: f64, hi: f64) -> (f64, f64) {
         (lo, hi)
     } else {
         (lo - 0.5, hi + 0.5)
-    }
-}
-
-/// Brightness temperature by interpolation on 257 exact points over a radiance range.
-struct TemperatureLookup {
-    lo: f64,
-    step: f64,
-    values: Vec<f64>,
-}
-
-impl TemperatureLookup {
-    fn new(band: &crate::optics::Band, lo: f64, hi: f64) -> TemperatureLookup {
-        let n = 257;
-        let step = ((hi - lo) / (n - 1) as f64).max(1e-12);
-        let values = (0..n)
-            .map(|i| {
-                band.brightness_temperature((lo + step * i as f64).max(0.0))
-                    .unwrap_or(0.0)
-            })
-            .collect();
-        TemperatureLookup { lo, step, values }
-    }
-
-    fn at(&self, radiance: f64) -> f64 {
-        let x = ((radiance - self.lo) / self.step).clamp(0.0, (self.values.len() - 1) as f64);
-        let i = (x as usize).min(self.values.len() - 2);
-        let f = x - i as f64;
-        self.values[i] + f * (self.values[i + 1] - self.values[i])
     }
 }

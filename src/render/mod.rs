@@ -58,8 +58,8 @@ pub struct StokesImage {
     pub height: usize,
     /// (S0, S1, S2) per pixel.
     pub stokes: Vec<[f64; 3]>,
-    /// Object index per pixel, or [`BACKGROUND`].
-    pub object: Vec<u32>,
+    /// Scene surface (object part, `Scene::surfaces`) seen at each pixel, or [`BACKGROUND`].
+    pub surface: Vec<u32>,
 }
 
 /// Wall-clock seconds of each stage.
@@ -228,12 +228,12 @@ fn shade_image(
         seed: scene.sensor.seed,
     };
     let mut stokes = vec![[0.0f64; 3]; width * height];
-    let mut object = vec![BACKGROUND; width * height];
+    let mut surface = vec![BACKGROUND; width * height];
     stokes
         .par_chunks_mut(width)
-        .zip(object.par_chunks_mut(width))
+        .zip(surface.par_chunks_mut(width))
         .enumerate()
-        .for_each(|(y, (row, row_object))| {
+        .for_each(|(y, (row, row_surface))| {
             for x in 0..width {
                 let fragment = fragments.fragments[y * width + x];
                 if fragment.triangle == NO_TRIANGLE {
@@ -268,7 +268,7 @@ fn shade_image(
                     s = through_atmosphere(s, range, atmosphere, path);
                 }
                 row[x] = s;
-                row_object[x] = scene.surfaces[mesh.triangle_surface[t] as usize].object as u32;
+                row_surface[x] = mesh.triangle_surface[t];
             }
             noise.apply_to_row(y, row);
             tick();
@@ -277,6 +277,6 @@ fn shade_image(
         width,
         height,
         stokes,
-        object,
+        surface,
     }
 }

@@ -5,7 +5,7 @@
 
 use super::figure;
 use super::shading::{dolp_aop, polarizer};
-use super::tables::TableResolution;
+use super::tables::{TableResolution, TemperatureLookup};
 use super::{RenderError, Rendered, StokesImage, Timings, BACKGROUND};
 use crate::material::write_atomically;
 use crate::scene::config::Shading;
@@ -100,7 +100,7 @@ impl StokesImage {
             mean: 0.0,
         };
         let mut count = 0usize;
-        for (&v, &o) in values.iter().zip(&self.object) {
+        for (&v, &o) in values.iter().zip(&self.surface) {
             if o != BACKGROUND {
                 let v = v as f64;
                 stats.min = stats.min.min(v);
@@ -137,6 +137,8 @@ pub struct PixelCounts {
     pub object: usize,
     pub background: usize,
     pub per_object: BTreeMap<String, usize>,
+    /// Keyed "object/part".
+    pub per_part: BTreeMap<String, usize>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -223,32 +225,31 @@ pub fn write_outputs(
             object_pixels: image.object_stats(data),
         })
         .collect();
-    let apparent = image
-        .object_stats(&channels[0].1)
-        .map(|s| {
-            let band = &scene.sensor.band;
-            let object_mean_t = {
-                let (mut sum, mut n) = (0.0, 0usize);
-                for (s0, &o) in channels[0].1.iter().zip(&image.object) {
-                    if o != BACKGROUND {
-                        sum += band.brightness_temperature((*s0 as f64).max(0.0)).unwrap_or(0.0);
-                        n += 1;
-                    }
-                }
-                sum / n.max(1) as f64
-            };
-            Stats {
-                min: band.brightness_temperature(s.min.max(0.0)).unwrap_or(0.0),
-                max: band.brightness_temperature(s.max.max(0.0)).unwrap_or(0.0),
-                mean: object_mean_t,
-            }
-        });
-    let mut per_object = BTreeMap::new();
-    for (i, name) in scene.object_names.iter().enumerate() {
-        let count = image.object.iter().filter(|&&o| o == i as u32).count();
-        *per_object.entry(name.clone()).or_insert(0) += count;
+    let apparent = image.object_stats(&channels[0].1).map(|s| {
+        let lookup = TemperatureLookup::new(&scene.sensor.band, s.min.max(0.0), s.max.max(0.0));
+        let temperatures: Vec<f32> = channels[0]
+            .1
+            .iter()
+            .map(|&r| lookup.at(r as f64) as f32)
+            .collect();
+        let mean = image.object_stats(&temperatures).map_or(0.0, |t| t.mean);
+        Stats {
+            min: lookup.at(s.min),
+            max: lookup.at(s.max),
+            mean,
+        }
+    });
+    let mut per_surface = vec![0usize; scene.surfaces.len()];
+    for &s in image.surface.iter().filter(|&&s| s != BACKGROUND) {
+        per_surface[s as usize] += 1;
     }
-    let object_pixels = image.object.iter().filter(|&&o| o != BACKGROUND).count();
+    let (mut per_object, mut per_part) = (BTreeMap::new(), BTreeMap::new());
+    for (surface, &count) in scene.surfaces.iter().zip(&per_surface) {
+        let object = scene.object_names[surface.object].clone();
+        per_part.insert(format!("{object}/{}", surface.part), count);
+        *per_object.entry(object).or_insert(0) += count;
+    }
+    let object_pixels: usize = per_surface.iter().sum();
     let mut timings = rendered.timings;
     timings.write = write_start.elapsed().as_secs_f64();
     timings.total = started.elapsed().as_secs_f64();
@@ -266,6 +267,7 @@ pub fn write_outputs(
             object: object_pixels,
             background: w * h - object_pixels,
             per_object,
+            per_part,
         },
         channels: summary_stats,
         apparent_temperature_k: apparent,

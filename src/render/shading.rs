@@ -40,7 +40,6 @@ impl Shader<'_> {
             *normal
         };
         let cos_r = n.dot(&w_r);
-        let theta_r = cos_r.clamp(-1.0, 1.0).acos().min(THETA_MAX);
 
         // Local frame: e_x uphill (world up projected on the tangent plane), e_y = n × e_x.
         let up = Vector3::z();
@@ -67,8 +66,10 @@ impl Shader<'_> {
         };
 
         let tables = &self.tables[material];
-        let e = tables.emissivity(theta_r);
-        let r = tables.reflected(cos_tilt.acos(), theta_r, phi);
+        // Silhouettes: interpolated normals may face slightly away; read the grazing limit.
+        let cos_table = cos_r.max(THETA_MAX.cos());
+        let e = tables.emissivity(cos_table);
+        let r = tables.reflected(cos_tilt.acos(), cos_table, phi);
         let l = self.radiance.radiance(temperature);
         let local = Stokes::new(e[0] * l + r[0], e[1] * l + r[1], r[2], 0.0);
 

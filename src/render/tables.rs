@@ -7,8 +7,12 @@
 //! * the diffuse term (ρ_d/π)∫L cosθ dΩ, which depends on the tilt alone.
 //!
 //! Both ε and R come from the same kernel ([`super::kernel`]), ε_j = δ_j0 − Σ K_j (Kirchhoff, DESIGN
-//! §1.4), and are interpolated linearly in θ_r on the same grid, so an isothermal enclosure gives
+//! §1.4), and are interpolated linearly on the same θ_r grid, so an isothermal enclosure gives
 //! S = (L_bb(T), 0, 0) to rounding, whatever the table resolution.
+//!
+//! The θ_r axis is uniform in v = θ_r + (1 − cos θ_r): steps toward grazing, where Fresnel
+//! reflectance and polarization change fastest, are half those at the normal (θ_r also moves the
+//! mirror direction across the sky, so it cannot be coarse anywhere).
 
 use super::kernel::{cosine_rule, specular_kernel, KernelQuadrature, SpecularKernel};
 use crate::optics::Band;
@@ -20,6 +24,25 @@ use std::f64::consts::{FRAC_1_PI, PI};
 
 /// Largest emission/view angle tabulated; beyond it the table is clamped (silhouette pixels).
 pub const THETA_MAX: f64 = 89.0 * PI / 180.0;
+
+/// The θ_r table coordinate v = θ + (1 − cos θ), from cos θ.
+#[inline]
+fn theta_coordinate(cos_theta: f64) -> f64 {
+    cos_theta.clamp(-1.0, 1.0).acos() + 1.0 - cos_theta
+}
+
+/// θ with θ + (1 − cos θ) = v (Newton; v is increasing and convex enough on [0, π/2]).
+fn theta_of_coordinate(v: f64) -> f64 {
+    let mut theta = v / 1.5;
+    for _ in 0..30 {
+        let step = (theta + 1.0 - theta.cos() - v) / (1.0 + theta.sin());
+        theta -= step;
+        if step.abs() < 1e-15 {
+            break;
+        }
+    }
+    theta
+}
 
 /// n equally spaced points from `start` to `end`.
 #[derive(Clone, Copy, Debug)]
@@ -73,14 +96,13 @@ pub struct TableResolution {
 
 impl TableResolution {
     /// Finer grids for narrower lobes: the reflected environment changes over an angle ~ the
-    /// lobe width, a few σ radians. Steps of 3° (σ ≤ 0.075) to 6° (σ ≥ 0.15) in tilt and azimuth,
-    /// at most 2° in θ_r.
+    /// lobe width, a few σ radians. Steps of 3° (σ ≤ 0.075) to 6° (σ ≥ 0.15) in tilt and azimuth;
+    /// in θ_r 61 nodes (2.4° at the normal, 1.2° at grazing) for narrow lobes, 46 otherwise.
     pub fn for_material(pbrdf: &Pbrdf) -> TableResolution {
         let step_deg = (pbrdf.distribution().sigma() * 40.0).clamp(3.0, 6.0);
-        let theta_step = step_deg.min(2.0);
         TableResolution {
             tilt: (180.0 / step_deg).ceil() as usize + 1,
-            theta: (THETA_MAX.to_degrees() / theta_step).ceil() as usize + 1,
+            theta: if step_deg < 4.0 { 61 } else { 46 },
             phi: (180.0 / step_deg).ceil() as usize + 1,
             merge_cell_deg: 0.5 * step_deg,
         }
@@ -93,6 +115,7 @@ impl TableResolution {
 
 #[derive(Clone, Debug)]
 pub struct MaterialTables {
+    /// Over v = θ_r + (1 − cos θ_r).
     theta: UniformGrid,
     tilt: UniformGrid,
     phi: UniformGrid,
@@ -114,7 +137,7 @@ impl MaterialTables {
         resolution: TableResolution,
         quadrature: &KernelQuadrature,
     ) -> Result<MaterialTables, ModelError> {
-        let theta = UniformGrid::new(0.0, THETA_MAX, resolution.theta);
+        let theta = UniformGrid::new(0.0, theta_coordinate(THETA_MAX.cos()), resolution.theta);
         let tilt = UniformGrid::new(0.0, PI, resolution.tilt);
         let phi = UniformGrid::new(0.0, PI, resolution.phi);
         let quadrature = KernelQuadrature {
@@ -123,7 +146,7 @@ impl MaterialTables {
         };
         let kernels: Vec<SpecularKernel> = (0..theta.len())
             .into_par_iter()
-            .map(|i| specular_kernel(pbrdf, theta.value(i), &quadrature))
+            .map(|i| specular_kernel(pbrdf, theta_of_coordinate(theta.value(i)), &quadrature))
             .collect();
 
         let diffuse_rule = cosine_rule(8, 32);
@@ -137,7 +160,7 @@ impl MaterialTables {
                 let e0 = 1.0 - total[0] - diffuse_albedo;
                 if e0 < -1e-9 {
                     return Err(ModelError::ReflectanceAboveOne {
-                        theta_deg: theta.value(i).to_degrees(),
+                        theta_deg: theta_of_coordinate(theta.value(i)).to_degrees(),
                         reflectance: 1.0 - e0,
                     });
                 }
@@ -204,22 +227,23 @@ impl MaterialTables {
         })
     }
 
-    /// (ε0, ε1) at emission angle θ (psps frame; ε2 = ε3 = 0 for isotropic surfaces).
+    /// (ε0, ε1) at emission angle θ, given as cos θ (psps frame; ε2 = ε3 = 0 for isotropic
+    /// surfaces). Angles beyond [`THETA_MAX`] read the last node.
     #[inline]
-    pub fn emissivity(&self, theta: f64) -> [f64; 2] {
-        let (i, f) = self.theta.locate(theta);
+    pub fn emissivity(&self, cos_theta: f64) -> [f64; 2] {
+        let (i, f) = self.theta.locate(theta_coordinate(cos_theta));
         let (a, b) = (self.emissivity[i], self.emissivity[i + 1]);
         [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])]
     }
 
     /// Reflected environment (S0, S1, S2) toward ω_r in its psps frame, for a normal tilted by
-    /// `tilt` from world up and ω_r at zenith `theta` and azimuth `phi` ∈ [−π, π] from uphill.
-    /// Mirror symmetry about the plane of the normal and world up: R2(−φ) = −R2(φ).
+    /// `tilt` from world up and ω_r at zenith θ (given as cos θ) and azimuth `phi` ∈ [−π, π] from
+    /// uphill. Mirror symmetry about the plane of the normal and world up: R2(−φ) = −R2(φ).
     #[inline]
-    pub fn reflected(&self, tilt: f64, theta: f64, phi: f64) -> [f64; 3] {
+    pub fn reflected(&self, tilt: f64, cos_theta: f64, phi: f64) -> [f64; 3] {
         let sign = if phi < 0.0 { -1.0 } else { 1.0 };
         let (ti, tf) = self.tilt.locate(tilt);
-        let (ki, kf) = self.theta.locate(theta);
+        let (ki, kf) = self.theta.locate(theta_coordinate(cos_theta));
         let (pi, pf) = self.phi.locate(phi.abs());
         let (n_theta, n_phi) = (self.theta.len(), self.phi.len());
         let mut out = [0.0f64; 3];
@@ -265,6 +289,37 @@ impl RadianceTable {
     }
 }
 
+/// Brightness temperature (K) of band radiance over a radiance range, by linear interpolation
+/// on 257 exact inversions (`Band::brightness_temperature` is a Newton solve per call); clamped
+/// to the range. For previews and summaries, not for physics.
+pub struct TemperatureLookup {
+    lo: f64,
+    step: f64,
+    values: Vec<f64>,
+}
+
+impl TemperatureLookup {
+    pub fn new(band: &Band, lo: f64, hi: f64) -> TemperatureLookup {
+        let n = 257;
+        let step = ((hi - lo) / (n - 1) as f64).max(1e-12);
+        let values = (0..n)
+            .map(|i| {
+                band.brightness_temperature((lo + step * i as f64).max(0.0))
+                    .unwrap_or(0.0)
+            })
+            .collect();
+        TemperatureLookup { lo, step, values }
+    }
+
+    #[inline]
+    pub fn at(&self, radiance: f64) -> f64 {
+        let x = ((radiance - self.lo) / self.step).clamp(0.0, (self.values.len() - 1) as f64);
+        let i = (x as usize).min(self.values.len() - 2);
+        let f = x - i as f64;
+        self.values[i] + f * (self.values[i + 1] - self.values[i])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -280,6 +335,14 @@ mod tests {
         assert_eq!(g.locate(-1.0), (0, 0.0));
         let (i, f) = g.locate(2.0);
         assert_eq!((i, f), (9, 1.0));
+    }
+
+    #[test]
+    fn theta_coordinate_inverts() {
+        for theta in [0.0f64, 0.1, 0.7, 1.2, THETA_MAX] {
+            let back = theta_of_coordinate(theta_coordinate(theta.cos()));
+            assert!((back - theta).abs() < 1e-12, "{theta}");
+        }
     }
 
     #[test]
@@ -312,9 +375,9 @@ mod tests {
         };
         let tables =
             MaterialTables::build(&pbrdf, &env, resolution, &KernelQuadrature::default()).unwrap();
-        for (tilt, theta, phi) in [(0.3, 0.2, 1.0), (2.0, 1.3, -2.5), (1.1, 1.5, 0.0)] {
-            let e = tables.emissivity(theta);
-            let r = tables.reflected(tilt, theta, phi);
+        for (tilt, theta, phi) in [(0.3, 0.2f64, 1.0), (2.0, 1.3, -2.5), (1.1, 1.5, 0.0)] {
+            let e = tables.emissivity(theta.cos());
+            let r = tables.reflected(tilt, theta.cos(), phi);
             assert!((e[0] * l + r[0] - l).abs() < 1e-6 * l);
             assert!((e[1] * l + r[1]).abs() < 1e-6 * l);
             assert!(r[2].abs() < 1e-6 * l);
