@@ -34,10 +34,15 @@ pub struct SceneError {
 }
 
 impl SceneError {
+    /// Messages are kept to one line (some parsers format theirs over several).
     fn new(file: &Path, message: impl Into<String>) -> SceneError {
         SceneError {
             file: file.to_owned(),
-            message: message.into(),
+            message: message
+                .into()
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" "),
         }
     }
 }
@@ -95,8 +100,15 @@ pub struct Scene {
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| SceneError::new(path, format!("cannot read the scene: {e}")))?;
-    let config: SceneConfig = toml::from_str(&text)
-        .map_err(|e| SceneError::new(path, format!("not a valid scene: {e}")))?;
+    let config: SceneConfig = toml::from_str(&text).map_err(|e| {
+        let at = e.span().map_or(String::new(), |span| {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            format!("line {line}, column {column}: ")
+        });
+        SceneError::new(path, format!("not a valid scene: {at}{}", e.message()))
+    })?;
     build_scene(path, config)
 }
 
