@@ -36,7 +36,15 @@ fn car_renders_with_warm_hood_and_cool_glass() {
         std::fs::rename(&out, keep).unwrap();
     }
     println!("{}", serde_json::to_string_pretty(&summary).unwrap());
-    for file in ["S0.tif", "DoLP.tif", "stokes.exr", "S0.png", "AoP.png", "composite.png", "summary.json"] {
+    for file in [
+        "S0.tif",
+        "DoLP.tif",
+        "stokes.exr",
+        "S0.png",
+        "AoP.png",
+        "composite.png",
+        "summary.json",
+    ] {
         assert!(out.join(file).is_file(), "{file}");
     }
 }

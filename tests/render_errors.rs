@@ -54,21 +54,44 @@ fn a_valid_mesh_scene_renders() {
 #[test]
 fn missing_mesh_file() {
     let text = refuse(&scene_with_mesh("nowhere.obj", ""), &[]);
-    expect(&text, &["nowhere.obj", "cannot read the mesh", "objects[0] 'thing'"]);
+    expect(
+        &text,
+        &["nowhere.obj", "cannot read the mesh", "objects[0] 'thing'"],
+    );
 }
 
 #[test]
 fn missing_material() {
-    let scene = scene_with_mesh("panel.obj", "").replace("material = \"m\"\ntemperature", "material = \"unobtainium\"\ntemperature");
+    let scene = scene_with_mesh("panel.obj", "").replace(
+        "material = \"m\"\ntemperature",
+        "material = \"unobtainium\"\ntemperature",
+    );
     let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
-    expect(&text, &["scene.toml", "objects[0] 'thing'", "part 'panel'", "unobtainium", "not in the library"]);
+    expect(
+        &text,
+        &[
+            "scene.toml",
+            "objects[0] 'thing'",
+            "part 'panel'",
+            "unobtainium",
+            "not in the library",
+        ],
+    );
 }
 
 #[test]
 fn unknown_part() {
     let scene = scene_with_mesh("panel.obj", "[objects.parts.hood]\ntemperature_k = 320.0\n");
     let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
-    expect(&text, &["scene.toml", "part 'hood' is not in", "panel.obj", "its parts: panel"]);
+    expect(
+        &text,
+        &[
+            "scene.toml",
+            "part 'hood' is not in",
+            "panel.obj",
+            "its parts: panel",
+        ],
+    );
 }
 
 #[test]
@@ -84,14 +107,26 @@ fn malformed_toml() {
 fn degenerate_triangle() {
     let obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 0 1\ng panel\nf 1 2 4\nf 1 2 3\n";
     let text = refuse(&scene_with_mesh("flat.obj", ""), &[("flat.obj", obj)]);
-    expect(&text, &["flat.obj", "line 7", "degenerate triangle", "part 'panel'", "objects[0] 'thing'"]);
+    expect(
+        &text,
+        &[
+            "flat.obj",
+            "line 7",
+            "degenerate triangle",
+            "part 'panel'",
+            "objects[0] 'thing'",
+        ],
+    );
 }
 
 #[test]
 fn nan_in_mesh() {
     let obj = "v 0 0 0\nv 1 nan 0\nv 0 0 1\nf 1 2 3\n";
     let text = refuse(&scene_with_mesh("nan.obj", ""), &[("nan.obj", obj)]);
-    expect(&text, &["nan.obj", "line 2", "vertex 2 has a non-finite coordinate"]);
+    expect(
+        &text,
+        &["nan.obj", "line 2", "vertex 2 has a non-finite coordinate"],
+    );
     let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
                property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
                0 0 0\n1 0 inf\n0 0 1\n3 0 1 2\n";
@@ -101,16 +136,30 @@ fn nan_in_mesh() {
 
 #[test]
 fn bad_values_name_their_key() {
-    let scene = scene_with_mesh("panel.obj", "").replace("zenith_emissivity = 0.75", "zenith_emissivity = 1.75");
+    let scene = scene_with_mesh("panel.obj", "")
+        .replace("zenith_emissivity = 0.75", "zenith_emissivity = 1.75");
     let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
-    expect(&text, &["scene.toml", "environment.sky.zenith_emissivity = 1.75"]);
+    expect(
+        &text,
+        &["scene.toml", "environment.sky.zenith_emissivity = 1.75"],
+    );
     let scene = scene_with_mesh("panel.obj", "").replace("sigma = 0.2", "sigma = -0.2");
     let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
-    expect(&text, &["scene.toml", "inline material [materials.m]", "σ = -0.2"]);
-    let scene = scene_with_mesh("panel.obj", "").replace("temperature_k = 300.0", "temperature_k = -4.0");
+    expect(
+        &text,
+        &["scene.toml", "inline material [materials.m]", "σ = -0.2"],
+    );
+    let scene =
+        scene_with_mesh("panel.obj", "").replace("temperature_k = 300.0", "temperature_k = -4.0");
     let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
-    expect(&text, &["scene.toml", "objects[0] 'thing'", "temperature_k = -4"]);
-    let text = refuse(&scene_with_mesh("panel.stl", ""), &[("panel.stl", TRIANGLE_OBJ)]);
+    expect(
+        &text,
+        &["scene.toml", "objects[0] 'thing'", "temperature_k = -4"],
+    );
+    let text = refuse(
+        &scene_with_mesh("panel.stl", ""),
+        &[("panel.stl", TRIANGLE_OBJ)],
+    );
     expect(&text, &["panel.stl", "must end in .obj or .ply"]);
 }
 
@@ -121,7 +170,10 @@ fn energy_non_conserving_material_is_named() {
         .replace("shadowing = \"smith\"", "shadowing = \"none\"")
         .replace("sigma = 0.2\nq = 2.0", "sigma = 0.8\nq = 1.6");
     let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
-    expect(&text, &["scene.toml", "material 'm' (inline)", "reflectance"]);
+    expect(
+        &text,
+        &["scene.toml", "material 'm' (inline)", "reflectance"],
+    );
 }
 
 #[test]

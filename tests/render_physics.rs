@@ -29,7 +29,10 @@ fn sphere_pixels(scene: &Scene, image: &StokesImage) -> Vec<(usize, Vector3<f64>
         if s == BACKGROUND {
             continue;
         }
-        let (x, y) = ((i % image.width) as f64 + 0.5, (i / image.width) as f64 + 0.5);
+        let (x, y) = (
+            (i % image.width) as f64 + 0.5,
+            (i / image.width) as f64 + 0.5,
+        );
         let d = camera.ray_direction(x, y);
         let o = camera.position;
         let b = o.dot(&d);
@@ -126,10 +129,17 @@ fn emission_alone_is_polarized_along_the_projected_normal() {
         }
         checked += 1;
     }
-    println!("emission: {checked} pixels, worst ΔDoLP {worst_dolp:.2e}, worst ΔAoP {:.3}°", worst_aop.to_degrees());
+    println!(
+        "emission: {checked} pixels, worst ΔDoLP {worst_dolp:.2e}, worst ΔAoP {:.3}°",
+        worst_aop.to_degrees()
+    );
     assert!(checked > 5000, "{checked}");
     assert!(worst_dolp < 1e-3, "DoLP off by {worst_dolp}");
-    assert!(worst_aop < 1f64.to_radians(), "AoP off by {}°", worst_aop.to_degrees());
+    assert!(
+        worst_aop < 1f64.to_radians(),
+        "AoP off by {}°",
+        worst_aop.to_degrees()
+    );
 }
 
 #[test]
@@ -155,7 +165,10 @@ fn reflection_alone_is_polarized_across_the_projected_normal() {
         assert!(gap < 1f64.to_radians(), "pixel {i}: AoP {aop} vs {across}");
         checked += 1;
     }
-    println!("reflection: {checked} pixels, worst ΔAoP {:.3}°", worst.to_degrees());
+    println!(
+        "reflection: {checked} pixels, worst ΔAoP {:.3}°",
+        worst.to_degrees()
+    );
     assert!(checked > 3000, "{checked}");
 }
 

@@ -61,7 +61,10 @@ fn brute_force(pbrdf: &Pbrdf, theta_r: f64, env: impl Fn(&Vector3<f64>) -> f64) 
     const FACETS: usize = 300;
     const DIFFUSE: usize = 100;
     let total = (FACETS * FACETS + DIFFUSE * DIFFUSE) as f64;
-    let (frac_facet, frac_diffuse) = ((FACETS * FACETS) as f64 / total, (DIFFUSE * DIFFUSE) as f64 / total);
+    let (frac_facet, frac_diffuse) = (
+        (FACETS * FACETS) as f64 / total,
+        (DIFFUSE * DIFFUSE) as f64 / total,
+    );
     let scattered = Direction::from_angles(theta_r, 0.0);
     let w_r = scattered.vector;
     let d = pbrdf.distribution();
@@ -81,7 +84,10 @@ fn brute_force(pbrdf: &Pbrdf, theta_r: f64, env: impl Fn(&Vector3<f64>) -> f64) 
     };
     for i in 0..FACETS {
         for j in 0..FACETS {
-            let (u, v) = ((i as f64 + 0.5) / FACETS as f64, (j as f64 + 0.5) / FACETS as f64);
+            let (u, v) = (
+                (i as f64 + 0.5) / FACETS as f64,
+                (j as f64 + 0.5) / FACETS as f64,
+            );
             let tan2 = sample_tan2(d, u);
             let (sin_p, cos_p) = (2.0 * PI * v).sin_cos();
             let t = tan2.sqrt();
@@ -104,13 +110,52 @@ fn brute_force(pbrdf: &Pbrdf, theta_r: f64, env: impl Fn(&Vector3<f64>) -> f64) 
 
 /// The materials of the car scene (measurements/README.md truths) and the inline asphalt.
 fn materials() -> Vec<(&'static str, Pbrdf)> {
-    let m = |d, n, k, rho| Pbrdf::new(d, Shadowing::Smith, RefractiveIndex::new(n, k), rho).unwrap();
+    let m =
+        |d, n, k, rho| Pbrdf::new(d, Shadowing::Smith, RefractiveIndex::new(n, k), rho).unwrap();
     vec![
-        ("smooth_glass σ0.03", m(SlopeDistribution::Cauchy { sigma: 0.03, q: 3.0 }, 2.2, 0.1, 0.0)),
-        ("paper_paint σ0.1", m(SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 }, 1.2, 0.2, 0.0)),
-        ("anodized σ0.15", m(SlopeDistribution::Gaussian { sigma: 0.15 }, 3.0, 1.0, 0.01)),
-        ("rough_paint σ0.3", m(SlopeDistribution::Cauchy { sigma: 0.3, q: 2.5 }, 1.55, 0.05, 0.03)),
-        ("asphalt σ0.5", m(SlopeDistribution::Cauchy { sigma: 0.5, q: 2.0 }, 1.6, 0.1, 0.05)),
+        (
+            "smooth_glass σ0.03",
+            m(
+                SlopeDistribution::Cauchy {
+                    sigma: 0.03,
+                    q: 3.0,
+                },
+                2.2,
+                0.1,
+                0.0,
+            ),
+        ),
+        (
+            "paper_paint σ0.1",
+            m(
+                SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
+                1.2,
+                0.2,
+                0.0,
+            ),
+        ),
+        (
+            "anodized σ0.15",
+            m(SlopeDistribution::Gaussian { sigma: 0.15 }, 3.0, 1.0, 0.01),
+        ),
+        (
+            "rough_paint σ0.3",
+            m(
+                SlopeDistribution::Cauchy { sigma: 0.3, q: 2.5 },
+                1.55,
+                0.05,
+                0.03,
+            ),
+        ),
+        (
+            "asphalt σ0.5",
+            m(
+                SlopeDistribution::Cauchy { sigma: 0.5, q: 2.0 },
+                1.6,
+                0.1,
+                0.05,
+            ),
+        ),
     ]
 }
 
@@ -162,9 +207,8 @@ fn reflection_integral_matches_brute_force() {
             let sky = |w: &Vector3<f64>| env.radiance_at_sine(w.dot(&up));
             let reference = brute_force(&pbrdf, theta, sky);
             let specular = specular_kernel(&pbrdf, theta, &quadrature).apply(sky);
-            let diffuse: f64 = diffuse_rule.iter().map(|(w, wt)| wt * sky(w)).sum::<f64>()
-                * pbrdf.rho_d()
-                / PI;
+            let diffuse: f64 =
+                diffuse_rule.iter().map(|(w, wt)| wt * sky(w)).sum::<f64>() * pbrdf.rho_d() / PI;
             let ours = [specular[0] + diffuse, specular[1], specular[2]];
             worst_s0 = worst_s0.max((ours[0] - reference[0]).abs() / reference[0]);
             worst_dolp = worst_dolp.max((dolp(ours) - dolp(reference)).abs());
@@ -213,7 +257,10 @@ fn reflection_tables_match_brute_force() {
             "table {name} {resolution:?}: reflected S0 {worst_reflected:.2e} DoLP {worst_reflected_dolp:.2e}; \
              leaving S0 {worst_s0:.2e} DoLP {worst_dolp:.2e}"
         );
-        assert!(worst_reflected < 5e-3, "{name}: reflected S0 off by {worst_reflected}");
+        assert!(
+            worst_reflected < 5e-3,
+            "{name}: reflected S0 off by {worst_reflected}"
+        );
         assert!(
             worst_reflected_dolp < 2e-3,
             "{name}: reflected DoLP off by {worst_reflected_dolp}"

@@ -9,6 +9,7 @@ use super::shading::dolp_aop;
 use super::tables::TemperatureLookup;
 use super::{StokesImage, BACKGROUND};
 use crate::report::{register_fonts, FONT};
+use crate::scene::config::Shading;
 use crate::scene::Scene;
 use image::ImageEncoder;
 use plotters::prelude::*;
@@ -112,12 +113,14 @@ impl Previews {
             .file_stem()
             .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
         let (lo_um, hi_um) = band.limits_um();
+        let shading = match scene.shading {
+            Shading::Pixel => "per-pixel",
+            Shading::Gouraud => "Gouraud",
+        };
         let caption = format!(
-            "{stem}: {}×{}, {:?} shading, {lo_um}–{hi_um} µm, air {:.2} K",
-            image.width, image.height, scene.shading, scene.air_temperature_k
-        )
-        .replace("Pixel shading", "per-pixel shading")
-        .replace("Gouraud shading", "Gouraud shading");
+            "{stem}: {}×{}, {shading} shading, {lo_um}–{hi_um} µm, air {:.2} K",
+            image.width, image.height, scene.air_temperature_k
+        );
         Previews {
             width: image.width,
             height: image.height,
@@ -180,15 +183,30 @@ impl Previews {
         }
     }
 
-    /// Each panel at full resolution as (file name, PNG bytes).
-    pub fn panels_png(&self) -> io::Result<Vec<(String, Vec<u8>)>> {
-        self.panels
-            .iter()
-            .map(|panel| {
-                let canvas = draw_panel(panel, self.width, self.height, self.width, self.height)?;
-                Ok((panel.file.to_owned(), canvas.png()?))
-            })
-            .collect()
+    /// Number of preview panels.
+    pub fn len(&self) -> usize {
+        self.panels.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.panels.is_empty()
+    }
+
+    /// File name of panel `i` ("S0.png", …).
+    pub fn file_name(&self, i: usize) -> &'static str {
+        self.panels[i].file
+    }
+
+    /// Panel `i` at full resolution, PNG encoded.
+    pub fn panel_png(&self, i: usize) -> io::Result<Vec<u8>> {
+        draw_panel(
+            &self.panels[i],
+            self.width,
+            self.height,
+            self.width,
+            self.height,
+        )?
+        .png()
     }
 
     /// The five panels in a 3 × 2 grid (the sixth cell holds the caption), each image at most
@@ -214,7 +232,10 @@ impl Previews {
         let (w, h) = (sheet.width as u32, sheet.height as u32);
         {
             let root = BitMapBackend::with_buffer(&mut sheet.rgb, (w, h)).into_drawing_area();
-            let title = (FONT, 22.0).into_font().style(FontStyle::Bold).color(&BLACK);
+            let title = (FONT, 22.0)
+                .into_font()
+                .style(FontStyle::Bold)
+                .color(&BLACK);
             root.draw_text(
                 "LWIR polarimetric simulation (Stokes images)",
                 &title.pos(Pos::new(HPos::Center, VPos::Top)),
@@ -319,7 +340,10 @@ fn draw_panel(
     let (w, h) = (width as u32, height as u32);
     {
         let root = BitMapBackend::with_buffer(&mut canvas.rgb, (w, h)).into_drawing_area();
-        let title = (FONT, font * 1.05).into_font().style(FontStyle::Bold).color(&BLACK);
+        let title = (FONT, font * 1.05)
+            .into_font()
+            .style(FontStyle::Bold)
+            .color(&BLACK);
         root.draw_text(
             &panel.title,
             &title.pos(Pos::new(HPos::Left, VPos::Center)),
@@ -348,7 +372,8 @@ fn draw_panel(
             let y = title_h as i32 + ((1.0 - t) * (img_h as f64 - 1.0)).round() as i32;
             root.draw(&PathElement::new(vec![(x, y), (x + 4, y)], BLACK))
                 .map_err(draw_error)?;
-            root.draw_text(&text, &label, (x + 6, y)).map_err(draw_error)?;
+            root.draw_text(&text, &label, (x + 6, y))
+                .map_err(draw_error)?;
         }
         root.draw(&Rectangle::new(
             [

@@ -19,7 +19,7 @@
 //! narrow specular lobe from ~1000 nodes to a few dozen.
 
 use crate::optics::Stokes;
-use crate::pbrdf::{Direction, Pbrdf};
+use crate::pbrdf::{Direction, Pbrdf, SlopeDistribution};
 use gauss_quad::legendre::GaussLegendre;
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -39,9 +39,12 @@ pub struct KernelQuadrature {
     pub first_panel: f64,
     pub growth: f64,
     /// Nodes whose directions fall in the same cube cell of this size (radians) are merged; the
-    /// cells double in size with every doubling of the angle from the specular direction beyond
+    /// cells grow fourfold with every doubling of the angle from the specular direction beyond
     /// a few lobe widths, where the kernel is small and smooth.
     pub merge_cell: f64,
+    /// The finely merged core around the specular direction holds the facets up to this
+    /// quantile of the slope distribution (its mirror angle, at least 4 cells).
+    pub merge_core: f64,
 }
 
 impl Default for KernelQuadrature {
@@ -55,6 +58,7 @@ impl Default for KernelQuadrature {
             first_panel: 0.5,
             growth: 2.0,
             merge_cell: 0.5f64.to_radians(),
+            merge_core: 0.9,
         }
     }
 }
@@ -81,14 +85,18 @@ impl SpecularKernel {
 
     /// Σ_k K_k: the specular directional-hemispherical reflectance (Stokes) of ω_r.
     pub fn total(&self) -> [f64; 3] {
-        self.weights.iter().fold([0.0; 3], |a, k| {
-            [a[0] + k[0], a[1] + k[1], a[2] + k[2]]
-        })
+        self.weights
+            .iter()
+            .fold([0.0; 3], |a, k| [a[0] + k[0], a[1] + k[1], a[2] + k[2]])
     }
 }
 
 /// The specular kernel of `pbrdf` for ω_r = (sinθ_r, 0, cosθ_r), 0 ≤ θ_r < π/2.
-pub fn specular_kernel(pbrdf: &Pbrdf, theta_r: f64, quadrature: &KernelQuadrature) -> SpecularKernel {
+pub fn specular_kernel(
+    pbrdf: &Pbrdf,
+    theta_r: f64,
+    quadrature: &KernelQuadrature,
+) -> SpecularKernel {
     let scattered = Direction::from_angles(theta_r, 0.0);
     let w_r = scattered.vector;
     let (sin_r, cos_r) = theta_r.sin_cos();
@@ -111,7 +119,8 @@ pub fn specular_kernel(pbrdf: &Pbrdf, theta_r: f64, quadrature: &KernelQuadratur
     let arc_rule = unit_rule(quadrature.arc);
 
     let specular = Vector3::new(-sin_r, 0.0, cos_r);
-    let core = (4.0 * distribution.slope_scale()).max(4.0 * quadrature.merge_cell);
+    let core_slope = slope_quantile(pbrdf.distribution(), quadrature.merge_core);
+    let core = (2.0 * core_slope.atan()).max(4.0 * quadrature.merge_cell);
     let mut nodes = NodeMerger::new(quadrature.merge_cell, specular, core);
     let mut add_facet = |u: f64, delta: f64, measure: f64| {
         let (sin_d, cos_d) = delta.sin_cos();
@@ -170,6 +179,18 @@ pub fn specular_kernel(pbrdf: &Pbrdf, theta_r: f64, quadrature: &KernelQuadratur
     nodes.finish()
 }
 
+/// The slope m = tan θ below which a fraction `p` of the facets lie: the inverse CDFs of
+/// DESIGN §1.2, tan²θ = a((1 − p)^(1/(1−q)) − 1) (Cauchy, a = 2σ²) and −2σ² ln(1 − p) (Gaussian).
+pub fn slope_quantile(distribution: SlopeDistribution, p: f64) -> f64 {
+    let tan2 = match distribution {
+        SlopeDistribution::Cauchy { sigma, q } => {
+            2.0 * sigma * sigma * ((1.0 - p).powf(1.0 / (1.0 - q)) - 1.0)
+        }
+        SlopeDistribution::Gaussian { sigma } => -2.0 * sigma * sigma * (1.0 - p).ln(),
+    };
+    tan2.max(0.0).sqrt()
+}
+
 /// Cosine-weighted hemisphere rule (ω, weight) with Σ weight = π: Gauss–Legendre in r² over the
 /// projected disk, trapezoid in azimuth. Times ρ_d/π it is the diffuse kernel.
 pub fn cosine_rule(radial: usize, azimuthal: usize) -> Vec<(Vector3<f64>, f64)> {
@@ -213,7 +234,8 @@ fn panel_edges(first: f64, growth: f64, split: f64, end: f64) -> Vec<f64> {
 
 /// Sums nodes falling in the same cube cell of the unit sphere. Within `core` radians of the
 /// specular direction the cells are `cell` wide; beyond, level ℓ = ⌈log₂(α/core)⌉ cells are
-/// 2^ℓ times wider.
+/// 4^ℓ times wider: each doubling of the distance holds a few cells, whose weights fall off
+/// with the slope density's tail.
 struct NodeMerger {
     cell: f64,
     specular: Vector3<f64>,
@@ -241,7 +263,7 @@ impl NodeMerger {
         } else {
             (angle / self.core).log2().ceil() as i32
         };
-        let cell = self.cell * f64::powi(2.0, level);
+        let cell = self.cell * f64::powi(4.0, level);
         let key = direction.map(|c| (c / cell).floor() as i32);
         let key = [level, key.x, key.y, key.z];
         let i = *self.index_of.entry(key).or_insert_with(|| {
@@ -273,10 +295,25 @@ impl NodeMerger {
 mod tests {
     use super::*;
     use crate::optics::RefractiveIndex;
-    use crate::pbrdf::{HemisphereQuadrature, Shadowing, SlopeDistribution};
+    use crate::pbrdf::{HemisphereQuadrature, Shadowing};
 
     fn material(distribution: SlopeDistribution, shadowing: Shadowing, rho_d: f64) -> Pbrdf {
-        Pbrdf::new(distribution, shadowing, RefractiveIndex::new(1.6, 0.1), rho_d).unwrap()
+        Pbrdf::new(
+            distribution,
+            shadowing,
+            RefractiveIndex::new(1.6, 0.1),
+            rho_d,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn slope_quantiles_invert_the_distributions() {
+        // Cauchy q = 2 is GGX: P(m < x) = x²/(x² + a); Gaussian: 1 − exp(−x²/(2σ²)).
+        let x = slope_quantile(SlopeDistribution::Cauchy { sigma: 0.2, q: 2.0 }, 0.9);
+        assert!((x * x / (x * x + 0.08) - 0.9).abs() < 1e-12);
+        let x = slope_quantile(SlopeDistribution::Gaussian { sigma: 0.2 }, 0.5);
+        assert!((1.0 - (-x * x / 0.08).exp() - 0.5).abs() < 1e-12);
     }
 
     #[test]
@@ -296,10 +333,22 @@ mod tests {
         let quadrature = KernelQuadrature::default();
         let reference = HemisphereQuadrature::fine();
         for (distribution, shadowing) in [
-            (SlopeDistribution::Cauchy { sigma: 0.5, q: 2.0 }, Shadowing::Smith),
-            (SlopeDistribution::Cauchy { sigma: 0.03, q: 3.0 }, Shadowing::Smith),
+            (
+                SlopeDistribution::Cauchy { sigma: 0.5, q: 2.0 },
+                Shadowing::Smith,
+            ),
+            (
+                SlopeDistribution::Cauchy {
+                    sigma: 0.03,
+                    q: 3.0,
+                },
+                Shadowing::Smith,
+            ),
             (SlopeDistribution::Gaussian { sigma: 0.15 }, Shadowing::None),
-            (SlopeDistribution::Gaussian { sigma: 0.1 }, Shadowing::TorranceSparrow),
+            (
+                SlopeDistribution::Gaussian { sigma: 0.1 },
+                Shadowing::TorranceSparrow,
+            ),
         ] {
             let pbrdf = material(distribution, shadowing, 0.0);
             for theta_deg in [0.0f64, 25.0, 60.0, 80.0] {
@@ -308,7 +357,11 @@ mod tests {
                 let exact =
                     pbrdf.reflected_stokes(&Direction::from_angles(theta, 0.0), env, &reference);
                 // Torrance–Sparrow's min() kinks limit both quadratures to ~1e-4 at grazing.
-                let relative = if shadowing == Shadowing::TorranceSparrow { 1e-3 } else { 2e-4 };
+                let relative = if shadowing == Shadowing::TorranceSparrow {
+                    1e-3
+                } else {
+                    2e-4
+                };
                 let tolerance = relative * exact[0];
                 for j in 0..3 {
                     assert!(
@@ -324,7 +377,11 @@ mod tests {
 
     #[test]
     fn merging_shrinks_narrow_lobes_without_changing_the_result() {
-        let smooth = material(SlopeDistribution::Gaussian { sigma: 0.03 }, Shadowing::Smith, 0.0);
+        let smooth = material(
+            SlopeDistribution::Gaussian { sigma: 0.03 },
+            Shadowing::Smith,
+            0.0,
+        );
         let merged = KernelQuadrature {
             merge_cell: 1f64.to_radians(),
             ..KernelQuadrature::default()
@@ -335,7 +392,12 @@ mod tests {
         };
         let a = specular_kernel(&smooth, 0.5, &merged);
         let b = specular_kernel(&smooth, 0.5, &unmerged);
-        assert!(a.directions.len() * 3 < b.directions.len(), "{} vs {}", a.directions.len(), b.directions.len());
+        assert!(
+            a.directions.len() * 3 < b.directions.len(),
+            "{} vs {}",
+            a.directions.len(),
+            b.directions.len()
+        );
         let env = |w: &Vector3<f64>| 10.0 + 3.0 * w.x + 5.0 * (1.0 - w.z).powi(2);
         let (sa, sb) = (a.apply(env), b.apply(env));
         assert!((sa - sb).norm() < 1e-4 * sb[0], "{sa:?} vs {sb:?}");

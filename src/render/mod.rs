@@ -142,7 +142,8 @@ pub fn render(scene: &Scene, progress: bool) -> Result<Rendered, RenderError> {
     let bar = progress_bar(progress, scene);
     let tick = || bar.inc(1);
     let raster_start = Instant::now();
-    let near = 1e-3 * (scene.camera.position.norm().max(1.0));
+    // Near plane: far below any scene detail, far above f64 depth resolution.
+    let near = (1e-5 * mesh_extent(&mesh.positions)).max(1e-9);
     let fragments = rasterize(&scene.camera, &mesh.positions, &mesh.triangles, near, &tick);
     timings.raster = raster_start.elapsed().as_secs_f64();
 
@@ -161,6 +162,22 @@ pub fn render(scene: &Scene, progress: bool) -> Result<Rendered, RenderError> {
         timings,
         table_resolutions: resolutions,
     })
+}
+
+/// Diagonal of the bounding box of the vertices.
+fn mesh_extent(positions: &[nalgebra::Vector3<f64>]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (0..3)
+        .map(|k| (hi[k] - lo[k]).max(0.0).powi(2))
+        .sum::<f64>()
+        .sqrt()
 }
 
 fn progress_bar(progress: bool, scene: &Scene) -> ProgressBar {
@@ -246,21 +263,29 @@ fn shade_image(
                 let [i0, i1, i2] = mesh.triangles[t].map(|v| v as usize);
                 let (b1, b2) = (fragment.b1 as f64, fragment.b2 as f64);
                 let b0 = 1.0 - b1 - b2;
-                let point = mesh.positions[i0] * b0 + mesh.positions[i1] * b1 + mesh.positions[i2] * b2;
+                let point =
+                    mesh.positions[i0] * b0 + mesh.positions[i1] * b1 + mesh.positions[i2] * b2;
                 let mut s = match scene.shading {
                     Shading::Gouraud => {
                         let [a, b, c] = [i0, i1, i2].map(|v| vertex_stokes[v]);
                         [0, 1, 2].map(|j| a[j] * b0 + b[j] * b1 + c[j] * b2)
                     }
                     Shading::Pixel => {
-                        let normal = (mesh.normals[i0] * b0 + mesh.normals[i1] * b1 + mesh.normals[i2] * b2)
-                            .normalize();
+                        let normal =
+                            (mesh.normals[i0] * b0 + mesh.normals[i1] * b1 + mesh.normals[i2] * b2)
+                                .normalize();
                         let geometric = (mesh.positions[i1] - mesh.positions[i0])
                             .cross(&(mesh.positions[i2] - mesh.positions[i0]));
                         let temperature = mesh.temperatures[i0] * b0
                             + mesh.temperatures[i1] * b1
                             + mesh.temperatures[i2] * b2;
-                        shader.shade(triangle_material(t), &point, &normal, &geometric, temperature)
+                        shader.shade(
+                            triangle_material(t),
+                            &point,
+                            &normal,
+                            &geometric,
+                            temperature,
+                        )
                     }
                 };
                 if let (Some(atmosphere), Some(path)) = (&scene.atmosphere, path_radiance) {

@@ -10,6 +10,7 @@ use super::{RenderError, Rendered, StokesImage, Timings, BACKGROUND};
 use crate::material::write_atomically;
 use crate::scene::config::Shading;
 use crate::scene::Scene;
+use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Cursor;
@@ -176,46 +177,49 @@ pub fn write_outputs(
     let write_start = Instant::now();
     let image = &rendered.image;
     let (w, h) = (image.width, image.height);
-    let mut files = Vec::new();
-    let mut put = |name: &str, bytes: Vec<u8>| -> Result<(), RenderError> {
-        let path = out_dir.join(name);
-        write_atomically(&path, &bytes).map_err(|source| RenderError::Write {
-            path: path.clone(),
-            source,
-        })?;
-        files.push(name.to_owned());
-        Ok(())
-    };
-
     let channels: Vec<(Channel, Vec<f32>)> = Channel::ALL
-        .iter()
+        .par_iter()
         .map(|&c| (c, image.channel(c)))
         .collect();
-    for (channel, data) in &channels {
-        let bytes = encode_tiff(w, h, data).map_err(|source| RenderError::Write {
-            path: out_dir.join(format!("{}.tif", channel.name())),
-            source,
-        })?;
-        put(&format!("{}.tif", channel.name()), bytes)?;
-    }
-    let exr = encode_exr(w, h, &channels).map_err(|source| RenderError::Write {
-        path: out_dir.join("stokes.exr"),
-        source,
-    })?;
-    put("stokes.exr", exr)?;
-
     let previews = figure::Previews::new(scene, image);
-    for (name, png) in previews.panels_png().map_err(|source| RenderError::Write {
-        path: out_dir.to_owned(),
-        source,
-    })? {
-        put(&name, png)?;
+
+    // Encode everything in memory, in parallel; write only when every encoding succeeded.
+    enum Job {
+        Tiff(usize),
+        Exr,
+        Panel(usize),
+        Composite,
     }
-    let composite = previews.composite_png().map_err(|source| RenderError::Write {
-        path: out_dir.join("composite.png"),
-        source,
-    })?;
-    put("composite.png", composite)?;
+    let mut jobs: Vec<Job> = (0..channels.len()).map(Job::Tiff).collect();
+    jobs.push(Job::Exr);
+    jobs.extend((0..previews.len()).map(Job::Panel));
+    jobs.push(Job::Composite);
+    let encoded: Vec<(String, Vec<u8>)> = jobs
+        .par_iter()
+        .map(|job| {
+            let (name, bytes) = match job {
+                Job::Tiff(i) => {
+                    let (channel, data) = &channels[*i];
+                    (format!("{}.tif", channel.name()), encode_tiff(w, h, data))
+                }
+                Job::Exr => ("stokes.exr".to_owned(), encode_exr(w, h, &channels)),
+                Job::Panel(i) => (previews.file_name(*i).to_owned(), previews.panel_png(*i)),
+                Job::Composite => ("composite.png".to_owned(), previews.composite_png()),
+            };
+            bytes
+                .map(|b| (name.clone(), b))
+                .map_err(|source| RenderError::Write {
+                    path: out_dir.join(&name),
+                    source,
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    let mut files = Vec::with_capacity(encoded.len() + 1);
+    for (name, bytes) in encoded {
+        let path = out_dir.join(&name);
+        write_atomically(&path, &bytes).map_err(|source| RenderError::Write { path, source })?;
+        files.push(name);
+    }
 
     let summary_stats: Vec<ChannelSummary> = channels
         .iter()
@@ -303,7 +307,7 @@ fn encode_tiff(width: usize, height: usize, data: &[f32]) -> std::io::Result<Vec
     Ok(bytes.into_inner())
 }
 
-/// One OpenEXR layer "stokes" with a 32-bit float channel per [`Channel`], RLE compressed.
+/// One OpenEXR layer "stokes" with a 32-bit float channel per [`Channel`], uncompressed.
 fn encode_exr(
     width: usize,
     height: usize,
@@ -317,7 +321,8 @@ fn encode_exr(
     let layer = Layer::new(
         (width, height),
         LayerAttributes::named("stokes"),
-        Encoding::FAST_LOSSLESS,
+        // Noisy float data does not compress; uncompressed is as small and fastest.
+        Encoding::UNCOMPRESSED,
         AnyChannels::sort(list),
     );
     let mut bytes = Cursor::new(Vec::new());
@@ -363,7 +368,10 @@ mod tests {
             .map(|c| c.name.to_string())
             .collect();
         assert_eq!(names, vec!["DoLP", "S0"]);
-        let s0: Vec<f32> = layer.channel_data.list[1].sample_data.values_as_f32().collect();
+        let s0: Vec<f32> = layer.channel_data.list[1]
+            .sample_data
+            .values_as_f32()
+            .collect();
         assert_eq!(s0, data);
     }
 }

@@ -159,7 +159,11 @@ fn clip_and_project(
 }
 
 /// Inclusive pixel range whose centres may be covered, or None if off screen.
-fn pixel_bounds(tri: &ScreenTriangle, width: usize, height: usize) -> Option<(usize, usize, usize, usize)> {
+fn pixel_bounds(
+    tri: &ScreenTriangle,
+    width: usize,
+    height: usize,
+) -> Option<(usize, usize, usize, usize)> {
     let min = |v: &[f64; 3]| v[0].min(v[1]).min(v[2]);
     let max = |v: &[f64; 3]| v[0].max(v[1]).max(v[2]);
     // Pixel i has its centre at i + ½.
@@ -305,9 +309,8 @@ mod tests {
         assert!(buffer.fragments[16].triangle == NO_TRIANGLE);
         for (i, f) in buffer.fragments.iter().enumerate() {
             if f.triangle != NO_TRIANGLE {
-                let [a, b, c] = [0, 1, 2].map(|k| {
-                    positions[[[0, 1, 2], [0, 2, 3]][f.triangle as usize][k] as usize]
-                });
+                let [a, b, c] = [0, 1, 2]
+                    .map(|k| positions[[[0, 1, 2], [0, 2, 3]][f.triangle as usize][k] as usize]);
                 let p = a * (1.0 - f.b1 as f64 - f.b2 as f64) + b * f.b1 as f64 + c * f.b2 as f64;
                 assert!((p.z + 1.0).abs() < 1e-4 && p.y > -5.0, "pixel {i}: {p:?}");
             }

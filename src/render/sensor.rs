@@ -17,7 +17,12 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 /// Atmospheric transmission and path emission for one pixel at `range` metres.
 #[inline]
-pub fn through_atmosphere(s: [f64; 3], range: f64, atmosphere: &Atmosphere, path_radiance: f64) -> [f64; 3] {
+pub fn through_atmosphere(
+    s: [f64; 3],
+    range: f64,
+    atmosphere: &Atmosphere,
+    path_radiance: f64,
+) -> [f64; 3] {
     let tau = (-atmosphere.extinction_per_m * range).exp();
     [
         tau * s[0] + (1.0 - tau) * path_radiance,
@@ -41,13 +46,10 @@ impl Noise {
         let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
         rng.set_stream(row as u64);
         for s in stokes.iter_mut() {
-            let i = [0.0, FRAC_PI_4, FRAC_PI_2, 3.0 * FRAC_PI_4]
-                .map(|alpha| polarizer(*s, alpha) + self.sigma_polarizer * standard_normal(&mut rng));
-            *s = [
-                0.5 * (i[0] + i[1] + i[2] + i[3]),
-                i[0] - i[2],
-                i[1] - i[3],
-            ];
+            let i = [0.0, FRAC_PI_4, FRAC_PI_2, 3.0 * FRAC_PI_4].map(|alpha| {
+                polarizer(*s, alpha) + self.sigma_polarizer * standard_normal(&mut rng)
+            });
+            *s = [0.5 * (i[0] + i[1] + i[2] + i[3]), i[0] - i[2], i[1] - i[3]];
         }
     }
 }

@@ -96,10 +96,10 @@ pub struct TableResolution {
 
 impl TableResolution {
     /// Finer grids for narrower lobes: the reflected environment changes over an angle ~ the
-    /// lobe width, a few σ radians. Steps of 3° (σ ≤ 0.075) to 6° (σ ≥ 0.15) in tilt and azimuth;
+    /// lobe width, a few σ radians. Steps of 3° (σ ≤ 0.06) to 8° (σ ≥ 0.16) in tilt and azimuth;
     /// in θ_r 61 nodes (2.4° at the normal, 1.2° at grazing) for narrow lobes, 46 otherwise.
     pub fn for_material(pbrdf: &Pbrdf) -> TableResolution {
-        let step_deg = (pbrdf.distribution().sigma() * 40.0).clamp(3.0, 6.0);
+        let step_deg = (pbrdf.distribution().sigma() * 50.0).clamp(3.0, 8.0);
         TableResolution {
             tilt: (180.0 / step_deg).ceil() as usize + 1,
             theta: if step_deg < 4.0 { 61 } else { 46 },
@@ -169,7 +169,9 @@ impl MaterialTables {
             .collect::<Result<Vec<_>, _>>()?;
 
         let (n_theta, n_phi) = (theta.len(), phi.len());
-        let sky = environment.sine_table(4096);
+        // 1024 cells (16 KiB) stay in L1; the window sky is smooth enough for Δu = 1/512.
+        let sky = environment.sine_table(1024);
+        let scale = sky.cells_per_unit;
         let trig: Vec<(f64, f64)> = (0..n_phi).map(|p| phi.value(p).sin_cos()).collect();
         let mut reflection = vec![[0f32; 3]; tilt.len() * n_theta * n_phi];
         reflection
@@ -181,16 +183,22 @@ impl MaterialTables {
                 let kernel = &kernels[k];
                 // ω_r sits at azimuth 0 in the kernel frame and at φ from uphill, so uphill is
                 // at azimuth −φ: up = (sin t cos φ, −sin t sin φ, cos t), and for each node
-                // u = ω·up = z cos t + x sin t cos φ − y sin t sin φ.
+                // u = ω·up = z cos t + x sin t cos φ − y sin t sin φ, here in table cells.
                 let projections: Vec<[f64; 3]> = kernel
                     .directions
                     .iter()
-                    .map(|w| [w.z * cos_t, w.x * sin_t, -w.y * sin_t])
+                    .map(|w| {
+                        [
+                            (w.z * cos_t + 1.0) * scale,
+                            w.x * sin_t * scale,
+                            -w.y * sin_t * scale,
+                        ]
+                    })
                     .collect();
                 for (slot, &(sin_p, cos_p)) in out.iter_mut().zip(&trig) {
                     let mut sum = [0f64; 3];
                     for ([a, b, c], weight) in projections.iter().zip(&kernel.weights) {
-                        let l = sky.radiance(a + b * cos_p + c * sin_p);
+                        let l = sky.at_cell(a + b * cos_p + c * sin_p);
                         sum[0] += weight[0] * l;
                         sum[1] += weight[1] * l;
                         sum[2] += weight[2] * l;
@@ -402,6 +410,9 @@ mod tests {
         };
         let err = MaterialTables::build(&pbrdf, &env, resolution, &KernelQuadrature::default())
             .unwrap_err();
-        assert!(matches!(err, ModelError::ReflectanceAboveOne { .. }), "{err}");
+        assert!(
+            matches!(err, ModelError::ReflectanceAboveOne { .. }),
+            "{err}"
+        );
     }
 }

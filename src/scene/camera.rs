@@ -26,9 +26,7 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Result<Camera, String> {
-        if !(position.iter().chain(look_at.iter()).chain(up_hint.iter()))
-            .all(|c| c.is_finite())
-        {
+        if !(position.iter().chain(look_at.iter()).chain(up_hint.iter())).all(|c| c.is_finite()) {
             return Err("camera position, look_at and up must be finite".into());
         }
         let view = look_at - position;

@@ -370,7 +370,11 @@ fn wheel(b: &mut Builder, x: f64, side: f64) {
         for pair in rings.windows(2) {
             for j in 0..SEGMENTS {
                 let j1 = (j + 1) % SEGMENTS;
-                b.quad([pair[0][j], pair[0][j1], pair[1][j1], pair[1][j]], inside, part);
+                b.quad(
+                    [pair[0][j], pair[0][j1], pair[1][j1], pair[1][j]],
+                    inside,
+                    part,
+                );
             }
         }
     };
@@ -384,7 +388,11 @@ fn wheel(b: &mut Builder, x: f64, side: f64) {
     let hub = b.vertex(centre + Vector3::new(0.0, side * 0.10, 0.0));
     let last = rim_rings.last().cloned().unwrap_or_default();
     for j in 0..SEGMENTS {
-        b.triangle([hub, last[j], last[(j + 1) % SEGMENTS]], centre - outward, "wheels");
+        b.triangle(
+            [hub, last[j], last[(j + 1) % SEGMENTS]],
+            centre - outward,
+            "wheels",
+        );
     }
     let inner_hub = b.vertex(centre - Vector3::new(0.0, side * 0.10, 0.0));
     let first = &tyre_rings[0];
@@ -530,7 +538,10 @@ mod tests {
         let tilt_from_vertical = n.z.asin().to_degrees();
         assert!(n.x > 0.0 && n.y.abs() < 1e-9);
         // A windshield raked ~30° from horizontal has its normal ~60° above the horizon.
-        assert!((55.0..68.0).contains(&tilt_from_vertical), "{tilt_from_vertical}");
+        assert!(
+            (55.0..68.0).contains(&tilt_from_vertical),
+            "{tilt_from_vertical}"
+        );
     }
 
     #[test]

@@ -79,33 +79,38 @@ impl Environment {
                     [self.ground, 0.0]
                 } else {
                     let (a, b) = (self.radiance_at_sine(u0), self.radiance_at_sine(u0 + h));
-                    // Value at u0 and slope per unit u within the cell.
-                    [a, (b - a) / h]
+                    [a, b - a]
                 }
             })
             .collect();
         SineTable {
-            inv_h: 1.0 / h,
-            h,
+            cells_per_unit: 1.0 / h,
             pieces,
         }
     }
 }
 
-/// [`Environment::sine_table`]: per cell, the radiance at its left end and its slope.
+/// [`Environment::sine_table`]: per cell, the radiance at its left end and its increase across
+/// the cell. Lookups take the cell coordinate x = (u + 1)·cells_per_unit, so that callers can fold
+/// the scaling into precomputed coefficients.
 pub struct SineTable {
-    inv_h: f64,
-    h: f64,
+    pub cells_per_unit: f64,
     pieces: Vec<[f64; 2]>,
 }
 
 impl SineTable {
+    /// Radiance at cell coordinate x (clamped to the table).
+    #[inline]
+    pub fn at_cell(&self, x: f64) -> f64 {
+        let i = (x.max(0.0) as usize).min(self.pieces.len() - 1);
+        let [a, rise] = self.pieces[i];
+        a + rise * (x - i as f64)
+    }
+
+    /// Radiance at u = sin(elevation).
     #[inline]
     pub fn radiance(&self, u: f64) -> f64 {
-        let x = (u + 1.0) * self.inv_h;
-        let i = (x.max(0.0) as usize).min(self.pieces.len() - 1);
-        let [a, slope] = self.pieces[i];
-        a + slope * (u + 1.0 - i as f64 * self.h)
+        self.at_cell((u + 1.0) * self.cells_per_unit)
     }
 }
 
@@ -178,9 +183,13 @@ fn validate_sky_table(elevation_deg: &[f64], values: &[f64]) -> Result<(), Strin
         ));
     }
     if elevation_deg[0] != 0.0 || *elevation_deg.last().unwrap_or(&0.0) != 90.0 {
-        return Err("environment.sky.elevation_deg must run from 0 (horizon) to 90 (zenith)".into());
+        return Err(
+            "environment.sky.elevation_deg must run from 0 (horizon) to 90 (zenith)".into(),
+        );
     }
-    if elevation_deg.windows(2).any(|w| !(w[1] > w[0])) {
+    if elevation_deg.iter().any(|e| !e.is_finite())
+        || elevation_deg.windows(2).any(|w| w[1] <= w[0])
+    {
         return Err("environment.sky.elevation_deg must be strictly increasing".into());
     }
     if let Some(v) = values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {

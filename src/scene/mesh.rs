@@ -127,12 +127,8 @@ impl ShadedMesh {
         self.positions.extend(other.positions);
         self.normals.extend(other.normals);
         self.temperatures.extend(other.temperatures);
-        self.triangles.extend(
-            other
-                .triangles
-                .into_iter()
-                .map(|t| t.map(|i| i + offset)),
-        );
+        self.triangles
+            .extend(other.triangles.into_iter().map(|t| t.map(|i| i + offset)));
         self.triangle_surface.extend(other.triangle_surface);
     }
 }
@@ -155,7 +151,10 @@ pub fn shade_mesh(raw: &RawMesh, setup: &ObjectShading) -> Result<ShadedMesh, St
         .iter()
         .map(|p| setup.transform.point(p))
         .collect();
-    if let Some(i) = positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+    if let Some(i) = positions
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+    {
         return Err(format!("vertex {} has a non-finite coordinate", i + 1));
     }
     let face_normals = checked_face_normals(raw, &positions)?;
@@ -191,6 +190,7 @@ fn checked_face_normals(
     raw: &RawMesh,
     positions: &[Vector3<f64>],
 ) -> Result<Vec<Vector3<f64>>, String> {
+    // Positions are finite here (checked by the caller), so the cross products are too.
     let extent = bounding_diagonal(positions);
     // Relative to the mesh size, so that millimetre and kilometre meshes are judged alike.
     let min_double_area = 1e-12 * extent * extent;
@@ -202,7 +202,7 @@ fn checked_face_normals(
             if face.vertices[0] == face.vertices[1]
                 || face.vertices[1] == face.vertices[2]
                 || face.vertices[0] == face.vertices[2]
-                || !(cross.norm() > min_double_area)
+                || cross.norm() <= min_double_area
             {
                 Err(format!(
                     "{}: degenerate triangle (zero area) in part '{}'",
@@ -230,7 +230,10 @@ fn bounding_diagonal(positions: &[Vector3<f64>]) -> f64 {
 }
 
 /// Per raw vertex: the file's temperature, or the average temperature of the parts that use it.
-fn vertex_temperatures(raw: &RawMesh, part_temperature: &[Option<f64>]) -> Result<Vec<f64>, String> {
+fn vertex_temperatures(
+    raw: &RawMesh,
+    part_temperature: &[Option<f64>],
+) -> Result<Vec<f64>, String> {
     if let Some(temperatures) = &raw.vertex_temperatures {
         if let Some(i) = temperatures
             .iter()
@@ -393,7 +396,10 @@ mod tests {
         assert_eq!(t_of(Vector3::new(0.0, 0.0, 0.0)), vec![300.0]);
         assert_eq!(t_of(Vector3::new(1.0, 1.0, 0.0)), vec![320.0]);
         assert_eq!(mesh.triangle_surface, vec![0, 1]);
-        assert!(mesh.normals.iter().all(|n| (n - Vector3::z()).norm() < 1e-12));
+        assert!(mesh
+            .normals
+            .iter()
+            .all(|n| (n - Vector3::z()).norm() < 1e-12));
     }
 
     #[test]
@@ -414,7 +420,10 @@ mod tests {
         assert!(err.contains("face 2") && err.contains("degenerate") && err.contains("'b'"));
         raw.positions[3] = Vector3::new(f64::NAN, 0.5, 0.0);
         let err = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap_err();
-        assert!(err.contains("vertex 4") && err.contains("non-finite"), "{err}");
+        assert!(
+            err.contains("vertex 4") && err.contains("non-finite"),
+            "{err}"
+        );
     }
 
     #[test]

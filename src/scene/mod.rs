@@ -272,7 +272,9 @@ fn build_object(
         if t.is_finite() && t >= 0.0 {
             Ok(t)
         } else {
-            Err(fail(format!("{what}temperature_k = {t} must be finite and ≥ 0")))
+            Err(fail(format!(
+                "{what}temperature_k = {t} must be finite and ≥ 0"
+            )))
         }
     };
     if let Some(t) = object.temperature_k {
@@ -288,7 +290,9 @@ fn build_object(
             continue;
         }
         let settings = object.parts.get(part);
-        let temperature = settings.and_then(|p| p.temperature_k).or(object.temperature_k);
+        let temperature = settings
+            .and_then(|p| p.temperature_k)
+            .or(object.temperature_k);
         if let Some(t) = temperature {
             check_temperature(t, &format!("part '{part}': "))?;
             if has_vertex_temperatures {
@@ -319,7 +323,10 @@ fn build_object(
     }
 
     if !(object.scale.is_finite() && object.scale > 0.0) {
-        return Err(fail(format!("scale = {} must be finite and > 0", object.scale)));
+        return Err(fail(format!(
+            "scale = {} must be finite and > 0",
+            object.scale
+        )));
     }
     if !object
         .translate
@@ -466,7 +473,9 @@ impl MaterialResolver<'_> {
                 return Ok(i);
             }
             let loaded = Material::load(&path).map_err(|e| e.to_string())?;
-            let pbrdf = loaded.pbrdf().map_err(|e| format!("{}: {e}", path.display()))?;
+            let pbrdf = loaded
+                .pbrdf()
+                .map_err(|e| format!("{}: {e}", path.display()))?;
             (
                 key,
                 SceneMaterial {

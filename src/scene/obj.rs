@@ -64,7 +64,9 @@ pub fn parse_obj(text: &str) -> Result<RawMesh, String> {
                 }
                 let with_normals = corners.iter().filter(|c| c.1.is_some()).count();
                 if with_normals != 0 && with_normals != corners.len() {
-                    return Err(at("some corners of the face have normals and some do not".into()));
+                    return Err(at(
+                        "some corners of the face have normals and some do not".into()
+                    ));
                 }
                 let part = *part.get_or_insert_with(|| mesh.part_index("default"));
                 for i in 1..corners.len() - 1 {
@@ -107,9 +109,7 @@ fn parse_corner(field: &str, mesh: &RawMesh) -> Result<(u32, Option<u32>), Strin
     let vertex = resolve_index(pieces.next().unwrap_or(""), mesh.positions.len(), "vertex")?;
     let _texture = pieces.next();
     let normal = match pieces.next() {
-        Some(text) if !text.is_empty() => {
-            Some(resolve_index(text, mesh.normals.len(), "normal")?)
-        }
+        Some(text) if !text.is_empty() => Some(resolve_index(text, mesh.normals.len(), "normal")?),
         _ => None,
     };
     Ok((vertex, normal))
@@ -182,16 +182,28 @@ mod tests {
     #[test]
     fn bad_files_name_the_line() {
         let cases = [
-            ("v 0 0 0\nv 1 0 nan\n", "line 2: vertex 2 has a non-finite coordinate"),
-            ("v 0 0 0\nv 1 0 0\nf 1 2 3\n", "line 3: vertex index 3 is out of range"),
+            (
+                "v 0 0 0\nv 1 0 nan\n",
+                "line 2: vertex 2 has a non-finite coordinate",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nf 1 2 3\n",
+                "line 3: vertex index 3 is out of range",
+            ),
             ("v 0 0\n", "line 1: a vertex needs 3 coordinates"),
             ("v 0 0 x\n", "line 1: 'x' is not a number"),
-            ("v 0 0 0\nbogus 1\n", "line 2: unsupported OBJ statement 'bogus'"),
+            (
+                "v 0 0 0\nbogus 1\n",
+                "line 2: unsupported OBJ statement 'bogus'",
+            ),
             ("v 0 0 0\n", "the mesh has no faces"),
         ];
         for (text, expected) in cases {
             let err = parse_obj(text).unwrap_err();
-            assert!(err.starts_with(expected), "{err:?} should start with {expected:?}");
+            assert!(
+                err.starts_with(expected),
+                "{err:?} should start with {expected:?}"
+            );
         }
     }
 
@@ -202,7 +214,12 @@ mod tests {
         let again = parse_obj(&format_obj(&mesh, "test")).unwrap();
         assert_eq!(again.parts, mesh.parts);
         assert_eq!(again.positions, mesh.positions);
-        let faces = |m: &RawMesh| m.faces.iter().map(|f| (f.vertices, f.part)).collect::<Vec<_>>();
+        let faces = |m: &RawMesh| {
+            m.faces
+                .iter()
+                .map(|f| (f.vertices, f.part))
+                .collect::<Vec<_>>()
+        };
         assert_eq!(faces(&again), faces(&mesh));
     }
 }

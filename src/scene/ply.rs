@@ -29,7 +29,9 @@ pub fn parse_ply(mut bytes: &[u8]) -> Result<RawMesh, String> {
     let has_normals = vertices
         .first()
         .is_some_and(|v| v.contains_key("nx") && v.contains_key("ny") && v.contains_key("nz"));
-    let has_temperature = vertices.first().is_some_and(|v| v.contains_key("temperature"));
+    let has_temperature = vertices
+        .first()
+        .is_some_and(|v| v.contains_key("temperature"));
     let mut temperatures = Vec::new();
     for (i, vertex) in vertices.iter().enumerate() {
         let scalar = |key: &str| -> Result<f64, String> {
@@ -144,7 +146,10 @@ mod tests {
     fn bad_faces_and_values_are_named() {
         let out_of_range = TRIANGLE.replace("4 0 1 3 2", "3 0 1 7");
         let err = parse_ply(out_of_range.as_bytes()).unwrap_err();
-        assert!(err.starts_with("face 1: vertex index 7 is out of range"), "{err}");
+        assert!(
+            err.starts_with("face 1: vertex index 7 is out of range"),
+            "{err}"
+        );
         let nan = TRIANGLE.replace("1 0 0 310", "1 nan 0 310");
         let err = parse_ply(nan.as_bytes()).unwrap_err();
         assert!(err.contains("vertex 2") || err.contains("PLY"), "{err}");

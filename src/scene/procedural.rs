@@ -145,7 +145,10 @@ mod tests {
         }
         // Inscribed polyhedron: slightly below 4πr² = 50.27.
         assert!(area < 16.0 * std::f64::consts::PI && area > 0.98 * 16.0 * std::f64::consts::PI);
-        assert!(mesh.positions.iter().all(|p| (p.norm() - 2.0).abs() < 1e-12));
+        assert!(mesh
+            .positions
+            .iter()
+            .all(|p| (p.norm() - 2.0).abs() < 1e-12));
     }
 
     #[test]

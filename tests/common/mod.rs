@@ -9,10 +9,47 @@ use std::path::Path;
 /// parameters, measurements/README.md) as a material library, standing in for `fits/`.
 pub fn write_truth_library(dir: &Path) {
     let materials = [
-        ("paper_paint", SlopeDistribution::Cauchy { sigma: 0.10, q: 1.8 }, 1.2, 0.2, 0.0, 9.925),
-        ("rough_paint", SlopeDistribution::Cauchy { sigma: 0.30, q: 2.5 }, 1.55, 0.05, 0.03, 9.925),
-        ("smooth_glass", SlopeDistribution::Cauchy { sigma: 0.03, q: 3.0 }, 2.2, 0.1, 0.0, 10.6),
-        ("anodized_panel", SlopeDistribution::Gaussian { sigma: 0.15 }, 3.0, 1.0, 0.01, 9.925),
+        (
+            "paper_paint",
+            SlopeDistribution::Cauchy {
+                sigma: 0.10,
+                q: 1.8,
+            },
+            1.2,
+            0.2,
+            0.0,
+            9.925,
+        ),
+        (
+            "rough_paint",
+            SlopeDistribution::Cauchy {
+                sigma: 0.30,
+                q: 2.5,
+            },
+            1.55,
+            0.05,
+            0.03,
+            9.925,
+        ),
+        (
+            "smooth_glass",
+            SlopeDistribution::Cauchy {
+                sigma: 0.03,
+                q: 3.0,
+            },
+            2.2,
+            0.1,
+            0.0,
+            10.6,
+        ),
+        (
+            "anodized_panel",
+            SlopeDistribution::Gaussian { sigma: 0.15 },
+            3.0,
+            1.0,
+            0.01,
+            9.925,
+        ),
     ];
     for (name, distribution, n, k, rho_d, wavelength_um) in materials {
         let material = Material {
@@ -41,7 +78,10 @@ pub fn car_scene(dir: &Path, width: u32, height: u32, shading: &str) -> std::pat
     std::fs::copy(root.join("scenes/car.obj"), dir.join("scenes/car.obj")).unwrap();
     let text = std::fs::read_to_string(root.join("scenes/car.toml"))
         .unwrap()
-        .replace("resolution = [640, 480]", &format!("resolution = [{width}, {height}]"))
+        .replace(
+            "resolution = [640, 480]",
+            &format!("resolution = [{width}, {height}]"),
+        )
         .replace("shading = \"pixel\"", &format!("shading = \"{shading}\""));
     let path = dir.join("scenes/car.toml");
     std::fs::write(&path, text).unwrap();
