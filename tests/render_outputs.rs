@@ -46,8 +46,10 @@ fn files_hold_the_rendered_channels() {
     }
     // Channel identities (DESIGN §1.6): I0 + I90 = I45 + I135 = S0, I0 − I90 = S1, DoLP, AoP.
     for i in 0..64 * 48 {
-        let [s0, s1, s2, dolp, aop, i0, i45, i90, i135] =
-            [0, 1, 2, 3, 4, 5, 6, 7, 8].map(|c| stacks[c][i] as f64);
+        let pixel: Vec<f64> = stacks.iter().map(|channel| channel[i] as f64).collect();
+        let [s0, s1, s2, dolp, aop, i0, i45, i90, i135] = pixel[..] else {
+            unreachable!("nine channels")
+        };
         assert!((i0 + i90 - s0).abs() < 1e-5 * s0 && (i45 + i135 - s0).abs() < 1e-5 * s0);
         assert!((i0 - i90 - s1).abs() < 1e-4 && (i45 - i135 - s2).abs() < 1e-4);
         assert!((dolp - s1.hypot(s2) / s0).abs() < 1e-6);
@@ -187,11 +189,8 @@ fn atmosphere_blends_toward_path_radiance_with_range() {
     let scene = load_scene(&write_scene(dir.path(), &text)).unwrap();
     let image = render(&scene, false).unwrap().image;
     let path = Band::lwir().radiance(300.0);
-    let normal = nalgebra::Vector3::new(
-        0.0,
-        (-70f64).to_radians().sin() * -1.0,
-        (-70f64).to_radians().cos(),
-    );
+    // The plate's +z normal turned −70° about x.
+    let normal = nalgebra::Vector3::new(0.0, 70f64.to_radians().sin(), 70f64.to_radians().cos());
     let mut ranges = Vec::new();
     for (i, &s) in image.surface.iter().enumerate() {
         if s == BACKGROUND {
