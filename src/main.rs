@@ -6,6 +6,13 @@ use irpol::commands::evaluate::{
     read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
 };
 use irpol::commands::{parse_sweep, ModelArgs};
+use irpol::fit::{
+    fit_files, parse_parameter_list, parse_parameter_values, DistributionKind, FitOptions,
+    FitOutcome, Optimizer, RobustLoss,
+};
+use irpol::pbrdf::Shadowing;
+use irpol::report::fit_report::{rebuild_report, write_fit_report};
+use irpol::report::index::write_library_index;
 use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -58,6 +65,46 @@ enum Command {
         which: String,
         #[arg(long, default_value = "reports")]
         out: PathBuf,
+    },
+    /// Fits pBRDF models to measurement CSVs and writes the material library.
+    Fit {
+        /// Measurement CSVs or folders of them.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// Fit only this distribution (cauchy or gaussian); default: both, keep the preferred.
+        #[arg(long)]
+        distribution: Option<String>,
+        /// Shadowing of the fitted model: none, torrance-sparrow or smith.
+        #[arg(long, default_value = "smith")]
+        shadowing: String,
+        /// Free parameters, e.g. sigma,q,n,k,rho (default: all that are not fixed).
+        #[arg(long)]
+        free: Option<String>,
+        /// Fixed parameter values, e.g. k=0.1,rho=0.
+        #[arg(long)]
+        fix: Option<String>,
+        /// Optimizer stages joined by +: ga, nm, lm (default ga+lm).
+        #[arg(long, default_value = "ga+lm")]
+        optimizer: String,
+        /// Seed of the genetic stage.
+        #[arg(long, default_value_t = FitOptions::default().seed)]
+        seed: u64,
+        /// Robust loss on normalized residuals: huber or cauchy, optionally with a scale (huber:2).
+        #[arg(long)]
+        robust: Option<String>,
+        /// Library folder for the material TOMLs.
+        #[arg(long, default_value = "fits")]
+        out: PathBuf,
+        /// Folder for the fit reports (PNG, SVG) and index.html.
+        #[arg(long, default_value = "reports")]
+        reports: PathBuf,
+    },
+    /// Rebuilds a material's fit report from its library entry and source CSV.
+    Report {
+        /// The material TOML.
+        material: PathBuf,
+        #[arg(long, default_value = "reports")]
+        reports: PathBuf,
     },
     /// A table of the materials in a library folder.
     Library {
@@ -171,9 +218,133 @@ fn run(command: Command) -> anyhow::Result<()> {
                 println!("wrote {}", path.display());
             }
         }
+        Command::Fit {
+            inputs,
+            distribution,
+            shadowing,
+            free,
+            fix,
+            optimizer,
+            seed,
+            robust,
+            out,
+            reports,
+        } => {
+            let options = fit_options(
+                distribution,
+                &shadowing,
+                free,
+                fix,
+                &optimizer,
+                seed,
+                robust,
+            )?;
+            let outcomes = fit_and_summarize(&inputs, &options, &out)?;
+            write_reports(&outcomes, &out, &reports)?;
+        }
+        Command::Report { material, reports } => {
+            for path in rebuild_report(&material, &reports)? {
+                println!("wrote {}", path.display());
+            }
+            let library = material
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            println!(
+                "wrote {}",
+                write_library_index(library, &reports)?.display()
+            );
+        }
         Command::Library { dir } => print_library(&dir)?,
         Command::Demo => demo()?,
     }
+    Ok(())
+}
+
+fn fit_options(
+    distribution: Option<String>,
+    shadowing: &str,
+    free: Option<String>,
+    fix: Option<String>,
+    optimizer: &str,
+    seed: u64,
+    robust: Option<String>,
+) -> anyhow::Result<FitOptions> {
+    let mut options = FitOptions {
+        shadowing: Shadowing::parse(shadowing).ok_or_else(|| {
+            anyhow::anyhow!("unknown shadowing '{shadowing}': use none, torrance-sparrow or smith")
+        })?,
+        optimizer: Optimizer::parse(optimizer).map_err(anyhow::Error::msg)?,
+        seed,
+        ..FitOptions::default()
+    };
+    if let Some(name) = distribution {
+        options.distribution = Some(DistributionKind::parse(&name).ok_or_else(|| {
+            anyhow::anyhow!("unknown distribution '{name}': use cauchy or gaussian")
+        })?);
+    }
+    if let Some(list) = free {
+        options.free = Some(parse_parameter_list(&list).map_err(anyhow::Error::msg)?);
+    }
+    if let Some(values) = fix {
+        options.fixed = parse_parameter_values(&values).map_err(anyhow::Error::msg)?;
+    }
+    if let Some(loss) = robust {
+        options.robust = Some(RobustLoss::parse(&loss).map_err(anyhow::Error::msg)?);
+    }
+    Ok(options)
+}
+
+/// Fits, writes the library entries and prints one line per material.
+fn fit_and_summarize(
+    inputs: &[PathBuf],
+    options: &FitOptions,
+    fits_dir: &Path,
+) -> anyhow::Result<Vec<FitOutcome>> {
+    let outcomes = fit_files(inputs, options, fits_dir, true)?;
+    for outcome in &outcomes {
+        let chosen = &outcome.chosen;
+        let parameters: Vec<String> = chosen
+            .free
+            .iter()
+            .zip(&chosen.values)
+            .map(|(p, v)| match chosen.error(*p) {
+                Some(e) => format!("{}={v:.5}±{e:.1e}", p.name()),
+                None => format!("{}={v:.5}", p.name()),
+            })
+            .collect();
+        let comparison = outcome
+            .comparison
+            .as_ref()
+            .map_or(String::new(), |c| format!("; {}", c.summary()));
+        println!(
+            "{}: {} {} χ²_red={:.3}{comparison} → {}",
+            outcome.material.name,
+            chosen.distribution.name(),
+            parameters.join(" "),
+            chosen.reduced_chi2,
+            fits_dir
+                .join(format!("{}.toml", outcome.material.name))
+                .display()
+        );
+    }
+    Ok(outcomes)
+}
+
+/// A report per fitted material and the library's index page.
+fn write_reports(
+    outcomes: &[FitOutcome],
+    fits_dir: &Path,
+    reports_dir: &Path,
+) -> anyhow::Result<()> {
+    for outcome in outcomes {
+        let paths = write_fit_report(&outcome.material, &outcome.measurement, reports_dir)?;
+        println!("  report {}", paths[0].display());
+    }
+    println!(
+        "  index  {}",
+        write_library_index(fits_dir, reports_dir)?.display()
+    );
     Ok(())
 }
 
@@ -215,8 +386,18 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
 }
 
 fn demo() -> anyhow::Result<()> {
-    let reports = PathBuf::from("reports");
-    println!("irpol demo: the paper's model figures (fitting and rendering steps are added as they land)");
+    let (measurements, fits, reports) = (
+        PathBuf::from("measurements"),
+        PathBuf::from("fits"),
+        PathBuf::from("reports"),
+    );
+    println!(
+        "irpol demo: fit the shipped measurements in {}",
+        measurements.display()
+    );
+    let outcomes = fit_and_summarize(&[measurements], &FitOptions::default(), &fits)?;
+    write_reports(&outcomes, &fits, &reports)?;
+    println!("the paper's model figures:");
     for figure in [PaperFigure::Fig2, PaperFigure::Fig3] {
         for path in write_paper_figure(figure, &reports)? {
             println!("  wrote {}", path.display());

@@ -1,5 +1,55 @@
-//! Fitting pBRDF models to Mueller-matrix measurements (DESIGN §3, `src/fit/`): objective and
-//! parameter transforms, the genetic global stage, the Nelder–Mead polish, uncertainties and
-//! model comparison.
+//! Fitting pBRDF models to Mueller-matrix measurements (DESIGN §3, `src/fit/`; issue 3).
+//!
+//! A [`MeasurementSet`](crate::measure::MeasurementSet) is fitted by weighted least squares over
+//! every Mueller element it holds ([`objective`](Objective)), with the weights from the file's
+//! `u_` columns or a default noise model ([`DEFAULT_M00_RELATIVE_ERROR`]), optionally with a
+//! [`RobustLoss`]. Any subset of σ, q, n, k, ρ_d is free inside bounds ([`parameters`]); the
+//! optimizer is a sequence of stages ([`Optimizer`]): a seeded genetic algorithm over the box
+//! ([`genetic`]), then local polishing by Nelder–Mead and/or Levenberg–Marquardt, with restarts
+//! out of the known traps of this problem (k = 0 is stationary for the linear elements; lobes
+//! pinned at a σ or q bound). The result carries 1-σ errors and correlations from the Jacobian
+//! ([`Uncertainty`]) and, when both slope distributions are fitted, an AIC/BIC comparison
+//! ([`ModelComparison`]).
+//!
+//! Entry points: [`fit_measurement`] for one set, [`fit_files`] for `irpol fit`.
 
+mod comparison;
+mod data;
+mod error;
+mod files;
 pub mod genetic;
+mod global;
+mod levenberg_marquardt;
+mod model_fit;
+mod nelder_mead;
+mod objective;
+mod optimize;
+mod options;
+mod outcome;
+pub mod parameters;
+mod robust;
+mod space;
+mod stages;
+mod uncertainty;
+
+pub use comparison::{aic, bic, ModelComparison};
+pub use data::{
+    ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00,
+};
+pub use error::FitError;
+pub use files::fit_files;
+pub use global::GeneticSettings;
+pub use levenberg_marquardt::LevenbergMarquardtSettings;
+pub use model_fit::ModelFit;
+pub use nelder_mead::NelderMeadSettings;
+pub use objective::{BoxCost, Objective};
+pub use optimize::OptimizerSettings;
+pub use options::{parse_parameter_list, parse_parameter_values, FitOptions};
+pub use outcome::{fit_measurement, FitOutcome};
+pub use parameters::{
+    DistributionKind, Interval, Parameter, ParameterBounds, ParameterValues, SMITH_MIN_Q,
+};
+pub use robust::RobustLoss;
+pub use space::ModelSpace;
+pub use stages::{ConvergenceHistory, Optimizer, Stage, StageHistory};
+pub use uncertainty::Uncertainty;

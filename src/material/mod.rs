@@ -79,9 +79,16 @@ pub struct FitRecord {
     pub uncertainty: BTreeMap<String, f64>,
     /// Correlation matrix of the free parameters, in `free_parameters` order.
     pub correlation: Vec<Vec<f64>>,
-    /// Free parameters the data do not determine (relative uncertainty > 50 % or |ρ| > 0.999).
+    /// Free parameters the data do not determine (no sensitivity, |ρ| > 0.999, or a 1-σ error
+    /// above both 50 % of the value and 1 % of the search interval).
     #[serde(default)]
     pub undetermined: Vec<String>,
+    /// Free parameters resting on a bound of their search interval (e.g. ρ_d = 0).
+    #[serde(default)]
+    pub at_bound: Vec<String>,
+    /// How the slope distribution was chosen when both were fitted (AIC/BIC comparison).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model_choice: Option<String>,
     /// The competing slope distribution's best fit, for model comparison.
     pub alternative: Option<AlternativeFit>,
     /// Best cost after each global-stage generation, then after each local-stage iteration (for the

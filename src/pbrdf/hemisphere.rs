@@ -135,10 +135,28 @@ impl Pbrdf {
         environment: impl Fn(&Vector3<f64>) -> f64,
         quadrature: &HemisphereQuadrature,
     ) -> Stokes {
+        let mut sum = Stokes::zeros();
+        self.visit_reflection_nodes(scattered, quadrature, |w_i, kernel| {
+            sum += kernel * environment(w_i)
+        });
+        sum
+    }
+
+    /// The quadrature of [`Pbrdf::reflected_stokes`] as explicit nodes: calls `visit(ω_i, K)` for
+    /// each incident direction ω_i (local frame) with the Stokes weight K such that
+    /// ∫ F_j0 L cosθ_i dΩ_i ≈ Σ K_j L(ω_i) for any environment L. Callers that integrate many
+    /// environments against one direction (a renderer's tables) keep the nodes instead of
+    /// re-evaluating the pBRDF.
+    pub fn visit_reflection_nodes(
+        &self,
+        scattered: &Direction,
+        quadrature: &HemisphereQuadrature,
+        mut visit: impl FnMut(&Vector3<f64>, Stokes),
+    ) {
         let w_r = scattered.vector;
         let cos_r = w_r.z;
         if cos_r <= 0.0 {
-            return Stokes::zeros();
+            return;
         }
         let sin_r = (1.0 - cos_r * cos_r).max(0.0).sqrt();
         let tangential = scattered.azimuthal_axis;
@@ -162,7 +180,8 @@ impl Pbrdf {
             u_last,
         );
 
-        let mut sum = Stokes::zeros();
+        // The scattered direction's shadowing factor is the same for every facet.
+        let masking_r = self.masking(cos_r);
         let mut add_facet = |u: f64, delta: f64, weight: f64| {
             let (sin_d, cos_d) = delta.sin_cos();
             let sec_h = (1.0 + u * u).sqrt();
@@ -173,9 +192,13 @@ impl Pbrdf {
             if cos_i <= 0.0 {
                 return; // rounding at the horizon cut
             }
-            let g = self
-                .shadowing()
-                .factor(distribution, 1.0 / sec_h, cos_i, cos_r, cos_beta);
+            let g = self.shadowing().factor_with_masking(
+                1.0 / sec_h,
+                cos_i,
+                cos_r,
+                cos_beta,
+                [self.masking(cos_i), masking_r],
+            );
             let fresnel = FresnelFractions::new(cos_beta, permittivity);
             let rs2 = fresnel.s_num.norm_sqr() / fresnel.s_den.norm_sqr();
             let rp2 = fresnel.p_num.norm_sqr() / fresnel.p_den.norm_sqr();
@@ -188,13 +211,16 @@ impl Pbrdf {
             } else {
                 (1.0, 0.0)
             };
-            let f = weight * g * cos_beta * sec_h * environment(&w_i);
+            let f = weight * g * cos_beta * sec_h / cos_r;
             let half_diff = 0.5 * (rs2 - rp2) * f;
-            sum += Stokes::new(
-                0.5 * (rs2 + rp2) * f,
-                cos2 * half_diff,
-                sin2 * half_diff,
-                0.0,
+            visit(
+                &w_i,
+                Stokes::new(
+                    0.5 * (rs2 + rp2) * f,
+                    cos2 * half_diff,
+                    sin2 * half_diff,
+                    0.0,
+                ),
             );
         };
 
@@ -234,17 +260,14 @@ impl Pbrdf {
                 }
             }
         }
-        sum /= cos_r;
-
         if self.rho_d() > 0.0 {
-            let diffuse: f64 = quadrature
-                .diffuse_rule
-                .iter()
-                .map(|(w_i, weight)| weight * environment(w_i))
-                .sum();
-            sum[0] += self.rho_d() * FRAC_1_PI * diffuse;
+            for (w_i, weight) in &quadrature.diffuse_rule {
+                visit(
+                    w_i,
+                    Stokes::new(self.rho_d() * FRAC_1_PI * weight, 0.0, 0.0, 0.0),
+                );
+            }
         }
-        sum
     }
 
     /// Polarized emissivity (ε0, ε1, ε2, ε3) at emission zenith θ_e (radians), in the psps frame of

@@ -14,5 +14,5 @@ pub use distribution::SlopeDistribution;
 pub use error::ModelError;
 pub use geometry::Direction;
 pub use hemisphere::HemisphereQuadrature;
-pub use model::Pbrdf;
+pub use model::{Pbrdf, ScatteringGeometry};
 pub use shadowing::Shadowing;

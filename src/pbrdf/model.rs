@@ -30,8 +30,106 @@ struct FacetReflection {
     rs2: f64,
     rp2: f64,
     cross: Complex64,
+}
+
+/// The cosines of a direction pair and its facet: θ_i, θ_r, facet tilt θ, local incidence β,
+/// with the (unnormalized) facet s axis.
+struct FacetGeometry {
+    cos_i: f64,
+    cos_r: f64,
+    cos_theta: f64,
+    cos_beta: f64,
     /// unit(ω_i × h) up to length: the facet s axis (h × k_in), ⊥ to both propagation directions.
     facet_s: Vector3<f64>,
+}
+
+impl FacetGeometry {
+    /// `None` when either direction is at or below the horizon.
+    #[inline]
+    fn new(incident: &Direction, scattered: &Direction) -> Option<FacetGeometry> {
+        let (w_i, w_r) = (&incident.vector, &scattered.vector);
+        let (cos_i, cos_r) = (w_i.z, w_r.z);
+        if cos_i <= 0.0 || cos_r <= 0.0 {
+            return None;
+        }
+        // Half vector h = (ω_i + ω_r)/|ω_i + ω_r|; cos β = h·ω_i = |ω_i + ω_r|/2 (paper eqs. 1–2 in
+        // vector form, regular at θ = 0 and β = 0).
+        let sum = w_i + w_r;
+        let sum_norm = sum.norm();
+        Some(FacetGeometry {
+            cos_i,
+            cos_r,
+            cos_theta: sum.z / sum_norm,
+            cos_beta: 0.5 * sum_norm,
+            facet_s: w_i.cross(&sum),
+        })
+    }
+
+    /// cos 2η_r, sin 2η_r of the facet frame against the psps frame of the scattered light.
+    /// At exact retroreflection (h ∥ ω_i) the facet plane is undefined and any facet s axis gives
+    /// the same matrix; take the scattered light's own s axis.
+    #[inline]
+    fn scattered_rotation(&self, scattered: &Direction) -> (f64, f64) {
+        if self.facet_s.norm_squared() < 1e-30 {
+            return (1.0, 0.0);
+        }
+        frame_rotation(
+            &self.facet_s,
+            &scattered.outgoing_s_axis(),
+            &scattered.vector,
+        )
+    }
+
+    /// cos 2η_i, sin 2η_i of the facet frame against the psps frame of the incident light:
+    /// k_in = −ω_i, s = −ê_φ(ω_i); the facet s axis h × k_in = ω_i × h.
+    #[inline]
+    fn incident_rotation(&self, incident: &Direction) -> (f64, f64) {
+        if self.facet_s.norm_squared() < 1e-30 {
+            return (1.0, 0.0);
+        }
+        let k_in = -incident.vector;
+        frame_rotation(&self.facet_s, &(-incident.azimuthal_axis), &k_in)
+    }
+}
+
+/// The model-independent part of one (ω_i, ω_r) pair (DESIGN §1.1, §1.3): the cosines of θ_i,
+/// θ_r, the facet tilt θ and the local incidence β, and the rotations (cos 2η, sin 2η) of the
+/// facet s/p frame against the psps frames of the incident and the scattered light. A caller
+/// that evaluates many models on the same directions (a fit) builds it once per pair and calls
+/// [`Pbrdf::mueller_for_geometry`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScatteringGeometry {
+    cos_i: f64,
+    cos_r: f64,
+    cos_theta: f64,
+    cos_beta: f64,
+    incident_rotation: (f64, f64),
+    scattered_rotation: (f64, f64),
+}
+
+impl ScatteringGeometry {
+    /// `None` when either direction is at or below the horizon, where the BRDF is zero.
+    pub fn new(incident: &Direction, scattered: &Direction) -> Option<ScatteringGeometry> {
+        let facet = FacetGeometry::new(incident, scattered)?;
+        Some(ScatteringGeometry {
+            cos_i: facet.cos_i,
+            cos_r: facet.cos_r,
+            cos_theta: facet.cos_theta,
+            cos_beta: facet.cos_beta,
+            incident_rotation: facet.incident_rotation(incident),
+            scattered_rotation: facet.scattered_rotation(scattered),
+        })
+    }
+
+    /// cos θ_i, the argument of the incident direction's [`Pbrdf::masking`].
+    pub fn cos_incident(&self) -> f64 {
+        self.cos_i
+    }
+
+    /// cos θ_r, the argument of the scattered direction's [`Pbrdf::masking`].
+    pub fn cos_scattered(&self) -> f64 {
+        self.cos_r
+    }
 }
 
 impl Pbrdf {
@@ -91,27 +189,17 @@ impl Pbrdf {
         self.shadowing.masking(&self.prepared, cos_theta)
     }
 
-    /// Geometry, distribution, shadowing and Fresnel part shared by the full and fast paths;
-    /// `None` when either direction is at or below the horizon. `masking` holds the
-    /// [`Pbrdf::masking`] factors of ω_i and ω_r, or `None` to compute them here.
+    /// Distribution, shadowing and Fresnel part shared by the full and fast paths. `masking`
+    /// holds the [`Pbrdf::masking`] factors of ω_i and ω_r, or `None` to compute them here.
     #[inline]
     fn facet_reflection(
         &self,
-        incident: &Direction,
-        scattered: &Direction,
+        cos_theta: f64,
+        cos_i: f64,
+        cos_r: f64,
+        cos_beta: f64,
         masking: Option<[f64; 2]>,
-    ) -> Option<FacetReflection> {
-        let (w_i, w_r) = (&incident.vector, &scattered.vector);
-        let (cos_i, cos_r) = (w_i.z, w_r.z);
-        if cos_i <= 0.0 || cos_r <= 0.0 {
-            return None;
-        }
-        // Half vector h = (ω_i + ω_r)/|ω_i + ω_r|; cos β = h·ω_i = |ω_i + ω_r|/2 (paper eqs. 1–2 in
-        // vector form, regular at θ = 0 and β = 0).
-        let sum = w_i + w_r;
-        let sum_norm = sum.norm();
-        let cos_beta = 0.5 * sum_norm;
-        let cos_theta = sum.z / sum_norm;
+    ) -> FacetReflection {
         let pdf = self.prepared.facet_pdf(cos_theta);
         let g = match masking {
             Some(masking) => self
@@ -124,30 +212,21 @@ impl Pbrdf {
         let scale = pdf * g / (4.0 * cos_theta * cos_i * cos_r);
         let (rs2, rp2, cross) =
             FresnelFractions::new(cos_beta, self.permittivity).reflectances_and_cross();
-        Some(FacetReflection {
+        FacetReflection {
             scale,
             rs2,
             rp2,
             cross,
-            facet_s: w_i.cross(&sum),
-        })
-    }
-
-    /// cos 2η_r, sin 2η_r of the facet frame against the psps frame of the scattered light.
-    /// At exact retroreflection (h ∥ ω_i) the facet plane is undefined and any facet s axis gives
-    /// the same matrix; take the scattered light's own s axis.
-    #[inline]
-    fn scattered_rotation(facet_s: &Vector3<f64>, scattered: &Direction) -> (f64, f64) {
-        if facet_s.norm_squared() < 1e-30 {
-            return (1.0, 0.0);
         }
-        frame_rotation(facet_s, &scattered.outgoing_s_axis(), &scattered.vector)
     }
 
     /// The full 4×4 Mueller BRDF (sr⁻¹) from `incident` (ω_i, toward the source) to `scattered`
     /// (ω_r, toward the viewer), in the psps frames of both (DESIGN §1.3). Zero below the horizon.
     pub fn mueller(&self, incident: &Direction, scattered: &Direction) -> Mueller {
-        self.mueller_from(incident, scattered, None)
+        match ScatteringGeometry::new(incident, scattered) {
+            Some(geometry) => self.mueller_at(&geometry, None),
+            None => Mueller::zeros(),
+        }
     }
 
     /// [`Pbrdf::mueller`] with the per-direction shadowing factors supplied by the caller:
@@ -159,27 +238,34 @@ impl Pbrdf {
         masking_i: f64,
         masking_r: f64,
     ) -> Mueller {
-        self.mueller_from(incident, scattered, Some([masking_i, masking_r]))
+        match ScatteringGeometry::new(incident, scattered) {
+            Some(geometry) => self.mueller_at(&geometry, Some([masking_i, masking_r])),
+            None => Mueller::zeros(),
+        }
+    }
+
+    /// [`Pbrdf::mueller_with_masking`] on a precomputed [`ScatteringGeometry`].
+    #[inline]
+    pub fn mueller_for_geometry(
+        &self,
+        geometry: &ScatteringGeometry,
+        masking_i: f64,
+        masking_r: f64,
+    ) -> Mueller {
+        self.mueller_at(geometry, Some([masking_i, masking_r]))
     }
 
     #[inline]
-    fn mueller_from(
-        &self,
-        incident: &Direction,
-        scattered: &Direction,
-        masking: Option<[f64; 2]>,
-    ) -> Mueller {
-        let Some(facet) = self.facet_reflection(incident, scattered, masking) else {
-            return Mueller::zeros();
-        };
-        // Incident frame: k_in = −ω_i, s = −ê_φ(ω_i); the facet s axis h × k_in = ω_i × h.
-        let (ci, si) = if facet.facet_s.norm_squared() < 1e-30 {
-            (1.0, 0.0)
-        } else {
-            let k_in = -incident.vector;
-            frame_rotation(&facet.facet_s, &(-incident.azimuthal_axis), &k_in)
-        };
-        let (cr, sr) = Self::scattered_rotation(&facet.facet_s, scattered);
+    fn mueller_at(&self, geometry: &ScatteringGeometry, masking: Option<[f64; 2]>) -> Mueller {
+        let facet = self.facet_reflection(
+            geometry.cos_theta,
+            geometry.cos_i,
+            geometry.cos_r,
+            geometry.cos_beta,
+            masking,
+        );
+        let (ci, si) = geometry.incident_rotation;
+        let (cr, sr) = geometry.scattered_rotation;
         let (a, b) = (0.5 * (facet.rs2 + facet.rp2), 0.5 * (facet.rs2 - facet.rp2));
         let (c, s) = (facet.cross.re, facet.cross.im);
         // L(−η_r) F_fres L(η_i) multiplied out (DESIGN §1.3).
@@ -209,12 +295,66 @@ impl Pbrdf {
     /// thermal scenes need. Skips the incident-frame rotation: (A, cos2η_r B, sin2η_r B, 0).
     #[inline]
     pub fn first_column(&self, incident: &Direction, scattered: &Direction) -> Stokes {
-        let Some(facet) = self.facet_reflection(incident, scattered, None) else {
+        let Some(geometry) = FacetGeometry::new(incident, scattered) else {
             return Stokes::zeros();
         };
-        let (cr, sr) = Self::scattered_rotation(&facet.facet_s, scattered);
+        let facet = self.facet_reflection(
+            geometry.cos_theta,
+            geometry.cos_i,
+            geometry.cos_r,
+            geometry.cos_beta,
+            None,
+        );
+        let (cr, sr) = geometry.scattered_rotation(scattered);
         let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
         let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
         Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cached paths (precomputed geometry, caller-supplied masking) give the same matrix as
+    /// the direct one, for every shadowing and at the pole and retroreflection special cases.
+    #[test]
+    fn precomputed_geometry_and_masking_reproduce_mueller() {
+        for shadowing in [
+            Shadowing::None,
+            Shadowing::TorranceSparrow,
+            Shadowing::Smith,
+        ] {
+            let model = Pbrdf::new(
+                SlopeDistribution::Cauchy { sigma: 0.2, q: 2.3 },
+                shadowing,
+                RefractiveIndex::new(1.5, 0.3),
+                0.02,
+            )
+            .unwrap();
+            for (i, r) in [
+                ((0.5, 0.0), (0.9, 2.5)),
+                ((0.0, 0.3), (0.7, 3.0)),
+                ((0.6, 1.0), (0.6, 1.0)),
+            ] {
+                let incident = Direction::from_angles(i.0, i.1);
+                let scattered = Direction::from_angles(r.0, r.1);
+                let direct = model.mueller(&incident, &scattered);
+                let geometry = ScatteringGeometry::new(&incident, &scattered).unwrap();
+                let cached = model.mueller_for_geometry(
+                    &geometry,
+                    model.masking(geometry.cos_incident()),
+                    model.masking(geometry.cos_scattered()),
+                );
+                assert!(
+                    (direct - cached).abs().max() <= 1e-15 * direct.abs().max(),
+                    "{shadowing:?} {i:?} {r:?}"
+                );
+                let first = model.first_column(&incident, &scattered);
+                assert!((direct.column(0) - first).abs().max() <= 1e-15 * direct.abs().max());
+            }
+        }
+        let below = Direction::from_angles(1.7, 0.0);
+        assert!(ScatteringGeometry::new(&below, &Direction::from_angles(0.3, 0.0)).is_none());
     }
 }

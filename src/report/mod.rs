@@ -2,6 +2,8 @@
 //! index. Plot text uses the DejaVu Sans font embedded in the binary, so figures render on a machine
 //! without any system fonts.
 
+pub mod fit_report;
+pub mod index;
 pub mod paper_figures;
 
 use std::sync::Once;
@@ -36,4 +38,25 @@ pub enum ReportError {
     },
     #[error(transparent)]
     Model(#[from] crate::pbrdf::ModelError),
+    #[error(transparent)]
+    Material(#[from] crate::material::MaterialError),
+    #[error(transparent)]
+    Measure(#[from] crate::measure::MeasureError),
+    #[error("{material}: the material has no fit record, so there is no measurement to report against (fit it with `irpol fit`)")]
+    NoFit { material: std::path::PathBuf },
+    #[error("{material}: its source CSV {csv} is missing (looked for {tried})")]
+    SourceMissing {
+        material: std::path::PathBuf,
+        csv: std::path::PathBuf,
+        tried: String,
+    },
+    #[error("{csv}: source CSV changed since the fit: sha256 {actual} ≠ {recorded} recorded in {material}; refit it with `irpol fit`")]
+    SourceChanged {
+        csv: std::path::PathBuf,
+        actual: String,
+        recorded: String,
+        material: std::path::PathBuf,
+    },
+    #[error("material name '{name}' cannot name a report file: it must be a plain file name without folders")]
+    MaterialName { name: String },
 }

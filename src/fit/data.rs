@@ -1,0 +1,175 @@
+//! A measurement prepared for fast repeated model evaluation: the model-independent scattering
+//! geometry of every point built once, the per-direction shadowing factors shared between points
+//! with the same zenith angle, and one standard deviation per observation (the weights of the
+//! least-squares objective).
+
+use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
+use crate::pbrdf::{Direction, ScatteringGeometry};
+
+use super::FitError;
+
+/// Default noise model when a file has no `u_` column for an element: a relative 3 % on m00 and
+/// 1 % of m00 on every other element, the typical performance of a rotating-retarder Mueller
+/// polarimeter (the polarization elements' error scales with the signal, not with themselves).
+pub const DEFAULT_M00_RELATIVE_ERROR: f64 = 0.03;
+/// See [`DEFAULT_M00_RELATIVE_ERROR`].
+pub const DEFAULT_OTHER_ERROR_PER_M00: f64 = 0.01;
+/// Floor of a default standard deviation, relative to the largest m00 of the file, so that a
+/// point with m00 = 0 does not get an infinite weight.
+const DEFAULT_ERROR_FLOOR: f64 = 1e-6;
+
+/// Where a standard deviation came from, per element of the set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ErrorSource {
+    /// The file's `u_` column.
+    File,
+    /// The default noise model ([`DEFAULT_M00_RELATIVE_ERROR`]).
+    DefaultModel,
+}
+
+/// One measured geometry, and its zenith angles' positions in
+/// [`MeasurementData::zenith_cosines`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PreparedGeometry {
+    pub scattering: ScatteringGeometry,
+    pub incident_zenith: usize,
+    pub scattered_zenith: usize,
+}
+
+/// The measurement in the form the objective consumes.
+#[derive(Clone, Debug)]
+pub struct MeasurementData {
+    pub(crate) geometry: Vec<PreparedGeometry>,
+    /// Distinct cos θ of all incident and scattered directions.
+    pub(crate) zenith_cosines: Vec<f64>,
+    /// Mueller (row, column) of each element present.
+    pub(crate) elements: Vec<(usize, usize)>,
+    /// Measured values, point-major (`point * elements.len() + element`).
+    pub(crate) values: Vec<f64>,
+    /// 1 / standard deviation, aligned with `values`.
+    pub(crate) inverse_sigma: Vec<f64>,
+    error_sources: Vec<ErrorSource>,
+}
+
+impl MeasurementData {
+    pub fn new(set: &MeasurementSet) -> Result<MeasurementData, FitError> {
+        let bad = |message: String| FitError::Measurement {
+            file: set.source.clone(),
+            message,
+        };
+        if set.points.is_empty() {
+            return Err(bad("the file has no data rows".into()));
+        }
+        if set.elements.first() != Some(&0) {
+            return Err(bad("the set has no m00 (it must come first)".into()));
+        }
+        if let Some(&e) = set.elements.iter().find(|&&e| e >= 16) {
+            return Err(bad(format!(
+                "Mueller index {e} is not an element of a 4×4 matrix"
+            )));
+        }
+        let width = set.elements.len();
+        let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
+        let floor = DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE);
+
+        let mut zenith_cosines: Vec<f64> = Vec::new();
+        let mut zenith_index = |cos: f64| -> usize {
+            match zenith_cosines.iter().position(|&c| c == cos) {
+                Some(i) => i,
+                None => {
+                    zenith_cosines.push(cos);
+                    zenith_cosines.len() - 1
+                }
+            }
+        };
+        let mut geometry = Vec::with_capacity(set.points.len());
+        let mut values = Vec::with_capacity(set.points.len() * width);
+        let mut inverse_sigma = Vec::with_capacity(set.points.len() * width);
+        for point in &set.points {
+            let at_line = |what: String| bad(format!("line {}: {what}", point.line));
+            if point.values.len() != width || point.uncertainties.len() != width {
+                return Err(at_line(format!(
+                    "{} values for {width} elements",
+                    point.values.len()
+                )));
+            }
+            let incident =
+                Direction::from_degrees_checked("theta_i_deg", point.theta_i_deg, point.phi_i_deg)
+                    .map_err(|e| at_line(e.to_string()))?;
+            let scattered =
+                Direction::from_degrees_checked("theta_r_deg", point.theta_r_deg, point.phi_r_deg)
+                    .map_err(|e| at_line(e.to_string()))?;
+            let scattering = ScatteringGeometry::new(&incident, &scattered)
+                .ok_or_else(|| at_line("a direction lies on the horizon".into()))?;
+            geometry.push(PreparedGeometry {
+                scattering,
+                incident_zenith: zenith_index(scattering.cos_incident()),
+                scattered_zenith: zenith_index(scattering.cos_scattered()),
+            });
+            let m00 = point.values[0];
+            for (column, (&value, uncertainty)) in
+                point.values.iter().zip(&point.uncertainties).enumerate()
+            {
+                let sigma = match uncertainty {
+                    Some(u) => *u,
+                    None if column == 0 => (DEFAULT_M00_RELATIVE_ERROR * m00).max(floor),
+                    None => (DEFAULT_OTHER_ERROR_PER_M00 * m00).max(floor),
+                };
+                if !(value.is_finite() && sigma.is_finite() && sigma > 0.0) {
+                    return Err(at_line(format!(
+                        "{} = {value} ± {sigma} is not a usable observation",
+                        MUELLER_ELEMENT_NAMES[set.elements[column]]
+                    )));
+                }
+                values.push(value);
+                inverse_sigma.push(1.0 / sigma);
+            }
+        }
+        let error_sources = set.points[0]
+            .uncertainties
+            .iter()
+            .map(|u| match u {
+                Some(_) => ErrorSource::File,
+                None => ErrorSource::DefaultModel,
+            })
+            .collect();
+        Ok(MeasurementData {
+            geometry,
+            zenith_cosines,
+            elements: set.elements.iter().map(|&e| (e / 4, e % 4)).collect(),
+            values,
+            inverse_sigma,
+            error_sources,
+        })
+    }
+
+    pub fn points(&self) -> usize {
+        self.geometry.len()
+    }
+    /// Number of observations (points × elements): the size of the residual vector.
+    pub fn observations(&self) -> usize {
+        self.values.len()
+    }
+    /// Whether any element of the fourth row or column (circular polarization) is measured:
+    /// they carry Im(r_s* r_p), which is odd in k, so k = 0 is then not a stationary point.
+    pub fn has_circular(&self) -> bool {
+        self.elements
+            .iter()
+            .any(|&(row, column)| row == 3 || column == 3)
+    }
+    /// Number of distinct zenith angles (shadowing factors per model evaluation).
+    pub fn zenith_count(&self) -> usize {
+        self.zenith_cosines.len()
+    }
+    pub fn element_count(&self) -> usize {
+        self.elements.len()
+    }
+    /// Where each element's standard deviations came from, aligned with the set's elements.
+    pub fn error_sources(&self) -> &[ErrorSource] {
+        &self.error_sources
+    }
+    /// Measured value and standard deviation of observation `index` (point-major).
+    pub fn observation(&self, index: usize) -> (f64, f64) {
+        (self.values[index], 1.0 / self.inverse_sigma[index])
+    }
+}

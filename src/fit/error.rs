@@ -1,0 +1,35 @@
+//! Why a fit is refused or fails.
+
+use crate::material::MaterialError;
+use crate::measure::MeasureError;
+use std::path::PathBuf;
+
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    /// A measurement file could not be read or is malformed (`file:line:column: …`).
+    #[error(transparent)]
+    Read(#[from] MeasureError),
+    /// A measurement set that cannot be fitted.
+    #[error("{}: {message}", file.display())]
+    Measurement { file: PathBuf, message: String },
+    /// Inconsistent or invalid fit options.
+    #[error("invalid fit options: {0}")]
+    Options(String),
+    /// Two inputs would write the same library entry.
+    #[error("{} and {} both hold material '{material}' and would both write {}", first.display(), second.display(), target.display())]
+    DuplicateMaterial {
+        material: String,
+        first: PathBuf,
+        second: PathBuf,
+        target: PathBuf,
+    },
+    /// An optimizer failed (a bug or a degenerate problem, not bad input).
+    #[error("{}: the {stage} stage failed: {message}", file.display())]
+    Optimizer {
+        file: PathBuf,
+        stage: String,
+        message: String,
+    },
+    #[error(transparent)]
+    Material(#[from] MaterialError),
+}

@@ -1,0 +1,107 @@
+//! `irpol fit` on files: read and validate every input first, fit them all, then write
+//! `fits/<material>.toml` for each (atomically), so a bad input leaves the library untouched.
+
+use super::data::MeasurementData;
+use super::options::FitOptions;
+use super::outcome::{fit_measurement, FitOutcome};
+use super::space::ModelSpace;
+use super::FitError;
+use crate::measure::{collect_measurement_files, read_measurement_csv, MeasurementSet};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::collections::BTreeMap;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+/// Fits every measurement CSV among `inputs` (files, or folders of `*.csv`) and writes each
+/// chosen model to `fits_dir/<material>.toml` with [`crate::material::Material::save`].
+///
+/// Nothing is written unless every input reads, validates and fits: malformed files, options
+/// that make no valid model, and two files of the same material are refused up front. A
+/// progress bar is drawn on stderr when `progress` is set and stderr is a terminal.
+pub fn fit_files(
+    inputs: &[PathBuf],
+    options: &FitOptions,
+    fits_dir: &Path,
+    progress: bool,
+) -> Result<Vec<FitOutcome>, FitError> {
+    let sets = read_all(inputs)?;
+    validate_options(options)?;
+    check_unique_materials(&sets, fits_dir)?;
+
+    let bar = (progress && std::io::stderr().is_terminal()).then(|| {
+        let bar = ProgressBar::new(sets.len() as u64);
+        bar.set_style(
+            ProgressStyle::with_template("fitting {bar:30} {pos}/{len} {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let mut outcomes = Vec::with_capacity(sets.len());
+    for set in &sets {
+        if let Some(bar) = &bar {
+            bar.set_message(set.material.clone());
+        }
+        let outcome = fit_measurement(set, options);
+        if let Some(bar) = &bar {
+            bar.inc(1);
+        }
+        outcomes.push(outcome.inspect_err(|_| {
+            if let Some(bar) = &bar {
+                bar.abandon();
+            }
+        })?);
+    }
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    for outcome in &outcomes {
+        let path = fits_dir.join(format!("{}.toml", outcome.material.name));
+        outcome.material.save(&path)?;
+    }
+    Ok(outcomes)
+}
+
+/// Reads every input and checks that each set can be fitted, before any fitting starts.
+fn read_all(inputs: &[PathBuf]) -> Result<Vec<MeasurementSet>, FitError> {
+    if inputs.is_empty() {
+        return Err(FitError::Options("no measurement file given".into()));
+    }
+    let files = collect_measurement_files(inputs)?;
+    let mut sets = Vec::with_capacity(files.len());
+    for file in &files {
+        let set = read_measurement_csv(file)?;
+        MeasurementData::new(&set)?;
+        sets.push(set);
+    }
+    Ok(sets)
+}
+
+/// Builds the model spaces the options ask for, which checks bounds, free and fixed values.
+fn validate_options(options: &FitOptions) -> Result<(), FitError> {
+    let free = options.free_parameters()?;
+    for kind in options.distributions() {
+        ModelSpace::new(
+            kind,
+            options.shadowing,
+            &free,
+            options.base_values(),
+            &options.bounds,
+        )?;
+    }
+    Ok(())
+}
+
+fn check_unique_materials(sets: &[MeasurementSet], fits_dir: &Path) -> Result<(), FitError> {
+    let mut seen: BTreeMap<&str, &Path> = BTreeMap::new();
+    for set in sets {
+        if let Some(first) = seen.insert(&set.material, &set.source) {
+            return Err(FitError::DuplicateMaterial {
+                material: set.material.clone(),
+                first: first.to_owned(),
+                second: set.source.clone(),
+                target: fits_dir.join(format!("{}.toml", set.material)),
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,203 @@
+//! One model family fitted to one measurement: optimization, goodness of fit and uncertainties.
+
+use super::comparison::{aic, bic};
+use super::data::MeasurementData;
+use super::objective::Objective;
+use super::optimize::minimize;
+use super::options::FitOptions;
+use super::parameters::{DistributionKind, Parameter, ParameterValues};
+use super::space::ModelSpace;
+use super::stages::ConvergenceHistory;
+use super::uncertainty::{estimate, Uncertainty};
+use super::FitError;
+use crate::material::ModelSpec;
+use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
+use crate::optics::Mueller;
+use std::collections::BTreeMap;
+
+/// The best fit of one slope distribution, with everything a report needs.
+#[derive(Clone, Debug)]
+pub struct ModelFit {
+    pub distribution: DistributionKind,
+    /// The fitted model (fixed parameters included).
+    pub model: ModelSpec,
+    /// Free parameters in canonical order, and their fitted values.
+    pub free: Vec<Parameter>,
+    pub values: Vec<f64>,
+    /// The minimized cost: χ², or Σρ(r) with a robust loss.
+    pub cost: f64,
+    /// Σ r² of the normalized residuals (= `cost` without a robust loss).
+    pub chi2: f64,
+    pub observations: usize,
+    pub degrees_of_freedom: usize,
+    pub reduced_chi2: f64,
+    pub aic: f64,
+    pub bic: f64,
+    /// Root-mean-square residual (sr⁻¹) per measured element, by name (`m00`, …).
+    pub rmse: BTreeMap<String, f64>,
+    pub uncertainty: Uncertainty,
+    pub history: ConvergenceHistory,
+    /// Model evaluations, all stages and the uncertainty estimate included.
+    pub evaluations: u64,
+    /// The model's full Mueller matrix (sr⁻¹) at every measured point, in file order.
+    pub model_muellers: Vec<Mueller>,
+    /// Normalized residuals (model − data)/σ, point-major, aligned with the set's elements.
+    pub normalized_residuals: Vec<f64>,
+}
+
+impl ModelFit {
+    /// The fitted value of `parameter` (free or fixed).
+    pub fn value(&self, parameter: Parameter) -> f64 {
+        match parameter {
+            Parameter::Sigma => self.model.distribution.sigma(),
+            Parameter::Q => match self.model.distribution {
+                crate::pbrdf::SlopeDistribution::Cauchy { q, .. } => q,
+                crate::pbrdf::SlopeDistribution::Gaussian { .. } => f64::NAN,
+            },
+            Parameter::N => self.model.n,
+            Parameter::K => self.model.k,
+            Parameter::RhoD => self.model.rho_d,
+        }
+    }
+
+    /// The 1-σ error of a free parameter.
+    pub fn error(&self, parameter: Parameter) -> Option<f64> {
+        let i = self
+            .uncertainty
+            .parameters
+            .iter()
+            .position(|&p| p == parameter)?;
+        Some(self.uncertainty.errors[i])
+    }
+
+    /// The model value of element `element` (a position in the set's `elements`) at `point`.
+    pub fn model_value(&self, set: &MeasurementSet, point: usize, element: usize) -> f64 {
+        let index = set.elements[element];
+        self.model_muellers[point][(index / 4, index % 4)]
+    }
+}
+
+/// The starting point of the first stage: the given start or [`Parameter::starting_value`] for
+/// the free parameters, the fixed values for the others.
+fn starting_values(space: &ModelSpace, options: &FitOptions) -> Result<ParameterValues, FitError> {
+    let mut values = options.base_values();
+    for &p in space.free() {
+        let start = match options.start.get(&p) {
+            Some(&value) => {
+                let interval = space.bounds().get(p);
+                if !interval.contains(value) {
+                    return Err(FitError::Options(format!(
+                        "the start value {p} = {value} is outside its bounds [{}, {}]",
+                        interval.lower, interval.upper
+                    )));
+                }
+                value
+            }
+            None => p.starting_value(),
+        };
+        values.set(p, start);
+    }
+    Ok(values)
+}
+
+/// Fits the `kind` family to a prepared measurement.
+pub(crate) fn fit_model(
+    set: &MeasurementSet,
+    data: &MeasurementData,
+    kind: DistributionKind,
+    options: &FitOptions,
+) -> Result<ModelFit, FitError> {
+    let space = ModelSpace::new(
+        kind,
+        options.shadowing,
+        &options.free_parameters()?,
+        options.base_values(),
+        &options.bounds,
+    )?;
+    let observations = data.observations();
+    if observations <= space.dimension() {
+        return Err(FitError::Measurement {
+            file: set.source.clone(),
+            message: format!(
+                "{observations} observations cannot determine {} free parameters",
+                space.dimension()
+            ),
+        });
+    }
+    let objective = Objective::new(data, &space, options.robust);
+    let start = space.search(&starting_values(&space, options)?);
+    let (best, history) = minimize(
+        &objective,
+        &options.optimizer,
+        &start,
+        options.seed,
+        &options.settings,
+    )
+    .map_err(|(stage, error)| FitError::Optimizer {
+        file: set.source.clone(),
+        stage: stage.to_string(),
+        message: error.to_string(),
+    })?;
+    let values = space.values(&best);
+    let invalid = |what: &str| FitError::Optimizer {
+        file: set.source.clone(),
+        stage: "final".into(),
+        message: format!("the best {kind} model could not be evaluated ({what})"),
+    };
+    let residuals = objective
+        .normalized_residuals(&values)
+        .ok_or_else(|| invalid("residuals"))?;
+    let model_muellers = objective
+        .model_muellers(&values)
+        .ok_or_else(|| invalid("Mueller matrices"))?;
+    let chi2: f64 = residuals.iter().map(|r| r * r).sum();
+    let free_count = space.dimension();
+    let degrees_of_freedom = observations - free_count;
+    let reduced_chi2 = chi2 / degrees_of_freedom as f64;
+    let uncertainty = estimate(&objective, &best, reduced_chi2);
+    Ok(ModelFit {
+        distribution: kind,
+        model: space.model_spec(&values, set.wavelength_um),
+        free: space.free().to_vec(),
+        values: space.free_values(&values),
+        cost: objective.cost(&best),
+        chi2,
+        observations,
+        degrees_of_freedom,
+        reduced_chi2,
+        aic: aic(chi2, free_count),
+        bic: bic(chi2, free_count, observations),
+        rmse: rmse_per_element(set, data, &residuals),
+        uncertainty,
+        history,
+        evaluations: objective.evaluations(),
+        model_muellers,
+        normalized_residuals: residuals,
+    })
+}
+
+/// RMS of (model − data) in sr⁻¹ per element, from the normalized residuals and the σ's.
+fn rmse_per_element(
+    set: &MeasurementSet,
+    data: &MeasurementData,
+    residuals: &[f64],
+) -> BTreeMap<String, f64> {
+    let width = set.elements.len();
+    set.elements
+        .iter()
+        .enumerate()
+        .map(|(e, &index)| {
+            let sum: f64 = (0..data.points())
+                .map(|p| {
+                    let i = p * width + e;
+                    let (_, sigma) = data.observation(i);
+                    (residuals[i] * sigma).powi(2)
+                })
+                .sum();
+            (
+                MUELLER_ELEMENT_NAMES[index].to_owned(),
+                (sum / data.points() as f64).sqrt(),
+            )
+        })
+        .collect()
+}

@@ -1,0 +1,247 @@
+//! Runs an [`Optimizer`]'s stages in order, each from the previous stage's best point.
+
+use super::global::{genetic, GeneticSettings};
+use super::levenberg_marquardt::{levenberg_marquardt, LevenbergMarquardtSettings};
+use super::nelder_mead::{nelder_mead, NelderMeadSettings};
+use super::objective::Objective;
+use super::parameters::Parameter;
+use super::stages::{ConvergenceHistory, Optimizer, Stage};
+use rayon::prelude::*;
+
+/// Settings of every stage (the defaults suit the 3–5 parameter fits of issue 3).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OptimizerSettings {
+    /// The GA when a local stage follows it.
+    pub genetic: GeneticSettings,
+    /// The GA when it is the only stage.
+    pub genetic_alone: GeneticSettings,
+    pub nelder_mead: NelderMeadSettings,
+    pub levenberg_marquardt: LevenbergMarquardtSettings,
+}
+
+impl Default for OptimizerSettings {
+    fn default() -> Self {
+        OptimizerSettings {
+            genetic: GeneticSettings::default(),
+            genetic_alone: GeneticSettings::alone(),
+            nelder_mead: NelderMeadSettings::default(),
+            levenberg_marquardt: LevenbergMarquardtSettings::default(),
+        }
+    }
+}
+
+impl OptimizerSettings {
+    /// The GA settings that apply to a run of `stages`.
+    pub fn genetic_for(&self, stages: &[Stage]) -> &GeneticSettings {
+        if stages == [Stage::Ga] {
+            &self.genetic_alone
+        } else {
+            &self.genetic
+        }
+    }
+}
+
+/// Minimizes `objective` from the search-box point `start` (the first point of the GA's initial
+/// population, or where a local first stage starts). Returns the best point found and the
+/// history of every stage.
+pub(crate) fn minimize(
+    objective: &Objective,
+    optimizer: &Optimizer,
+    start: &[f64],
+    seed: u64,
+    settings: &OptimizerSettings,
+) -> Result<(Vec<f64>, ConvergenceHistory), (Stage, argmin::core::Error)> {
+    let mut point = start.to_vec();
+    let mut history = ConvergenceHistory::default();
+    run_stages(
+        objective,
+        optimizer.stages(),
+        &mut point,
+        seed,
+        settings,
+        &mut history,
+    )?;
+    escape_traps(
+        objective,
+        optimizer,
+        &mut point,
+        seed,
+        settings,
+        &mut history,
+    )?;
+    Ok((point, history))
+}
+
+/// Restart points of the local stages (physical σ, q, n, k, ρ_d; only the free parameters are
+/// taken from them): smooth, medium and rough surfaces with low and high index, each with some
+/// absorption so that no restart sits on the k = 0 stationary boundary.
+const RESTARTS: [[f64; 5]; 4] = [
+    [0.03, 3.0, 2.0, 0.1, 0.01],
+    [0.1, 2.0, 1.5, 0.3, 0.01],
+    [0.3, 3.0, 1.5, 0.05, 0.03],
+    [0.1, 8.0, 3.0, 1.0, 0.01],
+];
+/// Values of k tried from a result in the k = 0 trap.
+const EXTINCTION_RESTARTS: [f64; 2] = [0.1, 1.0];
+/// A result with k below this (and k free) may sit in the k = 0 trap.
+const EXTINCTION_TRAP: f64 = 0.02;
+/// A coordinate within this fraction of its box width from a bound counts as pinned there.
+const PINNED: f64 = 1e-2;
+
+/// How a local result may be a trap rather than the global minimum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Trap {
+    /// k ≈ 0 without circular elements: the linear-polarization Mueller elements are even in k
+    /// (conjugating N conjugates r_s and r_p, which leaves |r_s|², |r_p|² and Re r_s* r_p
+    /// unchanged), so ∂F/∂k = 0 at k = 0 and a local search that reaches the k = 0 bound stays
+    /// there: derivative-based steps see no slope and the Gauss–Newton curvature in k vanishes.
+    ZeroExtinction,
+    /// σ pinned at either bound (a lobe far too narrow or too broad for the data) or q pinned at
+    /// its lower bound (an extremely heavy tail): the false minima that local searches from poor
+    /// starts reach on narrow specular lobes.
+    PinnedShape,
+}
+
+fn trap_at(objective: &Objective, point: &[f64]) -> Option<Trap> {
+    let space = objective.space();
+    let pinned = space.free().iter().enumerate().any(|(i, &p)| {
+        let margin = PINNED * (space.upper()[i] - space.lower()[i]);
+        let at_lower = point[i] <= space.lower()[i] + margin;
+        let at_upper = point[i] >= space.upper()[i] - margin;
+        match p {
+            Parameter::Sigma => at_lower || at_upper,
+            Parameter::Q => at_lower,
+            Parameter::N | Parameter::K | Parameter::RhoD => false,
+        }
+    });
+    let zero_extinction = space.free().contains(&Parameter::K)
+        && !objective.data().has_circular()
+        && space.values(point).get(Parameter::K) <= EXTINCTION_TRAP;
+    if pinned {
+        Some(Trap::PinnedShape)
+    } else if zero_extinction {
+        Some(Trap::ZeroExtinction)
+    } else {
+        None
+    }
+}
+
+/// When the local stages end in a [`Trap`], runs them again from other starts and keeps the
+/// best result: from the same point with k moved to each of [`EXTINCTION_RESTARTS`] for the
+/// k = 0 trap, from each of the [`RESTARTS`] for a pinned shape. Each remedy is tried at most
+/// once (escaping one trap can land in the other). Deterministic.
+fn escape_traps(
+    objective: &Objective,
+    optimizer: &Optimizer,
+    point: &mut Vec<f64>,
+    seed: u64,
+    settings: &OptimizerSettings,
+    history: &mut ConvergenceHistory,
+) -> Result<(), (Stage, argmin::core::Error)> {
+    let local: Vec<Stage> = optimizer
+        .stages()
+        .iter()
+        .copied()
+        .filter(|&s| s != Stage::Ga)
+        .collect();
+    if local.is_empty() {
+        return Ok(());
+    }
+    let mut tried = Vec::new();
+    while let Some(trap) = trap_at(objective, point).filter(|t| !tried.contains(t)) {
+        tried.push(trap);
+        escape(objective, &local, trap, point, seed, settings, history)?;
+    }
+    Ok(())
+}
+
+/// One remedy of [`escape_traps`].
+fn escape(
+    objective: &Objective,
+    local: &[Stage],
+    trap: Trap,
+    point: &mut Vec<f64>,
+    seed: u64,
+    settings: &OptimizerSettings,
+    history: &mut ConvergenceHistory,
+) -> Result<(), (Stage, argmin::core::Error)> {
+    let space = objective.space();
+    let starts: Vec<Vec<f64>> = match trap {
+        Trap::ZeroExtinction => EXTINCTION_RESTARTS
+            .iter()
+            .map(|&k| {
+                let mut values = space.values(point);
+                values.set(Parameter::K, k);
+                space.search(&values)
+            })
+            .collect(),
+        Trap::PinnedShape => RESTARTS
+            .iter()
+            .map(|restart| {
+                let mut values = space.values(point);
+                for &p in space.free() {
+                    values.set(p, restart[p.index()]);
+                }
+                space.search(&values)
+            })
+            .collect(),
+    };
+    // The restarts are independent: run them in parallel, then merge in start order so that
+    // the result and the history do not depend on the thread count.
+    let runs = starts
+        .into_par_iter()
+        .map(|mut trial| {
+            let mut trial_history = ConvergenceHistory::default();
+            run_stages(
+                objective,
+                local,
+                &mut trial,
+                seed,
+                settings,
+                &mut trial_history,
+            )?;
+            Ok((objective.cost(&trial), trial, trial_history))
+        })
+        .collect::<Result<Vec<_>, (Stage, argmin::core::Error)>>()?;
+    let mut best_cost = objective.cost(point);
+    for (cost, trial, trial_history) in runs {
+        history.stages.extend(trial_history.stages);
+        if cost < best_cost {
+            best_cost = cost;
+            *point = trial;
+        }
+    }
+    Ok(())
+}
+
+/// Runs `stages` from `point`, leaving the best point in it.
+fn run_stages(
+    objective: &Objective,
+    stages: &[Stage],
+    point: &mut Vec<f64>,
+    seed: u64,
+    settings: &OptimizerSettings,
+    history: &mut ConvergenceHistory,
+) -> Result<(), (Stage, argmin::core::Error)> {
+    for &stage in stages {
+        let (best, record) = match stage {
+            Stage::Ga => genetic(
+                objective,
+                seed,
+                settings.genetic_for(stages),
+                vec![point.clone()],
+            )
+            .map_err(|e| (stage, e))?,
+            Stage::Nm => {
+                nelder_mead(objective, point, &settings.nelder_mead).map_err(|e| (stage, e))?
+            }
+            Stage::Lm => levenberg_marquardt(objective, point, &settings.levenberg_marquardt),
+        };
+        // A stage never hands on a worse point than it was given.
+        if objective.cost(&best) <= objective.cost(point) {
+            *point = best;
+        }
+        history.stages.push(record);
+    }
+    Ok(())
+}

@@ -1,0 +1,176 @@
+//! What a fit is asked to do (the options of `irpol fit`, DESIGN §4).
+
+use super::optimize::OptimizerSettings;
+use super::parameters::{DistributionKind, Parameter, ParameterBounds, ParameterValues};
+use super::robust::RobustLoss;
+use super::stages::Optimizer;
+use super::FitError;
+use crate::pbrdf::Shadowing;
+use std::collections::BTreeMap;
+
+/// Options of [`super::fit_measurement`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOptions {
+    /// The slope distribution to fit; `None` fits both, keeps the one the data prefer (AIC) and
+    /// records the other as the alternative.
+    pub distribution: Option<DistributionKind>,
+    /// Shadowing of the fitted model (default Smith, which generated the shipped measurements).
+    pub shadowing: Shadowing,
+    /// Adjustable parameters; `None` = every parameter that is not in `fixed`. q is ignored for
+    /// the Gaussian.
+    pub free: Option<Vec<Parameter>>,
+    /// Values of parameters held fixed. A parameter neither free nor here takes
+    /// [`Parameter::default_value`].
+    pub fixed: BTreeMap<Parameter, f64>,
+    /// Where the first stage starts (the GA's first individual, or the local search's start),
+    /// per free parameter; [`Parameter::starting_value`] for the ones not given.
+    pub start: BTreeMap<Parameter, f64>,
+    pub optimizer: Optimizer,
+    /// Seed of the genetic stage (the local stages are deterministic).
+    pub seed: u64,
+    /// Robust loss on the normalized residuals (off by default).
+    pub robust: Option<RobustLoss>,
+    pub bounds: ParameterBounds,
+    pub settings: OptimizerSettings,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        FitOptions {
+            distribution: None,
+            shadowing: Shadowing::Smith,
+            free: None,
+            fixed: BTreeMap::new(),
+            start: BTreeMap::new(),
+            optimizer: Optimizer::default(),
+            seed: 0,
+            robust: None,
+            bounds: ParameterBounds::default(),
+            settings: OptimizerSettings::default(),
+        }
+    }
+}
+
+impl FitOptions {
+    /// The distributions to fit, the requested (or first) one first.
+    pub fn distributions(&self) -> Vec<DistributionKind> {
+        match self.distribution {
+            Some(kind) => vec![kind],
+            None => vec![DistributionKind::Cauchy, DistributionKind::Gaussian],
+        }
+    }
+
+    /// The free parameters (before dropping the ones a family lacks), checked against `fixed`.
+    pub fn free_parameters(&self) -> Result<Vec<Parameter>, FitError> {
+        match &self.free {
+            None => Ok(Parameter::ALL
+                .into_iter()
+                .filter(|p| !self.fixed.contains_key(p))
+                .collect()),
+            Some(free) => {
+                if let Some(p) = free.iter().find(|p| self.fixed.contains_key(p)) {
+                    return Err(FitError::Options(format!(
+                        "{p} is both free and fixed; drop it from --free or from --fix"
+                    )));
+                }
+                Ok(free.clone())
+            }
+        }
+    }
+
+    /// Values of every parameter that is not free: the fixed values, else the defaults.
+    pub fn base_values(&self) -> ParameterValues {
+        let mut values = ParameterValues(Parameter::ALL.map(|p| p.default_value()));
+        for (&p, &v) in &self.fixed {
+            values.set(p, v);
+        }
+        values
+    }
+}
+
+/// Parses a comma-separated parameter list such as `sigma,q,n` (`--free`).
+pub fn parse_parameter_list(text: &str) -> Result<Vec<Parameter>, String> {
+    let mut list = Vec::new();
+    for name in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let parameter = Parameter::parse(name)
+            .ok_or_else(|| format!("unknown parameter '{name}' (use sigma, q, n, k, rho_d)"))?;
+        if list.contains(&parameter) {
+            return Err(format!("parameter '{name}' is listed twice"));
+        }
+        list.push(parameter);
+    }
+    if list.is_empty() {
+        return Err("the parameter list is empty".into());
+    }
+    Ok(list)
+}
+
+/// Parses comma-separated `name=value` pairs such as `k=0.1,rho=0` (`--fix`).
+pub fn parse_parameter_values(text: &str) -> Result<BTreeMap<Parameter, f64>, String> {
+    let mut values = BTreeMap::new();
+    for pair in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let (name, value) = pair
+            .split_once('=')
+            .ok_or_else(|| format!("'{pair}' is not name=value (e.g. k=0.1)"))?;
+        let parameter = Parameter::parse(name).ok_or_else(|| {
+            format!(
+                "unknown parameter '{}' (use sigma, q, n, k, rho_d)",
+                name.trim()
+            )
+        })?;
+        let value: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| {
+                format!("the value of {parameter} in '{pair}' is not a finite number")
+            })?;
+        if values.insert(parameter, value).is_some() {
+            return Err(format!("{parameter} is given twice"));
+        }
+    }
+    if values.is_empty() {
+        return Err("no name=value pair given".into());
+    }
+    Ok(values)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn free_parameters_default_to_everything_not_fixed() {
+        let mut options = FitOptions {
+            fixed: parse_parameter_values("k=0.1, rho=0").unwrap(),
+            ..FitOptions::default()
+        };
+        assert_eq!(
+            options.free_parameters().unwrap(),
+            vec![Parameter::Sigma, Parameter::Q, Parameter::N]
+        );
+        assert_eq!(options.base_values().get(Parameter::K), 0.1);
+        assert_eq!(options.base_values().get(Parameter::N), 1.5);
+        options.free = Some(parse_parameter_list("sigma,k").unwrap());
+        assert!(options
+            .free_parameters()
+            .unwrap_err()
+            .to_string()
+            .contains("both free and fixed"));
+    }
+
+    #[test]
+    fn lists_and_values_are_checked() {
+        assert!(parse_parameter_list("sigma,sigma").is_err());
+        assert!(parse_parameter_list("sigma,alpha")
+            .unwrap_err()
+            .contains("alpha"));
+        assert!(parse_parameter_list("").is_err());
+        assert!(parse_parameter_values("k:0.1").is_err());
+        assert!(parse_parameter_values("k=abc").is_err());
+        assert!(parse_parameter_values("k=inf").is_err());
+        assert!(parse_parameter_values("k=1,k=2").is_err());
+        assert_eq!(parse_parameter_values("n=2.2").unwrap()[&Parameter::N], 2.2);
+    }
+}

@@ -1,0 +1,235 @@
+//! The result of fitting one measurement: the chosen model as a library [`Material`] with its
+//! fit record (DESIGN §2.2), the competing distribution's fit, and the comparison between them.
+
+use super::comparison::ModelComparison;
+use super::data::{ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR};
+use super::model_fit::{fit_model, ModelFit};
+use super::options::FitOptions;
+use super::parameters::{DistributionKind, Parameter};
+use super::stages::Stage;
+use super::FitError;
+use crate::material::{AlternativeFit, FitRecord, Material};
+use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
+use std::collections::BTreeMap;
+
+/// Everything a fit report needs about one measurement.
+#[derive(Clone, Debug)]
+pub struct FitOutcome {
+    pub measurement: MeasurementSet,
+    /// The chosen model, ready for `Material::save`, with `fit` filled.
+    pub material: Material,
+    /// The chosen distribution's fit.
+    pub chosen: ModelFit,
+    /// The other distribution's fit, when both were fitted.
+    pub alternative: Option<ModelFit>,
+    pub comparison: Option<ModelComparison>,
+}
+
+/// Fits one measurement (issue 3): each requested distribution (both in parallel when
+/// `options.distribution` is `None`), keeps the one with the lower AIC and records the other as
+/// the alternative. Deterministic for a given `options.seed`.
+pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<FitOutcome, FitError> {
+    let data = MeasurementData::new(set)?;
+    let (first, second) = match options.distribution {
+        Some(kind) => (fit_model(set, &data, kind, options)?, None),
+        None => {
+            let (cauchy, gaussian) = rayon::join(
+                || fit_model(set, &data, DistributionKind::Cauchy, options),
+                || fit_model(set, &data, DistributionKind::Gaussian, options),
+            );
+            (cauchy?, Some(gaussian?))
+        }
+    };
+    let (chosen, alternative, comparison) = match second {
+        None => (first, None, None),
+        Some(second) => {
+            let comparison = ModelComparison::new(
+                (first.distribution, first.aic, first.bic, first.free.len()),
+                (
+                    second.distribution,
+                    second.aic,
+                    second.bic,
+                    second.free.len(),
+                ),
+            );
+            if comparison.preferred == first.distribution {
+                (first, Some(second), Some(comparison))
+            } else {
+                (second, Some(first), Some(comparison))
+            }
+        }
+    };
+    let material = Material {
+        name: set.material.clone(),
+        tool_version: format!("irpol {}", env!("CARGO_PKG_VERSION")),
+        model: chosen.model.clone(),
+        fit: Some(fit_record(
+            set,
+            &data,
+            options,
+            &chosen,
+            alternative.as_ref(),
+            comparison.as_ref(),
+        )),
+    };
+    Ok(FitOutcome {
+        measurement: set.clone(),
+        material,
+        chosen,
+        alternative,
+        comparison,
+    })
+}
+
+fn names(parameters: &[Parameter]) -> Vec<String> {
+    parameters.iter().map(|p| p.name().to_owned()).collect()
+}
+
+/// The provenance and quality record of DESIGN §2.2.
+fn fit_record(
+    set: &MeasurementSet,
+    data: &MeasurementData,
+    options: &FitOptions,
+    chosen: &ModelFit,
+    alternative: Option<&ModelFit>,
+    comparison: Option<&ModelComparison>,
+) -> FitRecord {
+    let uncertainty = &chosen.uncertainty;
+    let (convergence, global_iterations) = chosen.history.best_cost_trace();
+    FitRecord {
+        source: set.source.clone(),
+        source_sha256: set.sha256.clone(),
+        points: set.points.len(),
+        elements: set
+            .elements
+            .iter()
+            .map(|&e| MUELLER_ELEMENT_NAMES[e].to_owned())
+            .collect(),
+        free_parameters: names(&chosen.free),
+        optimizer: options.optimizer.to_string(),
+        seed: options.seed,
+        settings: settings(data, options),
+        iterations: chosen.history.iterations(),
+        evaluations: chosen.evaluations,
+        cost: chosen.cost,
+        reduced_chi2: chosen.reduced_chi2,
+        degrees_of_freedom: chosen.degrees_of_freedom,
+        aic: chosen.aic,
+        bic: chosen.bic,
+        termination: chosen.history.termination(),
+        rmse: chosen.rmse.clone(),
+        uncertainty: uncertainty
+            .parameters
+            .iter()
+            .zip(&uncertainty.errors)
+            .map(|(p, &e)| (p.name().to_owned(), e))
+            .collect(),
+        correlation: uncertainty.correlation.clone(),
+        undetermined: names(&uncertainty.undetermined),
+        at_bound: names(&uncertainty.at_bound),
+        model_choice: comparison.map(ModelComparison::summary),
+        alternative: alternative.map(|other| AlternativeFit {
+            model: other.model.clone(),
+            cost: other.cost,
+            reduced_chi2: other.reduced_chi2,
+            aic: other.aic,
+            bic: other.bic,
+        }),
+        convergence,
+        global_iterations,
+    }
+}
+
+/// The settings that, with the optimizer name and seed, reproduce the fit.
+fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap<String, String> {
+    let mut settings = BTreeMap::new();
+    let from_file = data
+        .error_sources()
+        .iter()
+        .filter(|s| **s == ErrorSource::File)
+        .count();
+    let default_model = format!(
+        "default: {} % of m00 on m00, {} % of m00 on the others",
+        100.0 * DEFAULT_M00_RELATIVE_ERROR,
+        100.0 * super::data::DEFAULT_OTHER_ERROR_PER_M00
+    );
+    let errors = match from_file {
+        0 => default_model,
+        n if n == data.element_count() => "u_ columns of the file".to_owned(),
+        _ => format!("u_ columns where present, else {default_model}"),
+    };
+    settings.insert("uncertainties".into(), errors);
+    settings.insert(
+        "robust_loss".into(),
+        options
+            .robust
+            .map_or_else(|| "none".to_owned(), |loss| loss.to_string()),
+    );
+    settings.insert(
+        "distribution".into(),
+        match options.distribution {
+            Some(kind) => format!("{kind} (given)"),
+            None => "cauchy and gaussian fitted, lower AIC kept".into(),
+        },
+    );
+    let bounds = options.bounds.effective(options.shadowing);
+    settings.insert(
+        "bounds".into(),
+        Parameter::ALL
+            .iter()
+            .map(|&p| {
+                let i = bounds.get(p);
+                format!("{p} [{}, {}]", i.lower, i.upper)
+            })
+            .collect::<Vec<_>>()
+            .join(", "),
+    );
+    if !options.fixed.is_empty() {
+        settings.insert(
+            "fixed".into(),
+            options
+                .fixed
+                .iter()
+                .map(|(p, v)| format!("{p} = {v}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        );
+    }
+    let stages = options.optimizer.stages();
+    let s = &options.settings;
+    if stages.contains(&Stage::Ga) {
+        let ga = s.genetic_for(stages);
+        settings.insert(
+            "ga".into(),
+            format!(
+                "population {}, at most {} generations, stop after {} without {:e} relative gain",
+                ga.population,
+                ga.max_generations,
+                ga.stagnation_generations,
+                ga.stagnation_tolerance
+            ),
+        );
+    }
+    if stages.contains(&Stage::Nm) {
+        settings.insert(
+            "nm".into(),
+            format!(
+                "initial step {} rad (sine-mapped box), cost spread < {:e} × cost, at most {} steps, {} restarts",
+                s.nelder_mead.initial_step,
+                s.nelder_mead.relative_tolerance,
+                s.nelder_mead.max_iterations,
+                s.nelder_mead.restarts
+            ),
+        );
+    }
+    if stages.contains(&Stage::Lm) {
+        settings.insert(
+            "lm".into(),
+            format!(
+                "relative decrease < {:e}, at most {} iterations",
+                s.levenberg_marquardt.relative_tolerance, s.levenberg_marquardt.max_iterations
+            ),
+        );
+    }
+    settings
+}

@@ -1,0 +1,349 @@
+//! The fitted pBRDF parameters (σ, q, n, k, ρ_d of DESIGN §1.2–1.3), their bounds, and the search
+//! coordinates the optimizers work in.
+//!
+//! Every optimizer sees a parameter through a smooth, monotone map from the physical value to a
+//! *search coordinate* that spreads the parameter's plausible range evenly over a finite box:
+//!
+//! | parameter | default bounds                      | search coordinate  | why                               |
+//! |-----------|-------------------------------------|--------------------|-----------------------------------|
+//! | σ         | [0.005, 1.5]                        | ln σ               | roughness spans decades           |
+//! | q         | [1.05, 50] ([1.51, 50] with Smith)  | ln(q − 1)          | tail weight goes as 1/(q − 1)     |
+//! | n         | [1, 6]                              | n                  | dielectrics of the LWIR           |
+//! | k         | [0, 50]                             | asinh(k / 0.1)     | linear near 0, logarithmic above  |
+//! | ρ_d       | [0, 1]                              | ρ_d                | enters m00 linearly               |
+//!
+//! The genetic stage samples the search box; the local stages add a sine map on top of it
+//! (MINUIT's bounded transform) so that Nelder–Mead runs unconstrained and can settle exactly on
+//! a bound. The Smith Λ of the Cauchy distribution diverges for q ≤ 3/2 (DESIGN §1.3), hence the
+//! raised lower bound of q with Smith shadowing.
+
+use crate::pbrdf::{Shadowing, SlopeDistribution};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// A pBRDF parameter that a fit can adjust or hold fixed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Parameter {
+    /// Slope parameter σ of either distribution (DESIGN §1.2).
+    Sigma,
+    /// Cauchy exponent q (not a parameter of the Gaussian).
+    Q,
+    /// Real part n of the refractive index.
+    N,
+    /// Extinction coefficient k.
+    K,
+    /// Diffuse reflectance ρ_d.
+    RhoD,
+}
+
+impl Parameter {
+    /// All parameters in their canonical order (the order of vectors and matrices in a fit).
+    pub const ALL: [Parameter; 5] = [
+        Parameter::Sigma,
+        Parameter::Q,
+        Parameter::N,
+        Parameter::K,
+        Parameter::RhoD,
+    ];
+
+    /// The name used on the command line and in material files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Parameter::Sigma => "sigma",
+            Parameter::Q => "q",
+            Parameter::N => "n",
+            Parameter::K => "k",
+            Parameter::RhoD => "rho_d",
+        }
+    }
+
+    /// Parses a name of [`Parameter::name`]; `rho` is accepted for ρ_d (DESIGN §4).
+    pub fn parse(text: &str) -> Option<Parameter> {
+        match text.trim() {
+            "sigma" => Some(Parameter::Sigma),
+            "q" => Some(Parameter::Q),
+            "n" => Some(Parameter::N),
+            "k" => Some(Parameter::K),
+            "rho" | "rho_d" => Some(Parameter::RhoD),
+            _ => None,
+        }
+    }
+
+    /// Position in [`Parameter::ALL`].
+    pub fn index(&self) -> usize {
+        *self as usize
+    }
+
+    /// Value used when the parameter is neither free nor given a value: a moderately rough
+    /// dielectric without absorption or diffuse part.
+    pub fn default_value(&self) -> f64 {
+        match self {
+            Parameter::Sigma => 0.2,
+            Parameter::Q => 2.0,
+            Parameter::N => 1.5,
+            Parameter::K => 0.0,
+            Parameter::RhoD => 0.0,
+        }
+    }
+
+    /// Where a local search without a global stage starts: inside the box and away from the
+    /// k = 0 boundary, where the linear Mueller elements are stationary in k.
+    pub fn starting_value(&self) -> f64 {
+        match self {
+            Parameter::Sigma => 0.2,
+            Parameter::Q => 3.0,
+            Parameter::N => 1.8,
+            Parameter::K => 0.1,
+            Parameter::RhoD => 0.02,
+        }
+    }
+}
+
+impl fmt::Display for Parameter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The slope distribution family being fitted, without its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DistributionKind {
+    Cauchy,
+    Gaussian,
+}
+
+impl DistributionKind {
+    pub fn name(&self) -> &'static str {
+        match self {
+            DistributionKind::Cauchy => "cauchy",
+            DistributionKind::Gaussian => "gaussian",
+        }
+    }
+
+    pub fn parse(text: &str) -> Option<DistributionKind> {
+        match text.trim() {
+            "cauchy" => Some(DistributionKind::Cauchy),
+            "gaussian" => Some(DistributionKind::Gaussian),
+            _ => None,
+        }
+    }
+
+    /// The other family (the alternative of a model comparison).
+    pub fn other(&self) -> DistributionKind {
+        match self {
+            DistributionKind::Cauchy => DistributionKind::Gaussian,
+            DistributionKind::Gaussian => DistributionKind::Cauchy,
+        }
+    }
+
+    /// Whether `parameter` belongs to this family's model (q is Cauchy-only).
+    pub fn has(&self, parameter: Parameter) -> bool {
+        !(parameter == Parameter::Q && *self == DistributionKind::Gaussian)
+    }
+
+    /// The distribution with σ and q taken from a full parameter vector.
+    pub fn distribution(&self, values: &ParameterValues) -> SlopeDistribution {
+        let sigma = values.get(Parameter::Sigma);
+        match self {
+            DistributionKind::Cauchy => SlopeDistribution::Cauchy {
+                sigma,
+                q: values.get(Parameter::Q),
+            },
+            DistributionKind::Gaussian => SlopeDistribution::Gaussian { sigma },
+        }
+    }
+}
+
+impl fmt::Display for DistributionKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One value per [`Parameter`], in canonical order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParameterValues(pub [f64; 5]);
+
+impl ParameterValues {
+    pub fn get(&self, parameter: Parameter) -> f64 {
+        self.0[parameter.index()]
+    }
+    pub fn set(&mut self, parameter: Parameter, value: f64) {
+        self.0[parameter.index()] = value;
+    }
+}
+
+/// Closed interval [lower, upper] of physical values of one parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Interval {
+    pub lower: f64,
+    pub upper: f64,
+}
+
+impl Interval {
+    pub const fn new(lower: f64, upper: f64) -> Interval {
+        Interval { lower, upper }
+    }
+    pub fn contains(&self, value: f64) -> bool {
+        (self.lower..=self.upper).contains(&value)
+    }
+}
+
+/// Bounds of the physical parameters (DESIGN issue 3). The q interval's lower end is raised to
+/// [`SMITH_MIN_Q`] when Smith shadowing is used (see [`ParameterBounds::effective`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParameterBounds {
+    pub sigma: Interval,
+    pub q: Interval,
+    pub n: Interval,
+    pub k: Interval,
+    pub rho_d: Interval,
+}
+
+/// Lowest q searched with Smith shadowing: Λ of the Cauchy distribution exists only for q > 3/2
+/// and grows without bound as q → 3/2⁺.
+pub const SMITH_MIN_Q: f64 = 1.51;
+
+impl Default for ParameterBounds {
+    fn default() -> Self {
+        ParameterBounds {
+            sigma: Interval::new(0.005, 1.5),
+            q: Interval::new(1.05, 50.0),
+            n: Interval::new(1.0, 6.0),
+            k: Interval::new(0.0, 50.0),
+            rho_d: Interval::new(0.0, 1.0),
+        }
+    }
+}
+
+impl ParameterBounds {
+    pub fn get(&self, parameter: Parameter) -> Interval {
+        match parameter {
+            Parameter::Sigma => self.sigma,
+            Parameter::Q => self.q,
+            Parameter::N => self.n,
+            Parameter::K => self.k,
+            Parameter::RhoD => self.rho_d,
+        }
+    }
+
+    /// The bounds a fit with `shadowing` searches: q ≥ [`SMITH_MIN_Q`] with Smith.
+    pub fn effective(&self, shadowing: Shadowing) -> ParameterBounds {
+        let mut bounds = *self;
+        if shadowing == Shadowing::Smith {
+            bounds.q.lower = bounds.q.lower.max(SMITH_MIN_Q);
+        }
+        bounds
+    }
+
+    /// Checks that every interval is finite, ordered and inside the parameter's domain (σ > 0,
+    /// q > 1, n > 0, k ≥ 0, 0 ≤ ρ_d ≤ 1).
+    pub fn validate(&self) -> Result<(), String> {
+        for parameter in Parameter::ALL {
+            let Interval { lower, upper } = self.get(parameter);
+            let domain_ok = match parameter {
+                Parameter::Sigma | Parameter::N => lower > 0.0,
+                Parameter::Q => lower > 1.0,
+                Parameter::K => lower >= 0.0,
+                Parameter::RhoD => lower >= 0.0 && upper <= 1.0,
+            };
+            if !(lower.is_finite() && upper.is_finite() && lower < upper && domain_ok) {
+                return Err(format!(
+                    "the bounds [{lower}, {upper}] of {parameter} are invalid (finite, lower < upper, inside the parameter's domain)"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Scale of the asinh map of k: below ~0.1 the search coordinate is linear in k (k = 0 is an
+/// ordinary point), above it logarithmic (metals reach k ≈ 50 in the LWIR).
+const K_SCALE: f64 = 0.1;
+
+/// The physical value → search coordinate map of a parameter (table in the module docs).
+pub fn to_search(parameter: Parameter, value: f64) -> f64 {
+    match parameter {
+        Parameter::Sigma => value.ln(),
+        Parameter::Q => (value - 1.0).ln(),
+        Parameter::N | Parameter::RhoD => value,
+        Parameter::K => (value / K_SCALE).asinh(),
+    }
+}
+
+/// Inverse of [`to_search`].
+pub fn from_search(parameter: Parameter, coordinate: f64) -> f64 {
+    match parameter {
+        Parameter::Sigma => coordinate.exp(),
+        Parameter::Q => 1.0 + coordinate.exp(),
+        Parameter::N | Parameter::RhoD => coordinate,
+        Parameter::K => K_SCALE * coordinate.sinh(),
+    }
+}
+
+/// d(value)/d(coordinate) of [`from_search`], to carry Jacobians to physical parameters.
+pub fn value_per_coordinate(parameter: Parameter, coordinate: f64) -> f64 {
+    match parameter {
+        Parameter::Sigma => coordinate.exp(),
+        Parameter::Q => coordinate.exp(),
+        Parameter::N | Parameter::RhoD => 1.0,
+        Parameter::K => K_SCALE * coordinate.cosh(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn search_coordinates_round_trip_and_have_the_right_slope() {
+        for (parameter, value) in [
+            (Parameter::Sigma, 0.137),
+            (Parameter::Q, 1.8),
+            (Parameter::N, 2.4),
+            (Parameter::K, 0.0),
+            (Parameter::K, 37.0),
+            (Parameter::RhoD, 0.03),
+        ] {
+            let s = to_search(parameter, value);
+            assert!((from_search(parameter, s) - value).abs() < 1e-13 * value.max(1.0));
+            let h = 1e-6;
+            let numeric =
+                (from_search(parameter, s + h) - from_search(parameter, s - h)) / (2.0 * h);
+            let analytic = value_per_coordinate(parameter, s);
+            assert!((numeric / analytic - 1.0).abs() < 1e-8, "{parameter}");
+        }
+        // k's map is linear near 0: k = 0.01 sits at coordinate ≈ 0.1.
+        assert!((to_search(Parameter::K, 0.01) - 0.0998).abs() < 1e-3);
+    }
+
+    #[test]
+    fn smith_raises_the_lower_bound_of_q_and_bad_bounds_are_refused() {
+        let bounds = ParameterBounds::default();
+        assert_eq!(bounds.effective(Shadowing::Smith).q.lower, SMITH_MIN_Q);
+        assert_eq!(bounds.effective(Shadowing::TorranceSparrow).q.lower, 1.05);
+        assert!(bounds.validate().is_ok());
+        let mut bad = bounds;
+        bad.q = Interval::new(0.9, 10.0);
+        assert!(bad.validate().unwrap_err().contains("q"));
+        bad = bounds;
+        bad.rho_d = Interval::new(0.0, 1.5);
+        assert!(bad.validate().is_err());
+    }
+
+    #[test]
+    fn names_parse_back() {
+        for parameter in Parameter::ALL {
+            assert_eq!(Parameter::parse(parameter.name()), Some(parameter));
+        }
+        assert_eq!(Parameter::parse("rho"), Some(Parameter::RhoD));
+        assert_eq!(Parameter::parse("alpha"), None);
+        assert!(!DistributionKind::Gaussian.has(Parameter::Q));
+        assert_eq!(
+            DistributionKind::parse("cauchy").unwrap().other(),
+            DistributionKind::Gaussian
+        );
+    }
+}

@@ -1,0 +1,507 @@
+//! Fit reports (DESIGN §4, `irpol fit … --reports`, `irpol report`): one 2400 × 1800 figure per
+//! material, as PNG and SVG, that a researcher can put in a paper. It recomputes every model curve
+//! from the material's pBRDF, so the same (material, measurement) always gives the same figure.
+//!
+//! Panels: (a) m00 in the plane of incidence, (b) m00 on the out-of-plane rings, (c) the
+//! parameter table, (d) the linear-polarization block normalized by m00, (e) the DoLP for
+//! unpolarized illumination, (f) the polarized emissivity, (g) normalized residuals, (h) their
+//! histogram, (i) the optimizer's convergence. The competing distribution's best fit is dashed.
+
+mod data;
+mod diagnostics;
+mod profiles;
+mod style;
+mod table;
+
+pub use data::{DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00};
+use table::format_angle;
+pub(crate) use table::{
+    format_plain, format_with_uncertainty, is_free, lookup, parameters, preference, sha_prefix,
+};
+
+use super::paper_figures::encode_png;
+use super::{register_fonts, ReportError, FONT};
+use crate::material::{write_atomically, FitRecord, Material};
+use crate::measure::{parse_measurement_csv, MeasureError, MeasureErrorKind, MeasurementSet};
+use data::ReportData;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::FontStyle;
+use profiles::{draw_profile, linear_axis, log_axis, profile_series, Domain, Profile, Quantity};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+use style::{
+    draw_legend_column, draw_legend_row, draw_note, incidence_color, DrawResult, LegendEntry,
+    LineKind, Marker, YAxis, TITLE_SIZE,
+};
+
+/// Pixel size of the report figure.
+pub const REPORT_SIZE: (u32, u32) = (2400, 1800);
+const HEADER_HEIGHT: i32 = 100;
+const COLUMN_WIDTH: i32 = 600;
+
+/// The linear-polarization elements of panel (d), in reading order.
+const LINEAR_BLOCK: [usize; 8] = [1, 2, 4, 5, 6, 8, 9, 10];
+/// Elements that vanish in the plane of incidence by mirror symmetry (m02, m12, m20, m21): drawn
+/// on the rings, where they carry information.
+const ZERO_IN_PLANE: [usize; 4] = [2, 6, 8, 9];
+
+/// Writes `<out_dir>/<material>.png` and `.svg`; returns their paths.
+pub fn write_fit_report(
+    material: &Material,
+    set: &MeasurementSet,
+    out_dir: &Path,
+) -> Result<Vec<PathBuf>, ReportError> {
+    let stem = report_stem(&material.name)?;
+    let png = out_dir.join(format!("{stem}.png"));
+    let svg = out_dir.join(format!("{stem}.svg"));
+    let data = ReportData::new(material, set)?;
+    let draw_error = |path: &Path, e: &dyn std::fmt::Display| ReportError::Draw {
+        path: path.to_owned(),
+        message: e.to_string(),
+    };
+
+    let (width, height) = REPORT_SIZE;
+    let mut rgb = vec![0u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
+        draw_report(&root, material, set, &data).map_err(|e| draw_error(&png, &e))?;
+    }
+    let mut svg_text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg_text, (width, height)).into_drawing_area();
+        draw_report(&root, material, set, &data).map_err(|e| draw_error(&svg, &e))?;
+    }
+    let png_bytes = encode_png(&rgb, width, height).map_err(|e| draw_error(&png, &e))?;
+    for (path, bytes) in [(&png, png_bytes.as_slice()), (&svg, svg_text.as_bytes())] {
+        write_atomically(path, bytes).map_err(|source| ReportError::Write {
+            path: path.clone(),
+            source,
+        })?;
+    }
+    Ok(vec![png, svg])
+}
+
+/// Rebuilds the report of a library entry from its recorded source CSV (`irpol report
+/// <material.toml>`), refusing when the material has no fit, the CSV is gone or changed since
+/// the fit, or no longer reads.
+pub fn rebuild_report(
+    material_path: &Path,
+    reports_dir: &Path,
+) -> Result<Vec<PathBuf>, ReportError> {
+    let material = Material::load(material_path)?;
+    let fit = material.fit.as_ref().ok_or_else(|| ReportError::NoFit {
+        material: material_path.to_owned(),
+    })?;
+    let (csv, bytes) = verified_source(material_path, fit)?;
+    let set = parse_measurement_csv(&csv, &bytes)?;
+    write_fit_report(&material, &set, reports_dir)
+}
+
+/// Where the fit's source CSV may be: as recorded (relative to the working directory, where
+/// `irpol fit` was run), then relative to the library's parent folder (`fits/x.toml` →
+/// `<project>/…`), so that a project can be rebuilt from another directory.
+fn source_candidates(material_path: &Path, source: &Path) -> Vec<PathBuf> {
+    let mut candidates = vec![source.to_owned()];
+    if source.is_relative() {
+        if let Some(project) = material_path.parent().and_then(Path::parent) {
+            let beside = project.join(source);
+            if !candidates.contains(&beside) {
+                candidates.push(beside);
+            }
+        }
+    }
+    candidates
+}
+
+/// Finds the fit's source CSV and checks it is byte-for-byte the file that was fitted; returns
+/// its path and bytes.
+pub(crate) fn verified_source(
+    material_path: &Path,
+    fit: &FitRecord,
+) -> Result<(PathBuf, Vec<u8>), ReportError> {
+    let candidates = source_candidates(material_path, &fit.source);
+    let Some(csv) = candidates.iter().find(|p| p.is_file()).cloned() else {
+        return Err(ReportError::SourceMissing {
+            material: material_path.to_owned(),
+            csv: fit.source.clone(),
+            tried: candidates
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    };
+    let bytes = std::fs::read(&csv).map_err(|e| MeasureError {
+        file: csv.clone(),
+        line: 1,
+        column: 1,
+        kind: MeasureErrorKind::Unreadable {
+            reason: e.to_string(),
+        },
+    })?;
+    let actual: String = Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    if !actual.eq_ignore_ascii_case(fit.source_sha256.trim()) {
+        return Err(ReportError::SourceChanged {
+            csv,
+            actual,
+            recorded: fit.source_sha256.clone(),
+            material: material_path.to_owned(),
+        });
+    }
+    Ok((csv, bytes))
+}
+
+/// The material name as a file stem: a plain name, no folders.
+fn report_stem(name: &str) -> Result<&str, ReportError> {
+    let plain = !name.is_empty()
+        && name != "."
+        && name != ".."
+        && !name.contains(['/', '\\', '\0'])
+        && !name.starts_with('.');
+    if plain {
+        Ok(name)
+    } else {
+        Err(ReportError::MaterialName {
+            name: name.to_owned(),
+        })
+    }
+}
+
+/// The panel at grid column `column` (0–3), row `row` (0–2), `span` columns wide.
+fn panel<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    column: i32,
+    row: i32,
+    span: i32,
+) -> DrawingArea<DB, Shift> {
+    let row_height = (REPORT_SIZE.1 as i32 - HEADER_HEIGHT) / 3;
+    root.clone().shrink(
+        (column * COLUMN_WIDTH, HEADER_HEIGHT + row * row_height),
+        (span * COLUMN_WIDTH, row_height),
+    )
+}
+
+fn draw_report<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    material: &Material,
+    set: &MeasurementSet,
+    data: &ReportData,
+) -> DrawResult<DB> {
+    register_fonts();
+    root.fill(&WHITE)?;
+    draw_header(root, material, set, data)?;
+    draw_in_plane_m00(&panel(root, 0, 0, 2), data)?;
+    draw_rings_m00(&panel(root, 2, 0, 1), data)?;
+    table::draw_table(&panel(root, 3, 0, 1), material)?;
+    draw_linear_block(&panel(root, 0, 1, 2), data)?;
+    draw_dolp(&panel(root, 2, 1, 1), data)?;
+    diagnostics::draw_emissivity(&panel(root, 3, 1, 1), data)?;
+    diagnostics::draw_residuals(&panel(root, 0, 2, 2), data)?;
+    diagnostics::draw_histogram(&panel(root, 2, 2, 1), data)?;
+    diagnostics::draw_convergence(&panel(root, 3, 2, 1), material.fit.as_ref())?;
+    root.present()
+}
+
+/// Title line and the colour/line key shared by every data panel.
+fn draw_header<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    material: &Material,
+    set: &MeasurementSet,
+    data: &ReportData,
+) -> DrawResult<DB> {
+    let model = &material.model;
+    let title = format!(
+        "Fit report: {}   —   {} slopes, {} shadowing, λ = {} µm, {} points × {} Mueller elements from {}",
+        material.name,
+        model.distribution.name(),
+        model.shadowing.name(),
+        format_plain(set.wavelength_um),
+        set.points.len(),
+        set.elements.len(),
+        set.source.display()
+    );
+    let title_style = (FONT, TITLE_SIZE, FontStyle::Bold)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Left, VPos::Top));
+    root.draw_text(&title, &title_style.into_text_style(root), (24, 14))?;
+
+    let mut entries: Vec<LegendEntry> = data
+        .incidences
+        .iter()
+        .enumerate()
+        .map(|(i, theta)| {
+            LegendEntry::marker(
+                format!("θi = {}°", format_angle(*theta)),
+                incidence_color(i),
+                Marker::FilledCircle,
+            )
+        })
+        .collect();
+    entries.push(LegendEntry {
+        label: "measured ± 1σ".into(),
+        color: RGBColor(60, 60, 60),
+        line: None,
+        marker: Some(Marker::FilledCircle),
+    });
+    entries.push(LegendEntry::line(
+        format!("{} fit (chosen)", data.chosen_label),
+        BLACK,
+        LineKind::Solid,
+    ));
+    if let Some(alt) = &data.alternative_label {
+        entries.push(LegendEntry::line(
+            format!("{alt} fit (competing distribution)"),
+            BLACK,
+            LineKind::Dashed,
+        ));
+    }
+    draw_legend_row(root, &entries, (28, 72))
+}
+
+fn draw_in_plane_m00<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    data: &ReportData,
+) -> DrawResult<DB> {
+    let caption = "(a) m00 in the plane of incidence";
+    let series = profile_series(data, Quantity::M00, Domain::InPlane);
+    let Some(y) = log_axis(&series) else {
+        return draw_note(area, caption, "no measurements in the plane of incidence");
+    };
+    draw_profile(
+        area,
+        &Profile {
+            caption: caption.into(),
+            x_desc: Domain::InPlane.x_desc(false).into(),
+            y_desc: "m00 = f00, BRDF (sr⁻¹)".into(),
+            x_axis: Domain::InPlane.axis(area.dim_in_pixel().0),
+            y,
+            series,
+            error_bars: true,
+            compact: false,
+        },
+    )
+}
+
+/// Width of the ring legend strip at the right of panel (b).
+const RING_LEGEND_WIDTH: i32 = 150;
+/// Rings listed in the legend before "+ N more".
+const RING_LEGEND_ROWS: usize = 18;
+
+fn draw_rings_m00<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    data: &ReportData,
+) -> DrawResult<DB> {
+    let caption = "(b) m00 on out-of-plane rings";
+    let series = profile_series(data, Quantity::M00, Domain::Rings);
+    let Some(y) = log_axis(&series) else {
+        let note = match data.off_ring_points() {
+            0 => "no out-of-plane measurements".to_owned(),
+            1 => "no rings; the 1 off-plane point is in (g)".to_owned(),
+            n => format!("no rings; {n} off-plane points (a raster) are in (g)"),
+        };
+        return draw_note(area, caption, &note);
+    };
+    let (width, height) = area.dim_in_pixel();
+    let (chart_area, legend_area) = area.split_horizontally(width as i32 - RING_LEGEND_WIDTH);
+    draw_profile(
+        &chart_area,
+        &Profile {
+            caption: caption.into(),
+            x_desc: Domain::Rings.x_desc(false).into(),
+            y_desc: "m00 (sr⁻¹)".into(),
+            x_axis: Domain::Rings.axis(chart_area.dim_in_pixel().0),
+            y,
+            series,
+            error_bars: true,
+            compact: false,
+        },
+    )?;
+    let mut entries: Vec<LegendEntry> = data
+        .rings
+        .iter()
+        .take(RING_LEGEND_ROWS)
+        .map(|ring| {
+            LegendEntry::marker(
+                format!(
+                    "{}° → {}°",
+                    format_angle(data.incidences[ring.incidence]),
+                    format_angle(ring.theta_r_deg)
+                ),
+                incidence_color(ring.incidence),
+                Marker::for_rank(ring.rank),
+            )
+        })
+        .collect();
+    if data.rings.len() > RING_LEGEND_ROWS {
+        entries.push(LegendEntry::line(
+            format!("+ {} more", data.rings.len() - RING_LEGEND_ROWS),
+            WHITE,
+            LineKind::Solid,
+        ));
+    }
+    let off_ring = data.off_ring_points();
+    if off_ring > 0 {
+        // A raster around specular is not a ring; its points are among the residuals only.
+        entries.push(LegendEntry::line(
+            format!("{off_ring} raster pts"),
+            WHITE,
+            LineKind::Solid,
+        ));
+        entries.push(LegendEntry::line("only in (g)", WHITE, LineKind::Solid));
+    }
+    let heading = (FONT, style::LEGEND_SIZE)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Left, VPos::Top));
+    legend_area.draw_text("ring θi → θr", &heading, (4, 48))?;
+    let rows = entries.len() as i32;
+    let top = (48 + 24).min(height as i32 - rows * (style::LEGEND_SIZE + 7) - 10);
+    draw_legend_column(&legend_area, &entries, (4, top))?;
+    Ok(())
+}
+
+/// Said by the profile panels when the geometry has neither an in-plane sweep nor a ring.
+const NO_PROFILE_NOTE: &str = "no in-plane sweep or ring to draw along: see the residuals (g)";
+
+/// Panel (d): m_ij/m00 for the linear-polarization elements present, as a grid of small plots.
+fn draw_linear_block<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    data: &ReportData,
+) -> DrawResult<DB> {
+    let caption = "(d) Linear-polarization block normalized by m00: data vs model";
+    let elements: Vec<usize> = LINEAR_BLOCK
+        .into_iter()
+        .filter(|&e| data.has_element(e))
+        .collect();
+    if elements.is_empty() {
+        return draw_note(
+            area,
+            caption,
+            "only m00 was measured: no polarization elements to compare",
+        );
+    }
+    let has_in_plane = data.in_plane.iter().any(Option::is_some);
+    if !has_in_plane && data.rings.is_empty() {
+        return draw_note(area, caption, NO_PROFILE_NOTE);
+    }
+    let (width, _) = area.dim_in_pixel();
+    let caption_style = (FONT, style::CAPTION_SIZE)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Center, VPos::Top));
+    area.draw_text(caption, &caption_style, (width as i32 / 2, 12))?;
+    let grid = area
+        .clone()
+        .shrink((0, 40), (width, area.dim_in_pixel().1 - 40));
+    let columns = elements.len().min(4);
+    let rows = elements.len().div_ceil(4);
+    let cells = grid.split_evenly((rows, columns));
+    for (cell, &element) in cells.iter().zip(&elements) {
+        let on_rings =
+            !data.rings.is_empty() && (ZERO_IN_PLANE.contains(&element) || !has_in_plane);
+        let domain = if on_rings {
+            Domain::Rings
+        } else {
+            Domain::InPlane
+        };
+        let quantity = Quantity::Ratio(element);
+        let series = profile_series(data, quantity, domain);
+        draw_profile(
+            cell,
+            &Profile {
+                caption: format!(
+                    "{}{}",
+                    quantity.label(),
+                    if on_rings { " (rings)" } else { "" }
+                ),
+                x_desc: domain.x_desc(true).into(),
+                y_desc: String::new(),
+                x_axis: domain.axis(cell.dim_in_pixel().0),
+                y: linear_axis(&series, 1.5),
+                series,
+                error_bars: false,
+                compact: true,
+            },
+        )?;
+    }
+    Ok(())
+}
+
+/// Panel (e): DoLP for unpolarized illumination, √(m10² + m20²)/m00 (DESIGN §1.6).
+fn draw_dolp<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    data: &ReportData,
+) -> DrawResult<DB> {
+    let measured = data.has_element(4) && data.has_element(8);
+    let caption = if measured {
+        "(e) DoLP, unpolarized illumination".to_owned()
+    } else {
+        "(e) DoLP, model only (m10, m20 not both measured)".to_owned()
+    };
+    let domain = if data.in_plane.iter().any(Option::is_some) {
+        Domain::InPlane
+    } else if !data.rings.is_empty() {
+        Domain::Rings
+    } else {
+        return draw_note(area, &caption, NO_PROFILE_NOTE);
+    };
+    let series = profile_series(data, Quantity::Dolp, domain);
+    let y = match linear_axis(&series, 1.0) {
+        YAxis::Linear { high, .. } => YAxis::Linear { low: 0.0, high },
+        other => other,
+    };
+    draw_profile(
+        area,
+        &Profile {
+            caption,
+            x_desc: domain.x_desc(true).into(),
+            y_desc: "DoLP = √(m10² + m20²)/m00".into(),
+            x_axis: domain.axis(area.dim_in_pixel().0),
+            y,
+            series,
+            error_bars: false,
+            compact: false,
+        },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn report_files_are_named_by_a_plain_material_name() {
+        assert_eq!(report_stem("gloss paint-2").unwrap(), "gloss paint-2");
+        for bad in ["", ".", "..", "../etc", "a/b", "a\\b", ".hidden"] {
+            let message = report_stem(bad).unwrap_err().to_string();
+            assert!(message.contains("plain file name"), "{bad}: {message}");
+        }
+    }
+
+    #[test]
+    fn the_source_is_looked_for_as_recorded_then_beside_the_library() {
+        let fits = Path::new("/project/fits/paint.toml");
+        assert_eq!(
+            source_candidates(fits, Path::new("measurements/paint.csv")),
+            [
+                PathBuf::from("measurements/paint.csv"),
+                PathBuf::from("/project/measurements/paint.csv")
+            ]
+        );
+        assert_eq!(
+            source_candidates(fits, Path::new("/data/paint.csv")),
+            [PathBuf::from("/data/paint.csv")]
+        );
+        // fits/paint.toml relative to the working directory: both readings coincide.
+        assert_eq!(
+            source_candidates(Path::new("fits/paint.toml"), Path::new("m/p.csv")),
+            [PathBuf::from("m/p.csv")]
+        );
+    }
+}

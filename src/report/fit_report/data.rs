@@ -1,0 +1,625 @@
+//! The numbers behind a fit report, computed once and drawn twice (PNG and SVG): every measured
+//! point placed on the goniometer's plane of incidence or on an out-of-plane ring, its standard
+//! deviation and normalized residual, and the chosen and competing models evaluated along each
+//! plane and ring and as polarized emissivity (DESIGN §1.3–1.4).
+
+use crate::material::Material;
+use crate::measure::MeasurementSet;
+use crate::optics::{Mueller, Stokes};
+use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
+
+use super::super::ReportError;
+
+/// The fit's default noise model where a file has no `u_` column: 3 % of m00 on m00 and 1 % of m00
+/// on every other element (a rotating-retarder polarimeter), floored at 1e-6 of the largest m00 so
+/// that a zero reading keeps a finite weight. Mirrors `fit::data` so that report residuals are the
+/// ones the optimizer minimized.
+pub const DEFAULT_M00_RELATIVE_ERROR: f64 = 0.03;
+pub const DEFAULT_OTHER_ERROR_PER_M00: f64 = 0.01;
+const DEFAULT_ERROR_FLOOR: f64 = 1e-6;
+
+/// Two angles are the same goniometer setting when they agree to a microdegree.
+const SAME_ANGLE_DEG: f64 = 1e-6;
+
+/// A model drawn in the report: the chosen fit or the competing distribution's best fit.
+pub struct ModelCurveSource {
+    pub label: String,
+    pub pbrdf: Pbrdf,
+}
+
+/// One measured element: value and 1-σ (sr⁻¹).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reading {
+    pub value: f64,
+    pub sigma: f64,
+}
+
+/// A measured geometry as the report sees it.
+#[derive(Clone, Debug)]
+pub struct PointView {
+    /// Index into [`ReportData::incidences`].
+    pub incidence: usize,
+    /// Detector zenith signed for the plane of incidence (DESIGN §1.1): + on the specular side
+    /// (φ_r = φ_i + 180°), − toward the source (φ_r = φ_i); `None` off the plane.
+    pub signed_zenith: Option<f64>,
+    /// Index into [`ReportData::rings`] when the point lies on an out-of-plane ring.
+    pub ring: Option<usize>,
+    /// φ_r − φ_i in [0°, 360°).
+    pub relative_azimuth: f64,
+    /// θ_r signed by hemisphere: + when the detector is on the forward (specular) half,
+    /// 90° ≤ φ_r − φ_i ≤ 270°. Equals `signed_zenith` in the plane.
+    pub forward_zenith: f64,
+    /// The measured elements by Mueller index r*4 + c.
+    pub readings: [Option<Reading>; 16],
+    /// The chosen model at this geometry.
+    pub model: Mueller,
+}
+
+/// A model evaluated along a one-parameter sweep of geometry (detector zenith or azimuth).
+#[derive(Clone, Debug)]
+pub struct ModelSweep {
+    pub x: Vec<f64>,
+    pub chosen: Vec<Mueller>,
+    pub alternative: Option<Vec<Mueller>>,
+}
+
+/// Points of one incidence angle and one detector zenith off the plane of incidence.
+#[derive(Clone, Debug)]
+pub struct Ring {
+    pub incidence: usize,
+    pub theta_r_deg: f64,
+    /// Position among the rings of the same incidence angle (for the marker shape).
+    pub rank: usize,
+    /// The models against φ_r − φ_i over 0…360°.
+    pub sweep: ModelSweep,
+}
+
+/// One normalized residual (data − model)/σ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Residual {
+    pub forward_zenith: f64,
+    pub element: usize,
+    pub value: f64,
+}
+
+/// ε0 and ε1 against emission angle for the chosen and the competing model.
+#[derive(Clone, Debug)]
+pub struct EmissivityCurves {
+    pub theta_deg: Vec<f64>,
+    pub chosen: Vec<Stokes>,
+    pub alternative: Option<Vec<Stokes>>,
+}
+
+pub struct ReportData {
+    /// Distinct incidence angles (°), ascending: the colour key of every panel.
+    pub incidences: Vec<f64>,
+    /// Mueller indices present in the measurement, ascending.
+    pub elements: Vec<usize>,
+    pub points: Vec<PointView>,
+    /// In-plane model sweeps, one per incidence angle (`None` when no point of that angle lies in
+    /// the plane).
+    pub in_plane: Vec<Option<ModelSweep>>,
+    pub rings: Vec<Ring>,
+    pub residuals: Vec<Residual>,
+    pub emissivity: EmissivityCurves,
+    pub chosen_label: String,
+    pub alternative_label: Option<String>,
+}
+
+impl ReportData {
+    pub fn new(material: &Material, set: &MeasurementSet) -> Result<ReportData, ReportError> {
+        let chosen = ModelCurveSource {
+            label: material.model.distribution.name().to_owned(),
+            pbrdf: material.pbrdf()?,
+        };
+        let alternative = match material.fit.as_ref().and_then(|f| f.alternative.as_ref()) {
+            Some(alt) => Some(ModelCurveSource {
+                label: alt.model.distribution.name().to_owned(),
+                pbrdf: alt.model.pbrdf()?,
+            }),
+            None => None,
+        };
+
+        let incidences = distinct_sorted(set.points.iter().map(|p| p.theta_i_deg));
+        let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
+        let floor = DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE);
+
+        let mut points = Vec::with_capacity(set.points.len());
+        for p in &set.points {
+            let incident = checked_direction("theta_i_deg", p.theta_i_deg, p.phi_i_deg)?;
+            let scattered = checked_direction("theta_r_deg", p.theta_r_deg, p.phi_r_deg)?;
+            let relative_azimuth = (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0);
+            let signed_zenith = in_plane_zenith(p.theta_r_deg, relative_azimuth);
+            let forward_zenith = signed_zenith.unwrap_or({
+                if (90.0..=270.0).contains(&relative_azimuth) {
+                    p.theta_r_deg
+                } else {
+                    -p.theta_r_deg
+                }
+            });
+            let mut readings = [None; 16];
+            for (column, &element) in set.elements.iter().enumerate() {
+                let value = p.values[column];
+                let sigma = p.uncertainties[column].unwrap_or(if element == 0 {
+                    (DEFAULT_M00_RELATIVE_ERROR * p.values[0]).max(floor)
+                } else {
+                    (DEFAULT_OTHER_ERROR_PER_M00 * p.values[0]).max(floor)
+                });
+                readings[element] = Some(Reading { value, sigma });
+            }
+            points.push(PointView {
+                incidence: position_of(&incidences, p.theta_i_deg),
+                signed_zenith,
+                ring: None,
+                relative_azimuth,
+                forward_zenith,
+                readings,
+                model: chosen.pbrdf.mueller(&incident, &scattered),
+            });
+        }
+
+        let rings = find_rings(&mut points, set, &incidences, &chosen, alternative.as_ref());
+        let in_plane = incidences
+            .iter()
+            .enumerate()
+            .map(|(group, &theta_i)| {
+                points
+                    .iter()
+                    .any(|p| p.incidence == group && p.signed_zenith.is_some())
+                    .then(|| in_plane_sweep(theta_i, &chosen, alternative.as_ref()))
+            })
+            .collect();
+        let residuals = points
+            .iter()
+            .flat_map(|p| {
+                p.readings.iter().enumerate().filter_map(|(element, r)| {
+                    r.map(|r| Residual {
+                        forward_zenith: p.forward_zenith,
+                        element,
+                        value: (r.value - p.model[(element / 4, element % 4)]) / r.sigma,
+                    })
+                })
+            })
+            .collect();
+        let emissivity = emissivity_curves(&chosen, alternative.as_ref());
+
+        Ok(ReportData {
+            incidences,
+            elements: set.elements.clone(),
+            points,
+            in_plane,
+            rings,
+            residuals,
+            emissivity,
+            chosen_label: chosen.label,
+            alternative_label: alternative.map(|a| a.label),
+        })
+    }
+
+    pub fn has_element(&self, element: usize) -> bool {
+        self.elements.contains(&element)
+    }
+
+    /// Off-plane points that lie on no ring (a raster around specular): they appear only among
+    /// the residuals.
+    pub fn off_ring_points(&self) -> usize {
+        self.points
+            .iter()
+            .filter(|p| p.signed_zenith.is_none() && p.ring.is_none())
+            .count()
+    }
+}
+
+fn checked_direction(name: &'static str, theta: f64, phi: f64) -> Result<Direction, ReportError> {
+    Ok(Direction::from_degrees_checked(name, theta, phi)?)
+}
+
+/// Signed detector zenith when (θ_r, φ_r − φ_i) lies in the plane of incidence.
+fn in_plane_zenith(theta_r_deg: f64, relative_azimuth: f64) -> Option<f64> {
+    let off_specular = (relative_azimuth - 180.0).abs();
+    let off_source = relative_azimuth.min(360.0 - relative_azimuth);
+    if theta_r_deg.abs() < SAME_ANGLE_DEG || off_specular < SAME_ANGLE_DEG {
+        Some(theta_r_deg)
+    } else if off_source < SAME_ANGLE_DEG {
+        Some(-theta_r_deg)
+    } else {
+        None
+    }
+}
+
+fn distinct_sorted(values: impl Iterator<Item = f64>) -> Vec<f64> {
+    let mut all: Vec<f64> = values.collect();
+    all.sort_by(f64::total_cmp);
+    all.dedup_by(|a, b| (*a - *b).abs() < SAME_ANGLE_DEG);
+    all
+}
+
+fn position_of(sorted: &[f64], value: f64) -> usize {
+    sorted
+        .iter()
+        .position(|&v| (v - value).abs() < SAME_ANGLE_DEG)
+        .unwrap_or(0)
+}
+
+/// A group of off-plane points at one (θ_i, θ_r) is drawn as a ring when it spans at least this
+/// much azimuth; a small raster around specular (a few degrees of φ_r) would only pile up at 180°.
+const RING_MIN_SPAN_DEG: f64 = 60.0;
+
+/// Groups the out-of-plane points by (θ_i, θ_r) into rings. A ring also claims the in-plane
+/// points of the same (θ_i, θ_r), which are its φ_r − φ_i = 0° and 180° members.
+fn find_rings(
+    points: &mut [PointView],
+    set: &MeasurementSet,
+    incidences: &[f64],
+    chosen: &ModelCurveSource,
+    alternative: Option<&ModelCurveSource>,
+) -> Vec<Ring> {
+    let same_group = |view: &PointView, theta_r: f64, key: (usize, f64)| {
+        view.incidence == key.0 && (theta_r - key.1).abs() < SAME_ANGLE_DEG
+    };
+    let mut keys: Vec<(usize, f64)> = Vec::new();
+    for (view, p) in points.iter().zip(&set.points) {
+        if view.signed_zenith.is_none()
+            && !keys.iter().any(|&key| same_group(view, p.theta_r_deg, key))
+        {
+            keys.push((view.incidence, p.theta_r_deg));
+        }
+    }
+    keys.retain(|&key| {
+        let azimuths = points
+            .iter()
+            .zip(&set.points)
+            .filter(|(view, p)| same_group(view, p.theta_r_deg, key))
+            .map(|(view, _)| view.relative_azimuth);
+        let (low, high) = azimuths.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+        high - low >= RING_MIN_SPAN_DEG
+    });
+    keys.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    for (view, p) in points.iter_mut().zip(&set.points) {
+        view.ring = keys
+            .iter()
+            .position(|&key| same_group(view, p.theta_r_deg, key));
+    }
+    keys.iter()
+        .enumerate()
+        .map(|(index, &(incidence, theta_r_deg))| Ring {
+            incidence,
+            theta_r_deg,
+            rank: keys[..index]
+                .iter()
+                .filter(|&&(i, _)| i == incidence)
+                .count(),
+            sweep: ring_sweep(incidences[incidence], theta_r_deg, chosen, alternative),
+        })
+        .collect()
+}
+
+/// Detector zeniths for an in-plane curve: every 0.5° to ±89.5°, and every 0.05° within 3° of
+/// specular so that a narrow lobe (σ ≈ 0.03) is drawn at its true height.
+fn in_plane_grid(theta_i_deg: f64) -> Vec<f64> {
+    let coarse = (-179..=179).map(|i| i as f64 * 0.5);
+    let fine = (-60..=60)
+        .map(|i| theta_i_deg + i as f64 * 0.05)
+        .filter(|x| *x < 89.5);
+    distinct_sorted(coarse.chain(fine))
+}
+
+/// Relative azimuths for a ring: every 1°, and every 0.1° within 5° of the specular direction.
+fn ring_grid() -> Vec<f64> {
+    let coarse = (0..=360).map(f64::from);
+    let fine = (-50..=50).map(|i| 180.0 + i as f64 * 0.1);
+    distinct_sorted(coarse.chain(fine))
+}
+
+fn sweep(
+    x: Vec<f64>,
+    geometry: impl Fn(f64) -> (Direction, Direction),
+    chosen: &ModelCurveSource,
+    alternative: Option<&ModelCurveSource>,
+) -> ModelSweep {
+    let evaluate = |model: &Pbrdf| -> Vec<Mueller> {
+        x.iter()
+            .map(|&x| {
+                let (incident, scattered) = geometry(x);
+                model.mueller(&incident, &scattered)
+            })
+            .collect()
+    };
+    ModelSweep {
+        chosen: evaluate(&chosen.pbrdf),
+        alternative: alternative.map(|a| evaluate(&a.pbrdf)),
+        x,
+    }
+}
+
+fn in_plane_sweep(
+    theta_i_deg: f64,
+    chosen: &ModelCurveSource,
+    alternative: Option<&ModelCurveSource>,
+) -> ModelSweep {
+    let incident = Direction::from_angles(theta_i_deg.to_radians(), 0.0);
+    sweep(
+        in_plane_grid(theta_i_deg),
+        |zenith| {
+            let phi_r = if zenith >= 0.0 { 180f64 } else { 0.0 };
+            let scattered = Direction::from_angles(zenith.abs().to_radians(), phi_r.to_radians());
+            (incident, scattered)
+        },
+        chosen,
+        alternative,
+    )
+}
+
+fn ring_sweep(
+    theta_i_deg: f64,
+    theta_r_deg: f64,
+    chosen: &ModelCurveSource,
+    alternative: Option<&ModelCurveSource>,
+) -> ModelSweep {
+    let incident = Direction::from_angles(theta_i_deg.to_radians(), 0.0);
+    sweep(
+        ring_grid(),
+        |azimuth| {
+            let scattered = Direction::from_angles(theta_r_deg.to_radians(), azimuth.to_radians());
+            (incident, scattered)
+        },
+        chosen,
+        alternative,
+    )
+}
+
+/// Emission angles 0…88° every 2° (the hemispherical quadrature is accurate to 1e-5 there).
+fn emissivity_curves(
+    chosen: &ModelCurveSource,
+    alternative: Option<&ModelCurveSource>,
+) -> EmissivityCurves {
+    let theta_deg: Vec<f64> = (0..=44).map(|i| 2.0 * i as f64).collect();
+    let radians: Vec<f64> = theta_deg.iter().map(|t| t.to_radians()).collect();
+    let quadrature = HemisphereQuadrature::default();
+    EmissivityCurves {
+        chosen: chosen.pbrdf.emissivity_table(&radians, &quadrature),
+        alternative: alternative.map(|a| a.pbrdf.emissivity_table(&radians, &quadrature)),
+        theta_deg,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::{AlternativeFit, ModelSpec};
+    use crate::measure::MeasurementPoint;
+    use crate::pbrdf::{Shadowing, SlopeDistribution};
+    use std::collections::BTreeMap;
+
+    fn spec(distribution: SlopeDistribution) -> ModelSpec {
+        ModelSpec {
+            distribution,
+            shadowing: Shadowing::Smith,
+            n: 1.5,
+            k: 0.1,
+            rho_d: 0.01,
+            wavelength_um: 10.0,
+        }
+    }
+
+    fn material(with_alternative: bool) -> Material {
+        let model = spec(SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 });
+        let fit = with_alternative.then(|| crate::material::FitRecord {
+            source: "x.csv".into(),
+            source_sha256: String::new(),
+            points: 0,
+            elements: vec![],
+            free_parameters: vec![],
+            optimizer: "nm".into(),
+            seed: 0,
+            settings: BTreeMap::new(),
+            iterations: 0,
+            evaluations: 0,
+            cost: 1.0,
+            reduced_chi2: 1.0,
+            degrees_of_freedom: 1,
+            aic: 0.0,
+            bic: 0.0,
+            termination: String::new(),
+            rmse: BTreeMap::new(),
+            uncertainty: BTreeMap::new(),
+            correlation: vec![],
+            undetermined: vec![],
+            alternative: Some(AlternativeFit {
+                model: spec(SlopeDistribution::Gaussian { sigma: 0.15 }),
+                cost: 2.0,
+                reduced_chi2: 2.0,
+                aic: 1.0,
+                bic: 1.0,
+            }),
+            convergence: vec![],
+            global_iterations: 0,
+            at_bound: Vec::new(),
+            model_choice: None,
+        });
+        Material {
+            name: "test".into(),
+            tool_version: "test".into(),
+            model,
+            fit,
+        }
+    }
+
+    /// A set of m00 and m10 at the given (θ_i, φ_i, θ_r, φ_r), valued by `value(m)`.
+    fn set_of(
+        geometry: &[(f64, f64, f64, f64)],
+        value: impl Fn(&Mueller) -> [f64; 2],
+        uncertainties: [Option<f64>; 2],
+    ) -> MeasurementSet {
+        let model = material(false).pbrdf().unwrap();
+        let points = geometry
+            .iter()
+            .enumerate()
+            .map(|(i, &(ti, pi, tr, pr))| {
+                let m = model.mueller(
+                    &Direction::from_angles(ti.to_radians(), pi.to_radians()),
+                    &Direction::from_angles(tr.to_radians(), pr.to_radians()),
+                );
+                MeasurementPoint {
+                    theta_i_deg: ti,
+                    phi_i_deg: pi,
+                    theta_r_deg: tr,
+                    phi_r_deg: pr,
+                    values: value(&m).to_vec(),
+                    uncertainties: uncertainties.to_vec(),
+                    line: i as u64 + 2,
+                }
+            })
+            .collect();
+        MeasurementSet {
+            source: "x.csv".into(),
+            sha256: String::new(),
+            material: "test".into(),
+            wavelength_um: 10.0,
+            metadata: BTreeMap::new(),
+            elements: vec![0, 4],
+            points,
+        }
+    }
+
+    fn exact(m: &Mueller) -> [f64; 2] {
+        [m[(0, 0)], m[(1, 0)]]
+    }
+
+    #[test]
+    fn points_are_placed_in_the_plane_on_rings_or_in_a_raster() {
+        let geometry = [
+            (60.0, 0.0, 30.0, 180.0), // specular side of the plane
+            (60.0, 10.0, 30.0, 10.0), // toward the source (φ_r = φ_i)
+            (60.0, 0.0, 0.0, 90.0),   // detector at the normal: in every plane
+            (60.0, 0.0, 45.0, 30.0),  // a ring spanning 120°
+            (60.0, 0.0, 45.0, 90.0),
+            (60.0, 0.0, 45.0, 150.0),
+            (60.0, 0.0, 45.0, 180.0), // its in-plane member
+            (60.0, 0.0, 58.0, 175.0), // a raster of 10° around specular: no ring
+            (60.0, 0.0, 58.0, 185.0),
+            (20.0, 0.0, 45.0, 200.0), // another incidence angle
+        ];
+        let set = set_of(&geometry, exact, [None, None]);
+        let data = ReportData::new(&material(false), &set).unwrap();
+        assert_eq!(data.incidences, [20.0, 60.0]);
+        let signed: Vec<Option<f64>> = data.points.iter().map(|p| p.signed_zenith).collect();
+        assert_eq!(
+            signed,
+            [
+                Some(30.0),
+                Some(-30.0),
+                Some(0.0),
+                None,
+                None,
+                None,
+                Some(45.0),
+                None,
+                None,
+                None
+            ]
+        );
+        let forward: Vec<f64> = data.points.iter().map(|p| p.forward_zenith).collect();
+        assert_eq!(
+            forward[3..6],
+            [-45.0, 45.0, 45.0],
+            "90° ≤ φr−φi ≤ 270° is forward"
+        );
+        assert_eq!(data.rings.len(), 1);
+        assert_eq!(
+            (data.rings[0].incidence, data.rings[0].theta_r_deg),
+            (1, 45.0)
+        );
+        let on_ring: Vec<bool> = data.points.iter().map(|p| p.ring == Some(0)).collect();
+        assert_eq!(
+            on_ring,
+            [false, false, false, true, true, true, true, false, false, false]
+        );
+        assert_eq!(data.off_ring_points(), 3);
+        // Only θi = 60° has in-plane points, so only it gets an in-plane model sweep.
+        assert!(data.in_plane[0].is_none() && data.in_plane[1].is_some());
+    }
+
+    #[test]
+    fn residuals_are_data_minus_model_over_sigma() {
+        let geometry = [(40.0, 0.0, 40.0, 180.0), (40.0, 0.0, 20.0, 0.0)];
+        let exact_set = set_of(&geometry, exact, [None, None]);
+        let data = ReportData::new(&material(false), &exact_set).unwrap();
+        assert_eq!(data.residuals.len(), 4);
+        assert!(data.residuals.iter().all(|r| r.value.abs() < 1e-12));
+
+        // Without u_ columns: σ(m00) = 3 % and σ(m10) = 1 % of the measured m00 (the fit's noise
+        // model), so a reading 3 % high is 1/1.03 σ off.
+        let shifted = set_of(
+            &geometry,
+            |m| [1.03 * m[(0, 0)], m[(1, 0)] - 0.02 * m[(0, 0)]],
+            [None, None],
+        );
+        let data = ReportData::new(&material(false), &shifted).unwrap();
+        let values: Vec<f64> = data.residuals.iter().map(|r| r.value).collect();
+        let (up, down) = (1.0 / 1.03, -2.0 / 1.03);
+        for (got, want) in values.iter().zip([up, down, up, down]) {
+            assert!((got - want).abs() < 1e-9, "{values:?}");
+        }
+        // With them, the file's σ is used as is.
+        let with_u = set_of(
+            &geometry,
+            |m| [m[(0, 0)] + 0.004, m[(1, 0)]],
+            [Some(0.002), Some(1.0)],
+        );
+        let data = ReportData::new(&material(false), &with_u).unwrap();
+        assert!((data.residuals[0].value - 2.0).abs() < 1e-9);
+        assert_eq!(data.residuals[0].forward_zenith, 40.0);
+        assert_eq!(data.residuals[2].forward_zenith, -20.0);
+    }
+
+    #[test]
+    fn sweeps_and_emissivity_are_the_models_own_values() {
+        let set = set_of(&[(30.0, 0.0, 30.0, 180.0)], exact, [None, None]);
+        let material = material(true);
+        let data = ReportData::new(&material, &set).unwrap();
+        let sweep = data.in_plane[0].as_ref().unwrap();
+        let specular = sweep
+            .x
+            .iter()
+            .position(|&x| (x - 30.0).abs() < 1e-9)
+            .unwrap();
+        let at = |model: &Pbrdf| {
+            model.mueller(
+                &Direction::from_angles(30f64.to_radians(), 0.0),
+                &Direction::from_angles(30f64.to_radians(), std::f64::consts::PI),
+            )
+        };
+        assert_eq!(sweep.chosen[specular], at(&material.pbrdf().unwrap()));
+        let alternative = material.fit.as_ref().unwrap().alternative.as_ref().unwrap();
+        assert_eq!(
+            sweep.alternative.as_ref().unwrap()[specular],
+            at(&alternative.model.pbrdf().unwrap())
+        );
+        assert_eq!(data.alternative_label.as_deref(), Some("gaussian"));
+        // Toward the source the detector sits at φ_r = φ_i: the retro direction at −30°.
+        let retro = sweep
+            .x
+            .iter()
+            .position(|&x| (x + 30.0).abs() < 1e-9)
+            .unwrap();
+        let expected = material.pbrdf().unwrap().mueller(
+            &Direction::from_angles(30f64.to_radians(), 0.0),
+            &Direction::from_angles(30f64.to_radians(), 0.0),
+        );
+        assert_eq!(sweep.chosen[retro], expected);
+
+        let e = &data.emissivity;
+        assert_eq!(e.theta_deg.first(), Some(&0.0));
+        assert_eq!(e.theta_deg.last(), Some(&88.0));
+        let direct = material
+            .pbrdf()
+            .unwrap()
+            .emissivity(60f64.to_radians(), &HemisphereQuadrature::default());
+        assert_eq!(e.chosen[30], direct);
+        // Isotropic surface: emission is p-polarized (ε1 < 0) away from the normal.
+        assert!(e.chosen[1..].iter().all(|s| s[1] < 0.0 && s[0] < 1.0));
+    }
+}

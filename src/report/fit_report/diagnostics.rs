@@ -1,0 +1,499 @@
+//! The fit's diagnostic panels: normalized residuals against detector zenith and their histogram,
+//! the optimizer's convergence, and the polarized emissivity the fit implies (DESIGN §1.4).
+
+use super::data::{ReportData, Residual};
+use super::style::{
+    draw_legend_column, draw_note, log_tick, DrawResult, LegendEntry, LineKind, Marker,
+    AXIS_DESC_SIZE, CAPTION_SIZE, GREY, LEGEND_SIZE, TICK_SIZE,
+};
+use crate::material::FitRecord;
+use crate::report::FONT;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+type Area<DB> = DrawingArea<DB, Shift>;
+
+/// Residual colours by the kind of Mueller element.
+const M00_COLOR: RGBColor = RGBColor(20, 20, 20);
+const LINEAR_COLOR: RGBColor = RGBColor(230, 97, 1);
+const CIRCULAR_COLOR: RGBColor = RGBColor(94, 60, 153);
+
+/// The element classes of the residual panel: m00; the linear block (rows and columns 0–2);
+/// the circular row and column (index 3).
+fn element_class(element: usize) -> usize {
+    match (element / 4, element % 4) {
+        (0, 0) => 0,
+        (r, c) if r < 3 && c < 3 => 1,
+        _ => 2,
+    }
+}
+
+const CLASS_NAMES: [&str; 3] = ["m00", "m01…m22 (linear)", "m03…m33 (circular)"];
+const CLASS_COLORS: [RGBColor; 3] = [M00_COLOR, LINEAR_COLOR, CIRCULAR_COLOR];
+
+fn chart_builder<'a, 'b, DB: DrawingBackend>(
+    area: &'a Area<DB>,
+    caption: &str,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(caption, (FONT, CAPTION_SIZE))
+        .margin(12)
+        .margin_right(22)
+        .x_label_area_size(58)
+        .y_label_area_size(78);
+    builder
+}
+
+/// (data − model)/σ of every measured element against the signed detector zenith.
+pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) -> DrawResult<DB> {
+    let caption = "(g) Normalized residuals (data − model)/σ, chosen model";
+    if data.residuals.is_empty() {
+        return draw_note(area, caption, "no residuals");
+    }
+    let largest = data
+        .residuals
+        .iter()
+        .map(|r| r.value.abs())
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    let bound = (largest * 1.1).clamp(4.0, 12.0);
+    let hidden = data
+        .residuals
+        .iter()
+        .filter(|r| r.value.is_nan() || r.value.abs() > bound)
+        .count();
+    let mut chart = chart_builder(area, caption).build_cartesian_2d(-90.0..90.0, -bound..bound)?;
+    chart
+        .configure_mesh()
+        .x_labels(13)
+        .y_labels(9)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .x_desc("detector zenith θr (°): + forward (specular) half, − backward half")
+        .y_desc("(data − model)/σ")
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_DESC_SIZE))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .draw()?;
+    chart.draw_series(LineSeries::new(
+        [(-90.0, 0.0), (90.0, 0.0)],
+        GREY.stroke_width(1),
+    ))?;
+    for level in [-3.0, 3.0] {
+        chart.draw_series(DashedLineSeries::new(
+            [(-90.0, level), (90.0, level)],
+            6,
+            5,
+            GREY.stroke_width(1),
+        ))?;
+    }
+    // Draw the many polarization residuals first so that m00 stays visible on top.
+    for class in [2, 1, 0] {
+        let points: Vec<&Residual> = data
+            .residuals
+            .iter()
+            .filter(|r| element_class(r.element) == class && r.value.abs() <= bound)
+            .collect();
+        let color = CLASS_COLORS[class].mix(if class == 0 { 0.8 } else { 0.45 });
+        chart.draw_series(
+            points
+                .iter()
+                .map(|r| Circle::new((r.forward_zenith, r.value), 2, color.filled())),
+        )?;
+    }
+    let mut entries: Vec<LegendEntry> = (0..3)
+        .filter(|&class| {
+            data.residuals
+                .iter()
+                .any(|r| element_class(r.element) == class)
+        })
+        .map(|class| {
+            LegendEntry::marker(
+                CLASS_NAMES[class],
+                CLASS_COLORS[class],
+                Marker::FilledCircle,
+            )
+        })
+        .collect();
+    entries.push(LegendEntry::line("±3σ", GREY, LineKind::Dashed));
+    if hidden > 0 {
+        entries.push(LegendEntry::line(
+            format!("{hidden} beyond ±{bound:.0}σ not shown"),
+            WHITE,
+            LineKind::Solid,
+        ));
+    }
+    let (x, y) = chart.plotting_area().get_pixel_range();
+    let legend_origin = (
+        x.end - area.get_base_pixel().0 - 260,
+        y.start - area.get_base_pixel().1 + 6,
+    );
+    draw_legend_column(area, &entries, legend_origin)?;
+    Ok(())
+}
+
+/// Bins of the residual histogram: 0.25σ wide over ±5σ.
+const BIN_WIDTH: f64 = 0.25;
+const HISTOGRAM_LIMIT: f64 = 5.0;
+
+/// Counts per bin of `values` over ±[`HISTOGRAM_LIMIT`], and how many fall outside.
+pub fn histogram(values: &[f64]) -> (Vec<usize>, usize) {
+    let bins = (2.0 * HISTOGRAM_LIMIT / BIN_WIDTH).round() as usize;
+    let mut counts = vec![0; bins];
+    let mut outside = 0;
+    for &v in values {
+        let bin = ((v + HISTOGRAM_LIMIT) / BIN_WIDTH).floor();
+        if bin >= 0.0 && (bin as usize) < bins {
+            counts[bin as usize] += 1;
+        } else {
+            outside += 1;
+        }
+    }
+    (counts, outside)
+}
+
+/// Histogram of the normalized residuals against the standard normal they should follow.
+pub fn draw_histogram<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) -> DrawResult<DB> {
+    let caption = "(h) Residual distribution";
+    let values: Vec<f64> = data
+        .residuals
+        .iter()
+        .map(|r| r.value)
+        .filter(|v| v.is_finite())
+        .collect();
+    if values.is_empty() {
+        return draw_note(area, caption, "no residuals");
+    }
+    let (counts, outside) = histogram(&values);
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let sd = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+    // Printed to two decimals: keep a tiny negative mean from showing as "-0.00".
+    let mean = if mean.abs() < 0.005 { 0.0 } else { mean };
+    let expected =
+        |x: f64| n * BIN_WIDTH * (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    let top = counts.iter().copied().max().unwrap_or(0) as f64;
+    // At least a few counts high, so that the integer tick labels stay distinct.
+    let high = (top.max(expected(0.0)) * 1.3).max(5.0);
+    let mut chart = chart_builder(area, caption)
+        .build_cartesian_2d(-HISTOGRAM_LIMIT..HISTOGRAM_LIMIT, 0.0..high)?;
+    chart
+        .configure_mesh()
+        .x_labels(11)
+        .y_labels(6)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .x_desc("(data − model)/σ")
+        .y_desc(format!("count per {BIN_WIDTH}σ bin"))
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_DESC_SIZE))
+        .light_line_style(RGBColor(240, 240, 240))
+        .bold_line_style(RGBColor(220, 220, 220))
+        .draw()?;
+    let bar = RGBColor(31, 119, 180);
+    chart.draw_series(counts.iter().enumerate().map(|(i, &count)| {
+        let x0 = -HISTOGRAM_LIMIT + i as f64 * BIN_WIDTH;
+        Rectangle::new(
+            [(x0, 0.0), (x0 + BIN_WIDTH, count as f64)],
+            bar.mix(0.55).filled(),
+        )
+    }))?;
+    let curve: Vec<(f64, f64)> = (0..=200)
+        .map(|i| {
+            let x = -HISTOGRAM_LIMIT + i as f64 * 0.05;
+            (x, expected(x))
+        })
+        .collect();
+    chart.draw_series(LineSeries::new(curve, BLACK.stroke_width(2)))?;
+    let mut entries = vec![
+        LegendEntry::line(
+            format!("residuals, N = {}", values.len()),
+            bar,
+            LineKind::Patch,
+        ),
+        LegendEntry::line("N(0, 1) expected", BLACK, LineKind::Solid),
+        LegendEntry::line(
+            format!("mean {mean:+.2}, s.d. {sd:.2}"),
+            WHITE,
+            LineKind::Solid,
+        ),
+    ];
+    if outside > 0 {
+        entries.push(LegendEntry::line(
+            format!("{outside} beyond ±{HISTOGRAM_LIMIT:.0}σ"),
+            WHITE,
+            LineKind::Solid,
+        ));
+    }
+    let (_, y) = chart.plotting_area().get_pixel_range();
+    let (x, _) = chart.plotting_area().get_pixel_range();
+    draw_legend_column(
+        area,
+        &entries,
+        (
+            x.start - area.get_base_pixel().0 + 8,
+            y.start - area.get_base_pixel().1 + 6,
+        ),
+    )?;
+    Ok(())
+}
+
+/// Best cost per GA generation, then per local-stage iteration, on a log axis.
+pub fn draw_convergence<DB: DrawingBackend>(
+    area: &Area<DB>,
+    fit: Option<&FitRecord>,
+) -> DrawResult<DB> {
+    let caption = "(i) Optimizer convergence";
+    let Some(fit) = fit else {
+        return draw_note(area, caption, "no fit record");
+    };
+    let costs: Vec<(f64, f64)> = fit
+        .convergence
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.is_finite() && **c > 0.0)
+        .map(|(i, &c)| (i as f64, c))
+        .collect();
+    if costs.len() < 2 {
+        return draw_note(area, caption, "no convergence history recorded");
+    }
+    let global = fit.global_iterations.min(fit.convergence.len());
+    let dof = fit.degrees_of_freedom as f64;
+    let low = costs.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+    let high = costs.iter().map(|c| c.1).fold(0.0, f64::max);
+    let show_dof = dof > 0.0 && dof > low / 100.0;
+    let (low, high) = (low.min(if show_dof { dof } else { low }) / 1.6, high * 1.6);
+    let last = (fit.convergence.len() - 1) as f64;
+    let mut chart = chart_builder(area, caption)
+        .build_cartesian_2d(0.0..last.max(1.0), (low..high).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_labels(8)
+        .y_labels(8)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&log_tick)
+        .x_desc("step: GA generation, then local-stage iteration")
+        .y_desc("best cost χ² = Σ ((data − model)/σ)²")
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_DESC_SIZE))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .draw()?;
+    let global_color = RGBColor(31, 119, 180);
+    let local_color = RGBColor(214, 39, 40);
+    let split = global.min(costs.len());
+    let (global_costs, local_costs) = costs.split_at(split);
+    let mut entries = Vec::new();
+    if !global_costs.is_empty() {
+        chart.draw_series(LineSeries::new(
+            global_costs.to_vec(),
+            global_color.stroke_width(2),
+        ))?;
+        entries.push(LegendEntry::line(
+            format!("global stage ({} generations)", global_costs.len()),
+            global_color,
+            LineKind::Solid,
+        ));
+    }
+    if !local_costs.is_empty() {
+        // Start the local line at the global stage's last best so that the two connect.
+        let local: Vec<(f64, f64)> = global_costs
+            .last()
+            .into_iter()
+            .chain(local_costs)
+            .copied()
+            .collect();
+        chart.draw_series(LineSeries::new(local, local_color.stroke_width(2)))?;
+        entries.push(LegendEntry::line(
+            format!("local stage ({} iterations)", local_costs.len()),
+            local_color,
+            LineKind::Solid,
+        ));
+    }
+    if global > 0 && global < fit.convergence.len() {
+        let x = global as f64 - 0.5;
+        chart.draw_series(DashedLineSeries::new(
+            [(x, low), (x, high)],
+            6,
+            5,
+            BLACK.stroke_width(1),
+        ))?;
+        let at = chart.backend_coord(&(x, high));
+        let base = area.get_base_pixel();
+        area.draw_text(
+            "polish starts",
+            &(FONT, LEGEND_SIZE)
+                .into_font()
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Right, VPos::Top)),
+            (at.0 - base.0 - 6, at.1 - base.1 + 6),
+        )?;
+    }
+    if show_dof {
+        chart.draw_series(DashedLineSeries::new(
+            [(0.0, dof), (last, dof)],
+            3,
+            4,
+            GREY.stroke_width(1),
+        ))?;
+        entries.push(LegendEntry::line(
+            format!("degrees of freedom {dof:.0} (χ²red = 1)"),
+            GREY,
+            LineKind::Dashed,
+        ));
+    }
+    entries.push(LegendEntry::line(
+        format!("final χ² = {}", super::table::format_plain(fit.cost)),
+        WHITE,
+        LineKind::Solid,
+    ));
+    let (x, y) = chart.plotting_area().get_pixel_range();
+    let base = area.get_base_pixel();
+    let legend_width = 300;
+    draw_legend_column(
+        area,
+        &entries,
+        (x.end - base.0 - legend_width - 6, y.start - base.1 + 40),
+    )?;
+    Ok(())
+}
+
+/// ε0 (left axis) and −ε1 (right axis) against emission angle for both models.
+pub fn draw_emissivity<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) -> DrawResult<DB> {
+    let caption = "(f) Polarized emissivity implied by the fit";
+    let curves = &data.emissivity;
+    let series = |values: &[crate::optics::Stokes], j: usize, sign: f64| -> Vec<(f64, f64)> {
+        curves
+            .theta_deg
+            .iter()
+            .zip(values)
+            .map(|(&t, e)| (t, sign * e[j]))
+            .collect()
+    };
+    let mut e0 = vec![series(&curves.chosen, 0, 1.0)];
+    let mut e1 = vec![series(&curves.chosen, 1, -1.0)];
+    if let Some(alt) = &curves.alternative {
+        e0.push(series(alt, 0, 1.0));
+        e1.push(series(alt, 1, -1.0));
+    }
+    let e0_low = e0.iter().flatten().map(|p| p.1).fold(1.0, f64::min);
+    let e1_high = e1.iter().flatten().map(|p| p.1).fold(0.0, f64::max);
+    let e0_range = floor_to((e0_low - 0.05).min(0.9), 0.05)..1.0;
+    let e1_range = 0.0..(e1_high * 1.15).max(0.01);
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, (FONT, CAPTION_SIZE))
+        .margin(12)
+        .x_label_area_size(58)
+        .y_label_area_size(78)
+        .right_y_label_area_size(78)
+        .build_cartesian_2d(0.0..90.0, e0_range.clone())?
+        .set_secondary_coord(0.0..90.0, e1_range);
+    chart
+        .configure_mesh()
+        .x_labels(10)
+        .y_labels(8)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.2}"))
+        .x_desc("emission angle θe (°)")
+        .y_desc("ε0 (black, left axis)")
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_DESC_SIZE))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .draw()?;
+    let e1_color = RGBColor(214, 39, 40);
+    chart
+        .configure_secondary_axes()
+        .y_labels(8)
+        .y_label_formatter(&|v| format!("{v:.3}"))
+        .y_desc("−ε1 (red, right axis)")
+        .label_style((FONT, TICK_SIZE).into_font().color(&e1_color))
+        .axis_desc_style((FONT, AXIS_DESC_SIZE).into_font().color(&e1_color))
+        .draw()?;
+    for (i, line) in e0.into_iter().enumerate() {
+        let inside: Vec<(f64, f64)> = line
+            .into_iter()
+            .filter(|p| e0_range.contains(&p.1))
+            .collect();
+        if i == 0 {
+            chart.draw_series(LineSeries::new(inside, BLACK.stroke_width(2)))?;
+        } else {
+            chart.draw_series(DashedLineSeries::new(inside, 7, 5, BLACK.stroke_width(2)))?;
+        }
+    }
+    for (i, line) in e1.into_iter().enumerate() {
+        if i == 0 {
+            chart.draw_secondary_series(LineSeries::new(line, e1_color.stroke_width(2)))?;
+        } else {
+            chart.draw_secondary_series(DashedLineSeries::new(
+                line,
+                7,
+                5,
+                e1_color.stroke_width(2),
+            ))?;
+        }
+    }
+    let mut entries = vec![
+        LegendEntry::line(format!("ε0, {}", data.chosen_label), BLACK, LineKind::Solid),
+        LegendEntry::line(
+            format!("−ε1, {}", data.chosen_label),
+            e1_color,
+            LineKind::Solid,
+        ),
+    ];
+    if let Some(alt) = &data.alternative_label {
+        entries.push(LegendEntry::line(
+            format!("ε0, {alt}"),
+            BLACK,
+            LineKind::Dashed,
+        ));
+        entries.push(LegendEntry::line(
+            format!("−ε1, {alt}"),
+            e1_color,
+            LineKind::Dashed,
+        ));
+    }
+    if e0_low < 0.0 {
+        entries.push(LegendEntry::line(
+            "ε0 < 0: reflectance > 1 (not energy conserving)",
+            e1_color,
+            LineKind::Dashed,
+        ));
+    }
+    let (x, y) = chart.plotting_area().get_pixel_range();
+    let base = area.get_base_pixel();
+    draw_legend_column(area, &entries, (x.start - base.0 + 8, y.end - base.1 - 150))?;
+    Ok(())
+}
+
+/// `value` rounded down to a multiple of `step`.
+fn floor_to(value: f64, step: f64) -> f64 {
+    (value / step).floor() * step
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn histogram_bins_are_quarter_sigma_and_count_the_overflow() {
+        let (counts, outside) = histogram(&[-5.0, -0.1, 0.0, 0.1, 0.26, 4.99, 5.0, -7.0, f64::NAN]);
+        assert_eq!(counts.len(), 40);
+        assert_eq!(counts[0], 1, "−5 opens the first bin");
+        assert_eq!(
+            (counts[19], counts[20], counts[21], counts[39]),
+            (1, 2, 1, 1)
+        );
+        assert_eq!(outside, 3, "5.0, −7 and NaN");
+        assert_eq!(counts.iter().sum::<usize>() + outside, 9);
+    }
+
+    #[test]
+    fn element_classes_split_intensity_linear_and_circular() {
+        let classes: Vec<usize> = (0..16).map(element_class).collect();
+        assert_eq!(classes, [0, 1, 1, 2, 1, 1, 1, 2, 1, 1, 1, 2, 2, 2, 2, 2]);
+    }
+}

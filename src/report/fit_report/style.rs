@@ -1,0 +1,387 @@
+//! Colours, markers, legends and line clipping shared by the report's panels. Every text uses the
+//! embedded font ([`FONT`]) so that the figure renders without system fonts.
+
+use super::super::FONT;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+pub type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+/// Font sizes in pixels for the 2400 × 1800 figure.
+pub const TITLE_SIZE: i32 = 30;
+pub const CAPTION_SIZE: i32 = 21;
+pub const AXIS_DESC_SIZE: i32 = 17;
+pub const TICK_SIZE: i32 = 15;
+pub const LEGEND_SIZE: i32 = 15;
+pub const SMALL_CAPTION_SIZE: i32 = 17;
+pub const SMALL_TICK_SIZE: i32 = 13;
+
+/// Colour of incidence angle number `index` (Tableau 10, readable on white and in grey print).
+pub fn incidence_color(index: usize) -> RGBColor {
+    const PALETTE: [RGBColor; 10] = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+        RGBColor(214, 39, 40),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
+        RGBColor(227, 119, 194),
+        RGBColor(127, 127, 127),
+        RGBColor(188, 189, 34),
+        RGBColor(23, 190, 207),
+    ];
+    PALETTE[index % PALETTE.len()]
+}
+
+pub const GREY: RGBColor = RGBColor(110, 110, 110);
+
+/// The shape of a measured point; rings of one incidence angle differ by shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Marker {
+    FilledCircle,
+    FilledTriangle,
+    HollowCircle,
+    HollowTriangle,
+}
+
+impl Marker {
+    pub fn for_rank(rank: usize) -> Marker {
+        [
+            Marker::FilledCircle,
+            Marker::FilledTriangle,
+            Marker::HollowCircle,
+            Marker::HollowTriangle,
+        ][rank % 4]
+    }
+
+    fn style(self, color: RGBColor) -> ShapeStyle {
+        match self {
+            Marker::FilledCircle | Marker::FilledTriangle => color.filled(),
+            Marker::HollowCircle | Marker::HollowTriangle => color.stroke_width(2),
+        }
+    }
+
+    /// The marker as a drawable element at a backend (pixel) position.
+    pub fn element<DB: DrawingBackend>(
+        self,
+        at: (i32, i32),
+        size: i32,
+        color: RGBColor,
+    ) -> DynElement<'static, DB, (i32, i32)> {
+        match self {
+            Marker::FilledCircle | Marker::HollowCircle => {
+                Circle::new(at, size, self.style(color)).into_dyn()
+            }
+            Marker::FilledTriangle | Marker::HollowTriangle => {
+                TriangleMarker::new(at, size + 1, self.style(color)).into_dyn()
+            }
+        }
+    }
+
+    /// The marker at a data coordinate.
+    pub fn at<DB: DrawingBackend>(
+        self,
+        at: (f64, f64),
+        size: i32,
+        color: RGBColor,
+    ) -> DynElement<'static, DB, (f64, f64)> {
+        match self {
+            Marker::FilledCircle | Marker::HollowCircle => {
+                Circle::new(at, size, self.style(color)).into_dyn()
+            }
+            Marker::FilledTriangle | Marker::HollowTriangle => {
+                TriangleMarker::new(at, size + 1, self.style(color)).into_dyn()
+            }
+        }
+    }
+}
+
+/// How a legend entry is drawn: a line sample, a marker, or both.
+#[derive(Clone, Debug)]
+pub struct LegendEntry {
+    pub label: String,
+    pub color: RGBColor,
+    pub line: Option<LineKind>,
+    pub marker: Option<Marker>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LineKind {
+    Solid,
+    Dashed,
+    /// A filled patch, for bars.
+    Patch,
+}
+
+impl LegendEntry {
+    pub fn line(label: impl Into<String>, color: RGBColor, kind: LineKind) -> LegendEntry {
+        LegendEntry {
+            label: label.into(),
+            color,
+            line: Some(kind),
+            marker: None,
+        }
+    }
+    pub fn marker(label: impl Into<String>, color: RGBColor, marker: Marker) -> LegendEntry {
+        LegendEntry {
+            label: label.into(),
+            color,
+            line: None,
+            marker: Some(marker),
+        }
+    }
+}
+
+const SAMPLE_WIDTH: i32 = 34;
+
+fn draw_sample<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entry: &LegendEntry,
+    x: i32,
+    y: i32,
+) -> DrawResult<DB> {
+    match entry.line {
+        Some(LineKind::Solid) => area.draw(&PathElement::new(
+            vec![(x, y), (x + SAMPLE_WIDTH, y)],
+            entry.color.stroke_width(2),
+        ))?,
+        Some(LineKind::Dashed) => {
+            for start in [0, 13, 26] {
+                area.draw(&PathElement::new(
+                    vec![(x + start, y), (x + (start + 8).min(SAMPLE_WIDTH), y)],
+                    entry.color.stroke_width(2),
+                ))?;
+            }
+        }
+        Some(LineKind::Patch) => area.draw(&Rectangle::new(
+            [(x + 6, y - 6), (x + SAMPLE_WIDTH - 6, y + 6)],
+            entry.color.mix(0.55).filled(),
+        ))?,
+        None => {}
+    }
+    if let Some(marker) = entry.marker {
+        area.draw(&marker.element((x + SAMPLE_WIDTH / 2, y), 4, entry.color))?;
+    }
+    Ok(())
+}
+
+/// Draws `entries` one per row with the top-left corner at `(x, y)` of `area` on a framed white
+/// box; returns the box's pixel size.
+pub fn draw_legend_column<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[LegendEntry],
+    (x, y): (i32, i32),
+) -> Result<(i32, i32), DrawingAreaErrorKind<DB::ErrorType>> {
+    let font = (FONT, LEGEND_SIZE).into_font();
+    let row = LEGEND_SIZE + 7;
+    let mut text_width = 0;
+    for entry in entries {
+        text_width = text_width.max(
+            area.estimate_text_size(&entry.label, &font.clone().into_text_style(area))?
+                .0 as i32,
+        );
+    }
+    let (width, height) = (
+        SAMPLE_WIDTH + text_width + 22,
+        row * entries.len() as i32 + 8,
+    );
+    area.draw(&Rectangle::new(
+        [(x, y), (x + width, y + height)],
+        WHITE.mix(0.9).filled(),
+    ))?;
+    area.draw(&Rectangle::new(
+        [(x, y), (x + width, y + height)],
+        RGBColor(170, 170, 170).stroke_width(1),
+    ))?;
+    let style = font.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center));
+    for (i, entry) in entries.iter().enumerate() {
+        let cy = y + 4 + row * i as i32 + row / 2;
+        draw_sample(area, entry, x + 6, cy)?;
+        area.draw_text(&entry.label, &style, (x + SAMPLE_WIDTH + 14, cy))?;
+    }
+    Ok((width, height))
+}
+
+/// Draws `entries` in one row starting at `(x, y)` (vertical centre), without a frame.
+pub fn draw_legend_row<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[LegendEntry],
+    (mut x, y): (i32, i32),
+) -> DrawResult<DB> {
+    let font = (FONT, LEGEND_SIZE + 2).into_font();
+    let style = font.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center));
+    for entry in entries {
+        draw_sample(area, entry, x, y)?;
+        area.draw_text(&entry.label, &style, (x + SAMPLE_WIDTH + 8, y))?;
+        x += SAMPLE_WIDTH
+            + 8
+            + area
+                .estimate_text_size(&entry.label, &font.clone().into_text_style(area))?
+                .0 as i32
+            + 26;
+    }
+    Ok(())
+}
+
+/// A message in the middle of an empty panel, so a missing quantity is said rather than blank.
+pub fn draw_note<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: &str,
+    note: &str,
+) -> DrawResult<DB> {
+    let (w, h) = area.dim_in_pixel();
+    let caption_style = (FONT, CAPTION_SIZE)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Center, VPos::Top));
+    area.draw_text(caption, &caption_style, (w as i32 / 2, 8))?;
+    let style = (FONT, AXIS_DESC_SIZE)
+        .into_font()
+        .color(&GREY)
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    area.draw_text(note, &style, (w as i32 / 2, h as i32 / 2))?;
+    area.draw(&Rectangle::new(
+        [(20, 45), (w as i32 - 20, h as i32 - 20)],
+        RGBColor(200, 200, 200).stroke_width(1),
+    ))?;
+    Ok(())
+}
+
+/// The y axis of a profile panel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum YAxis {
+    Log { low: f64, high: f64 },
+    Linear { low: f64, high: f64 },
+}
+
+impl YAxis {
+    pub fn bounds(&self) -> (f64, f64) {
+        match *self {
+            YAxis::Log { low, high } | YAxis::Linear { low, high } => (low, high),
+        }
+    }
+    pub fn contains(&self, y: f64) -> bool {
+        let (low, high) = self.bounds();
+        y.is_finite() && y >= low && y <= high
+    }
+
+    /// The axis' own scale: ln y on a log axis (−∞ for y ≤ 0), y on a linear one.
+    fn scaled(&self, y: f64) -> f64 {
+        match self {
+            YAxis::Log { .. } if y > 0.0 => y.ln(),
+            YAxis::Log { .. } => f64::NEG_INFINITY,
+            YAxis::Linear { .. } => y,
+        }
+    }
+
+    /// Splits a polyline into the pieces inside the axis range, ending each piece on the
+    /// boundary where it leaves (interpolated in the axis' own scale). Plotters would otherwise
+    /// squash out-of-range points onto the frame.
+    pub fn clip(&self, line: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+        let (low, high) = self.bounds();
+        let (t_low, t_high) = (self.scaled(low), self.scaled(high));
+        // Where the segment a→b, one end inside and one outside, meets the boundary.
+        let crossing = |a: (f64, f64), b: (f64, f64)| -> (f64, f64) {
+            let (ta, tb) = (self.scaled(a.1), self.scaled(b.1));
+            let a_inside = self.contains(a.1);
+            let outside = if a_inside { tb } else { ta };
+            let (edge, t_edge) = if outside > t_high {
+                (high, t_high)
+            } else {
+                (low, t_low)
+            };
+            let fraction = if ta.is_finite() && tb.is_finite() && ta != tb {
+                ((t_edge - ta) / (tb - ta)).clamp(0.0, 1.0)
+            } else if a_inside {
+                0.0
+            } else {
+                1.0
+            };
+            (a.0 + fraction * (b.0 - a.0), edge)
+        };
+        let mut pieces = Vec::new();
+        let mut current: Vec<(f64, f64)> = Vec::new();
+        for (i, &p) in line.iter().enumerate() {
+            let previous = i.checked_sub(1).map(|j| line[j]);
+            match (previous, self.contains(p.1)) {
+                (Some(q), true) if !self.contains(q.1) => {
+                    current.push(crossing(q, p));
+                    current.push(p);
+                }
+                (_, true) => current.push(p),
+                (Some(q), false) if self.contains(q.1) => {
+                    current.push(crossing(q, p));
+                    pieces.push(std::mem::take(&mut current));
+                }
+                (_, false) => {}
+            }
+        }
+        if !current.is_empty() {
+            pieces.push(current);
+        }
+        pieces.retain(|piece| piece.len() > 1);
+        pieces
+    }
+}
+
+/// Tick labels of a log axis: decimals from 0.001 to 1000 ("0.01", "10"), else "1e-4".
+pub fn log_tick(value: &f64) -> String {
+    if (1e-3..1e4).contains(value) {
+        let decimals = (-value.log10().floor()).max(0.0) as usize;
+        format!("{value:.decimals$}")
+    } else {
+        format!("{value:.0e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_are_cut_at_the_axis_range_not_squashed_onto_it() {
+        let linear = YAxis::Linear {
+            low: 0.0,
+            high: 1.0,
+        };
+        let pieces = linear.clip(&[(0.0, 0.5), (1.0, 1.5), (2.0, 2.5), (3.0, 0.5), (4.0, 0.25)]);
+        // Leaves at y = 1 halfway to x = 1; re-enters 3/4 of the way from x = 2 (2.5 → 0.5).
+        assert_eq!(
+            pieces,
+            vec![
+                vec![(0.0, 0.5), (0.5, 1.0)],
+                vec![(2.75, 1.0), (3.0, 0.5), (4.0, 0.25)]
+            ]
+        );
+        // A log axis interpolates geometrically; zero (log −∞) ends a piece at its last point.
+        let log = YAxis::Log {
+            low: 1e-3,
+            high: 1.0,
+        };
+        let pieces = log.clip(&[
+            (0.0, 1e-2),
+            (1.0, 1e-4),
+            (2.0, 0.0),
+            (3.0, 1e-2),
+            (4.0, 0.1),
+        ]);
+        assert_eq!(pieces.len(), 2);
+        let (x, y) = pieces[0][1];
+        assert!(
+            (x - 0.5).abs() < 1e-12 && (y - 1e-3).abs() < 1e-15,
+            "{pieces:?}"
+        );
+        assert_eq!(pieces[1], vec![(3.0, 1e-3), (3.0, 1e-2), (4.0, 0.1)]);
+        assert!(log.clip(&[(0.0, 5.0), (1.0, 7.0)]).is_empty());
+    }
+
+    #[test]
+    fn log_ticks_are_decimals_within_reason() {
+        let labels: Vec<String> = [1e-4, 1e-3, 0.01, 1.0, 100.0, 1e4]
+            .iter()
+            .map(log_tick)
+            .collect();
+        assert_eq!(labels, ["1e-4", "0.001", "0.01", "1", "100", "1e4"]);
+    }
+}

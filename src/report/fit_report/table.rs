@@ -1,0 +1,516 @@
+//! The report's parameter table: fitted values with 1-σ uncertainties beside the competing
+//! distribution's best fit, fit quality (reduced χ², AIC, BIC), the preferred model, the data
+//! and optimizer, and the provenance of the measurement (DESIGN §2.2).
+
+use super::style::{DrawResult, CAPTION_SIZE, LEGEND_SIZE};
+use crate::material::{FitRecord, Material, ModelSpec};
+use crate::pbrdf::SlopeDistribution;
+use crate::report::FONT;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::FontStyle;
+
+/// Characters of the SHA-256 shown in the table and the index.
+pub const SHA_PREFIX: usize = 16;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tone {
+    Normal,
+    Muted,
+    Warning,
+}
+
+/// One line of the table.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Row {
+    Heading(String),
+    /// Cells placed at the table's column stops.
+    Cells(Vec<String>, Tone),
+    /// Free text across the width, wrapped.
+    Text(String, Tone),
+}
+
+/// `value ± sigma` rounded to the uncertainty's second significant digit; without a usable
+/// uncertainty, four significant digits.
+pub fn format_with_uncertainty(value: f64, sigma: Option<f64>) -> (String, Option<String>) {
+    match sigma.filter(|s| s.is_finite() && *s > 0.0) {
+        Some(sigma) => {
+            let decimals = (1 - sigma.log10().floor() as i32).clamp(0, 10) as usize;
+            (
+                format!("{value:.decimals$}"),
+                Some(format!("{sigma:.decimals$}")),
+            )
+        }
+        None => (format_plain(value), None),
+    }
+}
+
+/// Four significant digits, in scientific form outside 1e-3…1e4.
+pub fn format_plain(value: f64) -> String {
+    if value == 0.0 {
+        "0".into()
+    } else if (1e-3..1e4).contains(&value.abs()) {
+        let decimals = (3 - value.abs().log10().floor() as i32).max(0) as usize;
+        format!("{value:.decimals$}")
+    } else {
+        format!("{value:.3e}")
+    }
+}
+
+/// An angle in degrees with at most two decimals and no trailing zeros ("20", "62.5").
+pub fn format_angle(degrees: f64) -> String {
+    let text = format!("{degrees:.2}");
+    text.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+/// The model parameters: (symbol, name in `FitRecord` maps, value).
+pub fn parameters(model: &ModelSpec) -> Vec<(&'static str, &'static str, Option<f64>)> {
+    let q = match model.distribution {
+        SlopeDistribution::Cauchy { q, .. } => Some(q),
+        SlopeDistribution::Gaussian { .. } => None,
+    };
+    vec![
+        ("σ", "sigma", Some(model.distribution.sigma())),
+        ("q", "q", q),
+        ("n", "n", Some(model.n)),
+        ("k", "k", Some(model.k)),
+        ("ρd", "rho_d", Some(model.rho_d)),
+    ]
+}
+
+/// A fit map entry under the parameter's name, accepting `rho` for `rho_d` (DESIGN §4 spelling).
+pub fn lookup<'a, T>(map: impl Fn(&str) -> Option<&'a T>, name: &str) -> Option<&'a T> {
+    map(name).or_else(|| (name == "rho_d").then(|| map("rho")).flatten())
+}
+
+pub fn is_free(fit: &FitRecord, name: &str) -> bool {
+    fit.free_parameters
+        .iter()
+        .any(|p| p == name || (name == "rho_d" && p == "rho"))
+}
+
+/// Which distribution the information criteria prefer, and by how much (Burnham & Anderson:
+/// ΔAIC < 2 does not distinguish the models).
+pub fn preference(material: &Material) -> Option<String> {
+    let fit = material.fit.as_ref()?;
+    let alt = fit.alternative.as_ref()?;
+    let chosen = material.model.distribution.name();
+    let other = alt.model.distribution.name();
+    let delta_aic = alt.aic - fit.aic;
+    let delta_bic = alt.bic - fit.bic;
+    let winner = if delta_aic >= 0.0 { chosen } else { other };
+    Some(if delta_aic.abs() < 2.0 {
+        format!(
+            "{chosen} ≈ {other}: |ΔAIC| = {:.1} < 2 does not distinguish them",
+            delta_aic.abs()
+        )
+    } else {
+        format!(
+            "{winner} preferred: ΔAIC = {:.1}, ΔBIC = {:.1} ({other} − {chosen})",
+            delta_aic, delta_bic
+        )
+    })
+}
+
+pub fn sha_prefix(sha: &str) -> String {
+    let prefix: String = sha.chars().take(SHA_PREFIX).collect();
+    if sha.chars().count() > SHA_PREFIX {
+        format!("{prefix}…")
+    } else {
+        prefix
+    }
+}
+
+/// The rows of the table.
+pub fn table_rows(material: &Material) -> Vec<Row> {
+    let model = &material.model;
+    let fit = material.fit.as_ref();
+    let alternative = fit.and_then(|f| f.alternative.as_ref());
+    let mut rows = vec![Row::Heading(format!(
+        "Parameters ({} slopes, {} shadowing)",
+        model.distribution.name(),
+        model.shadowing.name()
+    ))];
+    let mut header = vec![
+        String::new(),
+        format!("{} (chosen)", model.distribution.name()),
+        "± 1σ".into(),
+    ];
+    if let Some(alt) = alternative {
+        header.push(format!("{} (alt.)", alt.model.distribution.name()));
+    }
+    rows.push(Row::Cells(header, Tone::Muted));
+    let alternative_values = alternative.map(|a| parameters(&a.model));
+    for (i, (symbol, name, value)) in parameters(model).into_iter().enumerate() {
+        let alt_value = alternative_values
+            .as_ref()
+            .and_then(|values| values[i].2)
+            .map(format_plain)
+            .unwrap_or_else(|| "—".into());
+        let Some(value) = value else {
+            if alternative.is_some() {
+                rows.push(Row::Cells(
+                    vec![symbol.into(), "—".into(), String::new(), alt_value],
+                    Tone::Normal,
+                ));
+            }
+            continue;
+        };
+        let (text, sigma_text, tone) = match fit {
+            Some(fit) if is_free(fit, name) => {
+                let sigma = lookup(|k| fit.uncertainty.get(k), name).copied();
+                let (text, sigma_text) = format_with_uncertainty(value, sigma);
+                let undetermined = fit.undetermined.iter().any(|u| u == name);
+                let sigma_text = match (sigma_text, undetermined) {
+                    (Some(s), false) => format!("± {s}"),
+                    (Some(s), true) => format!("± {s} undetermined"),
+                    (None, _) => "± ? undetermined".into(),
+                };
+                let tone = if undetermined {
+                    Tone::Warning
+                } else {
+                    Tone::Normal
+                };
+                (text, sigma_text, tone)
+            }
+            Some(_) => (format_plain(value), "fixed".into(), Tone::Muted),
+            None => (format_plain(value), String::new(), Tone::Normal),
+        };
+        let mut cells = vec![symbol.to_owned(), text, sigma_text];
+        if alternative.is_some() {
+            cells.push(alt_value);
+        }
+        rows.push(Row::Cells(cells, tone));
+    }
+    let Some(fit) = fit else {
+        rows.push(Row::Text(
+            "No fit record: the model was not fitted by irpol.".into(),
+            Tone::Warning,
+        ));
+        return rows;
+    };
+
+    rows.push(Row::Heading("Fit quality".into()));
+    let quality: [(&str, f64, Option<f64>); 4] = [
+        (
+            "reduced χ²",
+            fit.reduced_chi2,
+            alternative.map(|a| a.reduced_chi2),
+        ),
+        ("cost χ²", fit.cost, alternative.map(|a| a.cost)),
+        ("AIC", fit.aic, alternative.map(|a| a.aic)),
+        ("BIC", fit.bic, alternative.map(|a| a.bic)),
+    ];
+    for (name, chosen, alt) in quality {
+        let mut cells = vec![name.to_owned(), format_plain(chosen), String::new()];
+        if let Some(alt) = alt {
+            cells.push(format_plain(alt));
+        }
+        rows.push(Row::Cells(cells, Tone::Normal));
+    }
+    match preference(material) {
+        Some(text) => rows.push(Row::Text(text, Tone::Normal)),
+        None => rows.push(Row::Text(
+            "no competing distribution was fitted".into(),
+            Tone::Muted,
+        )),
+    }
+    if let Some(text) = strongest_correlation(fit) {
+        rows.push(Row::Text(text, Tone::Normal));
+    }
+    if !fit.undetermined.is_empty() {
+        rows.push(Row::Text(
+            format!(
+                "not determined by these data: {} (relative σ > 50 % or |ρ| > 0.999)",
+                fit.undetermined.join(", ")
+            ),
+            Tone::Warning,
+        ));
+    }
+
+    rows.push(Row::Heading("Data and optimizer".into()));
+    rows.push(Row::Text(
+        format!(
+            "{} points × {} elements ({}), {} degrees of freedom{}",
+            fit.points,
+            fit.elements.len(),
+            element_span(&fit.elements),
+            fit.degrees_of_freedom,
+            fit.rmse
+                .get("m00")
+                .map(|r| format!(", RMSE m00 = {} sr⁻¹", format_plain(*r)))
+                .unwrap_or_default()
+        ),
+        Tone::Normal,
+    ));
+    let local = fit.convergence.len().saturating_sub(fit.global_iterations);
+    rows.push(Row::Text(
+        format!(
+            "{}, seed {}: {} generations + {} local iterations, {} evaluations",
+            fit.optimizer, fit.seed, fit.global_iterations, local, fit.evaluations
+        ),
+        Tone::Normal,
+    ));
+    rows.push(Row::Text(
+        format!("termination: {}", fit.termination),
+        Tone::Normal,
+    ));
+    rows.push(Row::Text(
+        format!(
+            "source {}, sha256 {}; {}",
+            fit.source.display(),
+            sha_prefix(&fit.source_sha256),
+            material.tool_version
+        ),
+        Tone::Muted,
+    ));
+    rows
+}
+
+/// The table's symbol of a parameter name ("sigma" → "σ").
+fn symbol(name: &str) -> &str {
+    match name {
+        "sigma" => "σ",
+        "rho_d" | "rho" => "ρd",
+        other => other,
+    }
+}
+
+fn element_span(elements: &[String]) -> String {
+    match elements {
+        [] => "none".into(),
+        [one] => one.clone(),
+        [first, .., last] => format!("{first}…{last}"),
+    }
+}
+
+/// The largest off-diagonal |correlation| of the free parameters, named.
+fn strongest_correlation(fit: &FitRecord) -> Option<String> {
+    let names = &fit.free_parameters;
+    let mut best: Option<(f64, usize, usize)> = None;
+    for (i, row) in fit.correlation.iter().enumerate().take(names.len()) {
+        for (j, &rho) in row.iter().enumerate().take(i) {
+            if rho.is_finite() && best.is_none_or(|(b, _, _)| rho.abs() > b.abs()) {
+                best = Some((rho, i, j));
+            }
+        }
+    }
+    best.map(|(rho, i, j)| {
+        format!(
+            "strongest correlation ρ({}, {}) = {rho:+.3}",
+            symbol(&names[j]),
+            symbol(&names[i])
+        )
+    })
+}
+
+/// Draws the table into `area` under a caption; long text wraps at the area's width.
+pub fn draw_table<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    material: &Material,
+) -> DrawResult<DB> {
+    let (width, _) = area.dim_in_pixel();
+    let left = 18;
+    let right = width as i32 - 12;
+    let stops = [left, left + 105, left + 245, left + 395];
+    let caption = (FONT, CAPTION_SIZE)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Center, VPos::Top));
+    area.draw_text(
+        &format!("(c) {} — fitted parameters", material.name),
+        &caption,
+        (width as i32 / 2, 12),
+    )?;
+    let size = LEGEND_SIZE + 1;
+    let line = size + 7;
+    let mut y = 50;
+    for row in table_rows(material) {
+        match row {
+            Row::Heading(text) => {
+                y += 4;
+                let style = (FONT, size + 1, FontStyle::Bold).into_font().color(&BLACK);
+                area.draw_text(&text, &style.into_text_style(area), (left, y))?;
+                area.draw(&PathElement::new(
+                    vec![(left, y + line - 3), (right, y + line - 3)],
+                    RGBColor(190, 190, 190).stroke_width(1),
+                ))?;
+                y += line + 2;
+            }
+            Row::Cells(cells, tone) => {
+                let style = tone_style(tone, size);
+                for (cell, &x) in cells.iter().zip(&stops) {
+                    area.draw_text(cell, &style, (x, y))?;
+                }
+                y += line;
+            }
+            Row::Text(text, tone) => {
+                let style = tone_style(tone, size);
+                for piece in wrap(area, &text, &style, (right - left) as u32)? {
+                    area.draw_text(&piece, &style, (left, y))?;
+                    y += line;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn tone_style(tone: Tone, size: i32) -> TextStyle<'static> {
+    let color = match tone {
+        Tone::Normal => RGBColor(0, 0, 0),
+        Tone::Muted => RGBColor(95, 95, 95),
+        Tone::Warning => RGBColor(190, 30, 30),
+    };
+    (FONT, size).into_font().color(&color)
+}
+
+/// Splits `text` at spaces into lines no wider than `width` pixels.
+fn wrap<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    style: &TextStyle,
+    width: u32,
+) -> Result<Vec<String>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut lines: Vec<String> = Vec::new();
+    let mut current = String::new();
+    for word in text.split(' ') {
+        let candidate = if current.is_empty() {
+            word.to_owned()
+        } else {
+            format!("{current} {word}")
+        };
+        if !current.is_empty() && area.estimate_text_size(&candidate, style)?.0 > width {
+            lines.push(std::mem::replace(&mut current, word.to_owned()));
+        } else {
+            current = candidate;
+        }
+    }
+    lines.push(current);
+    Ok(lines)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::AlternativeFit;
+    use crate::pbrdf::Shadowing;
+    use std::collections::BTreeMap;
+
+    #[test]
+    fn values_are_rounded_to_their_uncertainty() {
+        let cases = [
+            ((0.100_34, Some(0.0012)), ("0.1003", Some("0.0012"))),
+            ((1.812_3, Some(0.034)), ("1.812", Some("0.034"))),
+            ((123.4, Some(12.0)), ("123", Some("12"))),
+            ((0.02, Some(0.0)), ("0.02000", None)),
+            ((2.5e-5, None), ("2.500e-5", None)),
+        ];
+        for ((value, sigma), (text, sigma_text)) in cases {
+            let (got, got_sigma) = format_with_uncertainty(value, sigma);
+            assert_eq!((got.as_str(), got_sigma.as_deref()), (text, sigma_text));
+        }
+        assert_eq!(format_plain(0.0), "0");
+        assert_eq!(format_plain(9.925), "9.925");
+        assert_eq!(format_angle(20.0), "20");
+        assert_eq!(format_angle(62.5), "62.5");
+        assert_eq!(sha_prefix(&"ab".repeat(32)), format!("{}…", "ab".repeat(8)));
+    }
+
+    fn material(aic: f64, alternative_aic: f64) -> Material {
+        let model = ModelSpec {
+            distribution: SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
+            shadowing: Shadowing::Smith,
+            n: 1.2,
+            k: 0.2,
+            rho_d: 0.0,
+            wavelength_um: 9.925,
+        };
+        Material {
+            name: "m".into(),
+            tool_version: "t".into(),
+            fit: Some(FitRecord {
+                source: "m.csv".into(),
+                source_sha256: "0".repeat(64),
+                points: 10,
+                elements: vec!["m00".into(), "m10".into()],
+                free_parameters: vec!["sigma".into(), "q".into(), "rho".into()],
+                optimizer: "ga+nm".into(),
+                seed: 1,
+                settings: BTreeMap::new(),
+                iterations: 3,
+                evaluations: 30,
+                cost: 18.0,
+                reduced_chi2: 1.06,
+                degrees_of_freedom: 17,
+                aic,
+                bic: aic + 3.0,
+                termination: "converged".into(),
+                rmse: BTreeMap::new(),
+                uncertainty: BTreeMap::from([("sigma".into(), 0.0012), ("rho".into(), 0.001)]),
+                correlation: vec![
+                    vec![1.0, -0.95, 0.1],
+                    vec![-0.95, 1.0, 0.2],
+                    vec![0.1, 0.2, 1.0],
+                ],
+                undetermined: vec!["q".into()],
+                alternative: Some(AlternativeFit {
+                    model: ModelSpec {
+                        distribution: SlopeDistribution::Gaussian { sigma: 0.09 },
+                        ..model.clone()
+                    },
+                    cost: 30.0,
+                    reduced_chi2: 1.6,
+                    aic: alternative_aic,
+                    bic: alternative_aic + 3.0,
+                }),
+                convergence: vec![],
+                global_iterations: 0,
+                at_bound: Vec::new(),
+                model_choice: None,
+            }),
+            model,
+        }
+    }
+
+    #[test]
+    fn the_lower_aic_is_preferred_unless_within_two() {
+        assert_eq!(
+            preference(&material(24.0, 36.5)).unwrap(),
+            "cauchy preferred: ΔAIC = 12.5, ΔBIC = 12.5 (gaussian − cauchy)"
+        );
+        assert!(preference(&material(40.0, 36.0))
+            .unwrap()
+            .starts_with("gaussian preferred: ΔAIC = -4.0"));
+        assert!(preference(&material(24.0, 25.0))
+            .unwrap()
+            .contains("|ΔAIC| = 1.0 < 2 does not distinguish"));
+    }
+
+    #[test]
+    fn table_rows_show_uncertainties_fixed_and_undetermined_parameters() {
+        let rows = table_rows(&material(24.0, 36.5));
+        let cells = |symbol: &str| {
+            rows.iter()
+                .find_map(|row| match row {
+                    Row::Cells(cells, tone) if cells[0] == symbol => Some((cells.clone(), *tone)),
+                    _ => None,
+                })
+                .unwrap()
+        };
+        assert_eq!(cells("σ").0, ["σ", "0.1000", "± 0.0012", "0.09000"]);
+        assert_eq!(cells("q").1, Tone::Warning, "q is undetermined");
+        assert_eq!(cells("q").0[2], "± ? undetermined");
+        assert_eq!(cells("n").0[1..3], ["1.200", "fixed"]);
+        assert_eq!(
+            cells("ρd").0[1..3],
+            ["0.0000", "± 0.0010"],
+            "`rho` names ρ_d"
+        );
+        assert!(rows.contains(&Row::Text(
+            "strongest correlation ρ(σ, q) = -0.950".into(),
+            Tone::Normal
+        )));
+    }
+}

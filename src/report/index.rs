@@ -1,0 +1,331 @@
+//! `reports/index.html`: one self-contained page over the material library (DESIGN §4) — every
+//! material with its parameters ± 1σ, fit quality, preferred distribution, provenance (source
+//! CSV, SHA-256, whether the file still matches) and its report figure. Inline CSS and relative
+//! links only, so the page works from a file browser and when the folder is copied elsewhere.
+
+use super::fit_report::{
+    format_plain, format_with_uncertainty, is_free, lookup, parameters, preference, sha_prefix,
+    verified_source,
+};
+use super::ReportError;
+use crate::material::{list_library, write_atomically, Material};
+use std::fmt::Write as _;
+use std::path::{Component, Path, PathBuf};
+
+/// Writes `<reports_dir>/index.html` for the library in `library_dir`; returns its path.
+pub fn write_library_index(library_dir: &Path, reports_dir: &Path) -> Result<PathBuf, ReportError> {
+    let materials = list_library(library_dir)?;
+    let index = reports_dir.join("index.html");
+    std::fs::create_dir_all(reports_dir).map_err(|source| ReportError::Write {
+        path: reports_dir.to_owned(),
+        source,
+    })?;
+    let html = library_page(library_dir, reports_dir, &materials);
+    write_atomically(&index, html.as_bytes()).map_err(|source| ReportError::Write {
+        path: index.clone(),
+        source,
+    })?;
+    Ok(index)
+}
+
+/// Text made safe for HTML element content and attribute values.
+pub fn escape_html(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// A relative path as a URL: each segment percent-encoded (RFC 3986 unreserved characters kept),
+/// joined by '/'. Escape the result with [`escape_html`] only if it can hold '&' (it cannot).
+fn url_of(path: &Path) -> String {
+    path.components()
+        .map(|c| match c {
+            Component::ParentDir => "..".to_owned(),
+            Component::CurDir => ".".to_owned(),
+            other => percent_encode(&other.as_os_str().to_string_lossy()),
+        })
+        .collect::<Vec<_>>()
+        .join("/")
+}
+
+fn percent_encode(segment: &str) -> String {
+    let mut out = String::new();
+    for byte in segment.bytes() {
+        if byte.is_ascii_alphanumeric() || b"-._~".contains(&byte) {
+            out.push(byte as char);
+        } else {
+            let _ = write!(out, "%{byte:02X}");
+        }
+    }
+    out
+}
+
+/// `target` relative to the folder `from`, both resolved on disk; the absolute target when
+/// they share no root (another drive) or cannot be resolved.
+fn relative_to(from: &Path, target: &Path) -> PathBuf {
+    let (Ok(from), Ok(target)) = (from.canonicalize(), target.canonicalize()) else {
+        return target.to_owned();
+    };
+    let from: Vec<Component> = from.components().collect();
+    let to: Vec<Component> = target.components().collect();
+    let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
+    if common == 0 {
+        return target;
+    }
+    let mut relative = PathBuf::new();
+    for _ in common..from.len() {
+        relative.push("..");
+    }
+    for component in &to[common..] {
+        relative.push(component.as_os_str());
+    }
+    relative
+}
+
+/// "value ± σ" of one parameter in the index, or "value (fixed)".
+fn parameter_text(material: &Material, name: &str, value: f64) -> String {
+    match material.fit.as_ref() {
+        Some(fit) if is_free(fit, name) => {
+            let sigma = lookup(|k| fit.uncertainty.get(k), name).copied();
+            match format_with_uncertainty(value, sigma) {
+                (value, Some(sigma)) => format!("{value} ± {sigma}"),
+                (value, None) => format!("{value} ± ?"),
+            }
+        }
+        Some(_) => format!("{} (fixed)", format_plain(value)),
+        None => format_plain(value),
+    }
+}
+
+/// Whether the fit's source CSV is still the file that was fitted.
+fn provenance(material_path: &Path, material: &Material) -> (String, &'static str) {
+    let Some(fit) = material.fit.as_ref() else {
+        return ("not fitted by irpol".into(), "warn");
+    };
+    match verified_source(material_path, fit) {
+        Ok(_) => ("source unchanged".into(), "ok"),
+        Err(ReportError::SourceChanged { .. }) => {
+            ("source CSV changed since the fit".into(), "warn")
+        }
+        Err(ReportError::SourceMissing { .. }) => ("source CSV not found".into(), "warn"),
+        Err(other) => (other.to_string(), "warn"),
+    }
+}
+
+const STYLE: &str = "
+body { font-family: 'DejaVu Sans', Helvetica, Arial, sans-serif; margin: 24px auto; max-width: 1500px;
+       color: #1b1b1b; background: #fafafa; padding: 0 16px; }
+h1 { font-size: 1.6em; margin-bottom: 0.2em; }
+p.lead { color: #555; margin-top: 0; }
+table { border-collapse: collapse; background: #fff; }
+th, td { padding: 5px 10px; border-bottom: 1px solid #e2e2e2; text-align: left; vertical-align: top; }
+th { background: #f0f0f0; font-weight: 600; }
+td.num { font-variant-numeric: tabular-nums; white-space: nowrap; }
+section.material { background: #fff; border: 1px solid #ddd; border-radius: 6px; margin: 28px 0;
+                   padding: 12px 18px; }
+section.material h2 { margin: 4px 0 8px; font-size: 1.3em; }
+.facts { display: flex; flex-wrap: wrap; gap: 28px; }
+.facts table { font-size: 0.95em; }
+img.report { width: 100%; height: auto; border: 1px solid #ddd; margin-top: 12px; }
+.ok { color: #1a7f37; } .warn { color: #b42318; } .muted { color: #666; }
+code { font-family: 'DejaVu Sans Mono', Menlo, Consolas, monospace; font-size: 0.92em; }
+";
+
+fn library_page(
+    library_dir: &Path,
+    reports_dir: &Path,
+    materials: &[(PathBuf, Material)],
+) -> String {
+    let mut html = String::new();
+    let _ = write!(
+        html,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
+         <title>irpol material library</title>\n<style>{STYLE}</style>\n</head>\n<body>\n\
+         <h1>irpol material library</h1>\n<p class=\"lead\">{} material{} in <code>{}</code>; \
+         polarimetric BRDF fits (DESIGN §1.3), parameters with 1-σ uncertainties.</p>\n",
+        materials.len(),
+        if materials.len() == 1 { "" } else { "s" },
+        escape_html(&library_dir.display().to_string())
+    );
+    if materials.is_empty() {
+        html.push_str("<p>No materials yet: run <code>irpol fit</code>.</p>\n</body>\n</html>\n");
+        return html;
+    }
+    summary_table(&mut html, materials);
+    for (path, material) in materials {
+        material_section(&mut html, reports_dir, path, material);
+    }
+    let _ = write!(
+        html,
+        "<p class=\"muted\">Written by irpol {}.</p>\n</body>\n</html>\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    html
+}
+
+fn anchor(material: &Material) -> String {
+    format!("m-{}", percent_encode(&material.name))
+}
+
+fn summary_table(html: &mut String, materials: &[(PathBuf, Material)]) {
+    html.push_str(
+        "<table>\n<tr><th>material</th><th>distribution</th><th>shadowing</th><th>λ (µm)</th>\
+         <th>σ</th><th>q</th><th>n</th><th>k</th><th>ρ<sub>d</sub></th><th>reduced χ²</th>\
+         <th>points</th><th>provenance</th></tr>\n",
+    );
+    for (path, material) in materials {
+        let model = &material.model;
+        let cells: Vec<String> = parameters(model)
+            .into_iter()
+            .map(|(_, name, value)| match value {
+                Some(value) => escape_html(&parameter_text(material, name, value)),
+                None => "—".into(),
+            })
+            .collect();
+        let (chi2, points) = material.fit.as_ref().map_or(("—".into(), "—".into()), |f| {
+            (format_plain(f.reduced_chi2), f.points.to_string())
+        });
+        let (status, class) = provenance(path, material);
+        let _ = write!(
+            html,
+            "<tr><td><a href=\"#{}\">{}</a></td><td>{}</td><td>{}</td><td class=\"num\">{}</td>",
+            anchor(material),
+            escape_html(&material.name),
+            model.distribution.name(),
+            model.shadowing.name(),
+            format_plain(model.wavelength_um)
+        );
+        for cell in cells {
+            let _ = write!(html, "<td class=\"num\">{cell}</td>");
+        }
+        let _ = writeln!(
+            html,
+            "<td class=\"num\">{chi2}</td><td class=\"num\">{points}</td>\
+             <td class=\"{class}\">{}</td></tr>",
+            escape_html(&status)
+        );
+    }
+    html.push_str("</table>\n");
+}
+
+fn material_section(html: &mut String, reports_dir: &Path, path: &Path, material: &Material) {
+    let model = &material.model;
+    let name = escape_html(&material.name);
+    let _ = write!(
+        html,
+        "<section class=\"material\" id=\"{}\">\n<h2>{name}</h2>\n<p>{} slopes, {} shadowing, \
+         λ = {} µm — <a href=\"{}\">material file</a></p>\n<div class=\"facts\">\n",
+        anchor(material),
+        model.distribution.name(),
+        model.shadowing.name(),
+        format_plain(model.wavelength_um),
+        escape_html(&url_of(&relative_to(reports_dir, path)))
+    );
+
+    html.push_str("<table>\n<tr><th>parameter</th><th>value ± 1σ</th></tr>\n");
+    for (symbol, name, value) in parameters(model) {
+        if let Some(value) = value {
+            let _ = writeln!(
+                html,
+                "<tr><td>{}</td><td class=\"num\">{}</td></tr>",
+                escape_html(symbol),
+                escape_html(&parameter_text(material, name, value))
+            );
+        }
+    }
+    html.push_str("</table>\n");
+
+    match material.fit.as_ref() {
+        Some(fit) => {
+            html.push_str("<table>\n<tr><th>fit quality</th><th></th></tr>\n");
+            let mut rows = vec![
+                ("reduced χ²", format_plain(fit.reduced_chi2)),
+                ("χ² (cost)", format_plain(fit.cost)),
+                (
+                    "AIC / BIC",
+                    format!("{} / {}", format_plain(fit.aic), format_plain(fit.bic)),
+                ),
+                (
+                    "data",
+                    format!(
+                        "{} points × {} elements, {} degrees of freedom",
+                        fit.points,
+                        fit.elements.len(),
+                        fit.degrees_of_freedom
+                    ),
+                ),
+                (
+                    "optimizer",
+                    format!("{} (seed {}), {}", fit.optimizer, fit.seed, fit.termination),
+                ),
+            ];
+            if let Some(alt) = &fit.alternative {
+                rows.push((
+                    "competing fit",
+                    format!(
+                        "{}: reduced χ² {}, AIC {}, BIC {}",
+                        alt.model.distribution.name(),
+                        format_plain(alt.reduced_chi2),
+                        format_plain(alt.aic),
+                        format_plain(alt.bic)
+                    ),
+                ));
+            }
+            rows.push((
+                "preferred",
+                preference(material).unwrap_or_else(|| "no competing distribution fitted".into()),
+            ));
+            if !fit.undetermined.is_empty() {
+                rows.push(("not determined", fit.undetermined.join(", ")));
+            }
+            for (key, value) in rows {
+                let _ = writeln!(
+                    html,
+                    "<tr><td>{}</td><td>{}</td></tr>",
+                    escape_html(key),
+                    escape_html(&value)
+                );
+            }
+            let (status, class) = provenance(path, material);
+            let _ = writeln!(
+                html,
+                "<tr><td>source</td><td><code>{}</code> sha256 <code>{}</code> \
+                 <span class=\"{class}\">{}</span></td></tr>\n</table>",
+                escape_html(&fit.source.display().to_string()),
+                escape_html(&sha_prefix(&fit.source_sha256)),
+                escape_html(&status)
+            );
+        }
+        None => html.push_str("<p class=\"warn\">Not fitted by irpol: no fit record.</p>\n"),
+    }
+    html.push_str("</div>\n");
+
+    let png = format!("{}.png", material.name);
+    if reports_dir.join(&png).is_file() {
+        let svg = format!("{}.svg", material.name);
+        let _ = writeln!(
+            html,
+            "<a href=\"{}\"><img class=\"report\" src=\"{}\" alt=\"fit report of {name}\" \
+             loading=\"lazy\"></a>",
+            escape_html(&url_of(Path::new(&svg))),
+            escape_html(&url_of(Path::new(&png)))
+        );
+    } else {
+        let _ = writeln!(
+            html,
+            "<p class=\"muted\">No report figure yet: <code>irpol report {}</code>.</p>",
+            escape_html(&path.display().to_string())
+        );
+    }
+    html.push_str("</section>\n");
+}
