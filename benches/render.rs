@@ -1,5 +1,5 @@
-//! Rendering benchmarks: the shipped car scene (with the synthetic materials' true parameters as
-//! its library), per-pixel shading, at 640×480 and 1920×1080. Each iteration is a whole render in
+//! Rendering benchmarks: the shipped car scene with the shipped material library (`fits/`),
+//! per-pixel shading, at 640×480 and 1920×1080. Each iteration is a whole render in
 //! memory: per-material tables, rasterization, shading, noise (file writing excluded).
 
 #[path = "../tests/common/mod.rs"]
@@ -15,7 +15,7 @@ fn car(c: &mut Criterion) {
     group.sample_size(10);
     for (w, h) in [(640, 480), (1920, 1080)] {
         let scene_dir = dir.path().join(format!("{w}x{h}"));
-        let path = common::car_scene(&scene_dir, w, h, "pixel");
+        let path = common::car_scene_with_shipped_fits(&scene_dir, w, h, "pixel");
         let scene = load_scene(&path).unwrap();
         group.bench_function(format!("{w}x{h}"), |b| {
             b.iter(|| render(&scene, false).unwrap())

@@ -84,3 +84,21 @@ fn gouraud_car_is_close_to_per_pixel() {
         assert!((p - g).abs() < 0.01 * p, "{p} vs {g}");
     }
 }
+
+#[test]
+fn shipped_scene_renders_with_the_shipped_library() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = load_scene(&root.join("scenes/car.toml")).unwrap();
+    let names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(
+        names,
+        vec![
+            "paper_paint",
+            "rough_paint",
+            "smooth_glass",
+            "anodized_panel",
+            "asphalt"
+        ]
+    );
+    assert_eq!((scene.camera.width, scene.camera.height), (640, 480));
+}

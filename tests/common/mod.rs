@@ -69,12 +69,37 @@ pub fn write_truth_library(dir: &Path) {
     }
 }
 
-/// A copy of the shipped car scene in `dir/scenes`, with its library in `dir/fits`, at the given
-/// resolution and shading.
+/// A copy of the shipped car scene in `dir/scenes`, with the truth library in `dir/fits`, at the
+/// given resolution and shading.
 pub fn car_scene(dir: &Path, width: u32, height: u32, shading: &str) -> std::path::PathBuf {
+    write_truth_library(&dir.join("fits"));
+    car_scene_files(dir, width, height, shading)
+}
+
+/// As [`car_scene`] but with the shipped fitted library (`fits/`).
+pub fn car_scene_with_shipped_fits(
+    dir: &Path,
+    width: u32,
+    height: u32,
+    shading: &str,
+) -> std::path::PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::create_dir_all(dir.join("fits")).unwrap();
+    for name in [
+        "paper_paint",
+        "rough_paint",
+        "smooth_glass",
+        "anodized_panel",
+    ] {
+        let file = format!("{name}.toml");
+        std::fs::copy(root.join("fits").join(&file), dir.join("fits").join(&file)).unwrap();
+    }
+    car_scene_files(dir, width, height, shading)
+}
+
+fn car_scene_files(dir: &Path, width: u32, height: u32, shading: &str) -> std::path::PathBuf {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     std::fs::create_dir_all(dir.join("scenes")).unwrap();
-    write_truth_library(&dir.join("fits"));
     std::fs::copy(root.join("scenes/car.obj"), dir.join("scenes/car.obj")).unwrap();
     let text = std::fs::read_to_string(root.join("scenes/car.toml"))
         .unwrap()
