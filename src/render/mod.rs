@@ -215,15 +215,15 @@ fn shade_image(
                     vertex_material[v as usize] = triangle_material(t);
                 }
             }
+            // A vertex is shaded from its front: one just past a silhouette reads grazing.
             (0..mesh.positions.len())
                 .into_par_iter()
                 .map(|v| {
-                    let n = &mesh.normals[v];
                     shader.shade(
                         vertex_material[v],
                         &mesh.positions[v],
-                        n,
-                        n,
+                        &mesh.normals[v],
+                        false,
                         mesh.temperatures[v],
                     )
                 })
@@ -276,16 +276,15 @@ fn shade_image(
                                 .normalize();
                         let geometric = (mesh.positions[i1] - mesh.positions[i0])
                             .cross(&(mesh.positions[i2] - mesh.positions[i0]));
+                        // The back of a face is seen when its winding and its interpolated normal
+                        // both face away (a silhouette of a closed mesh has only the latter; a
+                        // mesh whose winding disagrees with its normals only the former).
+                        let to_camera = scene.camera.position - point;
+                        let back = geometric.dot(&to_camera) < 0.0 && normal.dot(&to_camera) < 0.0;
                         let temperature = mesh.temperatures[i0] * b0
                             + mesh.temperatures[i1] * b1
                             + mesh.temperatures[i2] * b2;
-                        shader.shade(
-                            triangle_material(t),
-                            &point,
-                            &normal,
-                            &geometric,
-                            temperature,
-                        )
+                        shader.shade(triangle_material(t), &point, &normal, back, temperature)
                     }
                 };
                 if let (Some(atmosphere), Some(path)) = (&scene.atmosphere, path_radiance) {

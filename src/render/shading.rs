@@ -22,23 +22,19 @@ pub struct Shader<'a> {
 
 impl Shader<'_> {
     /// (S0, S1, S2) in the pixel frame leaving `point` with unit shading normal `normal` at
-    /// `temperature`, material `material`. Surfaces are two-sided: when `geometric_normal` faces
-    /// away from the camera the back side is shaded; a shading normal that faces away only
-    /// because of interpolation (silhouettes) is treated as grazing.
+    /// `temperature`, material `material`; `back` shades the other side of the surface (the
+    /// camera sees a face from behind). A normal that faces away from the camera otherwise (an
+    /// interpolated normal at a silhouette) is read at grazing.
     pub fn shade(
         &self,
         material: usize,
         point: &Vector3<f64>,
         normal: &Vector3<f64>,
-        geometric_normal: &Vector3<f64>,
+        back: bool,
         temperature: f64,
     ) -> [f64; 3] {
         let w_r = (self.camera.position - point).normalize();
-        let n = if geometric_normal.dot(&w_r) < 0.0 {
-            -normal
-        } else {
-            *normal
-        };
+        let n = if back { -normal } else { *normal };
         let cos_r = n.dot(&w_r);
 
         // Local frame: e_x uphill (world up projected on the tangent plane), e_y = n × e_x.

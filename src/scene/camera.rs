@@ -45,9 +45,12 @@ impl Camera {
                 "camera fov_deg = {fov_y_deg} must be within (0°, 179°)"
             ));
         }
-        if width == 0 || height == 0 || width > 16384 || height > 16384 {
+        // ~200 bytes per pixel in flight (Stokes, fragments, channels, encoded files): 8K UHD
+        // stays within a few GiB.
+        if width == 0 || height == 0 || width as u64 * height as u64 > 7680 * 4320 {
             return Err(format!(
-                "camera resolution {width}×{height} must be within 1…16384 pixels a side"
+                "camera resolution {width}×{height} must be at least 1×1 and at most 7680×4320 \
+                 pixels in total"
             ));
         }
         let tan_half_fov_y = (0.5 * fov_y_deg.to_radians()).tan();
