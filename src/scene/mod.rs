@@ -1,1 +1,513 @@
-//! (module scene)
+//! Scenes (DESIGN §2.3): the scene TOML, meshes (OBJ with groups as parts, PLY with per-vertex
+//! temperature), procedural test objects, the camera, the environment, and the materials of every
+//! part, resolved into one world-space [`ShadedMesh`] ready for `render`.
+//!
+//! Paths in a scene are relative to the scene file. Every error names the file and the item
+//! ("scenes/car.toml: objects[0] 'car', part 'hood': …", "scenes/car.obj: line 12: …").
+
+pub mod camera;
+pub mod car;
+pub mod config;
+pub mod environment;
+pub mod mesh;
+pub mod obj;
+pub mod ply;
+pub mod procedural;
+
+use crate::material::Material;
+use crate::optics::{Band, RefractiveIndex};
+use crate::pbrdf::{Pbrdf, SlopeDistribution};
+use camera::Camera;
+use config::{InlineMaterialConfig, ObjectConfig, SceneConfig, Shading, ShapeConfig};
+use environment::Environment;
+use mesh::{ObjectShading, RawMesh, ShadedMesh, Transform};
+use nalgebra::Vector3;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// A scene or one of its files is unusable; `file` is the file at fault.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {message}", file.display())]
+pub struct SceneError {
+    pub file: PathBuf,
+    pub message: String,
+}
+
+impl SceneError {
+    /// Messages are kept to one line (some parsers format theirs over several).
+    fn new(file: &Path, message: impl Into<String>) -> SceneError {
+        SceneError {
+            file: file.to_owned(),
+            message: message
+                .into()
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" "),
+        }
+    }
+}
+
+/// A material used by the scene, with its validated pBRDF.
+#[derive(Clone, Debug)]
+pub struct SceneMaterial {
+    /// The name given in the scene.
+    pub name: String,
+    /// Where it came from: the material file, or "inline".
+    pub origin: String,
+    pub pbrdf: Pbrdf,
+}
+
+/// One part of one object: what `ShadedMesh::triangle_surface` indexes.
+#[derive(Clone, Debug)]
+pub struct Surface {
+    pub object: usize,
+    pub part: String,
+    pub material: usize,
+}
+
+#[derive(Clone, Debug)]
+pub struct Sensor {
+    pub band: Band,
+    pub netd_mk: f64,
+    pub seed: u64,
+    pub netd_reference_k: f64,
+}
+
+/// Optional atmospheric path: S_sensor = τ S + (1 − τ) L_bb(T_path) δ_j0, τ = exp(−β·range).
+#[derive(Clone, Copy, Debug)]
+pub struct Atmosphere {
+    pub extinction_per_m: f64,
+    pub temperature_k: f64,
+}
+
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub path: PathBuf,
+    pub camera: Camera,
+    pub sensor: Sensor,
+    pub air_temperature_k: f64,
+    pub environment: Environment,
+    pub atmosphere: Option<Atmosphere>,
+    pub shading: Shading,
+    pub aop_mask_dolp: f64,
+    pub materials: Vec<SceneMaterial>,
+    pub object_names: Vec<String>,
+    pub surfaces: Vec<Surface>,
+    pub mesh: ShadedMesh,
+}
+
+/// Reads and resolves a scene file: meshes, materials, environment. Nothing is written.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SceneError::new(path, format!("cannot read the scene: {e}")))?;
+    let config: SceneConfig = toml::from_str(&text).map_err(|e| {
+        let at = e.span().map_or(String::new(), |span| {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            format!("line {line}, column {column}: ")
+        });
+        SceneError::new(path, format!("not a valid scene: {at}{}", e.message()))
+    })?;
+    build_scene(path, config)
+}
+
+fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
+    let fail = |message: String| SceneError::new(path, message);
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+
+    let c = &config.camera;
+    let camera = Camera::new(
+        Vector3::from(c.position),
+        Vector3::from(c.look_at),
+        Vector3::from(c.up),
+        c.fov_deg,
+        c.resolution[0],
+        c.resolution[1],
+    )
+    .map_err(&fail)?;
+
+    let s = &config.sensor;
+    let band = Band::new(
+        s.band_um[0],
+        s.band_um[1],
+        s.response
+            .as_ref()
+            .map(|r| r.iter().map(|&[w, v]| (w, v)).collect()),
+    )
+    .map_err(|e| fail(format!("sensor: {e}")))?;
+    let air = config.environment.air_temperature_k;
+    let netd_reference_k = s.netd_reference_k.unwrap_or(air);
+    if !(s.netd_mk.is_finite() && s.netd_mk >= 0.0) {
+        return Err(fail(format!("sensor.netd_mk = {} must be ≥ 0", s.netd_mk)));
+    }
+    if !(netd_reference_k.is_finite() && netd_reference_k > 0.0) && s.netd_mk > 0.0 {
+        return Err(fail(format!(
+            "sensor.netd_reference_k = {netd_reference_k} must be > 0 when there is noise"
+        )));
+    }
+    let environment = Environment::new(&config.environment, &band).map_err(&fail)?;
+
+    let atmosphere = match &config.atmosphere {
+        None => None,
+        Some(a) => {
+            let temperature_k = a.temperature_k.unwrap_or(air);
+            if !(a.extinction_per_km.is_finite() && a.extinction_per_km >= 0.0) {
+                return Err(fail(format!(
+                    "atmosphere.extinction_per_km = {} must be finite and ≥ 0",
+                    a.extinction_per_km
+                )));
+            }
+            if !(temperature_k.is_finite() && temperature_k >= 0.0) {
+                return Err(fail(format!(
+                    "atmosphere.temperature_k = {temperature_k} must be finite and ≥ 0"
+                )));
+            }
+            Some(Atmosphere {
+                extinction_per_m: a.extinction_per_km * 1e-3,
+                temperature_k,
+            })
+        }
+    };
+    let mask = config.render.aop_mask_dolp;
+    if !(mask.is_finite() && (0.0..=1.0).contains(&mask)) {
+        return Err(fail(format!(
+            "render.aop_mask_dolp = {mask} must be within [0, 1]"
+        )));
+    }
+    if config.objects.is_empty() {
+        return Err(fail("the scene has no [[objects]]".into()));
+    }
+
+    let library = dir.join(config.material_library.as_deref().unwrap_or("fits"));
+    let mut materials = MaterialResolver {
+        scene: path,
+        dir,
+        library,
+        inline: &config.materials,
+        resolved: Vec::new(),
+        index_of: HashMap::new(),
+    };
+    let mut surfaces = Vec::new();
+    let mut object_names = Vec::new();
+    let mut mesh = ShadedMesh::default();
+    for (index, object) in config.objects.iter().enumerate() {
+        let name = object.name.clone().unwrap_or_else(|| {
+            object
+                .mesh
+                .as_deref()
+                .and_then(|m| Path::new(m).file_stem())
+                .map_or(format!("object{}", index + 1), |s| {
+                    s.to_string_lossy().into_owned()
+                })
+        });
+        let label = format!("objects[{index}] '{name}'");
+        let object_mesh = build_object(
+            object,
+            &label,
+            object_names.len(),
+            &mut materials,
+            &mut surfaces,
+        )?;
+        object_names.push(name);
+        mesh.append(object_mesh);
+    }
+
+    Ok(Scene {
+        path: path.to_owned(),
+        camera,
+        sensor: Sensor {
+            band,
+            netd_mk: s.netd_mk,
+            seed: s.seed,
+            netd_reference_k,
+        },
+        air_temperature_k: air,
+        environment,
+        atmosphere,
+        shading: config.render.shading,
+        aop_mask_dolp: mask,
+        materials: materials.resolved,
+        object_names,
+        surfaces,
+        mesh,
+    })
+}
+
+/// Loads an object's mesh, checks its parts against the scene, resolves part materials and
+/// temperatures, and returns its world-space shading mesh.
+fn build_object(
+    object: &ObjectConfig,
+    label: &str,
+    object_index: usize,
+    materials: &mut MaterialResolver,
+    surfaces: &mut Vec<Surface>,
+) -> Result<ShadedMesh, SceneError> {
+    let scene = materials.scene;
+    let fail = |message: String| SceneError::new(scene, format!("{label}: {message}"));
+    let (raw, mesh_file) = load_object_mesh(object, materials.dir).map_err(|e| match e {
+        MeshLoadError::Scene(message) => fail(message),
+        MeshLoadError::File(file, message) => {
+            SceneError::new(&file, format!("{message} (in {label})"))
+        }
+    })?;
+    let mesh_file_label = mesh_file
+        .as_ref()
+        .map_or("the shape".to_owned(), |f| f.display().to_string());
+
+    let used = raw.used_parts();
+    for part in object.parts.keys() {
+        if !used.contains(&part.as_str()) {
+            return Err(fail(format!(
+                "part '{part}' is not in {mesh_file_label} (its parts: {})",
+                used.join(", ")
+            )));
+        }
+    }
+    let has_vertex_temperatures = raw.vertex_temperatures.is_some();
+    let check_temperature = |t: f64, what: &str| {
+        if t.is_finite() && t >= 0.0 {
+            Ok(t)
+        } else {
+            Err(fail(format!(
+                "{what}temperature_k = {t} must be finite and ≥ 0"
+            )))
+        }
+    };
+    if let Some(t) = object.temperature_k {
+        check_temperature(t, "")?;
+    }
+    let mut part_temperature = Vec::with_capacity(raw.parts.len());
+    let mut part_surface = Vec::with_capacity(raw.parts.len());
+    for part in &raw.parts {
+        if !used.contains(&part.as_str()) {
+            // A group with no faces is never drawn and needs no material.
+            part_temperature.push(None);
+            part_surface.push(u32::MAX);
+            continue;
+        }
+        let settings = object.parts.get(part);
+        let temperature = settings
+            .and_then(|p| p.temperature_k)
+            .or(object.temperature_k);
+        if let Some(t) = temperature {
+            check_temperature(t, &format!("part '{part}': "))?;
+            if has_vertex_temperatures {
+                return Err(fail(format!(
+                    "{mesh_file_label} has per-vertex temperatures; remove temperature_k \
+                     (part '{part}') or the PLY property"
+                )));
+            }
+        }
+        part_temperature.push(temperature);
+        let material_name = settings
+            .and_then(|p| p.material.as_deref())
+            .or(object.material.as_deref())
+            .ok_or_else(|| {
+                fail(format!(
+                    "part '{part}' has no material (set material on the object or the part)"
+                ))
+            })?;
+        let material = materials
+            .resolve(material_name)
+            .map_err(|e| fail(format!("part '{part}': {e}")))?;
+        part_surface.push(surfaces.len() as u32);
+        surfaces.push(Surface {
+            object: object_index,
+            part: part.clone(),
+            material,
+        });
+    }
+
+    if !(object.scale.is_finite() && object.scale > 0.0) {
+        return Err(fail(format!(
+            "scale = {} must be finite and > 0",
+            object.scale
+        )));
+    }
+    if !object
+        .translate
+        .iter()
+        .chain(object.rotate_deg.iter())
+        .all(|v| v.is_finite())
+    {
+        return Err(fail("translate and rotate_deg must be finite".into()));
+    }
+    let crease = object.crease_angle_deg;
+    if !(crease.is_finite() && (0.0..=180.0).contains(&crease)) {
+        return Err(fail(format!(
+            "crease_angle_deg = {crease} must be within [0°, 180°]"
+        )));
+    }
+    let setup = ObjectShading {
+        transform: Transform::new(object.scale, object.rotate_deg, object.translate),
+        crease_angle_deg: crease,
+        part_temperature: &part_temperature,
+        part_surface: &part_surface,
+    };
+    mesh::shade_mesh(&raw, &setup).map_err(|message| match &mesh_file {
+        Some(file) => SceneError::new(file, format!("{message} (in {label})")),
+        None => fail(message),
+    })
+}
+
+enum MeshLoadError {
+    /// The object entry itself is wrong.
+    Scene(String),
+    /// The mesh file is missing or malformed.
+    File(PathBuf, String),
+}
+
+fn load_object_mesh(
+    object: &ObjectConfig,
+    dir: &Path,
+) -> Result<(RawMesh, Option<PathBuf>), MeshLoadError> {
+    match (&object.mesh, &object.shape) {
+        (Some(_), Some(_)) => Err(MeshLoadError::Scene(
+            "give either mesh or shape, not both".into(),
+        )),
+        (None, None) => Err(MeshLoadError::Scene("needs a mesh file or a shape".into())),
+        (None, Some(shape)) => procedural_shape(shape)
+            .map(|m| (m, None))
+            .map_err(MeshLoadError::Scene),
+        (Some(file), None) => {
+            let path = dir.join(file);
+            let file_error = |m: String| MeshLoadError::File(path.clone(), m);
+            let bytes = std::fs::read(&path)
+                .map_err(|e| file_error(format!("cannot read the mesh: {e}")))?;
+            let extension = path
+                .extension()
+                .map(|e| e.to_string_lossy().to_ascii_lowercase());
+            let raw = match extension.as_deref() {
+                Some("obj") => {
+                    let text = String::from_utf8(bytes)
+                        .map_err(|_| file_error("an OBJ file must be UTF-8 text".into()))?;
+                    obj::parse_obj(&text)
+                }
+                Some("ply") => ply::parse_ply(&bytes),
+                _ => {
+                    return Err(file_error(
+                        "unknown mesh format: the file name must end in .obj or .ply".into(),
+                    ))
+                }
+            }
+            .map_err(file_error)?;
+            Ok((raw, Some(path)))
+        }
+    }
+}
+
+fn procedural_shape(shape: &ShapeConfig) -> Result<RawMesh, String> {
+    match *shape {
+        ShapeConfig::Sphere {
+            radius,
+            subdivisions,
+        } => {
+            if !(radius.is_finite() && radius > 0.0) {
+                return Err(format!("shape.radius = {radius} must be finite and > 0"));
+            }
+            if subdivisions > 7 {
+                return Err(format!(
+                    "shape.subdivisions = {subdivisions} is too fine (at most 7: 327 680 faces)"
+                ));
+            }
+            Ok(procedural::icosphere(radius, subdivisions))
+        }
+        ShapeConfig::Plane { size, divisions } => {
+            if !size.iter().all(|s| s.is_finite() && *s > 0.0) {
+                return Err("shape.size must be finite and > 0".into());
+            }
+            if !divisions.iter().all(|d| (1..=4096).contains(d)) {
+                return Err("shape.divisions must be within 1…4096".into());
+            }
+            Ok(procedural::plane(size, divisions))
+        }
+    }
+}
+
+/// Resolves material references: an inline name, a file path (ends in .toml or has a /), or a
+/// library name (`<library>/<name>.toml`). Each distinct material is loaded once.
+struct MaterialResolver<'a> {
+    scene: &'a Path,
+    dir: &'a Path,
+    library: PathBuf,
+    inline: &'a std::collections::BTreeMap<String, InlineMaterialConfig>,
+    resolved: Vec<SceneMaterial>,
+    index_of: HashMap<String, usize>,
+}
+
+impl MaterialResolver<'_> {
+    fn resolve(&mut self, reference: &str) -> Result<usize, String> {
+        let (key, material) = if let Some(inline) = self.inline.get(reference) {
+            let key = format!("inline:{reference}");
+            if let Some(&i) = self.index_of.get(&key) {
+                return Ok(i);
+            }
+            let pbrdf = inline_pbrdf(inline)
+                .map_err(|e| format!("inline material [materials.{reference}]: {e}"))?;
+            (
+                key,
+                SceneMaterial {
+                    name: reference.to_owned(),
+                    origin: "inline".into(),
+                    pbrdf,
+                },
+            )
+        } else {
+            let path = if reference.ends_with(".toml") || reference.contains('/') {
+                self.dir.join(reference)
+            } else {
+                crate::material::find_material(&self.library, reference).map_err(|e| {
+                    format!(
+                        "{e}; define it inline under [materials.{reference}] in {} or set \
+                         material_library",
+                        self.scene.display()
+                    )
+                })?
+            };
+            let key = format!("file:{}", path.display());
+            if let Some(&i) = self.index_of.get(&key) {
+                return Ok(i);
+            }
+            let loaded = Material::load(&path).map_err(|e| e.to_string())?;
+            let pbrdf = loaded
+                .pbrdf()
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            (
+                key,
+                SceneMaterial {
+                    name: reference.to_owned(),
+                    origin: path.display().to_string(),
+                    pbrdf,
+                },
+            )
+        };
+        self.resolved.push(material);
+        self.index_of.insert(key, self.resolved.len() - 1);
+        Ok(self.resolved.len() - 1)
+    }
+}
+
+fn inline_pbrdf(m: &InlineMaterialConfig) -> Result<Pbrdf, String> {
+    let distribution = match (m.distribution.as_str(), m.q) {
+        ("cauchy", Some(q)) => SlopeDistribution::Cauchy { sigma: m.sigma, q },
+        ("cauchy", None) => return Err("distribution cauchy needs q".into()),
+        ("gaussian", None) => SlopeDistribution::Gaussian { sigma: m.sigma },
+        ("gaussian", Some(_)) => return Err("distribution gaussian takes no q".into()),
+        (other, _) => {
+            return Err(format!(
+                "distribution '{other}' is unknown (cauchy or gaussian)"
+            ))
+        }
+    };
+    Pbrdf::new(
+        distribution,
+        m.shadowing,
+        RefractiveIndex::new(m.n, m.k),
+        m.rho_d,
+    )
+    .map_err(|e| e.to_string())
+}

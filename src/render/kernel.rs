@@ -1,0 +1,405 @@
+//! The reflection integral of DESIGN §1.5 as an explicit weighted sum, for the renderer's tables:
+//!
+//!   ∫ F_j0(ω_i→ω_r) L(ω_i) cosθ_i dΩ_i  ≈  Σ_k K_jk L(ω_k)   (specular part, j = 0, 1, 2)
+//!   (ρ_d/π) ∫ L(ω_i) cosθ_i dΩ_i        ≈  Σ_m D_m L(ω_m)    (diffuse part)
+//!
+//! in the local frame (normal ẑ) with ω_r = (sinθ_r, 0, cosθ_r) and the Stokes vector in the psps
+//! frame of ω_r. `Pbrdf::reflected_stokes` returns the sum for one environment; a table over
+//! thousands of surface orientations needs the nodes and weights themselves, so that the pBRDF is
+//! evaluated once per node instead of once per node and table entry (a Smith–Cauchy material costs
+//! ~2 µs per evaluation and ~1000 nodes: 2 ms per entry, minutes per table).
+//!
+//! The nodes follow the same slope-space construction as `pbrdf::hemisphere` (the lobe is the
+//! slope density; the horizon cut is exact in polar slope coordinates): ω_k is the mirror of ω_r
+//! about the facet normal of slope (u, Δ), and with dΩ_i = 4 cosβ dΩ_h, dΩ_h = cos³θ_h d²m,
+//!   K_jk = F_spec,j0(ω_k→ω_r) cosθ_k · 4 cosβ cos³θ_h · u du dΔ.
+//! The physics (F_j0) comes from `Pbrdf::first_column`; only the node placement lives here.
+//! Nodes closer than a fraction of a degree are then merged (weights summed at the weighted mean
+//! direction), which is exact for an environment constant over the merged cell and shrinks a
+//! narrow specular lobe from ~1000 nodes to a few dozen.
+
+use crate::optics::Stokes;
+use crate::pbrdf::{Direction, Pbrdf, SlopeDistribution};
+use gauss_quad::legendre::GaussLegendre;
+use nalgebra::Vector3;
+use std::collections::HashMap;
+use std::f64::consts::{FRAC_1_PI, PI};
+use std::num::NonZeroUsize;
+
+/// Node counts of the kernel quadrature (see [`KernelQuadrature::default`]).
+#[derive(Clone, Debug)]
+pub struct KernelQuadrature {
+    /// Trapezoid nodes over a full circle of facet azimuths.
+    pub full_circle: usize,
+    /// Gauss–Legendre nodes over an azimuth arc cut by the horizon.
+    pub arc: usize,
+    /// Gauss–Legendre nodes per radial slope panel.
+    pub per_panel: usize,
+    /// First radial panel width in units of the distribution's slope scale; later panels grow.
+    pub first_panel: f64,
+    pub growth: f64,
+    /// Nodes whose directions fall in the same cube cell of this size (radians) are merged; the
+    /// cells grow fourfold with every doubling of the angle from the specular direction beyond
+    /// a few lobe widths, where the kernel is small and smooth.
+    pub merge_cell: f64,
+    /// The finely merged core around the specular direction holds the facets up to this
+    /// quantile of the slope distribution (its mirror angle, at least 4 cells).
+    pub merge_core: f64,
+}
+
+impl Default for KernelQuadrature {
+    /// Within ~1e-4 of `reflected_stokes` with the default hemisphere quadrature for σ 0.03–0.5
+    /// (tests/render_tables.rs); merging at 0.5° changes a smooth sky by < 1e-5.
+    fn default() -> Self {
+        KernelQuadrature {
+            full_circle: 32,
+            arc: 16,
+            per_panel: 6,
+            first_panel: 0.5,
+            growth: 2.0,
+            merge_cell: 0.5f64.to_radians(),
+            merge_core: 0.9,
+        }
+    }
+}
+
+/// Specular nodes for one θ_r: directions ω_k (local frame, ω_r at azimuth 0) and Stokes weights.
+#[derive(Clone, Debug, Default)]
+pub struct SpecularKernel {
+    pub directions: Vec<Vector3<f64>>,
+    pub weights: Vec<[f64; 3]>,
+}
+
+impl SpecularKernel {
+    /// Σ_k K_k L(ω_k) for an environment given in the local frame.
+    pub fn apply(&self, environment: impl Fn(&Vector3<f64>) -> f64) -> Stokes {
+        let mut sum = [0.0; 3];
+        for (w, k) in self.directions.iter().zip(&self.weights) {
+            let l = environment(w);
+            sum[0] += k[0] * l;
+            sum[1] += k[1] * l;
+            sum[2] += k[2] * l;
+        }
+        Stokes::new(sum[0], sum[1], sum[2], 0.0)
+    }
+
+    /// Σ_k K_k: the specular directional-hemispherical reflectance (Stokes) of ω_r.
+    pub fn total(&self) -> [f64; 3] {
+        self.weights
+            .iter()
+            .fold([0.0; 3], |a, k| [a[0] + k[0], a[1] + k[1], a[2] + k[2]])
+    }
+}
+
+/// The specular kernel of `pbrdf` for ω_r = (sinθ_r, 0, cosθ_r), 0 ≤ θ_r < π/2.
+pub fn specular_kernel(
+    pbrdf: &Pbrdf,
+    theta_r: f64,
+    quadrature: &KernelQuadrature,
+) -> SpecularKernel {
+    let scattered = Direction::from_angles(theta_r, 0.0);
+    let w_r = scattered.vector;
+    let (sin_r, cos_r) = theta_r.sin_cos();
+    if cos_r <= 0.0 {
+        return SpecularKernel::default();
+    }
+    let distribution = pbrdf.prepared_distribution();
+    let rho_over_pi = pbrdf.rho_d() * FRAC_1_PI;
+    // Slopes u ≤ u_full mirror ω_r above the horizon at every azimuth, none beyond u_none; in
+    // between only |Δ| < arccos κ(u), κ = cosθ_r (u² − 1)/(2u sinθ_r) (DESIGN §1.1 geometry).
+    let u_full = cos_r / (1.0 + sin_r);
+    let u_none = (1.0 + sin_r) / cos_r;
+    let edges = panel_edges(
+        quadrature.first_panel * distribution.slope_scale(),
+        quadrature.growth,
+        u_full,
+        u_none.min(distribution.slope_cutoff()),
+    );
+    let panel_rule = unit_rule(quadrature.per_panel);
+    let arc_rule = unit_rule(quadrature.arc);
+
+    let specular = Vector3::new(-sin_r, 0.0, cos_r);
+    let core_slope = slope_quantile(pbrdf.distribution(), quadrature.merge_core);
+    let core = (2.0 * core_slope.atan()).max(4.0 * quadrature.merge_cell);
+    let mut nodes = NodeMerger::new(quadrature.merge_cell, specular, core);
+    let mut add_facet = |u: f64, delta: f64, measure: f64| {
+        let (sin_d, cos_d) = delta.sin_cos();
+        let sec_h = (1.0 + u * u).sqrt();
+        let h = Vector3::new(u * cos_d, u * sin_d, 1.0) / sec_h;
+        let cos_beta = h.dot(&w_r);
+        let w_i = h * (2.0 * cos_beta) - w_r;
+        if w_i.z <= 0.0 || cos_beta <= 0.0 {
+            return; // rounding at the horizon cut
+        }
+        let f = pbrdf.first_column(&Direction::from_unit_vector(w_i), &scattered);
+        let jacobian = 4.0 * cos_beta / (sec_h * sec_h * sec_h) * w_i.z * measure;
+        nodes.add(
+            w_i,
+            [
+                (f[0] - rho_over_pi) * jacobian,
+                f[1] * jacobian,
+                f[2] * jacobian,
+            ],
+        );
+    };
+    for panel in edges.windows(2) {
+        let (a, b) = (panel[0], panel[1]);
+        // The cut-arc width has √ behaviour at u_full and u_none; u = a + (b − a) sin²(πv/2)
+        // makes the integrand smooth there.
+        let singular = a == u_full || b == u_none;
+        for &(v, wv) in &panel_rule {
+            let (u, du) = if singular {
+                let half = 0.5 * PI * v;
+                (
+                    a + (b - a) * half.sin().powi(2),
+                    (b - a) * 0.5 * PI * (PI * v).sin(),
+                )
+            } else {
+                (a + (b - a) * v, b - a)
+            };
+            let radial = wv * du * u;
+            if u <= u_full {
+                let step = 2.0 * PI / quadrature.full_circle as f64;
+                for j in 0..quadrature.full_circle {
+                    add_facet(u, (j as f64 + 0.5) * step, radial * step);
+                }
+            } else {
+                let kappa = cos_r * (u * u - 1.0) / (2.0 * u * sin_r);
+                let half_width = kappa.clamp(-1.0, 1.0).acos();
+                for &(t, wt) in &arc_rule {
+                    add_facet(
+                        u,
+                        half_width * (2.0 * t - 1.0),
+                        radial * wt * 2.0 * half_width,
+                    );
+                }
+            }
+        }
+    }
+    nodes.finish()
+}
+
+/// The slope m = tan θ below which a fraction `p` of the facets lie: the inverse CDFs of
+/// DESIGN §1.2, tan²θ = a((1 − p)^(1/(1−q)) − 1) (Cauchy, a = 2σ²) and −2σ² ln(1 − p) (Gaussian).
+pub fn slope_quantile(distribution: SlopeDistribution, p: f64) -> f64 {
+    let tan2 = match distribution {
+        SlopeDistribution::Cauchy { sigma, q } => {
+            2.0 * sigma * sigma * ((1.0 - p).powf(1.0 / (1.0 - q)) - 1.0)
+        }
+        SlopeDistribution::Gaussian { sigma } => -2.0 * sigma * sigma * (1.0 - p).ln(),
+    };
+    tan2.max(0.0).sqrt()
+}
+
+/// Cosine-weighted hemisphere rule (ω, weight) with Σ weight = π: Gauss–Legendre in r² over the
+/// projected disk, trapezoid in azimuth. Times ρ_d/π it is the diffuse kernel.
+pub fn cosine_rule(radial: usize, azimuthal: usize) -> Vec<(Vector3<f64>, f64)> {
+    let dphi = 2.0 * PI / azimuthal as f64;
+    let mut rule = Vec::with_capacity(radial * azimuthal);
+    for (t, wt) in unit_rule(radial) {
+        let (r, z) = (t.sqrt(), (1.0 - t).sqrt());
+        for j in 0..azimuthal {
+            let (sin_p, cos_p) = ((j as f64 + 0.5) * dphi).sin_cos();
+            rule.push((Vector3::new(r * cos_p, r * sin_p, z), 0.5 * wt * dphi));
+        }
+    }
+    rule
+}
+
+fn unit_rule(points: usize) -> Vec<(f64, f64)> {
+    let rule = GaussLegendre::new(NonZeroUsize::new(points.max(1)).expect("≥ 1"));
+    rule.as_node_weight_pairs()
+        .iter()
+        .map(|&(x, w)| (0.5 * (x + 1.0), 0.5 * w))
+        .collect()
+}
+
+/// Radial panel edges from 0: the first `first` wide, each next `growth` times wider, ending at
+/// `end`, with `split` (the full-circle limit) inserted as an edge when inside.
+fn panel_edges(first: f64, growth: f64, split: f64, end: f64) -> Vec<f64> {
+    let mut edges = vec![0.0];
+    let (mut width, mut next) = (first, first);
+    while next < end {
+        edges.push(next);
+        width *= growth.max(1.1);
+        next += width;
+    }
+    edges.push(end);
+    if split > 0.0 && split < end && !edges.contains(&split) {
+        let at = edges.partition_point(|&e| e < split);
+        edges.insert(at, split);
+    }
+    edges
+}
+
+/// Sums nodes falling in the same cube cell of the unit sphere. Within `core` radians of the
+/// specular direction the cells are `cell` wide; beyond, level ℓ = ⌈log₂(α/core)⌉ cells are
+/// 4^ℓ times wider: each doubling of the distance holds a few cells, whose weights fall off
+/// with the slope density's tail.
+struct NodeMerger {
+    cell: f64,
+    specular: Vector3<f64>,
+    core: f64,
+    index_of: HashMap<[i32; 4], usize>,
+    /// Σ|K0|-weighted direction, Σ|K0|, and Σ K per merged node.
+    sums: Vec<(Vector3<f64>, f64, [f64; 3])>,
+}
+
+impl NodeMerger {
+    fn new(cell: f64, specular: Vector3<f64>, core: f64) -> NodeMerger {
+        NodeMerger {
+            cell,
+            specular,
+            core,
+            index_of: HashMap::new(),
+            sums: Vec::new(),
+        }
+    }
+
+    fn add(&mut self, direction: Vector3<f64>, weight: [f64; 3]) {
+        let angle = direction.dot(&self.specular).clamp(-1.0, 1.0).acos();
+        let level = if angle <= self.core {
+            0
+        } else {
+            (angle / self.core).log2().ceil() as i32
+        };
+        let cell = self.cell * f64::powi(4.0, level);
+        let key = direction.map(|c| (c / cell).floor() as i32);
+        let key = [level, key.x, key.y, key.z];
+        let i = *self.index_of.entry(key).or_insert_with(|| {
+            self.sums.push((Vector3::zeros(), 0.0, [0.0; 3]));
+            self.sums.len() - 1
+        });
+        let entry = &mut self.sums[i];
+        // |K0| + tiny keeps zero-weight nodes (fully shadowed) from producing a 0/0 direction.
+        let mass = weight[0].abs() + 1e-300;
+        entry.0 += direction * mass;
+        entry.1 += mass;
+        for (sum, w) in entry.2.iter_mut().zip(weight) {
+            *sum += w;
+        }
+    }
+
+    fn finish(self) -> SpecularKernel {
+        let mut kernel = SpecularKernel::default();
+        for (direction, mass, weight) in self.sums {
+            let mean = direction / mass;
+            kernel.directions.push(mean.normalize());
+            kernel.weights.push(weight);
+        }
+        kernel
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optics::RefractiveIndex;
+    use crate::pbrdf::{HemisphereQuadrature, Shadowing};
+
+    fn material(distribution: SlopeDistribution, shadowing: Shadowing, rho_d: f64) -> Pbrdf {
+        Pbrdf::new(
+            distribution,
+            shadowing,
+            RefractiveIndex::new(1.6, 0.1),
+            rho_d,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn slope_quantiles_invert_the_distributions() {
+        // Cauchy q = 2 is GGX: P(m < x) = x²/(x² + a); Gaussian: 1 − exp(−x²/(2σ²)).
+        let x = slope_quantile(SlopeDistribution::Cauchy { sigma: 0.2, q: 2.0 }, 0.9);
+        assert!((x * x / (x * x + 0.08) - 0.9).abs() < 1e-12);
+        let x = slope_quantile(SlopeDistribution::Gaussian { sigma: 0.2 }, 0.5);
+        assert!((1.0 - (-x * x / 0.08).exp() - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn cosine_rule_integrates_the_projected_solid_angle() {
+        let rule = cosine_rule(8, 24);
+        let total: f64 = rule.iter().map(|(_, w)| w).sum();
+        assert!((total - PI).abs() < 1e-12);
+        // ∫ cosθ · cosθ dΩ = 2π/3 (√(1 − r²) is not a polynomial in r²: not exact).
+        let second: f64 = rule.iter().map(|(d, w)| w * d.z).sum();
+        assert!((second - 2.0 * PI / 3.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn kernel_matches_the_pbrdf_reflection_integral() {
+        // A smooth but anisotropic sky: brighter toward +x and the horizon.
+        let env = |w: &Vector3<f64>| 10.0 + 3.0 * w.x + 5.0 * (1.0 - w.z).powi(2);
+        let quadrature = KernelQuadrature::default();
+        let reference = HemisphereQuadrature::fine();
+        for (distribution, shadowing) in [
+            (
+                SlopeDistribution::Cauchy { sigma: 0.5, q: 2.0 },
+                Shadowing::Smith,
+            ),
+            (
+                SlopeDistribution::Cauchy {
+                    sigma: 0.03,
+                    q: 3.0,
+                },
+                Shadowing::Smith,
+            ),
+            (SlopeDistribution::Gaussian { sigma: 0.15 }, Shadowing::None),
+            (
+                SlopeDistribution::Gaussian { sigma: 0.1 },
+                Shadowing::TorranceSparrow,
+            ),
+        ] {
+            let pbrdf = material(distribution, shadowing, 0.0);
+            for theta_deg in [0.0f64, 25.0, 60.0, 80.0] {
+                let theta = theta_deg.to_radians();
+                let ours = specular_kernel(&pbrdf, theta, &quadrature).apply(env);
+                let exact =
+                    pbrdf.reflected_stokes(&Direction::from_angles(theta, 0.0), env, &reference);
+                // Torrance–Sparrow's min() kinks limit both quadratures to ~1e-4 at grazing.
+                let relative = if shadowing == Shadowing::TorranceSparrow {
+                    1e-3
+                } else {
+                    2e-4
+                };
+                let tolerance = relative * exact[0];
+                for j in 0..3 {
+                    assert!(
+                        (ours[j] - exact[j]).abs() < tolerance,
+                        "{distribution:?} {shadowing:?} θ={theta_deg}: S{j} {} vs {}",
+                        ours[j],
+                        exact[j]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn merging_shrinks_narrow_lobes_without_changing_the_result() {
+        let smooth = material(
+            SlopeDistribution::Gaussian { sigma: 0.03 },
+            Shadowing::Smith,
+            0.0,
+        );
+        let merged = KernelQuadrature {
+            merge_cell: 1f64.to_radians(),
+            ..KernelQuadrature::default()
+        };
+        let unmerged = KernelQuadrature {
+            merge_cell: 1e-9,
+            ..KernelQuadrature::default()
+        };
+        let a = specular_kernel(&smooth, 0.5, &merged);
+        let b = specular_kernel(&smooth, 0.5, &unmerged);
+        assert!(
+            a.directions.len() * 3 < b.directions.len(),
+            "{} vs {}",
+            a.directions.len(),
+            b.directions.len()
+        );
+        let env = |w: &Vector3<f64>| 10.0 + 3.0 * w.x + 5.0 * (1.0 - w.z).powi(2);
+        let (sa, sb) = (a.apply(env), b.apply(env));
+        assert!((sa - sb).norm() < 1e-4 * sb[0], "{sa:?} vs {sb:?}");
+    }
+}

@@ -1,0 +1,377 @@
+//! Render outputs (DESIGN §4 `irpol render`): one 32-bit float single-channel TIFF per channel,
+//! `stokes.exr` with every channel, PNG previews with colour bars, `composite.png` (the paper's
+//! Fig. 5 layout) and `summary.json`. Each file is encoded in memory and written atomically
+//! (temporary sibling + rename); `summary.json` comes last, so its presence marks a complete set.
+
+use super::figure;
+use super::shading::{dolp_aop, polarizer};
+use super::tables::{TableResolution, TemperatureLookup};
+use super::{RenderError, Rendered, StokesImage, Timings, BACKGROUND};
+use crate::material::write_atomically;
+use crate::scene::config::Shading;
+use crate::scene::Scene;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::io::Cursor;
+use std::path::Path;
+use std::time::Instant;
+
+/// The image channels written (DESIGN §1.6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Channel {
+    S0,
+    S1,
+    S2,
+    Dolp,
+    Aop,
+    I0,
+    I45,
+    I90,
+    I135,
+}
+
+impl Channel {
+    pub const ALL: [Channel; 9] = [
+        Channel::S0,
+        Channel::S1,
+        Channel::S2,
+        Channel::Dolp,
+        Channel::Aop,
+        Channel::I0,
+        Channel::I45,
+        Channel::I90,
+        Channel::I135,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Channel::S0 => "S0",
+            Channel::S1 => "S1",
+            Channel::S2 => "S2",
+            Channel::Dolp => "DoLP",
+            Channel::Aop => "AoP",
+            Channel::I0 => "I0",
+            Channel::I45 => "I45",
+            Channel::I90 => "I90",
+            Channel::I135 => "I135",
+        }
+    }
+
+    pub fn unit(self) -> &'static str {
+        match self {
+            Channel::Dolp => "1",
+            Channel::Aop => "rad",
+            _ => "W m-2 sr-1",
+        }
+    }
+
+    /// The channel's value for a pixel-frame Stokes vector.
+    #[inline]
+    pub fn value(self, s: [f64; 3]) -> f64 {
+        use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+        match self {
+            Channel::S0 => s[0],
+            Channel::S1 => s[1],
+            Channel::S2 => s[2],
+            Channel::Dolp => dolp_aop(s).0,
+            Channel::Aop => dolp_aop(s).1,
+            Channel::I0 => polarizer(s, 0.0),
+            Channel::I45 => polarizer(s, FRAC_PI_4),
+            Channel::I90 => polarizer(s, FRAC_PI_2),
+            Channel::I135 => polarizer(s, 3.0 * FRAC_PI_4),
+        }
+    }
+}
+
+impl StokesImage {
+    /// One channel as 32-bit floats, row-major from the top.
+    pub fn channel(&self, channel: Channel) -> Vec<f32> {
+        self.stokes
+            .iter()
+            .map(|&s| channel.value(s) as f32)
+            .collect()
+    }
+
+    /// Minimum, maximum and mean of a channel over the object pixels (None without any).
+    pub fn object_stats(&self, values: &[f32]) -> Option<Stats> {
+        let mut stats = Stats {
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+            mean: 0.0,
+        };
+        let mut count = 0usize;
+        for (&v, &o) in values.iter().zip(&self.surface) {
+            if o != BACKGROUND {
+                let v = v as f64;
+                stats.min = stats.min.min(v);
+                stats.max = stats.max.max(v);
+                stats.mean += v;
+                count += 1;
+            }
+        }
+        (count > 0).then(|| Stats {
+            mean: stats.mean / count as f64,
+            ..stats
+        })
+    }
+}
+
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Stats {
+    pub min: f64,
+    pub max: f64,
+    pub mean: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ChannelSummary {
+    pub name: &'static str,
+    pub unit: &'static str,
+    /// Over object pixels; null when the camera sees no object.
+    pub object_pixels: Option<Stats>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct PixelCounts {
+    pub total: usize,
+    pub object: usize,
+    pub background: usize,
+    pub per_object: BTreeMap<String, usize>,
+    /// Keyed "object/part".
+    pub per_part: BTreeMap<String, usize>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct MaterialSummary {
+    pub name: String,
+    pub origin: String,
+    pub table: TableResolution,
+}
+
+/// `summary.json`, also returned to the caller.
+#[derive(Clone, Debug, Serialize)]
+pub struct RenderSummary {
+    pub scene: String,
+    pub output_dir: String,
+    pub width: usize,
+    pub height: usize,
+    pub shading: Shading,
+    pub band_um: [f64; 2],
+    pub pixels: PixelCounts,
+    pub channels: Vec<ChannelSummary>,
+    /// Brightness temperature of S0 over object pixels (K).
+    pub apparent_temperature_k: Option<Stats>,
+    pub materials: Vec<MaterialSummary>,
+    pub timings_s: Timings,
+    pub files: Vec<String>,
+}
+
+/// Writes every output of `rendered` into `out_dir` and returns the summary.
+pub fn write_outputs(
+    scene: &Scene,
+    rendered: &Rendered,
+    out_dir: &Path,
+    started: Instant,
+) -> Result<RenderSummary, RenderError> {
+    let write_start = Instant::now();
+    let image = &rendered.image;
+    let (w, h) = (image.width, image.height);
+    let channels: Vec<(Channel, Vec<f32>)> = Channel::ALL
+        .par_iter()
+        .map(|&c| (c, image.channel(c)))
+        .collect();
+    let previews = figure::Previews::new(scene, image);
+
+    // Encode everything in memory, in parallel; write only when every encoding succeeded.
+    enum Job {
+        Tiff(usize),
+        Exr,
+        Panel(usize),
+        Composite,
+    }
+    let mut jobs: Vec<Job> = (0..channels.len()).map(Job::Tiff).collect();
+    jobs.push(Job::Exr);
+    jobs.extend((0..previews.len()).map(Job::Panel));
+    jobs.push(Job::Composite);
+    let encoded: Vec<(String, Vec<u8>)> = jobs
+        .par_iter()
+        .map(|job| {
+            let (name, bytes) = match job {
+                Job::Tiff(i) => {
+                    let (channel, data) = &channels[*i];
+                    (format!("{}.tif", channel.name()), encode_tiff(w, h, data))
+                }
+                Job::Exr => ("stokes.exr".to_owned(), encode_exr(w, h, &channels)),
+                Job::Panel(i) => (previews.file_name(*i).to_owned(), previews.panel_png(*i)),
+                Job::Composite => ("composite.png".to_owned(), previews.composite_png()),
+            };
+            bytes
+                .map(|b| (name.clone(), b))
+                .map_err(|source| RenderError::Write {
+                    path: out_dir.join(&name),
+                    source,
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    let mut files = Vec::with_capacity(encoded.len() + 1);
+    for (name, bytes) in encoded {
+        let path = out_dir.join(&name);
+        write_atomically(&path, &bytes).map_err(|source| RenderError::Write { path, source })?;
+        files.push(name);
+    }
+
+    let summary_stats: Vec<ChannelSummary> = channels
+        .iter()
+        .map(|(c, data)| ChannelSummary {
+            name: c.name(),
+            unit: c.unit(),
+            object_pixels: image.object_stats(data),
+        })
+        .collect();
+    let apparent = image.object_stats(&channels[0].1).map(|s| {
+        let lookup = TemperatureLookup::new(&scene.sensor.band, s.min.max(0.0), s.max.max(0.0));
+        let temperatures: Vec<f32> = channels[0]
+            .1
+            .iter()
+            .map(|&r| lookup.at(r as f64) as f32)
+            .collect();
+        let mean = image.object_stats(&temperatures).map_or(0.0, |t| t.mean);
+        Stats {
+            min: lookup.at(s.min),
+            max: lookup.at(s.max),
+            mean,
+        }
+    });
+    let mut per_surface = vec![0usize; scene.surfaces.len()];
+    for &s in image.surface.iter().filter(|&&s| s != BACKGROUND) {
+        per_surface[s as usize] += 1;
+    }
+    let (mut per_object, mut per_part) = (BTreeMap::new(), BTreeMap::new());
+    for (surface, &count) in scene.surfaces.iter().zip(&per_surface) {
+        let object = scene.object_names[surface.object].clone();
+        per_part.insert(format!("{object}/{}", surface.part), count);
+        *per_object.entry(object).or_insert(0) += count;
+    }
+    let object_pixels: usize = per_surface.iter().sum();
+    let mut timings = rendered.timings;
+    timings.write = write_start.elapsed().as_secs_f64();
+    timings.total = started.elapsed().as_secs_f64();
+    let (lo, hi) = scene.sensor.band.limits_um();
+    files.push("summary.json".into());
+    let summary = RenderSummary {
+        scene: scene.path.display().to_string(),
+        output_dir: out_dir.display().to_string(),
+        width: w,
+        height: h,
+        shading: scene.shading,
+        band_um: [lo, hi],
+        pixels: PixelCounts {
+            total: w * h,
+            object: object_pixels,
+            background: w * h - object_pixels,
+            per_object,
+            per_part,
+        },
+        channels: summary_stats,
+        apparent_temperature_k: apparent,
+        materials: scene
+            .materials
+            .iter()
+            .zip(&rendered.table_resolutions)
+            .map(|(m, &table)| MaterialSummary {
+                name: m.name.clone(),
+                origin: m.origin.clone(),
+                table,
+            })
+            .collect(),
+        timings_s: timings,
+        files,
+    };
+    let json = serde_json::to_vec_pretty(&summary).map_err(|e| RenderError::Write {
+        path: out_dir.join("summary.json"),
+        source: std::io::Error::other(e),
+    })?;
+    let path = out_dir.join("summary.json");
+    write_atomically(&path, &json).map_err(|source| RenderError::Write { path, source })?;
+    Ok(summary)
+}
+
+/// Single-channel 32-bit IEEE float TIFF (SampleFormat = 3), uncompressed.
+fn encode_tiff(width: usize, height: usize, data: &[f32]) -> std::io::Result<Vec<u8>> {
+    let mut bytes = Cursor::new(Vec::new());
+    let mut encoder = tiff::encoder::TiffEncoder::new(&mut bytes).map_err(std::io::Error::other)?;
+    encoder
+        .write_image::<tiff::encoder::colortype::Gray32Float>(width as u32, height as u32, data)
+        .map_err(std::io::Error::other)?;
+    Ok(bytes.into_inner())
+}
+
+/// One OpenEXR layer "stokes" with a 32-bit float channel per [`Channel`], uncompressed.
+fn encode_exr(
+    width: usize,
+    height: usize,
+    channels: &[(Channel, Vec<f32>)],
+) -> std::io::Result<Vec<u8>> {
+    use exr::prelude::*;
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
+        .iter()
+        .map(|(c, data)| AnyChannel::new(c.name(), FlatSamples::F32(data.clone())))
+        .collect();
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::named("stokes"),
+        // Noisy float data does not compress; uncompressed is as small and fastest.
+        Encoding::UNCOMPRESSED,
+        AnyChannels::sort(list),
+    );
+    let mut bytes = Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(std::io::Error::other)?;
+    Ok(bytes.into_inner())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiff_and_exr_round_trip() {
+        let (w, h) = (5, 3);
+        let data: Vec<f32> = (0..15).map(|i| i as f32 * 0.25 - 1.0).collect();
+        let tiff = encode_tiff(w, h, &data).unwrap();
+        let mut decoder = tiff::decoder::Decoder::new(Cursor::new(tiff)).unwrap();
+        assert_eq!(decoder.dimensions().unwrap(), (5, 3));
+        match decoder.read_image().unwrap() {
+            tiff::decoder::DecodingResult::F32(back) => assert_eq!(back, data),
+            _ => panic!("not a float TIFF"),
+        }
+        let channels = vec![(Channel::S0, data.clone()), (Channel::Dolp, vec![0.5; 15])];
+        let exr_bytes = encode_exr(w, h, &channels).unwrap();
+        use exr::prelude::{ReadChannels, ReadLayers};
+        let image = exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(Cursor::new(exr_bytes))
+            .unwrap();
+        let layer = &image.layer_data;
+        assert_eq!(layer.size, exr::math::Vec2(5, 3));
+        let names: Vec<String> = layer
+            .channel_data
+            .list
+            .iter()
+            .map(|c| c.name.to_string())
+            .collect();
+        assert_eq!(names, vec!["DoLP", "S0"]);
+        let s0: Vec<f32> = layer.channel_data.list[1]
+            .sample_data
+            .values_as_f32()
+            .collect();
+        assert_eq!(s0, data);
+    }
+}

@@ -1,0 +1,257 @@
+//! The scene TOML as written by the user (DESIGN §2.3), before paths, meshes and materials are
+//! resolved. Every table refuses unknown keys so that a typo is an error, not a silent default.
+//!
+//! ```toml
+//! material_library = "../fits"        # optional; default "fits" next to the scene file
+//!
+//! [camera]
+//! position = [6.0, -7.0, 2.2]         # metres, world frame, z up
+//! look_at = [0.0, 0.0, 0.7]
+//! up = [0.0, 0.0, 1.0]                # optional, default +z
+//! fov_deg = 35.0                      # vertical field of view
+//! resolution = [640, 480]             # width, height in pixels
+//!
+//! [sensor]                            # optional
+//! band_um = [8.0, 14.0]
+//! response = [[8.0, 0.5], [10.0, 1.0], [14.0, 0.5]]   # optional (µm, relative response)
+//! netd_mk = 30.0                      # 0 = noise free
+//! seed = 1
+//! netd_reference_k = 300.0            # optional: where dL/dT is taken; default the air temperature
+//!
+//! [environment]
+//! air_temperature_k = 283.15
+//! sky = { model = "window", zenith_emissivity = 0.75 }
+//! # sky = { model = "table", elevation_deg = [0, 10, 90], brightness_temperature_k = [283, 270, 240] }
+//! # sky = { model = "table", elevation_deg = [0, 90], radiance = [30.0, 12.0] }
+//! ground = { temperature_k = 288.0, emissivity = 0.95 }
+//!
+//! [atmosphere]                        # optional: S_sensor = τS + (1−τ) L_bb(T_air) δ_j0
+//! extinction_per_km = 0.2             # τ = exp(−β·range)
+//!
+//! [render]                            # optional
+//! shading = "pixel"                   # or "gouraud"
+//! aop_mask_dolp = 0.002               # AoP preview masked where DoLP is below this
+//!
+//! [materials.asphalt]                 # inline materials, referred to by name
+//! distribution = "cauchy"
+//! sigma = 0.5
+//! q = 2.0
+//! n = 1.6
+//! k = 0.1
+//! rho_d = 0.05
+//! shadowing = "smith"
+//!
+//! [[objects]]
+//! name = "car"
+//! mesh = "car.obj"                    # OBJ (groups are parts) or PLY (per-vertex temperature)
+//! material = "paper_paint"            # default for parts not listed below
+//! temperature_k = 290.0
+//! translate = [0.0, 0.0, 0.0]         # transform: scale, then rotate x, y, z, then translate
+//! rotate_deg = [0.0, 0.0, 0.0]
+//! scale = 1.0
+//! [objects.parts.hood]
+//! temperature_k = 320.0
+//! ```
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneConfig {
+    /// Folder of the material library (names resolve to `<dir>/<name>.toml`), relative to the
+    /// scene file; default `fits`.
+    pub material_library: Option<String>,
+    pub camera: CameraConfig,
+    #[serde(default)]
+    pub sensor: SensorConfig,
+    pub environment: EnvironmentConfig,
+    pub atmosphere: Option<AtmosphereConfig>,
+    #[serde(default)]
+    pub render: RenderConfig,
+    /// Inline material definitions by name.
+    #[serde(default)]
+    pub materials: BTreeMap<String, InlineMaterialConfig>,
+    #[serde(default)]
+    pub objects: Vec<ObjectConfig>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraConfig {
+    pub position: [f64; 3],
+    pub look_at: [f64; 3],
+    #[serde(default = "world_up")]
+    pub up: [f64; 3],
+    pub fov_deg: f64,
+    pub resolution: [u32; 2],
+}
+
+fn world_up() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorConfig {
+    #[serde(default = "lwir_band")]
+    pub band_um: [f64; 2],
+    /// Spectral response (wavelength µm, relative response), piecewise linear.
+    pub response: Option<Vec<[f64; 2]>>,
+    /// Noise-equivalent temperature difference of each polarizer image, mK; 0 = no noise.
+    #[serde(default)]
+    pub netd_mk: f64,
+    #[serde(default)]
+    pub seed: u64,
+    /// Temperature at which NETD is converted to radiance (dL/dT); default the air temperature.
+    pub netd_reference_k: Option<f64>,
+}
+
+fn lwir_band() -> [f64; 2] {
+    [8.0, 14.0]
+}
+
+impl Default for SensorConfig {
+    fn default() -> Self {
+        SensorConfig {
+            band_um: lwir_band(),
+            response: None,
+            netd_mk: 0.0,
+            seed: 0,
+            netd_reference_k: None,
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentConfig {
+    pub air_temperature_k: f64,
+    pub sky: SkyConfig,
+    pub ground: GroundConfig,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "model", rename_all = "lowercase", deny_unknown_fields)]
+pub enum SkyConfig {
+    /// Clear-sky window model ε_sky(θ_z) = 1 − (1 − ε_zenith)^(1/cos θ_z) (DESIGN §1.5).
+    Window { zenith_emissivity: f64 },
+    /// A user table over elevation (degrees, 0 = horizon, 90 = zenith), in radiance
+    /// (W·m⁻²·sr⁻¹, band-integrated) or in brightness temperature (K); linear in between.
+    Table {
+        elevation_deg: Vec<f64>,
+        radiance: Option<Vec<f64>>,
+        brightness_temperature_k: Option<Vec<f64>>,
+    },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroundConfig {
+    pub temperature_k: f64,
+    pub emissivity: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AtmosphereConfig {
+    /// Extinction coefficient β (per km); τ = exp(−β·range).
+    pub extinction_per_km: f64,
+    /// Path temperature; default the air temperature.
+    pub temperature_k: Option<f64>,
+}
+
+#[derive(Debug, Deserialize, Default, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Shading {
+    /// Stokes vectors at the vertices, interpolated over triangles (the paper's Gouraud shading).
+    Gouraud,
+    /// Stokes vectors at every pixel from the interpolated normal and temperature.
+    #[default]
+    Pixel,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderConfig {
+    #[serde(default)]
+    pub shading: Shading,
+    #[serde(default = "default_aop_mask")]
+    pub aop_mask_dolp: f64,
+}
+
+fn default_aop_mask() -> f64 {
+    0.002
+}
+
+impl Default for RenderConfig {
+    fn default() -> Self {
+        RenderConfig {
+            shading: Shading::default(),
+            aop_mask_dolp: default_aop_mask(),
+        }
+    }
+}
+
+/// pBRDF parameters given directly in the scene (DESIGN §1.3); wavelength is not needed to render.
+#[derive(Debug, Deserialize, Clone)]
+#[serde(deny_unknown_fields)]
+pub struct InlineMaterialConfig {
+    pub distribution: String,
+    pub sigma: f64,
+    pub q: Option<f64>,
+    pub n: f64,
+    pub k: f64,
+    #[serde(default)]
+    pub rho_d: f64,
+    #[serde(default)]
+    pub shadowing: crate::pbrdf::Shadowing,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectConfig {
+    pub name: Option<String>,
+    /// OBJ or PLY file, relative to the scene file. Exactly one of `mesh` and `shape`.
+    pub mesh: Option<String>,
+    pub shape: Option<ShapeConfig>,
+    /// Default material and temperature of every part not listed in `parts`.
+    pub material: Option<String>,
+    pub temperature_k: Option<f64>,
+    #[serde(default)]
+    pub translate: [f64; 3],
+    #[serde(default)]
+    pub rotate_deg: [f64; 3],
+    #[serde(default = "unit_scale")]
+    pub scale: f64,
+    /// Normals of faces meeting at less than this angle are averaged (meshes without `vn`).
+    #[serde(default = "default_crease")]
+    pub crease_angle_deg: f64,
+    #[serde(default)]
+    pub parts: BTreeMap<String, PartConfig>,
+}
+
+fn unit_scale() -> f64 {
+    1.0
+}
+
+fn default_crease() -> f64 {
+    35.0
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartConfig {
+    pub material: Option<String>,
+    pub temperature_k: Option<f64>,
+}
+
+/// Procedural test objects (one part named `surface`), centred at the object origin.
+#[derive(Debug, Deserialize, Clone)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum ShapeConfig {
+    /// Icosphere: the icosahedron subdivided `subdivisions` times (20·4^n faces), smooth normals.
+    Sphere { radius: f64, subdivisions: u32 },
+    /// Square grid in the xy plane facing +z, `size` metres wide, `divisions` cells a side.
+    Plane { size: [f64; 2], divisions: [u32; 2] },
+}

@@ -1,0 +1,474 @@
+//! Triangle meshes: what a file holds ([`RawMesh`]: positions, optional normals, triangles tagged
+//! with a part, optional per-vertex temperatures) and what the renderer draws ([`ShadedMesh`]:
+//! world-space shading vertices, each with one normal and one temperature).
+//!
+//! Temperatures follow the paper's §4: a temperature per part, turned into a temperature per
+//! vertex (a vertex shared by several parts gets their average) and interpolated over triangles.
+
+use nalgebra::{Rotation3, Vector3};
+use std::collections::HashMap;
+
+/// Where a face came from in its file, for error messages ("line 12", "face 7").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FaceOrigin {
+    Line(usize),
+    Index(usize),
+}
+
+impl std::fmt::Display for FaceOrigin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FaceOrigin::Line(line) => write!(f, "line {line}"),
+            FaceOrigin::Index(index) => write!(f, "face {index}"),
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct RawFace {
+    pub vertices: [u32; 3],
+    /// Indices into [`RawMesh::normals`] (OBJ `f v//vn`), when the file gives them.
+    pub normals: Option<[u32; 3]>,
+    pub part: u32,
+    pub origin: FaceOrigin,
+}
+
+/// A mesh as read from a file or generated, in object coordinates.
+#[derive(Clone, Debug, Default)]
+pub struct RawMesh {
+    pub positions: Vec<Vector3<f64>>,
+    pub normals: Vec<Vector3<f64>>,
+    pub faces: Vec<RawFace>,
+    /// Part names (OBJ groups); `RawFace::part` indexes this.
+    pub parts: Vec<String>,
+    /// Per-vertex temperatures (PLY property `temperature`, K).
+    pub vertex_temperatures: Option<Vec<f64>>,
+}
+
+impl RawMesh {
+    /// Index of part `name`, appended if new.
+    pub fn part_index(&mut self, name: &str) -> u32 {
+        match self.parts.iter().position(|p| p == name) {
+            Some(i) => i as u32,
+            None => {
+                self.parts.push(name.to_owned());
+                (self.parts.len() - 1) as u32
+            }
+        }
+    }
+
+    /// Index of part `name`, if the mesh has it.
+    pub fn part_index_of(&self, name: &str) -> Option<u32> {
+        self.parts.iter().position(|p| p == name).map(|i| i as u32)
+    }
+
+    /// Names of the parts that own at least one face.
+    pub fn used_parts(&self) -> Vec<&str> {
+        let mut used = vec![false; self.parts.len()];
+        for face in &self.faces {
+            used[face.part as usize] = true;
+        }
+        self.parts
+            .iter()
+            .zip(used)
+            .filter(|(_, u)| *u)
+            .map(|(p, _)| p.as_str())
+            .collect()
+    }
+}
+
+/// Similarity transform applied to an object: scale, then rotations about x, y, z (degrees), then
+/// translation.
+#[derive(Clone, Copy, Debug)]
+pub struct Transform {
+    pub scale: f64,
+    pub rotation: Rotation3<f64>,
+    pub translation: Vector3<f64>,
+}
+
+impl Transform {
+    pub fn new(scale: f64, rotate_deg: [f64; 3], translate: [f64; 3]) -> Transform {
+        let [rx, ry, rz] = rotate_deg.map(f64::to_radians);
+        let rotation = Rotation3::from_axis_angle(&Vector3::z_axis(), rz)
+            * Rotation3::from_axis_angle(&Vector3::y_axis(), ry)
+            * Rotation3::from_axis_angle(&Vector3::x_axis(), rx);
+        Transform {
+            scale,
+            rotation,
+            translation: Vector3::from(translate),
+        }
+    }
+
+    pub fn point(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        self.rotation * (p * self.scale) + self.translation
+    }
+
+    /// Normals transform with the rotation alone (uniform scale keeps them perpendicular).
+    pub fn normal(&self, n: &Vector3<f64>) -> Vector3<f64> {
+        self.rotation * n
+    }
+}
+
+/// The renderer's mesh: shading vertices (a position, a unit normal and a temperature each) and
+/// triangles over them, every triangle tagged with a surface (an object part and its material).
+#[derive(Clone, Debug, Default)]
+pub struct ShadedMesh {
+    pub positions: Vec<Vector3<f64>>,
+    pub normals: Vec<Vector3<f64>>,
+    pub temperatures: Vec<f64>,
+    pub triangles: Vec<[u32; 3]>,
+    pub triangle_surface: Vec<u32>,
+}
+
+impl ShadedMesh {
+    /// Appends `other`, offsetting its vertex indices.
+    pub fn append(&mut self, other: ShadedMesh) {
+        let offset = self.positions.len() as u32;
+        self.positions.extend(other.positions);
+        self.normals.extend(other.normals);
+        self.temperatures.extend(other.temperatures);
+        self.triangles
+            .extend(other.triangles.into_iter().map(|t| t.map(|i| i + offset)));
+        self.triangle_surface.extend(other.triangle_surface);
+    }
+}
+
+/// What one object needs to turn its raw mesh into shading vertices.
+pub struct ObjectShading<'a> {
+    pub transform: Transform,
+    /// Faces whose normals differ by less than this are smoothed together (no `vn` in the file).
+    pub crease_angle_deg: f64,
+    /// Per raw part: the temperature (K) when the mesh has no per-vertex temperatures.
+    pub part_temperature: &'a [Option<f64>],
+    /// Per raw part: the scene surface index stored in [`ShadedMesh::triangle_surface`].
+    pub part_surface: &'a [u32],
+}
+
+/// Transforms, checks and converts a raw mesh. Errors name the face or vertex ("line 12: …").
+pub fn shade_mesh(raw: &RawMesh, setup: &ObjectShading) -> Result<ShadedMesh, String> {
+    let positions: Vec<Vector3<f64>> = raw
+        .positions
+        .iter()
+        .map(|p| setup.transform.point(p))
+        .collect();
+    if let Some(i) = positions
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+    {
+        return Err(format!("vertex {} has a non-finite coordinate", i + 1));
+    }
+    let face_normals = checked_face_normals(raw, &positions)?;
+    let vertex_temperature = vertex_temperatures(raw, setup.part_temperature)?;
+    let corner_normals = corner_normals(raw, setup, &face_normals)?;
+
+    // One shading vertex per distinct (position, part, normal): creases and part boundaries split
+    // vertices so that each side keeps its own normal and material.
+    let mut mesh = ShadedMesh::default();
+    let mut index_of: HashMap<(u32, u32, [u64; 3]), u32> = HashMap::new();
+    for (face, normals) in raw.faces.iter().zip(&corner_normals) {
+        let mut triangle = [0u32; 3];
+        for corner in 0..3 {
+            let v = face.vertices[corner];
+            let n = normals[corner];
+            let key = (v, face.part, [n.x.to_bits(), n.y.to_bits(), n.z.to_bits()]);
+            triangle[corner] = *index_of.entry(key).or_insert_with(|| {
+                mesh.positions.push(positions[v as usize]);
+                mesh.normals.push(n);
+                mesh.temperatures.push(vertex_temperature[v as usize]);
+                (mesh.positions.len() - 1) as u32
+            });
+        }
+        mesh.triangles.push(triangle);
+        mesh.triangle_surface
+            .push(setup.part_surface[face.part as usize]);
+    }
+    Ok(mesh)
+}
+
+/// Area-weighted face normals (the cross product, length = 2·area), refusing degenerate faces.
+fn checked_face_normals(
+    raw: &RawMesh,
+    positions: &[Vector3<f64>],
+) -> Result<Vec<Vector3<f64>>, String> {
+    // Positions are finite here (checked by the caller), so the cross products are too.
+    let extent = bounding_diagonal(positions);
+    // Relative to the mesh size, so that millimetre and kilometre meshes are judged alike.
+    let min_double_area = 1e-12 * extent * extent;
+    raw.faces
+        .iter()
+        .map(|face| {
+            let [a, b, c] = face.vertices.map(|i| positions[i as usize]);
+            let cross = (b - a).cross(&(c - a));
+            if face.vertices[0] == face.vertices[1]
+                || face.vertices[1] == face.vertices[2]
+                || face.vertices[0] == face.vertices[2]
+                || cross.norm() <= min_double_area
+            {
+                Err(format!(
+                    "{}: degenerate triangle (zero area) in part '{}'",
+                    face.origin, raw.parts[face.part as usize]
+                ))
+            } else {
+                Ok(cross)
+            }
+        })
+        .collect()
+}
+
+fn bounding_diagonal(positions: &[Vector3<f64>]) -> f64 {
+    let mut lo = Vector3::repeat(f64::INFINITY);
+    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+    for p in positions {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    if positions.is_empty() {
+        0.0
+    } else {
+        (hi - lo).norm()
+    }
+}
+
+/// Per raw vertex: the file's temperature, or the average temperature of the parts that use it.
+fn vertex_temperatures(
+    raw: &RawMesh,
+    part_temperature: &[Option<f64>],
+) -> Result<Vec<f64>, String> {
+    if let Some(temperatures) = &raw.vertex_temperatures {
+        if let Some(i) = temperatures
+            .iter()
+            .position(|t| !(t.is_finite() && *t >= 0.0))
+        {
+            return Err(format!(
+                "vertex {} has temperature {} K: temperatures must be finite and ≥ 0",
+                i + 1,
+                temperatures[i]
+            ));
+        }
+        return Ok(temperatures.clone());
+    }
+    // Distinct parts per vertex, so a vertex inside a part is not weighted by its face count.
+    let mut parts_of: Vec<Vec<u32>> = vec![Vec::new(); raw.positions.len()];
+    for face in &raw.faces {
+        for &v in &face.vertices {
+            let parts = &mut parts_of[v as usize];
+            if !parts.contains(&face.part) {
+                parts.push(face.part);
+            }
+        }
+    }
+    parts_of
+        .iter()
+        .map(|parts| {
+            if parts.is_empty() {
+                return Ok(0.0); // a vertex no face uses is never drawn
+            }
+            let mut sum = 0.0;
+            for &p in parts {
+                sum += part_temperature[p as usize].ok_or_else(|| {
+                    format!(
+                        "part '{}' has no temperature (set temperature_k on the object or the part)",
+                        raw.parts[p as usize]
+                    )
+                })?;
+            }
+            Ok(sum / parts.len() as f64)
+        })
+        .collect()
+}
+
+/// Unit normal at each face corner: the file's normals when given, otherwise the area-weighted
+/// average of the same part's faces around the vertex that bend by less than the crease angle.
+fn corner_normals(
+    raw: &RawMesh,
+    setup: &ObjectShading,
+    face_normals: &[Vector3<f64>],
+) -> Result<Vec<[Vector3<f64>; 3]>, String> {
+    let mut faces_at: Vec<Vec<u32>> = vec![Vec::new(); raw.positions.len()];
+    for (f, face) in raw.faces.iter().enumerate() {
+        if face.normals.is_none() {
+            for &v in &face.vertices {
+                faces_at[v as usize].push(f as u32);
+            }
+        }
+    }
+    let cos_crease = setup.crease_angle_deg.to_radians().cos();
+    raw.faces
+        .iter()
+        .enumerate()
+        .map(|(f, face)| {
+            let own = face_normals[f].normalize();
+            let mut corners = [Vector3::zeros(); 3];
+            for corner in 0..3 {
+                corners[corner] = match face.normals {
+                    Some(indices) => {
+                        let n = setup
+                            .transform
+                            .normal(&raw.normals[indices[corner] as usize]);
+                        let length = n.norm();
+                        if !(length > 1e-12 && length.is_finite()) {
+                            return Err(format!(
+                                "{}: vertex normal {} is zero or not finite",
+                                face.origin,
+                                indices[corner] + 1
+                            ));
+                        }
+                        n / length
+                    }
+                    None => {
+                        let mut sum = Vector3::zeros();
+                        for &g in &faces_at[face.vertices[corner] as usize] {
+                            let other = &face_normals[g as usize];
+                            if raw.faces[g as usize].part == face.part
+                                && other.normalize().dot(&own) >= cos_crease
+                            {
+                                sum += other;
+                            }
+                        }
+                        sum.normalize()
+                    }
+                };
+            }
+            Ok(corners)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square_with_two_parts() -> RawMesh {
+        // Two triangles sharing the edge (1, 2), each its own part.
+        let mut raw = RawMesh {
+            positions: vec![
+                Vector3::new(0.0, 0.0, 0.0),
+                Vector3::new(1.0, 0.0, 0.0),
+                Vector3::new(0.0, 1.0, 0.0),
+                Vector3::new(1.0, 1.0, 0.0),
+            ],
+            ..RawMesh::default()
+        };
+        let a = raw.part_index("a");
+        let b = raw.part_index("b");
+        raw.faces = vec![
+            RawFace {
+                vertices: [0, 1, 2],
+                normals: None,
+                part: a,
+                origin: FaceOrigin::Index(1),
+            },
+            RawFace {
+                vertices: [2, 1, 3],
+                normals: None,
+                part: b,
+                origin: FaceOrigin::Index(2),
+            },
+        ];
+        raw
+    }
+
+    fn shading<'a>(temps: &'a [Option<f64>], surfaces: &'a [u32]) -> ObjectShading<'a> {
+        ObjectShading {
+            transform: Transform::new(1.0, [0.0; 3], [0.0; 3]),
+            crease_angle_deg: 35.0,
+            part_temperature: temps,
+            part_surface: surfaces,
+        }
+    }
+
+    #[test]
+    fn shared_vertices_get_the_average_part_temperature() {
+        let raw = square_with_two_parts();
+        let temps = [Some(300.0), Some(320.0)];
+        let mesh = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap();
+        // Vertices 1 and 2 are split per part but both copies carry the average 310 K.
+        assert_eq!(mesh.positions.len(), 6);
+        let t_of = |p: Vector3<f64>| {
+            mesh.positions
+                .iter()
+                .zip(&mesh.temperatures)
+                .filter(|(q, _)| (*q - p).norm() < 1e-12)
+                .map(|(_, t)| *t)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(t_of(Vector3::new(1.0, 0.0, 0.0)), vec![310.0, 310.0]);
+        assert_eq!(t_of(Vector3::new(0.0, 0.0, 0.0)), vec![300.0]);
+        assert_eq!(t_of(Vector3::new(1.0, 1.0, 0.0)), vec![320.0]);
+        assert_eq!(mesh.triangle_surface, vec![0, 1]);
+        assert!(mesh
+            .normals
+            .iter()
+            .all(|n| (n - Vector3::z()).norm() < 1e-12));
+    }
+
+    #[test]
+    fn transform_scales_rotates_then_translates() {
+        let t = Transform::new(2.0, [0.0, 0.0, 90.0], [1.0, 0.0, 0.0]);
+        let p = t.point(&Vector3::new(1.0, 0.0, 0.0));
+        assert!((p - Vector3::new(1.0, 2.0, 0.0)).norm() < 1e-12);
+        let n = t.normal(&Vector3::new(1.0, 0.0, 0.0));
+        assert!((n - Vector3::new(0.0, 1.0, 0.0)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn degenerate_and_non_finite_geometry_is_refused() {
+        let mut raw = square_with_two_parts();
+        raw.positions[3] = Vector3::new(0.5, 0.5, 0.0); // on the shared edge: zero area
+        let temps = [Some(300.0), Some(320.0)];
+        let err = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap_err();
+        assert!(err.contains("face 2") && err.contains("degenerate") && err.contains("'b'"));
+        raw.positions[3] = Vector3::new(f64::NAN, 0.5, 0.0);
+        let err = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap_err();
+        assert!(
+            err.contains("vertex 4") && err.contains("non-finite"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_part_without_temperature_is_named() {
+        let raw = square_with_two_parts();
+        let err = shade_mesh(&raw, &shading(&[Some(1.0), None], &[0, 1])).unwrap_err();
+        assert!(err.contains("part 'b' has no temperature"), "{err}");
+    }
+
+    #[test]
+    fn creases_split_normals_and_smooth_faces_share_them() {
+        // A roof ridge: two faces meeting at 20° are smoothed, at 90° they are not.
+        for (angle_deg, smoothed) in [(20.0f64, true), (90.0, false)] {
+            let half = (angle_deg / 2.0).to_radians();
+            let mut raw = RawMesh {
+                positions: vec![
+                    Vector3::new(0.0, 0.0, 0.0),
+                    Vector3::new(0.0, 1.0, 0.0),
+                    Vector3::new(half.cos(), 0.0, -half.sin()),
+                    Vector3::new(-half.cos(), 0.0, -half.sin()),
+                ],
+                ..RawMesh::default()
+            };
+            let p = raw.part_index("roof");
+            raw.faces = vec![
+                RawFace {
+                    vertices: [0, 2, 1],
+                    normals: None,
+                    part: p,
+                    origin: FaceOrigin::Index(1),
+                },
+                RawFace {
+                    vertices: [0, 1, 3],
+                    normals: None,
+                    part: p,
+                    origin: FaceOrigin::Index(2),
+                },
+            ];
+            let mesh = shade_mesh(&raw, &shading(&[Some(1.0)], &[0])).unwrap();
+            let distinct = if smoothed { 4 } else { 6 };
+            assert_eq!(mesh.positions.len(), distinct, "angle {angle_deg}");
+            if smoothed {
+                let ridge = mesh.triangles[0][0] as usize;
+                assert!((mesh.normals[ridge] - Vector3::z()).norm() < 1e-12);
+            }
+        }
+    }
+}

@@ -1,0 +1,225 @@
+//! Wavefront OBJ: `v`, `vn`, `f` (any of `v`, `v/vt`, `v//vn`, `v/vt/vn`, negative indices
+//! relative to the end), `g`/`o` start a part (DESIGN §2.3: groups are parts). Polygons are split
+//! into triangle fans. Texture and material statements are accepted and ignored; anything else is
+//! refused so that a corrupt file is not half-read. Errors read `line N: what is wrong`.
+//!
+//! Own reader rather than a crate because part boundaries must keep the file's vertex indices:
+//! a vertex shared by two groups gets the average of their temperatures.
+
+use super::mesh::{FaceOrigin, RawFace, RawMesh};
+use nalgebra::Vector3;
+use std::fmt::Write as _;
+
+/// Statements that carry nothing the renderer uses.
+const IGNORED: &[&str] = &["vt", "vp", "s", "usemtl", "mtllib", "l", "p"];
+
+pub fn parse_obj(text: &str) -> Result<RawMesh, String> {
+    let mut mesh = RawMesh::default();
+    let mut part: Option<u32> = None;
+    for (number, line) in text.lines().enumerate() {
+        let line_no = number + 1;
+        let content = line.split('#').next().unwrap_or("").trim();
+        let mut fields = content.split_whitespace();
+        let Some(keyword) = fields.next() else {
+            continue;
+        };
+        let at = |message: String| format!("line {line_no}: {message}");
+        match keyword {
+            "v" => {
+                let numbers = parse_numbers(fields).map_err(at)?;
+                // x y z, optionally w (3+1) or a vertex colour (3+3).
+                if !matches!(numbers.len(), 3 | 4 | 6) {
+                    return Err(at(format!(
+                        "a vertex needs 3 coordinates, got {}",
+                        numbers.len()
+                    )));
+                }
+                let v = Vector3::new(numbers[0], numbers[1], numbers[2]);
+                if !v.iter().all(|c| c.is_finite()) {
+                    return Err(at(format!(
+                        "vertex {} has a non-finite coordinate",
+                        mesh.positions.len() + 1
+                    )));
+                }
+                mesh.positions.push(v);
+            }
+            "vn" => {
+                let numbers = parse_numbers(fields).map_err(at)?;
+                if numbers.len() != 3 || !numbers.iter().all(|c| c.is_finite()) {
+                    return Err(at("a normal needs 3 finite components".into()));
+                }
+                mesh.normals
+                    .push(Vector3::new(numbers[0], numbers[1], numbers[2]));
+            }
+            "f" => {
+                let corners = fields
+                    .map(|field| parse_corner(field, &mesh))
+                    .collect::<Result<Vec<_>, _>>()
+                    .map_err(at)?;
+                if corners.len() < 3 {
+                    return Err(at(format!(
+                        "a face needs at least 3 vertices, got {}",
+                        corners.len()
+                    )));
+                }
+                let with_normals = corners.iter().filter(|c| c.1.is_some()).count();
+                if with_normals != 0 && with_normals != corners.len() {
+                    return Err(at(
+                        "some corners of the face have normals and some do not".into()
+                    ));
+                }
+                let part = *part.get_or_insert_with(|| mesh.part_index("default"));
+                for i in 1..corners.len() - 1 {
+                    let picked = [corners[0], corners[i], corners[i + 1]];
+                    mesh.faces.push(RawFace {
+                        vertices: picked.map(|c| c.0),
+                        normals: (with_normals > 0).then(|| picked.map(|c| c.1.unwrap_or(0))),
+                        part,
+                        origin: FaceOrigin::Line(line_no),
+                    });
+                }
+            }
+            "g" | "o" => {
+                let name = fields.collect::<Vec<_>>().join(" ");
+                let name = if name.is_empty() { "default" } else { &name };
+                part = Some(mesh.part_index(name));
+            }
+            other if IGNORED.contains(&other) => {}
+            other => return Err(at(format!("unsupported OBJ statement '{other}'"))),
+        }
+    }
+    if mesh.faces.is_empty() {
+        return Err("the mesh has no faces".into());
+    }
+    Ok(mesh)
+}
+
+fn parse_numbers<'a>(fields: impl Iterator<Item = &'a str>) -> Result<Vec<f64>, String> {
+    fields
+        .map(|f| {
+            f.parse::<f64>()
+                .map_err(|_| format!("'{f}' is not a number"))
+        })
+        .collect()
+}
+
+/// One `f` corner: (0-based vertex index, 0-based normal index if any).
+fn parse_corner(field: &str, mesh: &RawMesh) -> Result<(u32, Option<u32>), String> {
+    let mut pieces = field.split('/');
+    let vertex = resolve_index(pieces.next().unwrap_or(""), mesh.positions.len(), "vertex")?;
+    let _texture = pieces.next();
+    let normal = match pieces.next() {
+        Some(text) if !text.is_empty() => Some(resolve_index(text, mesh.normals.len(), "normal")?),
+        _ => None,
+    };
+    Ok((vertex, normal))
+}
+
+/// OBJ indices are 1-based; negative ones count back from the last element defined so far.
+fn resolve_index(text: &str, defined: usize, what: &str) -> Result<u32, String> {
+    let index: i64 = text
+        .parse()
+        .map_err(|_| format!("'{text}' is not a {what} index"))?;
+    let resolved = if index > 0 {
+        index - 1
+    } else {
+        defined as i64 + index
+    };
+    if index == 0 || resolved < 0 || resolved >= defined as i64 {
+        return Err(format!(
+            "{what} index {index} is out of range ({defined} defined so far)"
+        ));
+    }
+    Ok(resolved as u32)
+}
+
+/// OBJ text of a mesh: vertices, then faces grouped by part (`g name`). Normals are not written;
+/// the reader recomputes them with its crease angle.
+pub fn format_obj(mesh: &RawMesh, header: &str) -> String {
+    let mut out = String::new();
+    for line in header.lines() {
+        let _ = writeln!(out, "# {line}");
+    }
+    for p in &mesh.positions {
+        let _ = writeln!(out, "v {:.5} {:.5} {:.5}", p.x, p.y, p.z);
+    }
+    for (index, name) in mesh.parts.iter().enumerate() {
+        let _ = writeln!(out, "g {name}");
+        for face in mesh.faces.iter().filter(|f| f.part as usize == index) {
+            let [a, b, c] = face.vertices.map(|v| v + 1);
+            let _ = writeln!(out, "f {a} {b} {c}");
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn groups_become_parts_and_quads_become_fans() {
+        let text = "# a box lid\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\n\
+                    g lid\nf 1 2 3 4\ng tip\nf -4 -3 5\n";
+        let mesh = parse_obj(text).unwrap();
+        assert_eq!(mesh.parts, vec!["lid", "tip"]);
+        assert_eq!(mesh.faces.len(), 3);
+        assert_eq!(mesh.faces[0].vertices, [0, 1, 2]);
+        assert_eq!(mesh.faces[1].vertices, [0, 2, 3]);
+        assert_eq!(mesh.faces[2].vertices, [1, 2, 4]);
+        assert_eq!(mesh.faces[2].part, 1);
+        assert_eq!(mesh.faces[2].origin, FaceOrigin::Line(10));
+    }
+
+    #[test]
+    fn normals_and_texture_coordinates_are_read() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3//1\n";
+        let mesh = parse_obj(text).unwrap();
+        assert_eq!(mesh.faces[0].normals, Some([0, 0, 0]));
+        assert_eq!(mesh.parts, vec!["default"]);
+    }
+
+    #[test]
+    fn bad_files_name_the_line() {
+        let cases = [
+            (
+                "v 0 0 0\nv 1 0 nan\n",
+                "line 2: vertex 2 has a non-finite coordinate",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nf 1 2 3\n",
+                "line 3: vertex index 3 is out of range",
+            ),
+            ("v 0 0\n", "line 1: a vertex needs 3 coordinates"),
+            ("v 0 0 x\n", "line 1: 'x' is not a number"),
+            (
+                "v 0 0 0\nbogus 1\n",
+                "line 2: unsupported OBJ statement 'bogus'",
+            ),
+            ("v 0 0 0\n", "the mesh has no faces"),
+        ];
+        for (text, expected) in cases {
+            let err = parse_obj(text).unwrap_err();
+            assert!(
+                err.starts_with(expected),
+                "{err:?} should start with {expected:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn written_meshes_read_back() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\ng a\nf 1 2 3\ng b\nf 3 2 4\n";
+        let mesh = parse_obj(text).unwrap();
+        let again = parse_obj(&format_obj(&mesh, "test")).unwrap();
+        assert_eq!(again.parts, mesh.parts);
+        assert_eq!(again.positions, mesh.positions);
+        let faces = |m: &RawMesh| {
+            m.faces
+                .iter()
+                .map(|f| (f.vertices, f.part))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(faces(&again), faces(&mesh));
+    }
+}

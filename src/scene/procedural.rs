@@ -1,0 +1,167 @@
+//! Procedural test objects with exact normals: an icosphere and a subdivided plane. Each is one
+//! part named `surface`.
+
+use super::mesh::{FaceOrigin, RawFace, RawMesh};
+use nalgebra::Vector3;
+use std::collections::HashMap;
+
+pub const SHAPE_PART: &str = "surface";
+
+/// Unit icosahedron subdivided `subdivisions` times (20·4ⁿ faces) and scaled to `radius`, with
+/// the exact radial normals, outward winding.
+pub fn icosphere(radius: f64, subdivisions: u32) -> RawMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut positions: Vec<Vector3<f64>> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|p| Vector3::from(*p).normalize())
+    .collect();
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut midpoint: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut middle = |a: u32, b: u32, positions: &mut Vec<Vector3<f64>>| {
+            *midpoint.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let m = (positions[a as usize] + positions[b as usize]).normalize();
+                positions.push(m);
+                (positions.len() - 1) as u32
+            })
+        };
+        let mut next = Vec::with_capacity(faces.len() * 4);
+        for [a, b, c] in faces {
+            let ab = middle(a, b, &mut positions);
+            let bc = middle(b, c, &mut positions);
+            let ca = middle(c, a, &mut positions);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    let normals = positions.clone();
+    let mut mesh = RawMesh {
+        positions: positions.iter().map(|p| p * radius).collect(),
+        normals,
+        ..RawMesh::default()
+    };
+    let part = mesh.part_index(SHAPE_PART);
+    mesh.faces = faces
+        .into_iter()
+        .enumerate()
+        .map(|(i, f)| RawFace {
+            vertices: f,
+            normals: Some(f),
+            part,
+            origin: FaceOrigin::Index(i + 1),
+        })
+        .collect();
+    mesh
+}
+
+/// A `size[0]` × `size[1]` plane in z = 0 centred at the origin, facing +z, cut into
+/// `divisions[0]` × `divisions[1]` squares of two triangles each.
+pub fn plane(size: [f64; 2], divisions: [u32; 2]) -> RawMesh {
+    let [nx, ny] = divisions.map(|d| d.max(1));
+    let mut mesh = RawMesh::default();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            mesh.positions.push(Vector3::new(
+                size[0] * (i as f64 / nx as f64 - 0.5),
+                size[1] * (j as f64 / ny as f64 - 0.5),
+                0.0,
+            ));
+        }
+    }
+    mesh.normals.push(Vector3::z());
+    let part = mesh.part_index(SHAPE_PART);
+    let index = |i: u32, j: u32| j * (nx + 1) + i;
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            );
+            for vertices in [[a, b, c], [a, c, d]] {
+                mesh.faces.push(RawFace {
+                    vertices,
+                    normals: Some([0, 0, 0]),
+                    part,
+                    origin: FaceOrigin::Index(mesh.faces.len() + 1),
+                });
+            }
+        }
+    }
+    mesh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn icosphere_is_a_closed_outward_sphere() {
+        let mesh = icosphere(2.0, 3);
+        assert_eq!(mesh.faces.len(), 20 * 64);
+        // Euler characteristic of a closed genus-0 surface: V − E + F = 2 with E = 3F/2.
+        assert_eq!(mesh.positions.len() as i64 - 3 * 20 * 64 / 2 + 20 * 64, 2);
+        let mut area = 0.0;
+        for face in &mesh.faces {
+            let [a, b, c] = face.vertices.map(|i| mesh.positions[i as usize]);
+            let cross = (b - a).cross(&(c - a));
+            assert!(cross.dot(&(a + b + c)) > 0.0, "inward face");
+            area += 0.5 * cross.norm();
+        }
+        // Inscribed polyhedron: slightly below 4πr² = 50.27.
+        assert!(area < 16.0 * std::f64::consts::PI && area > 0.98 * 16.0 * std::f64::consts::PI);
+        assert!(mesh
+            .positions
+            .iter()
+            .all(|p| (p.norm() - 2.0).abs() < 1e-12));
+    }
+
+    #[test]
+    fn plane_faces_up_and_covers_its_size() {
+        let mesh = plane([4.0, 2.0], [4, 2]);
+        assert_eq!(mesh.faces.len(), 16);
+        let mut area = 0.0;
+        for face in &mesh.faces {
+            let [a, b, c] = face.vertices.map(|i| mesh.positions[i as usize]);
+            let cross = (b - a).cross(&(c - a));
+            assert!(cross.z > 0.0);
+            area += 0.5 * cross.norm();
+        }
+        assert!((area - 8.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,159 @@
+//! Helpers shared by the render integration tests.
+#![allow(dead_code)]
+
+use irpol::material::{Material, ModelSpec};
+use irpol::pbrdf::{Shadowing, SlopeDistribution};
+use std::path::Path;
+
+/// Writes the materials of the shipped synthetic measurements (their generating "truth"
+/// parameters, measurements/README.md) as a material library, standing in for `fits/`.
+pub fn write_truth_library(dir: &Path) {
+    let materials = [
+        (
+            "paper_paint",
+            SlopeDistribution::Cauchy {
+                sigma: 0.10,
+                q: 1.8,
+            },
+            1.2,
+            0.2,
+            0.0,
+            9.925,
+        ),
+        (
+            "rough_paint",
+            SlopeDistribution::Cauchy {
+                sigma: 0.30,
+                q: 2.5,
+            },
+            1.55,
+            0.05,
+            0.03,
+            9.925,
+        ),
+        (
+            "smooth_glass",
+            SlopeDistribution::Cauchy {
+                sigma: 0.03,
+                q: 3.0,
+            },
+            2.2,
+            0.1,
+            0.0,
+            10.6,
+        ),
+        (
+            "anodized_panel",
+            SlopeDistribution::Gaussian { sigma: 0.15 },
+            3.0,
+            1.0,
+            0.01,
+            9.925,
+        ),
+    ];
+    for (name, distribution, n, k, rho_d, wavelength_um) in materials {
+        let material = Material {
+            name: name.into(),
+            tool_version: "test".into(),
+            model: ModelSpec {
+                distribution,
+                shadowing: Shadowing::Smith,
+                n,
+                k,
+                rho_d,
+                wavelength_um,
+            },
+            fit: None,
+        };
+        material.save(&dir.join(format!("{name}.toml"))).unwrap();
+    }
+}
+
+/// A copy of the shipped car scene in `dir/scenes`, with the truth library in `dir/fits`, at the
+/// given resolution and shading.
+pub fn car_scene(dir: &Path, width: u32, height: u32, shading: &str) -> std::path::PathBuf {
+    write_truth_library(&dir.join("fits"));
+    car_scene_files(dir, width, height, shading)
+}
+
+/// As [`car_scene`] but with the shipped fitted library (`fits/`).
+pub fn car_scene_with_shipped_fits(
+    dir: &Path,
+    width: u32,
+    height: u32,
+    shading: &str,
+) -> std::path::PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::create_dir_all(dir.join("fits")).unwrap();
+    for name in [
+        "paper_paint",
+        "rough_paint",
+        "smooth_glass",
+        "anodized_panel",
+    ] {
+        let file = format!("{name}.toml");
+        std::fs::copy(root.join("fits").join(&file), dir.join("fits").join(&file)).unwrap();
+    }
+    car_scene_files(dir, width, height, shading)
+}
+
+fn car_scene_files(dir: &Path, width: u32, height: u32, shading: &str) -> std::path::PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::create_dir_all(dir.join("scenes")).unwrap();
+    std::fs::copy(root.join("scenes/car.obj"), dir.join("scenes/car.obj")).unwrap();
+    let text = std::fs::read_to_string(root.join("scenes/car.toml"))
+        .unwrap()
+        .replace(
+            "resolution = [640, 480]",
+            &format!("resolution = [{width}, {height}]"),
+        )
+        .replace("shading = \"pixel\"", &format!("shading = \"{shading}\""));
+    let path = dir.join("scenes/car.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Writes `text` as `dir/scene.toml` and returns its path.
+pub fn write_scene(dir: &Path, text: &str) -> std::path::PathBuf {
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A camera 4 m from the origin along −y looking at it, square image.
+pub fn camera_toml(size: u32) -> String {
+    format!(
+        "[camera]\nposition = [0.0, -4.0, 0.0]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, 1.0]\n\
+         fov_deg = 36.0\nresolution = [{size}, {size}]\n"
+    )
+}
+
+/// An environment of uniform brightness temperature `t` (sky and a black-body ground).
+pub fn uniform_environment_toml(t: f64) -> String {
+    format!(
+        "[environment]\nair_temperature_k = {t}\n\
+         sky = {{ model = \"table\", elevation_deg = [0.0, 90.0], brightness_temperature_k = [{t}, {t}] }}\n\
+         ground = {{ temperature_k = {t}, emissivity = 1.0 }}\n"
+    )
+}
+
+/// The clear autumn sky of the car scene.
+pub const AUTUMN_ENVIRONMENT: &str = "[environment]\nair_temperature_k = 283.15\n\
+    sky = { model = \"window\", zenith_emissivity = 0.75 }\n\
+    ground = { temperature_k = 288.0, emissivity = 0.95 }\n";
+
+/// Unit sphere at the origin with an inline material `m`.
+pub fn sphere_toml(subdivisions: u32, temperature: f64) -> String {
+    format!(
+        "[[objects]]\nname = \"ball\"\nshape = {{ kind = \"sphere\", radius = 1.0, subdivisions = {subdivisions} }}\n\
+         material = \"m\"\ntemperature_k = {temperature}\n"
+    )
+}
+
+/// Inline material `m`: Cauchy σ, q, N = n + ik, ρ_d, Smith shadowing.
+pub fn material_toml(sigma: f64, q: f64, n: f64, k: f64, rho_d: f64) -> String {
+    format!(
+        "[materials.m]\ndistribution = \"cauchy\"\nsigma = {sigma}\nq = {q}\nn = {n}\nk = {k}\n\
+         rho_d = {rho_d}\nshadowing = \"smith\"\n"
+    )
+}

@@ -1,0 +1,104 @@
+//! The shipped car scene: its mesh is what the generator writes, and it renders to plausible
+//! LWIR polarimetric images.
+
+mod common;
+
+use irpol::optics::Band;
+use irpol::render::{render, render_scene, BACKGROUND};
+use irpol::scene::car::sedan;
+use irpol::scene::load_scene;
+use irpol::scene::obj::parse_obj;
+use std::path::Path;
+
+/// `scenes/car.obj` must be the generator's output (regenerate with IRPOL_WRITE_CAR=1).
+#[test]
+fn shipped_car_mesh_is_the_generated_one() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/car.obj");
+    if std::env::var_os("IRPOL_WRITE_CAR").is_some() {
+        irpol::scene::car::write_car_obj(&path).unwrap();
+    }
+    let shipped = parse_obj(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let generated = sedan();
+    assert_eq!(shipped.parts, generated.parts);
+    assert_eq!(shipped.faces.len(), generated.faces.len());
+    assert_eq!(shipped.positions.len(), generated.positions.len());
+    for (a, b) in shipped.positions.iter().zip(&generated.positions) {
+        assert!((a - b).norm() < 1e-5);
+    }
+}
+
+/// Mean S0 of the pixels that see `part` of the car.
+fn part_mean(scene: &irpol::scene::Scene, image: &irpol::render::StokesImage, part: &str) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (s, &surface) in image.stokes.iter().zip(&image.surface) {
+        if surface != BACKGROUND && scene.surfaces[surface as usize].part == part {
+            sum += s[0];
+            n += 1;
+        }
+    }
+    assert!(n > 20, "{part}: {n} pixels");
+    sum / n as f64
+}
+
+#[test]
+fn car_renders_with_warm_hood_and_cool_glass() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = common::car_scene(dir.path(), 320, 240, "pixel");
+    let out = dir.path().join("out");
+    let summary = render_scene(&path, &out, false).unwrap();
+    for file in &summary.files {
+        assert!(out.join(file).is_file(), "{file}");
+    }
+    if let Some(keep) = std::env::var_os("IRPOL_KEEP_RENDER") {
+        let _ = std::fs::remove_dir_all(&keep);
+        std::fs::rename(&out, keep).unwrap();
+    }
+    let scene = load_scene(&path).unwrap();
+    let image = render(&scene, false).unwrap().image;
+    let band = Band::lwir();
+    let t = |part: &str| {
+        band.brightness_temperature(part_mean(&scene, &image, part))
+            .unwrap()
+    };
+    let (hood, body, glass, ground) = (t("hood"), t("body"), t("side_windows"), t("ground"));
+    // Apparent temperatures sit below the true ones (ε < 1, cold sky reflected) but keep order.
+    assert!(hood > 310.0 && hood < 320.0, "hood {hood}");
+    // Body pixels next to the hood share its seam vertices (averaged to 305 K).
+    assert!(body > 283.0 && body < 295.0, "body {body}");
+    assert!(glass < body, "glass {glass} vs body {body}");
+    assert!(ground > 283.0 && ground < 288.0, "ground {ground}");
+    assert!(summary.pixels.per_part["car/hood"] > 500);
+}
+
+#[test]
+fn gouraud_car_is_close_to_per_pixel() {
+    let dir = tempfile::tempdir().unwrap();
+    let mean_s0 = |shading: &str| {
+        let path = common::car_scene(&dir.path().join(shading), 160, 120, shading);
+        let scene = load_scene(&path).unwrap();
+        let image = render(&scene, false).unwrap().image;
+        ["hood", "body", "windshield", "ground"].map(|p| part_mean(&scene, &image, p))
+    };
+    let (pixel, gouraud) = (mean_s0("pixel"), mean_s0("gouraud"));
+    for (p, g) in pixel.iter().zip(&gouraud) {
+        assert!((p - g).abs() < 0.01 * p, "{p} vs {g}");
+    }
+}
+
+#[test]
+fn shipped_scene_renders_with_the_shipped_library() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = load_scene(&root.join("scenes/car.toml")).unwrap();
+    let names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(
+        names,
+        vec![
+            "paper_paint",
+            "rough_paint",
+            "smooth_glass",
+            "anodized_panel",
+            "asphalt"
+        ]
+    );
+    assert_eq!((scene.camera.width, scene.camera.height), (640, 480));
+}

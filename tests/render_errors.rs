@@ -1,0 +1,190 @@
+//! Bad scenes are refused with one clear message naming the file and the item, and nothing is
+//! written (DESIGN §4: errors are one line, never a panic).
+
+mod common;
+
+use common::*;
+use irpol::render::render_scene;
+use std::path::Path;
+
+const TRIANGLE_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 0 0 1\ng panel\nf 1 2 3\n";
+
+/// A valid scene around one mesh object `mesh` with the given part table, plus `extra` lines.
+fn scene_with_mesh(mesh: &str, object_extra: &str) -> String {
+    format!(
+        "{}{}{}[[objects]]\nname = \"thing\"\nmesh = \"{mesh}\"\nmaterial = \"m\"\ntemperature_k = 300.0\n{object_extra}",
+        camera_toml(16),
+        AUTUMN_ENVIRONMENT,
+        material_toml(0.2, 2.0, 1.5, 0.1, 0.0),
+    )
+}
+
+/// Renders `scene` (with files `extra_files`) and returns the error text; checks that the output
+/// folder was not created.
+fn refuse(scene: &str, extra_files: &[(&str, &str)]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in extra_files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let path = write_scene(dir.path(), scene);
+    let out = dir.path().join("out");
+    let err = render_scene(&path, &out, false).expect_err("the scene should be refused");
+    assert!(!out.exists(), "something was written for a bad scene");
+    let text = err.to_string();
+    println!("{text}");
+    assert!(!text.contains('\n'), "not one line: {text}");
+    text
+}
+
+fn expect(text: &str, pieces: &[&str]) {
+    for piece in pieces {
+        assert!(text.contains(piece), "{text:?} lacks {piece:?}");
+    }
+}
+
+#[test]
+fn a_valid_mesh_scene_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("panel.obj"), TRIANGLE_OBJ).unwrap();
+    let path = write_scene(dir.path(), &scene_with_mesh("panel.obj", ""));
+    render_scene(&path, &dir.path().join("out"), false).unwrap();
+    assert!(dir.path().join("out/summary.json").is_file());
+}
+
+#[test]
+fn missing_mesh_file() {
+    let text = refuse(&scene_with_mesh("nowhere.obj", ""), &[]);
+    expect(
+        &text,
+        &["nowhere.obj", "cannot read the mesh", "objects[0] 'thing'"],
+    );
+}
+
+#[test]
+fn missing_material() {
+    let scene = scene_with_mesh("panel.obj", "").replace(
+        "material = \"m\"\ntemperature",
+        "material = \"unobtainium\"\ntemperature",
+    );
+    let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
+    expect(
+        &text,
+        &[
+            "scene.toml",
+            "objects[0] 'thing'",
+            "part 'panel'",
+            "unobtainium",
+            "not in the library",
+        ],
+    );
+}
+
+#[test]
+fn unknown_part() {
+    let scene = scene_with_mesh("panel.obj", "[objects.parts.hood]\ntemperature_k = 320.0\n");
+    let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
+    expect(
+        &text,
+        &[
+            "scene.toml",
+            "part 'hood' is not in",
+            "panel.obj",
+            "its parts: panel",
+        ],
+    );
+}
+
+#[test]
+fn malformed_toml() {
+    let text = refuse("[camera\nposition = [0, 0, 0]\n", &[]);
+    expect(&text, &["scene.toml", "not a valid scene", "line 1"]);
+    let typo = scene_with_mesh("panel.obj", "").replace("fov_deg", "fov");
+    let text = refuse(&typo, &[("panel.obj", TRIANGLE_OBJ)]);
+    expect(&text, &["scene.toml", "unknown field `fov`"]);
+}
+
+#[test]
+fn degenerate_triangle() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 0 1\ng panel\nf 1 2 4\nf 1 2 3\n";
+    let text = refuse(&scene_with_mesh("flat.obj", ""), &[("flat.obj", obj)]);
+    expect(
+        &text,
+        &[
+            "flat.obj",
+            "line 7",
+            "degenerate triangle",
+            "part 'panel'",
+            "objects[0] 'thing'",
+        ],
+    );
+}
+
+#[test]
+fn nan_in_mesh() {
+    let obj = "v 0 0 0\nv 1 nan 0\nv 0 0 1\nf 1 2 3\n";
+    let text = refuse(&scene_with_mesh("nan.obj", ""), &[("nan.obj", obj)]);
+    expect(
+        &text,
+        &["nan.obj", "line 2", "vertex 2 has a non-finite coordinate"],
+    );
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+               property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+               0 0 0\n1 0 inf\n0 0 1\n3 0 1 2\n";
+    let text = refuse(&scene_with_mesh("bad.ply", ""), &[("bad.ply", ply)]);
+    expect(&text, &["bad.ply"]);
+}
+
+#[test]
+fn bad_values_name_their_key() {
+    let scene = scene_with_mesh("panel.obj", "")
+        .replace("zenith_emissivity = 0.75", "zenith_emissivity = 1.75");
+    let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
+    expect(
+        &text,
+        &["scene.toml", "environment.sky.zenith_emissivity = 1.75"],
+    );
+    let scene = scene_with_mesh("panel.obj", "").replace("sigma = 0.2", "sigma = -0.2");
+    let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
+    expect(
+        &text,
+        &["scene.toml", "inline material [materials.m]", "σ = -0.2"],
+    );
+    let scene =
+        scene_with_mesh("panel.obj", "").replace("temperature_k = 300.0", "temperature_k = -4.0");
+    let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
+    expect(
+        &text,
+        &["scene.toml", "objects[0] 'thing'", "temperature_k = -4"],
+    );
+    let text = refuse(
+        &scene_with_mesh("panel.stl", ""),
+        &[("panel.stl", TRIANGLE_OBJ)],
+    );
+    expect(&text, &["panel.stl", "must end in .obj or .ply"]);
+}
+
+#[test]
+fn energy_non_conserving_material_is_named() {
+    // No shadowing with a wide Cauchy lobe reflects more than it receives at grazing angles.
+    let scene = scene_with_mesh("panel.obj", "")
+        .replace("shadowing = \"smith\"", "shadowing = \"none\"")
+        .replace("sigma = 0.2\nq = 2.0", "sigma = 0.8\nq = 1.6");
+    let text = refuse(&scene, &[("panel.obj", TRIANGLE_OBJ)]);
+    expect(
+        &text,
+        &["scene.toml", "material 'm' (inline)", "reflectance"],
+    );
+}
+
+#[test]
+fn output_folder_is_untouched_on_failure() {
+    // An existing output folder keeps its files when a later render fails.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("S0.tif"), b"old").unwrap();
+    let path = write_scene(dir.path(), &scene_with_mesh("missing.obj", ""));
+    assert!(render_scene(&path, &out, false).is_err());
+    assert_eq!(std::fs::read(out.join("S0.tif")).unwrap(), b"old");
+    assert!(Path::new(&out).read_dir().unwrap().count() == 1);
+}

@@ -1,0 +1,256 @@
+//! What `irpol render` writes and how the sensor side behaves: float TIFFs and the EXR hold the
+//! rendered values, the channels are consistent, previews and summary are complete; per-vertex
+//! PLY temperatures are interpolated perspective-correctly; the atmosphere and the NETD noise
+//! follow DESIGN §1.5 and are reproducible.
+
+mod common;
+
+use common::*;
+use irpol::optics::{Band, RefractiveIndex};
+use irpol::pbrdf::{HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
+use irpol::render::{render, render_scene, Channel, BACKGROUND};
+use irpol::scene::load_scene;
+use std::io::Cursor;
+
+fn read_tiff(path: &std::path::Path) -> (u32, u32, Vec<f32>) {
+    let mut decoder =
+        tiff::decoder::Decoder::new(Cursor::new(std::fs::read(path).unwrap())).unwrap();
+    let (w, h) = decoder.dimensions().unwrap();
+    match decoder.read_image().unwrap() {
+        tiff::decoder::DecodingResult::F32(data) => (w, h, data),
+        _ => panic!("{} is not a 32-bit float TIFF", path.display()),
+    }
+}
+
+#[test]
+fn files_hold_the_rendered_channels() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "{}{}{}{}",
+        camera_toml(48).replace("[48, 48]", "[64, 48]"),
+        AUTUMN_ENVIRONMENT,
+        material_toml(0.1, 1.8, 1.2, 0.2, 0.0),
+        sphere_toml(3, 300.0),
+    );
+    let path = write_scene(dir.path(), &text);
+    let out = dir.path().join("out");
+    let summary = render_scene(&path, &out, false).unwrap();
+    let image = render(&load_scene(&path).unwrap(), false).unwrap().image;
+
+    let mut stacks = Vec::new();
+    for channel in Channel::ALL {
+        let (w, h, data) = read_tiff(&out.join(format!("{}.tif", channel.name())));
+        assert_eq!((w, h), (64, 48));
+        assert_eq!(data, image.channel(channel), "{}", channel.name());
+        stacks.push(data);
+    }
+    // Channel identities (DESIGN §1.6): I0 + I90 = I45 + I135 = S0, I0 − I90 = S1, DoLP, AoP.
+    for i in 0..64 * 48 {
+        let pixel: Vec<f64> = stacks.iter().map(|channel| channel[i] as f64).collect();
+        let [s0, s1, s2, dolp, aop, i0, i45, i90, i135] = pixel[..] else {
+            unreachable!("nine channels")
+        };
+        assert!((i0 + i90 - s0).abs() < 1e-5 * s0 && (i45 + i135 - s0).abs() < 1e-5 * s0);
+        assert!((i0 - i90 - s1).abs() < 1e-4 && (i45 - i135 - s2).abs() < 1e-4);
+        assert!((dolp - s1.hypot(s2) / s0).abs() < 1e-6);
+        assert!(
+            aop > -std::f64::consts::FRAC_PI_2 - 1e-6 && aop <= std::f64::consts::FRAC_PI_2 + 1e-6
+        );
+    }
+
+    use exr::prelude::{ReadChannels, ReadLayers};
+    let exr = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(out.join("stokes.exr"))
+        .unwrap();
+    let mut names: Vec<String> = exr
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    names.sort();
+    let mut expected: Vec<String> = Channel::ALL.iter().map(|c| c.name().to_string()).collect();
+    expected.sort();
+    assert_eq!(names, expected);
+    let s0 = exr
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .find(|c| c.name.to_string() == "S0")
+        .unwrap();
+    assert_eq!(
+        s0.sample_data.values_as_f32().collect::<Vec<_>>(),
+        stacks[0]
+    );
+
+    for png in [
+        "S0.png",
+        "S1.png",
+        "S2.png",
+        "DoLP.png",
+        "AoP.png",
+        "composite.png",
+    ] {
+        let decoded = image::load_from_memory(&std::fs::read(out.join(png)).unwrap()).unwrap();
+        assert!(decoded.width() > 64 && decoded.height() > 48, "{png}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(json["width"], 64);
+    assert_eq!(json["pixels"]["total"], 64 * 48);
+    let object = json["pixels"]["object"].as_u64().unwrap();
+    assert_eq!(
+        object as usize,
+        image.surface.iter().filter(|&&s| s != BACKGROUND).count()
+    );
+    assert_eq!(json["pixels"]["per_part"]["ball/surface"], object);
+    assert_eq!(json["channels"].as_array().unwrap().len(), 9);
+    let t = &json["apparent_temperature_k"];
+    assert!(t["min"].as_f64().unwrap() < t["mean"].as_f64().unwrap());
+    assert!(t["max"].as_f64().unwrap() < 300.0 && t["min"].as_f64().unwrap() > 270.0);
+    assert_eq!(summary.files.len(), 17);
+    assert!(json["timings_s"]["total"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn ply_vertex_temperatures_are_interpolated_in_perspective() {
+    // A 2 m square facing the camera at y = 0, 280 K on its left edge and 320 K on its right,
+    // in a 0 K environment: S0 = ε0(θ) L_bb(T(x)) with T linear in world x.
+    let dir = tempfile::tempdir().unwrap();
+    let ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+        property float z\nproperty float temperature\nelement face 1\n\
+        property list uchar int vertex_indices\nend_header\n\
+        -1 0 -1 280\n1 0 -1 320\n1 0 1 320\n-1 0 1 280\n4 0 3 2 1\n";
+    std::fs::write(dir.path().join("square.ply"), ply).unwrap();
+    let text = format!(
+        "{}{}{}[[objects]]\nmesh = \"square.ply\"\nmaterial = \"m\"\nrotate_deg = [0.0, 0.0, 25.0]\n",
+        camera_toml(96),
+        uniform_environment_toml(0.0),
+        material_toml(0.2, 2.5, 1.5, 0.1, 0.0),
+    );
+    let scene = load_scene(&write_scene(dir.path(), &text)).unwrap();
+    let image = render(&scene, false).unwrap().image;
+    let pbrdf = Pbrdf::new(
+        SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 },
+        Shadowing::Smith,
+        RefractiveIndex::new(1.5, 0.1),
+        0.0,
+    )
+    .unwrap();
+    let band = Band::lwir();
+    let angle = 25f64.to_radians();
+    let (axis, normal) = (
+        nalgebra::Vector3::new(angle.cos(), angle.sin(), 0.0),
+        nalgebra::Vector3::new(-angle.sin(), angle.cos(), 0.0),
+    );
+    let mut checked = 0;
+    for (i, &s) in image.surface.iter().enumerate() {
+        if s == BACKGROUND {
+            continue;
+        }
+        let d = scene
+            .camera
+            .ray_direction((i % 96) as f64 + 0.5, (i / 96) as f64 + 0.5);
+        let o = scene.camera.position;
+        let p = o + d * (-o.dot(&normal) / d.dot(&normal));
+        let temperature = 300.0 + 20.0 * p.dot(&axis);
+        let cos_theta = normal.dot(&-d).abs();
+        let e = pbrdf.emissivity(cos_theta.acos(), &HemisphereQuadrature::default());
+        let expected = e[0] * band.radiance(temperature);
+        let got = image.stokes[i][0];
+        assert!(
+            (got - expected).abs() < 1e-3 * expected,
+            "pixel {i}: {got} vs {expected}"
+        );
+        checked += 1;
+    }
+    assert!(checked > 1500, "{checked}");
+}
+
+#[test]
+fn atmosphere_blends_toward_path_radiance_with_range() {
+    // Black, cold plate in a 0 K world seen through a 300 K atmosphere: S0 = (1 − τ) L_bb(300 K).
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "{}{}[atmosphere]\nextinction_per_km = 100.0\ntemperature_k = 300.0\n{}\
+         [[objects]]\nshape = {{ kind = \"plane\", size = [6.0, 6.0], divisions = [3, 3] }}\n\
+         material = \"m\"\ntemperature_k = 0.0\nrotate_deg = [-70.0, 0.0, 0.0]\n",
+        camera_toml(64),
+        uniform_environment_toml(0.0),
+        material_toml(0.2, 2.5, 1.5, 0.1, 0.0),
+    );
+    let scene = load_scene(&write_scene(dir.path(), &text)).unwrap();
+    let image = render(&scene, false).unwrap().image;
+    let path = Band::lwir().radiance(300.0);
+    // The plate's +z normal turned −70° about x.
+    let normal = nalgebra::Vector3::new(0.0, 70f64.to_radians().sin(), 70f64.to_radians().cos());
+    let mut ranges = Vec::new();
+    for (i, &s) in image.surface.iter().enumerate() {
+        if s == BACKGROUND {
+            continue;
+        }
+        let d = scene
+            .camera
+            .ray_direction((i % 64) as f64 + 0.5, (i / 64) as f64 + 0.5);
+        let o = scene.camera.position;
+        let range = -o.dot(&normal) / d.dot(&normal);
+        let expected = (1.0 - (-0.1 * range).exp()) * path;
+        assert!(
+            (image.stokes[i][0] - expected).abs() < 1e-5 * expected,
+            "pixel {i}"
+        );
+        assert!(image.stokes[i][1].abs() < 1e-9 && image.stokes[i][2].abs() < 1e-9);
+        ranges.push(range);
+    }
+    let spread = ranges.iter().cloned().fold(0.0, f64::max)
+        - ranges.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(
+        spread > 1.0,
+        "the plate should span a range of distances: {spread}"
+    );
+}
+
+#[test]
+fn netd_noise_has_its_stated_size_and_is_seeded() {
+    let make = |seed: u64| {
+        format!(
+            "{}[sensor]\nnetd_mk = 100.0\nseed = {seed}\nnetd_reference_k = 300.0\n{}{}{}",
+            camera_toml(96),
+            uniform_environment_toml(300.0),
+            material_toml(0.2, 2.5, 1.5, 0.1, 0.0),
+            sphere_toml(2, 300.0),
+        )
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let run = |seed: u64| {
+        render(
+            &load_scene(&write_scene(dir.path(), &make(seed))).unwrap(),
+            false,
+        )
+        .unwrap()
+        .image
+    };
+    let (a, b, c) = (run(7), run(7), run(8));
+    assert_eq!(a.stokes, b.stokes);
+    assert_ne!(a.stokes, c.stokes);
+    // Isothermal: every pixel is L_bb(300 K) plus noise; σ(S0) = σ_I = ½ NETD dL/dT.
+    let band = Band::lwir();
+    let (l, sigma) = (
+        band.radiance(300.0),
+        0.5 * 0.1 * band.radiance_derivative(300.0),
+    );
+    let n = a.stokes.len() as f64;
+    let mean = a.stokes.iter().map(|s| s[0]).sum::<f64>() / n;
+    let std = (a.stokes.iter().map(|s| (s[0] - mean).powi(2)).sum::<f64>() / n).sqrt();
+    let std1 = (a.stokes.iter().map(|s| s[1] * s[1]).sum::<f64>() / n).sqrt();
+    assert!((mean - l).abs() < 4.0 * sigma / n.sqrt());
+    assert!((std / sigma - 1.0).abs() < 0.05, "{std} vs {sigma}");
+    assert!((std1 / (sigma * 2f64.sqrt()) - 1.0).abs() < 0.05);
+}
