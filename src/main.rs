@@ -11,6 +11,7 @@ use irpol::fit::{
     FitOutcome, Optimizer, RobustLoss,
 };
 use irpol::pbrdf::Shadowing;
+use irpol::render::{default_output_dir, render_scene};
 use irpol::report::fit_report::{rebuild_report, write_fit_report};
 use irpol::report::index::write_library_index;
 use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
@@ -105,6 +106,14 @@ enum Command {
         material: PathBuf,
         #[arg(long, default_value = "reports")]
         reports: PathBuf,
+    },
+    /// Renders a scene's LWIR Stokes images (TIFF, EXR, PNG previews, composite, JSON summary).
+    Render {
+        /// The scene TOML.
+        scene: PathBuf,
+        /// Output folder (default out/<scene stem>/).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// A table of the materials in a library folder.
     Library {
@@ -283,6 +292,7 @@ fn run(command: Command) -> anyhow::Result<()> {
                 write_library_index(library, &reports)?.display()
             );
         }
+        Command::Render { scene, out } => render_and_summarize(&scene, out)?,
         Command::Library { dir } => print_library(&dir)?,
         Command::Demo => demo()?,
     }
@@ -368,6 +378,30 @@ fn significant(value: f64, digits: i32) -> String {
     format!("{value:.decimals$}")
 }
 
+fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {
+    let out = out.unwrap_or_else(|| default_output_dir(scene));
+    let summary = render_scene(scene, &out, true)?;
+    let temperature = summary
+        .apparent_temperature_k
+        .as_ref()
+        .map_or(String::new(), |t| {
+            format!(", apparent temperature {:.1}–{:.1} K", t.min, t.max)
+        });
+    say!(
+        "rendered {} ({}×{}, {:?} shading{temperature}) in {:.2} s → {}",
+        scene.display(),
+        summary.width,
+        summary.height,
+        summary.shading,
+        summary.timings_s.total,
+        out.display()
+    );
+    for file in &summary.files {
+        say!("  {file}");
+    }
+    Ok(())
+}
+
 /// A report per fitted material and the library's index page.
 fn write_reports(
     outcomes: &[FitOutcome],
@@ -449,5 +483,8 @@ fn demo() -> anyhow::Result<()> {
             say!("  wrote {}", path.display());
         }
     }
+    say!("the car scene, with the library just fitted:");
+    render_and_summarize(Path::new("scenes/car.toml"), None)?;
+    say!("open reports/index.html for the fits and out/car/composite.png for the imagery");
     Ok(())
 }
