@@ -11,7 +11,7 @@ mod common;
 
 use irpol::optics::{Band, RefractiveIndex};
 use irpol::pbrdf::{Direction, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
-use irpol::render::kernel::{cosine_rule, specular_kernel, KernelQuadrature};
+use irpol::render::kernel::{specular_kernel, KernelQuadrature};
 use irpol::render::tables::{MaterialTables, TableResolution};
 use irpol::scene::config::{EnvironmentConfig, GroundConfig, SkyConfig};
 use irpol::scene::environment::Environment;
@@ -198,7 +198,8 @@ fn reflection_integral_matches_brute_force() {
         merge_cell: 1e-9,
         ..KernelQuadrature::default()
     };
-    let diffuse_rule = cosine_rule(8, 32);
+    let hemisphere = quadrature.hemisphere();
+    let diffuse_rule = hemisphere.cosine_weighted_nodes();
     for (name, pbrdf) in materials() {
         let (mut worst_s0, mut worst_dolp) = (0.0f64, 0.0f64);
         for (tilt, theta, phi) in geometries() {

@@ -33,6 +33,18 @@ impl SlopeDistribution {
         }
     }
 
+    /// The slope m = tan θ below which a fraction `p` of the facets lie: the inverse CDFs of
+    /// DESIGN §1.2, tan²θ = a((1 − p)^(1/(1−q)) − 1) (Cauchy, a = 2σ²), −2σ² ln(1 − p) (Gaussian).
+    pub fn slope_quantile(&self, p: f64) -> f64 {
+        let tan2 = match *self {
+            SlopeDistribution::Cauchy { sigma, q } => {
+                2.0 * sigma * sigma * ((1.0 - p).powf(1.0 / (1.0 - q)) - 1.0)
+            }
+            SlopeDistribution::Gaussian { sigma } => -2.0 * sigma * sigma * (1.0 - p).ln(),
+        };
+        tan2.max(0.0).sqrt()
+    }
+
     pub fn validate(&self) -> Result<(), ModelError> {
         let sigma = self.sigma();
         if !(sigma.is_finite() && sigma > 0.0) {
@@ -261,6 +273,15 @@ mod tests {
             assert!((dist.smith_lambda(theta.cos()) - expect).abs() < 1e-13);
         }
         assert_eq!(dist.smith_lambda(1.0), 0.0);
+    }
+
+    #[test]
+    fn slope_quantiles_invert_the_distributions() {
+        // Cauchy q = 2 is GGX: P(m < x) = x²/(x² + a); Gaussian: 1 − exp(−x²/(2σ²)).
+        let x = SlopeDistribution::Cauchy { sigma: 0.2, q: 2.0 }.slope_quantile(0.9);
+        assert!((x * x / (x * x + 0.08) - 0.9).abs() < 1e-12);
+        let x = SlopeDistribution::Gaussian { sigma: 0.2 }.slope_quantile(0.5);
+        assert!((1.0 - (-x * x / 0.08).exp() - 0.5).abs() < 1e-12);
     }
 
     #[test]

@@ -75,6 +75,14 @@ impl HemisphereQuadrature {
     }
 }
 
+impl HemisphereQuadrature {
+    /// The cosine-weighted hemisphere rule (ω, w) with Σ w = π = ∫ cosθ dΩ, used for the diffuse
+    /// term: (ρ_d/π) ∫ L cosθ_i dΩ_i ≈ (ρ_d/π) Σ w L(ω).
+    pub fn cosine_weighted_nodes(&self) -> &[(Vector3<f64>, f64)] {
+        &self.diffuse_rule
+    }
+}
+
 impl Default for HemisphereQuadrature {
     fn default() -> HemisphereQuadrature {
         HemisphereQuadrature::new(48, 8, 0.5, 2.0)
@@ -148,6 +156,28 @@ impl Pbrdf {
     /// environments against one direction (a renderer's tables) keep the nodes instead of
     /// re-evaluating the pBRDF.
     pub fn visit_reflection_nodes(
+        &self,
+        scattered: &Direction,
+        quadrature: &HemisphereQuadrature,
+        mut visit: impl FnMut(&Vector3<f64>, Stokes),
+    ) {
+        if scattered.cos_theta() <= 0.0 {
+            return;
+        }
+        self.visit_specular_nodes(scattered, quadrature, &mut visit);
+        if self.rho_d() > 0.0 {
+            for (w_i, weight) in quadrature.cosine_weighted_nodes() {
+                visit(
+                    w_i,
+                    Stokes::new(self.rho_d() * FRAC_1_PI * weight, 0.0, 0.0, 0.0),
+                );
+            }
+        }
+    }
+
+    /// The facet (specular) part of [`Pbrdf::visit_reflection_nodes`] alone; the diffuse part is
+    /// (ρ_d/π) times [`HemisphereQuadrature::cosine_weighted_nodes`].
+    pub fn visit_specular_nodes(
         &self,
         scattered: &Direction,
         quadrature: &HemisphereQuadrature,
@@ -258,14 +288,6 @@ impl Pbrdf {
                         );
                     }
                 }
-            }
-        }
-        if self.rho_d() > 0.0 {
-            for (w_i, weight) in &quadrature.diffuse_rule {
-                visit(
-                    w_i,
-                    Stokes::new(self.rho_d() * FRAC_1_PI * weight, 0.0, 0.0, 0.0),
-                );
             }
         }
     }

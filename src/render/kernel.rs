@@ -19,20 +19,15 @@
 //! narrow specular lobe from ~1000 nodes to a few dozen.
 
 use crate::optics::Stokes;
-use crate::pbrdf::{Direction, Pbrdf, SlopeDistribution};
-use gauss_quad::legendre::GaussLegendre;
+use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
 use nalgebra::Vector3;
 use std::collections::HashMap;
-use std::f64::consts::{FRAC_1_PI, PI};
-use std::num::NonZeroUsize;
 
 /// Node counts of the kernel quadrature (see [`KernelQuadrature::default`]).
 #[derive(Clone, Debug)]
 pub struct KernelQuadrature {
-    /// Trapezoid nodes over a full circle of facet azimuths.
+    /// Trapezoid nodes over a full circle of facet azimuths (half as many per cut arc).
     pub full_circle: usize,
-    /// Gauss–Legendre nodes over an azimuth arc cut by the horizon.
-    pub arc: usize,
     /// Gauss–Legendre nodes per radial slope panel.
     pub per_panel: usize,
     /// First radial panel width in units of the distribution's slope scale; later panels grow.
@@ -47,13 +42,24 @@ pub struct KernelQuadrature {
     pub merge_core: f64,
 }
 
+impl KernelQuadrature {
+    /// The pBRDF hemisphere quadrature with these node counts.
+    pub fn hemisphere(&self) -> HemisphereQuadrature {
+        HemisphereQuadrature::new(
+            self.full_circle,
+            self.per_panel,
+            self.first_panel,
+            self.growth,
+        )
+    }
+}
+
 impl Default for KernelQuadrature {
     /// Within ~1e-4 of `reflected_stokes` with the default hemisphere quadrature for σ 0.03–0.5
     /// (tests/render_tables.rs); merging at 0.5° changes a smooth sky by < 1e-5.
     fn default() -> Self {
         KernelQuadrature {
             full_circle: 32,
-            arc: 16,
             per_panel: 6,
             first_panel: 0.5,
             growth: 2.0,
@@ -91,145 +97,26 @@ impl SpecularKernel {
     }
 }
 
-/// The specular kernel of `pbrdf` for ω_r = (sinθ_r, 0, cosθ_r), 0 ≤ θ_r < π/2.
+/// The specular kernel of `pbrdf` for ω_r = (sinθ_r, 0, cosθ_r), 0 ≤ θ_r < π/2: the pBRDF's own
+/// reflection quadrature nodes ([`Pbrdf::visit_specular_nodes`]), merged by direction.
 pub fn specular_kernel(
     pbrdf: &Pbrdf,
     theta_r: f64,
     quadrature: &KernelQuadrature,
 ) -> SpecularKernel {
     let scattered = Direction::from_angles(theta_r, 0.0);
-    let w_r = scattered.vector;
-    let (sin_r, cos_r) = theta_r.sin_cos();
-    if cos_r <= 0.0 {
+    if scattered.cos_theta() <= 0.0 {
         return SpecularKernel::default();
     }
-    let distribution = pbrdf.prepared_distribution();
-    let rho_over_pi = pbrdf.rho_d() * FRAC_1_PI;
-    // Slopes u ≤ u_full mirror ω_r above the horizon at every azimuth, none beyond u_none; in
-    // between only |Δ| < arccos κ(u), κ = cosθ_r (u² − 1)/(2u sinθ_r) (DESIGN §1.1 geometry).
-    let u_full = cos_r / (1.0 + sin_r);
-    let u_none = (1.0 + sin_r) / cos_r;
-    let edges = panel_edges(
-        quadrature.first_panel * distribution.slope_scale(),
-        quadrature.growth,
-        u_full,
-        u_none.min(distribution.slope_cutoff()),
-    );
-    let panel_rule = unit_rule(quadrature.per_panel);
-    let arc_rule = unit_rule(quadrature.arc);
-
+    let (sin_r, cos_r) = theta_r.sin_cos();
     let specular = Vector3::new(-sin_r, 0.0, cos_r);
-    let core_slope = slope_quantile(pbrdf.distribution(), quadrature.merge_core);
+    let core_slope = pbrdf.distribution().slope_quantile(quadrature.merge_core);
     let core = (2.0 * core_slope.atan()).max(4.0 * quadrature.merge_cell);
     let mut nodes = NodeMerger::new(quadrature.merge_cell, specular, core);
-    let mut add_facet = |u: f64, delta: f64, measure: f64| {
-        let (sin_d, cos_d) = delta.sin_cos();
-        let sec_h = (1.0 + u * u).sqrt();
-        let h = Vector3::new(u * cos_d, u * sin_d, 1.0) / sec_h;
-        let cos_beta = h.dot(&w_r);
-        let w_i = h * (2.0 * cos_beta) - w_r;
-        if w_i.z <= 0.0 || cos_beta <= 0.0 {
-            return; // rounding at the horizon cut
-        }
-        let f = pbrdf.first_column(&Direction::from_unit_vector(w_i), &scattered);
-        let jacobian = 4.0 * cos_beta / (sec_h * sec_h * sec_h) * w_i.z * measure;
-        nodes.add(
-            w_i,
-            [
-                (f[0] - rho_over_pi) * jacobian,
-                f[1] * jacobian,
-                f[2] * jacobian,
-            ],
-        );
-    };
-    for panel in edges.windows(2) {
-        let (a, b) = (panel[0], panel[1]);
-        // The cut-arc width has √ behaviour at u_full and u_none; u = a + (b − a) sin²(πv/2)
-        // makes the integrand smooth there.
-        let singular = a == u_full || b == u_none;
-        for &(v, wv) in &panel_rule {
-            let (u, du) = if singular {
-                let half = 0.5 * PI * v;
-                (
-                    a + (b - a) * half.sin().powi(2),
-                    (b - a) * 0.5 * PI * (PI * v).sin(),
-                )
-            } else {
-                (a + (b - a) * v, b - a)
-            };
-            let radial = wv * du * u;
-            if u <= u_full {
-                let step = 2.0 * PI / quadrature.full_circle as f64;
-                for j in 0..quadrature.full_circle {
-                    add_facet(u, (j as f64 + 0.5) * step, radial * step);
-                }
-            } else {
-                let kappa = cos_r * (u * u - 1.0) / (2.0 * u * sin_r);
-                let half_width = kappa.clamp(-1.0, 1.0).acos();
-                for &(t, wt) in &arc_rule {
-                    add_facet(
-                        u,
-                        half_width * (2.0 * t - 1.0),
-                        radial * wt * 2.0 * half_width,
-                    );
-                }
-            }
-        }
-    }
+    pbrdf.visit_specular_nodes(&scattered, &quadrature.hemisphere(), |w_i, k| {
+        nodes.add(*w_i, [k[0], k[1], k[2]])
+    });
     nodes.finish()
-}
-
-/// The slope m = tan θ below which a fraction `p` of the facets lie: the inverse CDFs of
-/// DESIGN §1.2, tan²θ = a((1 − p)^(1/(1−q)) − 1) (Cauchy, a = 2σ²) and −2σ² ln(1 − p) (Gaussian).
-pub fn slope_quantile(distribution: SlopeDistribution, p: f64) -> f64 {
-    let tan2 = match distribution {
-        SlopeDistribution::Cauchy { sigma, q } => {
-            2.0 * sigma * sigma * ((1.0 - p).powf(1.0 / (1.0 - q)) - 1.0)
-        }
-        SlopeDistribution::Gaussian { sigma } => -2.0 * sigma * sigma * (1.0 - p).ln(),
-    };
-    tan2.max(0.0).sqrt()
-}
-
-/// Cosine-weighted hemisphere rule (ω, weight) with Σ weight = π: Gauss–Legendre in r² over the
-/// projected disk, trapezoid in azimuth. Times ρ_d/π it is the diffuse kernel.
-pub fn cosine_rule(radial: usize, azimuthal: usize) -> Vec<(Vector3<f64>, f64)> {
-    let dphi = 2.0 * PI / azimuthal as f64;
-    let mut rule = Vec::with_capacity(radial * azimuthal);
-    for (t, wt) in unit_rule(radial) {
-        let (r, z) = (t.sqrt(), (1.0 - t).sqrt());
-        for j in 0..azimuthal {
-            let (sin_p, cos_p) = ((j as f64 + 0.5) * dphi).sin_cos();
-            rule.push((Vector3::new(r * cos_p, r * sin_p, z), 0.5 * wt * dphi));
-        }
-    }
-    rule
-}
-
-fn unit_rule(points: usize) -> Vec<(f64, f64)> {
-    let rule = GaussLegendre::new(NonZeroUsize::new(points.max(1)).expect("≥ 1"));
-    rule.as_node_weight_pairs()
-        .iter()
-        .map(|&(x, w)| (0.5 * (x + 1.0), 0.5 * w))
-        .collect()
-}
-
-/// Radial panel edges from 0: the first `first` wide, each next `growth` times wider, ending at
-/// `end`, with `split` (the full-circle limit) inserted as an edge when inside.
-fn panel_edges(first: f64, growth: f64, split: f64, end: f64) -> Vec<f64> {
-    let mut edges = vec![0.0];
-    let (mut width, mut next) = (first, first);
-    while next < end {
-        edges.push(next);
-        width *= growth.max(1.1);
-        next += width;
-    }
-    edges.push(end);
-    if split > 0.0 && split < end && !edges.contains(&split) {
-        let at = edges.partition_point(|&e| e < split);
-        edges.insert(at, split);
-    }
-    edges
 }
 
 /// Sums nodes falling in the same cube cell of the unit sphere. Within `core` radians of the
@@ -295,7 +182,7 @@ impl NodeMerger {
 mod tests {
     use super::*;
     use crate::optics::RefractiveIndex;
-    use crate::pbrdf::{HemisphereQuadrature, Shadowing};
+    use crate::pbrdf::{Shadowing, SlopeDistribution};
 
     fn material(distribution: SlopeDistribution, shadowing: Shadowing, rho_d: f64) -> Pbrdf {
         Pbrdf::new(
@@ -305,25 +192,6 @@ mod tests {
             rho_d,
         )
         .unwrap()
-    }
-
-    #[test]
-    fn slope_quantiles_invert_the_distributions() {
-        // Cauchy q = 2 is GGX: P(m < x) = x²/(x² + a); Gaussian: 1 − exp(−x²/(2σ²)).
-        let x = slope_quantile(SlopeDistribution::Cauchy { sigma: 0.2, q: 2.0 }, 0.9);
-        assert!((x * x / (x * x + 0.08) - 0.9).abs() < 1e-12);
-        let x = slope_quantile(SlopeDistribution::Gaussian { sigma: 0.2 }, 0.5);
-        assert!((1.0 - (-x * x / 0.08).exp() - 0.5).abs() < 1e-12);
-    }
-
-    #[test]
-    fn cosine_rule_integrates_the_projected_solid_angle() {
-        let rule = cosine_rule(8, 24);
-        let total: f64 = rule.iter().map(|(_, w)| w).sum();
-        assert!((total - PI).abs() < 1e-12);
-        // ∫ cosθ · cosθ dΩ = 2π/3 (√(1 − r²) is not a polynomial in r²: not exact).
-        let second: f64 = rule.iter().map(|(d, w)| w * d.z).sum();
-        assert!((second - 2.0 * PI / 3.0).abs() < 1e-3);
     }
 
     #[test]

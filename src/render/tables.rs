@@ -14,7 +14,7 @@
 //! reflectance and polarization change fastest, are half those at the normal (θ_r also moves the
 //! mirror direction across the sky, so it cannot be coarse anywhere).
 
-use super::kernel::{cosine_rule, specular_kernel, KernelQuadrature, SpecularKernel};
+use super::kernel::{specular_kernel, KernelQuadrature, SpecularKernel};
 use crate::optics::Band;
 use crate::pbrdf::{ModelError, Pbrdf};
 use crate::scene::environment::Environment;
@@ -149,7 +149,8 @@ impl MaterialTables {
             .map(|i| specular_kernel(pbrdf, theta_of_coordinate(theta.value(i)), &quadrature))
             .collect();
 
-        let diffuse_rule = cosine_rule(8, 32);
+        let hemisphere = quadrature.hemisphere();
+        let diffuse_rule = hemisphere.cosine_weighted_nodes();
         let rho_over_pi = pbrdf.rho_d() * FRAC_1_PI;
         let diffuse_albedo = rho_over_pi * diffuse_rule.iter().map(|(_, w)| w).sum::<f64>();
         let emissivity = kernels
