@@ -158,15 +158,43 @@ impl ModelFlags {
     }
 }
 
+/// `println!` that treats a closed stdout (`irpol … | head`) as the reader being done, not as a
+/// panic.
+macro_rules! say {
+    ($($arg:tt)*) => {
+        print_line(format_args!($($arg)*))
+    };
+}
+
+fn print_line(line: std::fmt::Arguments) {
+    if let Err(error) = writeln!(std::io::stdout(), "{line}") {
+        if error.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("irpol: error: cannot write to stdout: {error}");
+        std::process::exit(1);
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(error) if is_broken_pipe(&error) => ExitCode::SUCCESS,
         Err(error) => {
             eprintln!("irpol: error: {error:#}");
             ExitCode::FAILURE
         }
     }
+}
+
+/// The reader of stdout went away (`irpol eval … | head`): not a failure of ours.
+fn is_broken_pipe(error: &anyhow::Error) -> bool {
+    error.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }
 
 fn run(command: Command) -> anyhow::Result<()> {
@@ -215,7 +243,7 @@ fn run(command: Command) -> anyhow::Result<()> {
                 PaperFigure::Fig3
             };
             for path in write_paper_figure(figure, &out)? {
-                println!("wrote {}", path.display());
+                say!("wrote {}", path.display());
             }
         }
         Command::Fit {
@@ -244,13 +272,13 @@ fn run(command: Command) -> anyhow::Result<()> {
         }
         Command::Report { material, reports } => {
             for path in rebuild_report(&material, &reports)? {
-                println!("wrote {}", path.display());
+                say!("wrote {}", path.display());
             }
             let library = material
                 .parent()
                 .filter(|p| !p.as_os_str().is_empty())
                 .unwrap_or(Path::new("."));
-            println!(
+            say!(
                 "wrote {}",
                 write_library_index(library, &reports)?.display()
             );
@@ -309,15 +337,15 @@ fn fit_and_summarize(
             .iter()
             .zip(&chosen.values)
             .map(|(p, v)| match chosen.error(*p) {
-                Some(e) => format!("{}={v:.5}±{e:.1e}", p.name()),
-                None => format!("{}={v:.5}", p.name()),
+                Some(e) => format!("{}={}±{e:.1e}", p.name(), significant(*v, 6)),
+                None => format!("{}={}", p.name(), significant(*v, 6)),
             })
             .collect();
         let comparison = outcome
             .comparison
             .as_ref()
             .map_or(String::new(), |c| format!("; {}", c.summary()));
-        println!(
+        say!(
             "{}: {} {} χ²_red={:.3}{comparison} → {}",
             outcome.material.name,
             chosen.distribution.name(),
@@ -331,6 +359,15 @@ fn fit_and_summarize(
     Ok(outcomes)
 }
 
+/// `value` to `digits` significant digits in plain notation (0.0000061 stays readable as such).
+fn significant(value: f64, digits: i32) -> String {
+    if value == 0.0 || !value.is_finite() {
+        return format!("{value}");
+    }
+    let decimals = (digits - 1 - value.abs().log10().floor() as i32).clamp(0, 15) as usize;
+    format!("{value:.decimals$}")
+}
+
 /// A report per fitted material and the library's index page.
 fn write_reports(
     outcomes: &[FitOutcome],
@@ -339,9 +376,9 @@ fn write_reports(
 ) -> anyhow::Result<()> {
     for outcome in outcomes {
         let paths = write_fit_report(&outcome.material, &outcome.measurement, reports_dir)?;
-        println!("  report {}", paths[0].display());
+        say!("  report {}", paths[0].display());
     }
-    println!(
+    say!(
         "  index  {}",
         write_library_index(fits_dir, reports_dir)?.display()
     );
@@ -351,12 +388,21 @@ fn write_reports(
 fn print_library(dir: &Path) -> anyhow::Result<()> {
     let materials = irpol::material::list_library(dir)?;
     if materials.is_empty() {
-        println!("no materials in {}", dir.display());
+        say!("no materials in {}", dir.display());
         return Ok(());
     }
-    println!(
+    say!(
         "{:<18} {:<9} {:<17} {:>7} {:>6} {:>6} {:>6} {:>6} {:>7} {:>8}",
-        "material", "dist", "shadowing", "λ µm", "σ", "q", "n", "k", "ρ_d", "χ²_red"
+        "material",
+        "dist",
+        "shadowing",
+        "λ µm",
+        "σ",
+        "q",
+        "n",
+        "k",
+        "ρ_d",
+        "χ²_red"
     );
     for (_, m) in materials {
         let s = &m.model;
@@ -368,7 +414,7 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
             .fit
             .as_ref()
             .map_or("—".into(), |f| format!("{:.3}", f.reduced_chi2));
-        println!(
+        say!(
             "{:<18} {:<9} {:<17} {:>7.3} {:>6.3} {:>6} {:>6.3} {:>6.3} {:>7.4} {:>8}",
             m.name,
             s.distribution.name(),
@@ -391,16 +437,16 @@ fn demo() -> anyhow::Result<()> {
         PathBuf::from("fits"),
         PathBuf::from("reports"),
     );
-    println!(
+    say!(
         "irpol demo: fit the shipped measurements in {}",
         measurements.display()
     );
     let outcomes = fit_and_summarize(&[measurements], &FitOptions::default(), &fits)?;
     write_reports(&outcomes, &fits, &reports)?;
-    println!("the paper's model figures:");
+    say!("the paper's model figures:");
     for figure in [PaperFigure::Fig2, PaperFigure::Fig3] {
         for path in write_paper_figure(figure, &reports)? {
-            println!("  wrote {}", path.display());
+            say!("  wrote {}", path.display());
         }
     }
     Ok(())

@@ -102,7 +102,7 @@ fn default_fits_recover_the_generating_parameters_and_distribution() {
                 }
                 let value = fit.value(parameter);
                 let error = fit.error(parameter).unwrap();
-                line += &format!(" {parameter} {value:.4}±{error:.4} (true {true_value})");
+                line += &format!(" {parameter} {value:.5}±{error:.1e} (true {true_value})");
                 assert!(
                     (value - true_value).abs() <= tolerance(parameter, true_value),
                     "{name}: {parameter} = {value}, true {true_value}"

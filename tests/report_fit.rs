@@ -76,6 +76,26 @@ fn a_report_is_a_2400_by_1800_png_and_an_svg_with_labelled_axes() {
         assert!(svg.contains(label), "the SVG lacks {label:?}");
     }
     eprintln!("report rendered in {elapsed:?}");
+
+    // The same material and measurement always give the same figure, byte for byte.
+    let again = write_fit_report(&material, &set, &dir.path().join("again")).unwrap();
+    for (first, second) in paths.iter().zip(&again) {
+        assert_eq!(
+            std::fs::read(first).unwrap(),
+            std::fs::read(second).unwrap()
+        );
+    }
+}
+
+#[test]
+fn markup_in_a_material_name_is_escaped_in_the_svg() {
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, set) = synthetic_set(dir.path(), "x", &[0]);
+    let material = fitted_material("tar & <pitch>", &set, &csv);
+    let paths = write_fit_report(&material, &set, dir.path()).unwrap();
+    assert_eq!(paths[1], dir.path().join("tar & <pitch>.svg"));
+    let svg = std::fs::read_to_string(&paths[1]).unwrap();
+    assert!(svg.contains("tar &amp; &lt;pitch&gt;") && !svg.contains("<pitch>"));
 }
 
 #[test]

@@ -1,7 +1,8 @@
 //! Model comparison between the slope distributions by information criteria on the χ² of the
 //! weighted fit (Gaussian errors with the stated uncertainties, so −2 ln L = χ² + const):
 //! AIC = χ² + 2p, BIC = χ² + p ln N (N observations, p free parameters). The model with the
-//! lower AIC is preferred; on a tie the one with fewer parameters.
+//! lower AIC is preferred; on a tie the one with fewer parameters. The χ² is the plain one even
+//! when the fit used a robust loss.
 
 use super::parameters::DistributionKind;
 use serde::{Deserialize, Serialize};

@@ -1,6 +1,8 @@
 //! Parameter uncertainties at the optimum from the Jacobian of the normalized residuals
 //! (linearized least squares): C = s² (JᵀJ)⁻¹ in physical units, with s² the reduced χ², so that
 //! the errors stay honest when the stated measurement uncertainties are too small or too large.
+//! With a robust loss the same plain-least-squares covariance is evaluated at the robust
+//! optimum; outliers inflate the reduced χ² and so make the errors conservative.
 //!
 //! A parameter is *undetermined* when the data carry no information on it (its Jacobian column
 //! vanishes, e.g. k = 0 without circular elements, or JᵀJ is singular along it), when it is

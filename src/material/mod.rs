@@ -10,18 +10,19 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
 pub enum MaterialError {
-    #[error("{path}: cannot read the material file: {source}")]
+    #[error("{path}: cannot read the material file")]
     Read {
         path: PathBuf,
         source: std::io::Error,
     },
     #[error("{path}: not a valid material TOML: {message}")]
     Parse { path: PathBuf, message: String },
-    #[error("{path}: the model is invalid: {source}")]
-    Model { path: PathBuf, source: ModelError },
+    /// The model error is part of the message (not a `source`), so it reads the same with `{}`.
+    #[error("{path}: the model is invalid: {error}")]
+    Model { path: PathBuf, error: ModelError },
     #[error("material '{name}' is not in the library {dir} (no {dir}/{name}.toml)")]
     NotFound { name: String, dir: PathBuf },
-    #[error("{path}: cannot write: {source}")]
+    #[error("{path}: cannot write")]
     Write {
         path: PathBuf,
         source: std::io::Error,
@@ -131,9 +132,9 @@ impl Material {
         material
             .model
             .pbrdf()
-            .map_err(|source| MaterialError::Model {
+            .map_err(|error| MaterialError::Model {
                 path: path.to_owned(),
-                source,
+                error,
             })?;
         Ok(material)
     }

@@ -12,11 +12,13 @@ mod diagnostics;
 mod profiles;
 mod style;
 mod table;
+#[cfg(test)]
+mod test_records;
 
-pub use data::{DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00};
 use table::format_angle;
 pub(crate) use table::{
-    format_plain, format_with_uncertainty, is_free, lookup, parameters, preference, sha_prefix,
+    at_bound, format_plain, format_with_uncertainty, is_free, lookup, parameters, preference,
+    sha_prefix,
 };
 
 use super::paper_figures::encode_png;
@@ -116,44 +118,46 @@ fn source_candidates(material_path: &Path, source: &Path) -> Vec<PathBuf> {
 }
 
 /// Finds the fit's source CSV and checks it is byte-for-byte the file that was fitted; returns
-/// its path and bytes.
+/// its path and bytes. Of several candidates the first with the recorded hash wins (a same-named
+/// file elsewhere is not the source); if none has it, the first existing one is reported changed.
 pub(crate) fn verified_source(
     material_path: &Path,
     fit: &FitRecord,
 ) -> Result<(PathBuf, Vec<u8>), ReportError> {
     let candidates = source_candidates(material_path, &fit.source);
-    let Some(csv) = candidates.iter().find(|p| p.is_file()).cloned() else {
-        return Err(ReportError::SourceMissing {
-            material: material_path.to_owned(),
-            csv: fit.source.clone(),
-            tried: candidates
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-        });
-    };
-    let bytes = std::fs::read(&csv).map_err(|e| MeasureError {
-        file: csv.clone(),
-        line: 1,
-        column: 1,
-        kind: MeasureErrorKind::Unreadable {
-            reason: e.to_string(),
-        },
-    })?;
-    let actual: String = Sha256::digest(&bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    if !actual.eq_ignore_ascii_case(fit.source_sha256.trim()) {
-        return Err(ReportError::SourceChanged {
-            csv,
+    let mut first_changed = None;
+    for csv in candidates.iter().filter(|p| p.is_file()) {
+        let bytes = std::fs::read(csv).map_err(|e| MeasureError {
+            file: csv.clone(),
+            line: 1,
+            column: 1,
+            kind: MeasureErrorKind::Unreadable {
+                reason: e.to_string(),
+            },
+        })?;
+        let actual: String = Sha256::digest(&bytes)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        if actual.eq_ignore_ascii_case(fit.source_sha256.trim()) {
+            return Ok((csv.clone(), bytes));
+        }
+        first_changed.get_or_insert(ReportError::SourceChanged {
+            csv: csv.clone(),
             actual,
             recorded: fit.source_sha256.clone(),
             material: material_path.to_owned(),
         });
     }
-    Ok((csv, bytes))
+    Err(first_changed.unwrap_or_else(|| ReportError::SourceMissing {
+        material: material_path.to_owned(),
+        csv: fit.source.clone(),
+        tried: candidates
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+    }))
 }
 
 /// The material name as a file stem: a plain name, no folders.
@@ -216,14 +220,13 @@ fn draw_header<DB: DrawingBackend>(
 ) -> DrawResult<DB> {
     let model = &material.model;
     let title = format!(
-        "Fit report: {}   —   {} slopes, {} shadowing, λ = {} µm, {} points × {} Mueller elements from {}",
+        "Fit report: {}   —   {} slopes, {} shadowing, λ = {} µm, {} points × {} Mueller elements",
         material.name,
         model.distribution.name(),
         model.shadowing.name(),
         format_plain(set.wavelength_um),
         set.points.len(),
         set.elements.len(),
-        set.source.display()
     );
     let title_style = (FONT, TITLE_SIZE, FontStyle::Bold)
         .into_font()

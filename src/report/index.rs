@@ -4,8 +4,8 @@
 //! links only, so the page works from a file browser and when the folder is copied elsewhere.
 
 use super::fit_report::{
-    format_plain, format_with_uncertainty, is_free, lookup, parameters, preference, sha_prefix,
-    verified_source,
+    at_bound, format_plain, format_with_uncertainty, is_free, lookup, parameters, preference,
+    sha_prefix, verified_source,
 };
 use super::ReportError;
 use crate::material::{list_library, write_atomically, Material};
@@ -96,9 +96,14 @@ fn parameter_text(material: &Material, name: &str, value: f64) -> String {
     match material.fit.as_ref() {
         Some(fit) if is_free(fit, name) => {
             let sigma = lookup(|k| fit.uncertainty.get(k), name).copied();
+            let bound = if at_bound(fit, name) {
+                " (at bound)"
+            } else {
+                ""
+            };
             match format_with_uncertainty(value, sigma) {
-                (value, Some(sigma)) => format!("{value} ± {sigma}"),
-                (value, None) => format!("{value} ± ?"),
+                (value, Some(sigma)) => format!("{value} ± {sigma}{bound}"),
+                (value, None) => format!("{value} ± ?{bound}"),
             }
         }
         Some(_) => format!("{} (fixed)", format_plain(value)),
@@ -268,6 +273,7 @@ fn material_section(html: &mut String, reports_dir: &Path, path: &Path, material
                     "optimizer",
                     format!("{} (seed {}), {}", fit.optimizer, fit.seed, fit.termination),
                 ),
+                ("fitted by", material.tool_version.clone()),
             ];
             if let Some(alt) = &fit.alternative {
                 rows.push((

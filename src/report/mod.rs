@@ -31,7 +31,7 @@ pub enum ReportError {
         path: std::path::PathBuf,
         message: String,
     },
-    #[error("{path}: cannot write: {source}")]
+    #[error("{path}: cannot write")]
     Write {
         path: std::path::PathBuf,
         source: std::io::Error,
@@ -42,6 +42,8 @@ pub enum ReportError {
     Material(#[from] crate::material::MaterialError),
     #[error(transparent)]
     Measure(#[from] crate::measure::MeasureError),
+    #[error(transparent)]
+    Fit(#[from] crate::fit::FitError),
     #[error("{material}: the material has no fit record, so there is no measurement to report against (fit it with `irpol fit`)")]
     NoFit { material: std::path::PathBuf },
     #[error("{material}: its source CSV {csv} is missing (looked for {tried})")]

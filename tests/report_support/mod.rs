@@ -169,46 +169,44 @@ pub fn fitted_material(name: &str, set: &MeasurementSet, source: &Path) -> Mater
     correlation[0][1] = 0.87;
     correlation[1][0] = 0.87;
     let alt_cost = cost * 2.7;
+    let alternative = AlternativeFit {
+        model: competitor(),
+        cost: alt_cost,
+        reduced_chi2: alt_cost / (dof + 1) as f64,
+        aic: alt_cost + 8.0,
+        bic: alt_cost + 4.0 * ln_n,
+    };
+    // Through serde, so that fields the fit engine adds with serde defaults keep this compiling.
+    let fit: FitRecord = serde_json::from_value(serde_json::json!({
+        "source": source,
+        "source_sha256": set.sha256,
+        "points": set.points.len(),
+        "elements": set.elements.iter().map(|&e| MUELLER_ELEMENT_NAMES[e]).collect::<Vec<_>>(),
+        "free_parameters": free,
+        "optimizer": "ga+nm",
+        "seed": 7,
+        "settings": { "robust_loss": "none" },
+        "iterations": 65,
+        "evaluations": 16_400,
+        "cost": cost,
+        "reduced_chi2": cost / dof as f64,
+        "degrees_of_freedom": dof,
+        "aic": cost + 10.0,
+        "bic": cost + 5.0 * ln_n,
+        "termination": "nm: simplex diameter below 1e-8",
+        "rmse": { "m00": 0.0012 },
+        "uncertainty": uncertainty,
+        "correlation": correlation,
+        "undetermined": [],
+        "alternative": alternative,
+        "convergence": convergence,
+        "global_iterations": 40,
+    }))
+    .unwrap();
     Material {
         name: name.to_owned(),
         tool_version: "irpol test".into(),
         model: truth(),
-        fit: Some(FitRecord {
-            source: source.to_owned(),
-            source_sha256: set.sha256.clone(),
-            points: set.points.len(),
-            elements: set
-                .elements
-                .iter()
-                .map(|&e| MUELLER_ELEMENT_NAMES[e].to_owned())
-                .collect(),
-            free_parameters: free,
-            optimizer: "ga+nm".into(),
-            seed: 7,
-            settings: BTreeMap::new(),
-            iterations: 65,
-            evaluations: 16_400,
-            cost,
-            reduced_chi2: cost / dof as f64,
-            degrees_of_freedom: dof,
-            aic: cost + 10.0,
-            bic: cost + 5.0 * ln_n,
-            termination: "simplex diameter below 1e-8".into(),
-            rmse: BTreeMap::from([("m00".to_string(), 0.0012)]),
-            uncertainty,
-            correlation,
-            undetermined: vec![],
-            alternative: Some(AlternativeFit {
-                model: competitor(),
-                cost: alt_cost,
-                reduced_chi2: alt_cost / (dof + 1) as f64,
-                aic: alt_cost + 8.0,
-                bic: alt_cost + 4.0 * ln_n,
-            }),
-            convergence,
-            global_iterations: 40,
-            at_bound: Vec::new(),
-            model_choice: None,
-        }),
+        fit: Some(fit),
     }
 }

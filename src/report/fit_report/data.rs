@@ -3,20 +3,13 @@
 //! deviation and normalized residual, and the chosen and competing models evaluated along each
 //! plane and ring and as polarized emissivity (DESIGN §1.3–1.4).
 
+use crate::fit::MeasurementData;
 use crate::material::Material;
 use crate::measure::MeasurementSet;
 use crate::optics::{Mueller, Stokes};
 use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
 
 use super::super::ReportError;
-
-/// The fit's default noise model where a file has no `u_` column: 3 % of m00 on m00 and 1 % of m00
-/// on every other element (a rotating-retarder polarimeter), floored at 1e-6 of the largest m00 so
-/// that a zero reading keeps a finite weight. Mirrors `fit::data` so that report residuals are the
-/// ones the optimizer minimized.
-pub const DEFAULT_M00_RELATIVE_ERROR: f64 = 0.03;
-pub const DEFAULT_OTHER_ERROR_PER_M00: f64 = 0.01;
-const DEFAULT_ERROR_FLOOR: f64 = 1e-6;
 
 /// Two angles are the same goniometer setting when they agree to a microdegree.
 const SAME_ANGLE_DEG: f64 = 1e-6;
@@ -121,11 +114,13 @@ impl ReportData {
         };
 
         let incidences = distinct_sorted(set.points.iter().map(|p| p.theta_i_deg));
-        let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
-        let floor = DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE);
+        // The standard deviations the fit weighted by (the file's u_ columns or the fit's default
+        // noise model), so that report residuals are the ones the optimizer minimized.
+        let weights = MeasurementData::new(set)?;
+        let elements_per_point = set.elements.len();
 
         let mut points = Vec::with_capacity(set.points.len());
-        for p in &set.points {
+        for (point, p) in set.points.iter().enumerate() {
             let incident = checked_direction("theta_i_deg", p.theta_i_deg, p.phi_i_deg)?;
             let scattered = checked_direction("theta_r_deg", p.theta_r_deg, p.phi_r_deg)?;
             let relative_azimuth = (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0);
@@ -140,11 +135,7 @@ impl ReportData {
             let mut readings = [None; 16];
             for (column, &element) in set.elements.iter().enumerate() {
                 let value = p.values[column];
-                let sigma = p.uncertainties[column].unwrap_or(if element == 0 {
-                    (DEFAULT_M00_RELATIVE_ERROR * p.values[0]).max(floor)
-                } else {
-                    (DEFAULT_OTHER_ERROR_PER_M00 * p.values[0]).max(floor)
-                });
+                let (_, sigma) = weights.observation(point * elements_per_point + column);
                 readings[element] = Some(Reading { value, sigma });
             }
             points.push(PointView {
@@ -391,6 +382,7 @@ mod tests {
     use crate::material::{AlternativeFit, ModelSpec};
     use crate::measure::MeasurementPoint;
     use crate::pbrdf::{Shadowing, SlopeDistribution};
+    use crate::report::fit_report::test_records::fit_record;
     use std::collections::BTreeMap;
 
     fn spec(distribution: SlopeDistribution) -> ModelSpec {
@@ -406,38 +398,15 @@ mod tests {
 
     fn material(with_alternative: bool) -> Material {
         let model = spec(SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 });
-        let fit = with_alternative.then(|| crate::material::FitRecord {
-            source: "x.csv".into(),
-            source_sha256: String::new(),
-            points: 0,
-            elements: vec![],
-            free_parameters: vec![],
-            optimizer: "nm".into(),
-            seed: 0,
-            settings: BTreeMap::new(),
-            iterations: 0,
-            evaluations: 0,
-            cost: 1.0,
-            reduced_chi2: 1.0,
-            degrees_of_freedom: 1,
-            aic: 0.0,
-            bic: 0.0,
-            termination: String::new(),
-            rmse: BTreeMap::new(),
-            uncertainty: BTreeMap::new(),
-            correlation: vec![],
-            undetermined: vec![],
-            alternative: Some(AlternativeFit {
+        let fit = with_alternative.then(|| {
+            let alternative = AlternativeFit {
                 model: spec(SlopeDistribution::Gaussian { sigma: 0.15 }),
                 cost: 2.0,
                 reduced_chi2: 2.0,
                 aic: 1.0,
                 bic: 1.0,
-            }),
-            convergence: vec![],
-            global_iterations: 0,
-            at_bound: Vec::new(),
-            model_choice: None,
+            };
+            fit_record(serde_json::json!({ "alternative": alternative }))
         });
         Material {
             name: "test".into(),

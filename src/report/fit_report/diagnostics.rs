@@ -3,8 +3,8 @@
 
 use super::data::{ReportData, Residual};
 use super::style::{
-    draw_legend_column, draw_note, log_tick, DrawResult, LegendEntry, LineKind, Marker,
-    AXIS_DESC_SIZE, CAPTION_SIZE, GREY, LEGEND_SIZE, TICK_SIZE,
+    draw_legend_column, draw_legend_top_right, draw_note, log_tick, DrawResult, LegendEntry,
+    LineKind, Marker, AXIS_DESC_SIZE, CAPTION_SIZE, GREY, LEGEND_SIZE, TICK_SIZE,
 };
 use crate::material::FitRecord;
 use crate::report::FONT;
@@ -126,13 +126,7 @@ pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
             LineKind::Solid,
         ));
     }
-    let (x, y) = chart.plotting_area().get_pixel_range();
-    let legend_origin = (
-        x.end - area.get_base_pixel().0 - 260,
-        y.start - area.get_base_pixel().1 + 6,
-    );
-    draw_legend_column(area, &entries, legend_origin)?;
-    Ok(())
+    draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 8)
 }
 
 /// Bins of the residual histogram: 0.25σ wide over ±5σ.
@@ -228,8 +222,7 @@ pub fn draw_histogram<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
             LineKind::Solid,
         ));
     }
-    let (_, y) = chart.plotting_area().get_pixel_range();
-    let (x, _) = chart.plotting_area().get_pixel_range();
+    let (x, y) = chart.plotting_area().get_pixel_range();
     draw_legend_column(
         area,
         &entries,
@@ -264,7 +257,9 @@ pub fn draw_convergence<DB: DrawingBackend>(
     let dof = fit.degrees_of_freedom as f64;
     let low = costs.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
     let high = costs.iter().map(|c| c.1).fold(0.0, f64::max);
-    let show_dof = dof > 0.0 && dof > low / 100.0;
+    // χ² ≈ degrees of freedom marks a fit at the noise level; a robust cost Σρ(r) has no such mark.
+    let robust = super::table::robust_loss(fit);
+    let show_dof = robust.is_none() && dof > 0.0 && dof > low / 100.0;
     let (low, high) = (low.min(if show_dof { dof } else { low }) / 1.6, high * 1.6);
     let last = (fit.convergence.len() - 1) as f64;
     let mut chart = chart_builder(area, caption)
@@ -276,7 +271,10 @@ pub fn draw_convergence<DB: DrawingBackend>(
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&log_tick)
         .x_desc("step: GA generation, then local-stage iteration")
-        .y_desc("best cost χ² = Σ ((data − model)/σ)²")
+        .y_desc(match robust {
+            Some(loss) => format!("best cost Σρ(r), {loss} loss, r = (data − model)/σ"),
+            None => "best cost χ² = Σ ((data − model)/σ)²".to_owned(),
+        })
         .label_style((FONT, TICK_SIZE))
         .axis_desc_style((FONT, AXIS_DESC_SIZE))
         .light_line_style(RGBColor(235, 235, 235))
@@ -346,19 +344,15 @@ pub fn draw_convergence<DB: DrawingBackend>(
         ));
     }
     entries.push(LegendEntry::line(
-        format!("final χ² = {}", super::table::format_plain(fit.cost)),
+        format!(
+            "final {} = {}",
+            if robust.is_some() { "cost" } else { "χ²" },
+            super::table::format_plain(fit.cost)
+        ),
         WHITE,
         LineKind::Solid,
     ));
-    let (x, y) = chart.plotting_area().get_pixel_range();
-    let base = area.get_base_pixel();
-    let legend_width = 300;
-    draw_legend_column(
-        area,
-        &entries,
-        (x.end - base.0 - legend_width - 6, y.start - base.1 + 40),
-    )?;
-    Ok(())
+    draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 40)
 }
 
 /// ε0 (left axis) and −ε1 (right axis) against emission angle for both models.

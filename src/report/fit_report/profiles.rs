@@ -368,7 +368,7 @@ fn draw_axes<DB: DrawingBackend, Y: Ranged<ValueType = f64> + ValueFormatter<f64
     y_format: &dyn Fn(&f64) -> String,
 ) -> DrawResult<DB> {
     let (tick, desc) = if profile.compact {
-        (SMALL_TICK_SIZE, SMALL_TICK_SIZE + 1)
+        (SMALL_TICK_SIZE, SMALL_TICK_SIZE)
     } else {
         (TICK_SIZE, AXIS_DESC_SIZE)
     };

@@ -8,14 +8,15 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 pub type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
-/// Font sizes in pixels for the 2400 × 1800 figure.
+/// Font sizes in pixels for the 2400 × 1800 figure. All even: plotters places each glyph at
+/// size/2 + its top, truncated, so odd sizes put some letters (the z of "zenith") a pixel high.
 pub const TITLE_SIZE: i32 = 30;
-pub const CAPTION_SIZE: i32 = 21;
-pub const AXIS_DESC_SIZE: i32 = 17;
-pub const TICK_SIZE: i32 = 15;
-pub const LEGEND_SIZE: i32 = 15;
-pub const SMALL_CAPTION_SIZE: i32 = 17;
-pub const SMALL_TICK_SIZE: i32 = 13;
+pub const CAPTION_SIZE: i32 = 22;
+pub const AXIS_DESC_SIZE: i32 = 18;
+pub const TICK_SIZE: i32 = 16;
+pub const LEGEND_SIZE: i32 = 16;
+pub const SMALL_CAPTION_SIZE: i32 = 18;
+pub const SMALL_TICK_SIZE: i32 = 14;
 
 /// Colour of incidence angle number `index` (Tableau 10, readable on white and in grey print).
 pub fn incidence_color(index: usize) -> RGBColor {
@@ -166,26 +167,32 @@ fn draw_sample<DB: DrawingBackend>(
     Ok(())
 }
 
+const LEGEND_ROW: i32 = LEGEND_SIZE + 7;
+
+/// Pixel size of the framed box [`draw_legend_column`] draws for `entries`.
+pub fn legend_size<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[LegendEntry],
+) -> Result<(i32, i32), DrawingAreaErrorKind<DB::ErrorType>> {
+    let font = (FONT, LEGEND_SIZE).into_font().into_text_style(area);
+    let mut text_width = 0;
+    for entry in entries {
+        text_width = text_width.max(area.estimate_text_size(&entry.label, &font)?.0 as i32);
+    }
+    Ok((
+        SAMPLE_WIDTH + text_width + 22,
+        LEGEND_ROW * entries.len() as i32 + 8,
+    ))
+}
+
 /// Draws `entries` one per row with the top-left corner at `(x, y)` of `area` on a framed white
-/// box; returns the box's pixel size.
+/// box.
 pub fn draw_legend_column<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[LegendEntry],
     (x, y): (i32, i32),
-) -> Result<(i32, i32), DrawingAreaErrorKind<DB::ErrorType>> {
-    let font = (FONT, LEGEND_SIZE).into_font();
-    let row = LEGEND_SIZE + 7;
-    let mut text_width = 0;
-    for entry in entries {
-        text_width = text_width.max(
-            area.estimate_text_size(&entry.label, &font.clone().into_text_style(area))?
-                .0 as i32,
-        );
-    }
-    let (width, height) = (
-        SAMPLE_WIDTH + text_width + 22,
-        row * entries.len() as i32 + 8,
-    );
+) -> DrawResult<DB> {
+    let (width, height) = legend_size(area, entries)?;
     area.draw(&Rectangle::new(
         [(x, y), (x + width, y + height)],
         WHITE.mix(0.9).filled(),
@@ -194,13 +201,33 @@ pub fn draw_legend_column<DB: DrawingBackend>(
         [(x, y), (x + width, y + height)],
         RGBColor(170, 170, 170).stroke_width(1),
     ))?;
-    let style = font.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center));
+    let style = (FONT, LEGEND_SIZE)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Left, VPos::Center));
     for (i, entry) in entries.iter().enumerate() {
-        let cy = y + 4 + row * i as i32 + row / 2;
+        let cy = y + 4 + LEGEND_ROW * i as i32 + LEGEND_ROW / 2;
         draw_sample(area, entry, x + 6, cy)?;
         area.draw_text(&entry.label, &style, (x + SAMPLE_WIDTH + 14, cy))?;
     }
-    Ok((width, height))
+    Ok(())
+}
+
+/// Draws the legend inside the top-right corner of a chart's plotting area.
+pub fn draw_legend_top_right<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plot: (std::ops::Range<i32>, std::ops::Range<i32>),
+    entries: &[LegendEntry],
+    below_top: i32,
+) -> DrawResult<DB> {
+    let (width, _) = legend_size(area, entries)?;
+    let (base_x, base_y) = area.get_base_pixel();
+    let (x, y) = plot;
+    draw_legend_column(
+        area,
+        entries,
+        (x.end - base_x - width - 8, y.start - base_y + below_top),
+    )
 }
 
 /// Draws `entries` in one row starting at `(x, y)` (vertical centre), without a frame.

@@ -32,15 +32,17 @@ pub enum Row {
 }
 
 /// `value ± sigma` rounded to the uncertainty's second significant digit; without a usable
-/// uncertainty, four significant digits.
+/// uncertainty, four significant digits. An exact zero (a parameter on its bound) stays "0".
 pub fn format_with_uncertainty(value: f64, sigma: Option<f64>) -> (String, Option<String>) {
     match sigma.filter(|s| s.is_finite() && *s > 0.0) {
         Some(sigma) => {
             let decimals = (1 - sigma.log10().floor() as i32).clamp(0, 10) as usize;
-            (
-                format!("{value:.decimals$}"),
-                Some(format!("{sigma:.decimals$}")),
-            )
+            let value = if value == 0.0 {
+                "0".to_owned()
+            } else {
+                format!("{value:.decimals$}")
+            };
+            (value, Some(format!("{sigma:.decimals$}")))
         }
         None => (format_plain(value), None),
     }
@@ -84,6 +86,13 @@ pub fn lookup<'a, T>(map: impl Fn(&str) -> Option<&'a T>, name: &str) -> Option<
     map(name).or_else(|| (name == "rho_d").then(|| map("rho")).flatten())
 }
 
+/// Whether the fit left parameter `name` on a bound of its search interval.
+pub fn at_bound(fit: &FitRecord, name: &str) -> bool {
+    fit.at_bound
+        .iter()
+        .any(|p| p == name || (name == "rho_d" && p == "rho"))
+}
+
 pub fn is_free(fit: &FitRecord, name: &str) -> bool {
     fit.free_parameters
         .iter()
@@ -111,6 +120,15 @@ pub fn preference(material: &Material) -> Option<String> {
             delta_aic, delta_bic
         )
     })
+}
+
+/// The robust loss the fit minimized, if not plain least squares (`settings.robust_loss`, as the
+/// fit engine records it); then its cost is Σρ(r), not χ².
+pub fn robust_loss(fit: &FitRecord) -> Option<&str> {
+    fit.settings
+        .get("robust_loss")
+        .map(String::as_str)
+        .filter(|loss| *loss != "none")
 }
 
 pub fn sha_prefix(sha: &str) -> String {
@@ -172,6 +190,11 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
                 } else {
                     Tone::Normal
                 };
+                let text = if at_bound(fit, name) {
+                    format!("{text} †")
+                } else {
+                    text
+                };
                 (text, sigma_text, tone)
             }
             Some(_) => (format_plain(value), "fixed".into(), Tone::Muted),
@@ -192,13 +215,17 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
     };
 
     rows.push(Row::Heading("Fit quality".into()));
+    let cost_label = match robust_loss(fit) {
+        Some(loss) => format!("cost, {loss}"),
+        None => "cost χ²".to_owned(),
+    };
     let quality: [(&str, f64, Option<f64>); 4] = [
         (
             "reduced χ²",
             fit.reduced_chi2,
             alternative.map(|a| a.reduced_chi2),
         ),
-        ("cost χ²", fit.cost, alternative.map(|a| a.cost)),
+        (cost_label.as_str(), fit.cost, alternative.map(|a| a.cost)),
         ("AIC", fit.aic, alternative.map(|a| a.aic)),
         ("BIC", fit.bic, alternative.map(|a| a.bic)),
     ];
@@ -228,40 +255,43 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
             Tone::Warning,
         ));
     }
+    if !fit.at_bound.is_empty() {
+        let names: Vec<&str> = fit.at_bound.iter().map(|n| symbol(n)).collect();
+        rows.push(Row::Text(
+            format!("† at a bound of its search interval: {}", names.join(", ")),
+            Tone::Muted,
+        ));
+    }
 
     rows.push(Row::Heading("Data and optimizer".into()));
+    let rmse = fit
+        .rmse
+        .get("m00")
+        .map(|r| format!(", RMSE m00 = {} sr⁻¹", format_plain(*r)))
+        .unwrap_or_default();
     rows.push(Row::Text(
         format!(
-            "{} points × {} elements ({}), {} degrees of freedom{}",
+            "{} points × {} elements ({}), {} dof{rmse}",
             fit.points,
             fit.elements.len(),
             element_span(&fit.elements),
             fit.degrees_of_freedom,
-            fit.rmse
-                .get("m00")
-                .map(|r| format!(", RMSE m00 = {} sr⁻¹", format_plain(*r)))
-                .unwrap_or_default()
         ),
         Tone::Normal,
     ));
     let local = fit.convergence.len().saturating_sub(fit.global_iterations);
     rows.push(Row::Text(
         format!(
-            "{}, seed {}: {} generations + {} local iterations, {} evaluations",
-            fit.optimizer, fit.seed, fit.global_iterations, local, fit.evaluations
+            "{}, seed {}: {} generations + {} local iterations, {} evaluations; {}",
+            fit.optimizer, fit.seed, fit.global_iterations, local, fit.evaluations, fit.termination
         ),
         Tone::Normal,
     ));
     rows.push(Row::Text(
-        format!("termination: {}", fit.termination),
-        Tone::Normal,
-    ));
-    rows.push(Row::Text(
         format!(
-            "source {}, sha256 {}; {}",
+            "source {} (sha256 {})",
             fit.source.display(),
-            sha_prefix(&fit.source_sha256),
-            material.tool_version
+            sha_prefix(&fit.source_sha256)
         ),
         Tone::Muted,
     ));
@@ -323,14 +353,14 @@ pub fn draw_table<DB: DrawingBackend>(
         &caption,
         (width as i32 / 2, 12),
     )?;
-    let size = LEGEND_SIZE + 1;
-    let line = size + 7;
+    let size = LEGEND_SIZE;
+    let line = size + 8;
     let mut y = 50;
     for row in table_rows(material) {
         match row {
             Row::Heading(text) => {
                 y += 4;
-                let style = (FONT, size + 1, FontStyle::Bold).into_font().color(&BLACK);
+                let style = (FONT, size + 2, FontStyle::Bold).into_font().color(&BLACK);
                 area.draw_text(&text, &style.into_text_style(area), (left, y))?;
                 area.draw(&PathElement::new(
                     vec![(left, y + line - 3), (right, y + line - 3)],
@@ -396,7 +426,8 @@ mod tests {
     use super::*;
     use crate::material::AlternativeFit;
     use crate::pbrdf::Shadowing;
-    use std::collections::BTreeMap;
+    use crate::report::fit_report::test_records::fit_record;
+    use serde_json::json;
 
     #[test]
     fn values_are_rounded_to_their_uncertainty() {
@@ -430,32 +461,23 @@ mod tests {
         Material {
             name: "m".into(),
             tool_version: "t".into(),
-            fit: Some(FitRecord {
-                source: "m.csv".into(),
-                source_sha256: "0".repeat(64),
-                points: 10,
-                elements: vec!["m00".into(), "m10".into()],
-                free_parameters: vec!["sigma".into(), "q".into(), "rho".into()],
-                optimizer: "ga+nm".into(),
-                seed: 1,
-                settings: BTreeMap::new(),
-                iterations: 3,
-                evaluations: 30,
-                cost: 18.0,
-                reduced_chi2: 1.06,
-                degrees_of_freedom: 17,
-                aic,
-                bic: aic + 3.0,
-                termination: "converged".into(),
-                rmse: BTreeMap::new(),
-                uncertainty: BTreeMap::from([("sigma".into(), 0.0012), ("rho".into(), 0.001)]),
-                correlation: vec![
-                    vec![1.0, -0.95, 0.1],
-                    vec![-0.95, 1.0, 0.2],
-                    vec![0.1, 0.2, 1.0],
-                ],
-                undetermined: vec!["q".into()],
-                alternative: Some(AlternativeFit {
+            fit: Some(fit_record(json!({
+                "source": "m.csv",
+                "source_sha256": "0".repeat(64),
+                "points": 10,
+                "elements": ["m00", "m10"],
+                "free_parameters": ["sigma", "q", "rho"],
+                "optimizer": "ga+nm",
+                "cost": 18.0,
+                "reduced_chi2": 1.06,
+                "degrees_of_freedom": 17,
+                "aic": aic,
+                "bic": aic + 3.0,
+                "uncertainty": { "sigma": 0.0012, "rho": 0.001 },
+                "correlation": [[1.0, -0.95, 0.1], [-0.95, 1.0, 0.2], [0.1, 0.2, 1.0]],
+                "undetermined": ["q"],
+                "at_bound": ["rho_d"],
+                "alternative": AlternativeFit {
                     model: ModelSpec {
                         distribution: SlopeDistribution::Gaussian { sigma: 0.09 },
                         ..model.clone()
@@ -464,12 +486,8 @@ mod tests {
                     reduced_chi2: 1.6,
                     aic: alternative_aic,
                     bic: alternative_aic + 3.0,
-                }),
-                convergence: vec![],
-                global_iterations: 0,
-                at_bound: Vec::new(),
-                model_choice: None,
-            }),
+                },
+            }))),
             model,
         }
     }
@@ -503,14 +521,29 @@ mod tests {
         assert_eq!(cells("q").1, Tone::Warning, "q is undetermined");
         assert_eq!(cells("q").0[2], "± ? undetermined");
         assert_eq!(cells("n").0[1..3], ["1.200", "fixed"]);
-        assert_eq!(
-            cells("ρd").0[1..3],
-            ["0.0000", "± 0.0010"],
-            "`rho` names ρ_d"
-        );
+        assert_eq!(cells("ρd").0[1..3], ["0 †", "± 0.0010"], "`rho` names ρ_d");
+        assert!(rows.contains(&Row::Text(
+            "† at a bound of its search interval: ρd".into(),
+            Tone::Muted
+        )));
         assert!(rows.contains(&Row::Text(
             "strongest correlation ρ(σ, q) = -0.950".into(),
             Tone::Normal
         )));
+        assert_eq!(cells("cost χ²").0[1], "18.00");
+    }
+
+    #[test]
+    fn a_robust_cost_is_not_called_chi_squared() {
+        let mut m = material(24.0, 36.5);
+        let fit = m.fit.as_mut().unwrap();
+        fit.settings.insert("robust_loss".into(), "none".into());
+        assert_eq!(robust_loss(fit), None);
+        fit.settings
+            .insert("robust_loss".into(), "huber(1.5)".into());
+        assert_eq!(robust_loss(fit), Some("huber(1.5)"));
+        let rows = table_rows(&m);
+        assert!(rows.iter().any(|row| matches!(row,
+            Row::Cells(cells, _) if cells[0] == "cost, huber(1.5)" && cells[1] == "18.00")));
     }
 }
