@@ -56,6 +56,22 @@ impl ColorMap {
     }
 }
 
+/// A colour map sampled at 256 levels, for mapping millions of pixels.
+pub struct Lut([[u8; 3]; 256]);
+
+impl Lut {
+    pub fn new(map: &ColorMap) -> Lut {
+        Lut(std::array::from_fn(|i| map.at(i as f64 / 255.0)))
+    }
+
+    /// Colour at t ∈ [0, 1] (clamped; NaN maps to the low end), to the nearest level.
+    #[inline]
+    pub fn at(&self, t: f64) -> [u8; 3] {
+        let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+        self.0[(t * 255.0).round() as usize]
+    }
+}
+
 /// Cyclic colour for t ∈ [0, 1) with at(0) = at(1): a hue wheel at fixed saturation/lightness.
 pub fn cyclic(t: f64) -> [u8; 3] {
     let hue = t.rem_euclid(1.0) * 6.0;
@@ -84,6 +100,19 @@ mod tests {
         assert_eq!(THERMAL.at(-3.0), [0, 0, 10]);
         assert_eq!(SEQUENTIAL.at(2.0), [253, 231, 37]);
         assert_eq!(SEQUENTIAL.at(f64::NAN), [68, 1, 84]);
+    }
+
+    #[test]
+    fn lookup_tables_follow_their_maps() {
+        let lut = Lut::new(&DIVERGING);
+        for t in [0.0, 0.3, 0.5, 0.77, 1.0] {
+            let (a, b) = (lut.at(t), DIVERGING.at(t));
+            assert!(
+                (0..3).all(|k| (a[k] as i32 - b[k] as i32).abs() <= 2),
+                "{t}"
+            );
+        }
+        assert_eq!(lut.at(f64::NAN), DIVERGING.at(0.0));
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! the object pixels (symmetric for S1/S2), so a few glints do not wash out the image.
 //! Text is drawn with plotters using the embedded DejaVu Sans font.
 
-use super::colormap::{cyclic, ColorMap, DIVERGING, MASKED, SEQUENTIAL, THERMAL};
+use super::colormap::{cyclic, ColorMap, Lut, DIVERGING, MASKED, SEQUENTIAL, THERMAL};
 use super::shading::dolp_aop;
 use super::tables::TemperatureLookup;
 use super::{StokesImage, BACKGROUND};
@@ -15,6 +15,7 @@ use image::ImageEncoder;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::FontStyle;
+use rayon::prelude::*;
 use std::io;
 
 /// How a panel's colour bar is drawn: its colours bottom to top and labelled ticks.
@@ -45,15 +46,14 @@ pub struct Previews {
 
 impl Previews {
     pub fn new(scene: &Scene, image: &StokesImage) -> Previews {
-        let object = |i: usize| image.surface[i] != BACKGROUND;
         let any_object = image.surface.iter().any(|&o| o != BACKGROUND);
-        let pick = |f: &dyn Fn([f64; 3]) -> f64| -> Vec<f64> {
+        let pick = |f: &(dyn Fn([f64; 3]) -> f64 + Sync)| -> Vec<f64> {
             image
                 .stokes
-                .iter()
-                .enumerate()
-                .filter(|&(i, _)| object(i) || !any_object)
-                .map(|(_, &s)| f(s))
+                .par_iter()
+                .zip(&image.surface)
+                .filter(|&(_, &surface)| surface != BACKGROUND || !any_object)
+                .map(|(&s, _)| f(s))
                 .filter(|v| v.is_finite())
                 .collect()
         };
@@ -65,20 +65,22 @@ impl Previews {
         let t_of = |r: f64| band.brightness_temperature(r.max(0.0)).unwrap_or(0.0);
         let (t_lo, t_hi) = widen(t_of(r_lo), t_of(r_hi));
         let temperature = TemperatureLookup::new(band, r_lo.min(r_hi), r_hi.max(r_lo));
+        let thermal = Lut::new(&THERMAL);
         let s0_colors = image
             .stokes
-            .iter()
-            .map(|s| THERMAL.at((temperature.at(s[0]) - t_lo) / (t_hi - t_lo)))
+            .par_iter()
+            .map(|s| thermal.at((temperature.at(s[0]) - t_lo) / (t_hi - t_lo)))
             .collect();
 
+        let diverging = Lut::new(&DIVERGING);
         let symmetric = |j: usize| {
             let magnitudes = pick(&|s| s[j].abs());
             let (_, hi) = robust_range(magnitudes, 0.0, 0.99);
             let m = if hi > 0.0 { hi } else { 1.0 };
             let colors = image
                 .stokes
-                .iter()
-                .map(|s| DIVERGING.at(0.5 + 0.5 * s[j] / m))
+                .par_iter()
+                .map(|s| diverging.at(0.5 + 0.5 * s[j] / m))
                 .collect();
             (colors, m)
         };
@@ -88,16 +90,17 @@ impl Previews {
         let dolp = pick(&|s| dolp_aop(s).0);
         let (_, d_hi) = robust_range(dolp, 0.0, 0.99);
         let d_hi = if d_hi > 0.0 { d_hi } else { 1e-3 };
+        let sequential = Lut::new(&SEQUENTIAL);
         let dolp_colors = image
             .stokes
-            .iter()
-            .map(|&s| SEQUENTIAL.at(dolp_aop(s).0 / d_hi))
+            .par_iter()
+            .map(|&s| sequential.at(dolp_aop(s).0 / d_hi))
             .collect();
 
         let mask = scene.aop_mask_dolp;
         let aop_colors = image
             .stokes
-            .iter()
+            .par_iter()
             .map(|&s| {
                 let (d, a) = dolp_aop(s);
                 if d < mask || d == 0.0 {
@@ -285,14 +288,19 @@ impl Canvas {
 
     fn png(&self) -> io::Result<Vec<u8>> {
         let mut bytes = Vec::new();
-        image::codecs::png::PngEncoder::new(&mut bytes)
-            .write_image(
-                &self.rgb,
-                self.width as u32,
-                self.height as u32,
-                image::ExtendedColorType::Rgb8,
-            )
-            .map_err(io::Error::other)?;
+        // Fast deflate: previews are large and rewritten on every render.
+        image::codecs::png::PngEncoder::new_with_quality(
+            &mut bytes,
+            image::codecs::png::CompressionType::Fast,
+            image::codecs::png::FilterType::Adaptive,
+        )
+        .write_image(
+            &self.rgb,
+            self.width as u32,
+            self.height as u32,
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(io::Error::other)?;
         Ok(bytes)
     }
 }
