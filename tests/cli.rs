@@ -243,3 +243,41 @@ fn bad_input_gives_one_clear_line_and_a_failure_exit() {
         );
     }
 }
+
+#[test]
+fn fit_with_one_bad_file_writes_nothing_and_render_refuses_a_missing_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, "theta_i_deg;theta_r_deg;m00\n30;30;0.1\n").unwrap();
+    let good = concat!(env!("CARGO_MANIFEST_DIR"), "/measurements/paper_paint.csv");
+    let (fits, reports) = (dir.path().join("fits"), dir.path().join("reports"));
+    let (ok, _, stderr) = irpol(&[
+        "fit",
+        good,
+        bad.to_str().unwrap(),
+        "--out",
+        fits.to_str().unwrap(),
+        "--reports",
+        reports.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("bad.csv:1:") && stderr.contains("';'"),
+        "{stderr}"
+    );
+    assert!(
+        !fits.exists() && !reports.exists(),
+        "a failed fit must write nothing"
+    );
+
+    let (ok, _, stderr) = irpol(&[
+        "render",
+        "/no/scene.toml",
+        "--out",
+        dir.path().join("out").to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("/no/scene.toml") && stderr.lines().count() == 1,
+        "{stderr}"
+    );
+    assert!(!dir.path().join("out").exists());
+}
