@@ -61,11 +61,12 @@ impl FresnelFractions {
     #[inline]
     pub fn reflectances_and_cross(&self) -> (f64, f64, Complex64) {
         let (s_den2, p_den2) = (self.s_den.norm_sqr(), self.p_den.norm_sqr());
-        let rs2 = self.s_num.norm_sqr() / s_den2;
-        let rp2 = self.p_num.norm_sqr() / p_den2;
+        // One division for all three (divisions dominate this hot path).
+        let inverse = 1.0 / (s_den2 * p_den2);
+        let rs2 = self.s_num.norm_sqr() * p_den2 * inverse;
+        let rp2 = self.p_num.norm_sqr() * s_den2 * inverse;
         // r_s* r_p = (s_num* p_num)(s_den p_den*) / (|s_den|² |p_den|²)
-        let cross =
-            self.s_num.conj() * self.p_num * (self.s_den * self.p_den.conj()) / (s_den2 * p_den2);
+        let cross = self.s_num.conj() * self.p_num * (self.s_den * self.p_den.conj()) * inverse;
         (rs2, rp2, cross)
     }
 }

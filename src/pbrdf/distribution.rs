@@ -118,8 +118,9 @@ impl PreparedDistribution {
     #[inline]
     pub(crate) fn facet_pdf(&self, cos_theta: f64) -> f64 {
         let cos2 = cos_theta * cos_theta;
-        let tan2 = (1.0 - cos2) / cos2;
-        self.slope_pdf(tan2) / (cos2 * cos_theta)
+        let inverse_cos2 = 1.0 / cos2;
+        let tan2 = inverse_cos2 - 1.0;
+        self.slope_pdf(tan2) * inverse_cos2 / cos_theta
     }
 
     /// Smith Λ(θ) for a direction at zenith angle θ, μ = cot θ (DESIGN §1.3).

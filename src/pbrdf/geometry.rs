@@ -89,8 +89,8 @@ pub(crate) fn frame_rotation(
     let p_axis = k.cross(s_axis);
     let c = facet_s.dot(s_axis);
     let s = facet_s.dot(&p_axis);
-    let norm2 = c * c + s * s;
-    ((c * c - s * s) / norm2, 2.0 * c * s / norm2)
+    let inverse_norm2 = 1.0 / (c * c + s * s);
+    ((c * c - s * s) * inverse_norm2, 2.0 * c * s * inverse_norm2)
 }
 
 #[cfg(test)]
