@@ -25,8 +25,8 @@ use rayon::prelude::*;
 use std::f64::consts::{FRAC_1_PI, PI};
 
 /// Node counts of the hemispherical quadrature. `default()` meets 1e-5 absolute in emissivity for
-/// σ ≥ 0.02 up to 89° (shadowing none or Smith); `coarse()` is for renderer tables, `fine()` for
-/// reference values.
+/// σ ≥ 0.02 up to 89° (shadowing none or Smith); `fine()` is for reference values. The renderer's
+/// tables choose their own node counts (`render::kernel::KernelQuadrature::hemisphere`).
 #[derive(Clone, Debug)]
 pub struct HemisphereQuadrature {
     /// Trapezoid nodes over a full circle of facet azimuths (slopes whose mirror is never cut).
@@ -64,10 +64,6 @@ impl HemisphereQuadrature {
             panel_growth: panel_growth.max(1.1),
             diffuse_rule,
         }
-    }
-
-    pub fn coarse() -> HemisphereQuadrature {
-        HemisphereQuadrature::new(24, 6, 0.5, 2.5)
     }
 
     pub fn fine() -> HemisphereQuadrature {
