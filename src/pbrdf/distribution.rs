@@ -118,13 +118,12 @@ impl PreparedDistribution {
         }
     }
 
-    /// Facet-normal density per solid angle P(θ) = p(tan θ)/cos³θ (paper eq. 3).
+    /// The microfacet normal distribution D(θ) = P(θ)/cosθ = p(tanθ)/cos⁴θ of a facet tilted by
+    /// θ, from tan²θ (P is the paper's eq. 3 density per solid angle; ∫ D cosθ dΩ = 1).
     #[inline]
-    pub(crate) fn facet_pdf(&self, cos_theta: f64) -> f64 {
-        let cos2 = cos_theta * cos_theta;
-        let inverse_cos2 = 1.0 / cos2;
-        let tan2 = inverse_cos2 - 1.0;
-        self.slope_pdf(tan2) * inverse_cos2 / cos_theta
+    pub(crate) fn normal_distribution(&self, tan2_theta: f64) -> f64 {
+        let inverse_cos2 = 1.0 + tan2_theta;
+        self.slope_pdf(tan2_theta) * inverse_cos2 * inverse_cos2
     }
 
     /// Smith Λ(θ) for a direction at zenith angle θ, μ = cot θ (DESIGN §1.3).
@@ -210,7 +209,7 @@ mod tests {
 
     #[test]
     fn cauchy_with_q_2_is_ggx() {
-        // GGX D(h) = α² / (π cos⁴θ (α² + tan²θ)²) with α = √2σ, and D = P / cosθ.
+        // GGX D(h) = α² / (π cos⁴θ (α² + tan²θ)²) with α = √2σ.
         let sigma = 0.23;
         let alpha2 = 2.0 * sigma * sigma;
         let dist = SlopeDistribution::Cauchy { sigma, q: 2.0 }.prepare();
@@ -218,7 +217,7 @@ mod tests {
             let c = deg.to_radians().cos();
             let tan2 = (1.0 - c * c) / (c * c);
             let ggx = alpha2 / (PI * c.powi(4) * (alpha2 + tan2).powi(2));
-            assert!((dist.facet_pdf(c) / c / ggx - 1.0).abs() < 1e-13);
+            assert!((dist.normal_distribution(tan2) / ggx - 1.0).abs() < 1e-13);
         }
     }
 

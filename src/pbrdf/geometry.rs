@@ -5,12 +5,14 @@ use super::ModelError;
 use nalgebra::Vector3;
 
 /// A unit direction pointing away from the surface, with the horizontal axis ê_φ = unit(ẑ × ω) =
-/// (−sin φ, cos φ, 0) that fixes its psps frame. ê_φ is kept explicitly so that θ = 0 takes the
-/// limit θ → 0⁺ along the given azimuth φ (SCATMECH's choice), where ẑ × ω itself vanishes.
+/// (−sin φ, cos φ, 0) that fixes its psps frame, and ê_θ = ê_φ × ω = (cosθ cosφ, cosθ sinφ, −sinθ).
+/// The axes are kept explicitly so that θ = 0 takes the limit θ → 0⁺ along the given azimuth φ
+/// (SCATMECH's choice), where ẑ × ω itself vanishes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Direction {
     pub vector: Vector3<f64>,
     pub azimuthal_axis: Vector3<f64>,
+    pub polar_axis: Vector3<f64>,
 }
 
 impl Direction {
@@ -22,6 +24,7 @@ impl Direction {
         Direction {
             vector: Vector3::new(sin_t * cos_p, sin_t * sin_p, cos_t),
             azimuthal_axis: Vector3::new(-sin_p, cos_p, 0.0),
+            polar_axis: Vector3::new(cos_t * cos_p, cos_t * sin_p, -sin_t),
         }
     }
 
@@ -61,6 +64,7 @@ impl Direction {
         Direction {
             vector,
             azimuthal_axis,
+            polar_axis: azimuthal_axis.cross(&vector),
         }
     }
 
@@ -77,19 +81,47 @@ impl Direction {
     }
 }
 
-/// cos 2η and sin 2η of the rotation from the psps frame (s, p = k × s) of propagation k to the
-/// facet frame whose s axis is `facet_s` (any length, ⊥ k): cos η = ŝ_loc·s, sin η = ŝ_loc·p.
-/// Returned from the unnormalized vector as ((c²−s²)/(c²+s²), 2cs/(c²+s²)), no square root needed.
+/// The facet s axis ω_i × h ∝ ω_i × ω_r (h × k_in, ⊥ to both propagation directions) in the psps
+/// frame of the light incident from `incident`: (cos η_i, sin η_i) up to a common positive factor.
+/// There k = −ω_i, s = −ê_φ, p = k × s = −ê_θ, so with the triple-product identities
+/// cos η ∝ (ω_i × ω_r)·(−ê_φ) = −ω_r·ê_θ and sin η ∝ (ω_i × ω_r)·(−ê_θ) = ω_r·ê_φ.
 #[inline]
-pub(crate) fn frame_rotation(
-    facet_s: &Vector3<f64>,
-    s_axis: &Vector3<f64>,
-    k: &Vector3<f64>,
+pub(crate) fn facet_axis_in_incident_frame(
+    incident: &Direction,
+    scattered: &Direction,
 ) -> (f64, f64) {
-    let p_axis = k.cross(s_axis);
-    let c = facet_s.dot(s_axis);
-    let s = facet_s.dot(&p_axis);
-    let inverse_norm2 = 1.0 / (c * c + s * s);
+    let w_r = &scattered.vector;
+    (
+        -w_r.dot(&incident.polar_axis),
+        w_r.dot(&incident.azimuthal_axis),
+    )
+}
+
+/// The facet s axis ω_i × ω_r in the psps frame of the light scattered along `scattered`
+/// (k = ω_r, s = ê_φ, p = −ê_θ): cos η ∝ −ω_i·ê_θ, sin η ∝ −ω_i·ê_φ (see
+/// [`facet_axis_in_incident_frame`]).
+#[inline]
+pub(crate) fn facet_axis_in_scattered_frame(
+    incident: &Direction,
+    scattered: &Direction,
+) -> (f64, f64) {
+    let w_i = &incident.vector;
+    (
+        -w_i.dot(&scattered.polar_axis),
+        -w_i.dot(&scattered.azimuthal_axis),
+    )
+}
+
+/// (cos 2η, sin 2η) from (cos η, sin η) scaled by any common factor: ((c²−s²)/(c²+s²), 2cs/(c²+s²)),
+/// no square root needed. At exact retroreflection (ω_i = ω_r) the facet plane is undefined and
+/// any facet s axis gives the same matrix; take the frame's own s axis there.
+#[inline]
+pub(crate) fn double_angle((c, s): (f64, f64)) -> (f64, f64) {
+    let norm2 = c * c + s * s;
+    if norm2 < 1e-30 {
+        return (1.0, 0.0);
+    }
+    let inverse_norm2 = 1.0 / norm2;
     ((c * c - s * s) * inverse_norm2, 2.0 * c * s * inverse_norm2)
 }
 
@@ -104,6 +136,19 @@ mod tests {
         assert!((z_cross - d.azimuthal_axis).norm() < 1e-15);
         let back = Direction::from_unit_vector(d.vector);
         assert!((back.azimuthal_axis - d.azimuthal_axis).norm() < 1e-15);
+    }
+
+    #[test]
+    fn polar_axis_completes_a_right_handed_frame() {
+        for d in [
+            Direction::from_angles(0.7, 2.1),
+            Direction::from_angles(0.0, 0.5),
+            Direction::from_unit_vector(Vector3::new(0.3, -0.4, 0.5).normalize()),
+        ] {
+            // (ω, ê_θ, ê_φ) is the right-handed spherical frame (ê_r, ê_θ, ê_φ).
+            assert!((d.vector.cross(&d.polar_axis) - d.azimuthal_axis).norm() < 1e-15);
+            assert!((d.polar_axis.norm() - 1.0).abs() < 1e-15);
+        }
     }
 
     #[test]

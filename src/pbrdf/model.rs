@@ -3,10 +3,11 @@
 //! M = L(−η_r) F_fres(β) L(η_i).
 
 use super::distribution::PreparedDistribution;
-use super::geometry::{frame_rotation, Direction};
+use super::geometry::{
+    double_angle, facet_axis_in_incident_frame, facet_axis_in_scattered_frame, Direction,
+};
 use super::{ModelError, Shadowing, SlopeDistribution};
 use crate::optics::{FresnelFractions, Mueller, RefractiveIndex, Stokes};
-use nalgebra::Vector3;
 use num_complex::Complex64;
 use std::f64::consts::FRAC_1_PI;
 
@@ -32,15 +33,14 @@ struct FacetReflection {
     cross: Complex64,
 }
 
-/// The cosines of a direction pair and its facet: θ_i, θ_r, facet tilt θ, local incidence β,
-/// with the (unnormalized) facet s axis.
+/// The cosines of a direction pair and its facet: θ_i, θ_r, facet tilt θ (and tan²θ), local
+/// incidence β.
 struct FacetGeometry {
     cos_i: f64,
     cos_r: f64,
     cos_theta: f64,
+    tan2_theta: f64,
     cos_beta: f64,
-    /// unit(ω_i × h) up to length: the facet s axis (h × k_in), ⊥ to both propagation directions.
-    facet_s: Vector3<f64>,
 }
 
 impl FacetGeometry {
@@ -53,42 +53,17 @@ impl FacetGeometry {
             return None;
         }
         // Half vector h = (ω_i + ω_r)/|ω_i + ω_r|; cos β = h·ω_i = |ω_i + ω_r|/2 (paper eqs. 1–2 in
-        // vector form, regular at θ = 0 and β = 0).
+        // vector form, regular at θ = 0 and β = 0). tan²θ comes straight from the components of
+        // ω_i + ω_r: the facet density then waits for one division, not a square root and two.
         let sum = w_i + w_r;
         let sum_norm = sum.norm();
         Some(FacetGeometry {
             cos_i,
             cos_r,
             cos_theta: sum.z / sum_norm,
+            tan2_theta: (sum.x * sum.x + sum.y * sum.y) / (sum.z * sum.z),
             cos_beta: 0.5 * sum_norm,
-            facet_s: w_i.cross(&sum),
         })
-    }
-
-    /// cos 2η_r, sin 2η_r of the facet frame against the psps frame of the scattered light.
-    /// At exact retroreflection (h ∥ ω_i) the facet plane is undefined and any facet s axis gives
-    /// the same matrix; take the scattered light's own s axis.
-    #[inline]
-    fn scattered_rotation(&self, scattered: &Direction) -> (f64, f64) {
-        if self.facet_s.norm_squared() < 1e-30 {
-            return (1.0, 0.0);
-        }
-        frame_rotation(
-            &self.facet_s,
-            &scattered.outgoing_s_axis(),
-            &scattered.vector,
-        )
-    }
-
-    /// cos 2η_i, sin 2η_i of the facet frame against the psps frame of the incident light:
-    /// k_in = −ω_i, s = −ê_φ(ω_i); the facet s axis h × k_in = ω_i × h.
-    #[inline]
-    fn incident_rotation(&self, incident: &Direction) -> (f64, f64) {
-        if self.facet_s.norm_squared() < 1e-30 {
-            return (1.0, 0.0);
-        }
-        let k_in = -incident.vector;
-        frame_rotation(&self.facet_s, &(-incident.azimuthal_axis), &k_in)
     }
 }
 
@@ -102,6 +77,7 @@ pub struct ScatteringGeometry {
     cos_i: f64,
     cos_r: f64,
     cos_theta: f64,
+    tan2_theta: f64,
     cos_beta: f64,
     incident_rotation: (f64, f64),
     scattered_rotation: (f64, f64),
@@ -115,9 +91,10 @@ impl ScatteringGeometry {
             cos_i: facet.cos_i,
             cos_r: facet.cos_r,
             cos_theta: facet.cos_theta,
+            tan2_theta: facet.tan2_theta,
             cos_beta: facet.cos_beta,
-            incident_rotation: facet.incident_rotation(incident),
-            scattered_rotation: facet.scattered_rotation(scattered),
+            incident_rotation: double_angle(facet_axis_in_incident_frame(incident, scattered)),
+            scattered_rotation: double_angle(facet_axis_in_scattered_frame(incident, scattered)),
         })
     }
 
@@ -195,12 +172,14 @@ impl Pbrdf {
     fn facet_reflection(
         &self,
         cos_theta: f64,
+        tan2_theta: f64,
         cos_i: f64,
         cos_r: f64,
         cos_beta: f64,
         masking: Option<[f64; 2]>,
     ) -> FacetReflection {
-        let pdf = self.prepared.facet_pdf(cos_theta);
+        // P(θ)/(4 cosθ cosθ_i cosθ_r) = D(θ)/(4 cosθ_i cosθ_r) with D = P/cosθ.
+        let ndf = self.prepared.normal_distribution(tan2_theta);
         let g = match masking {
             Some(masking) => self
                 .shadowing
@@ -209,7 +188,7 @@ impl Pbrdf {
                 .shadowing
                 .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta),
         };
-        let scale = pdf * g / (4.0 * cos_theta * cos_i * cos_r);
+        let scale = ndf * g / (4.0 * cos_i * cos_r);
         let (rs2, rp2, cross) =
             FresnelFractions::new(cos_beta, self.permittivity).reflectances_and_cross();
         FacetReflection {
@@ -259,6 +238,7 @@ impl Pbrdf {
     fn mueller_at(&self, geometry: &ScatteringGeometry, masking: Option<[f64; 2]>) -> Mueller {
         let facet = self.facet_reflection(
             geometry.cos_theta,
+            geometry.tan2_theta,
             geometry.cos_i,
             geometry.cos_r,
             geometry.cos_beta,
@@ -266,11 +246,15 @@ impl Pbrdf {
         );
         let (ci, si) = geometry.incident_rotation;
         let (cr, sr) = geometry.scattered_rotation;
-        let (a, b) = (0.5 * (facet.rs2 + facet.rp2), 0.5 * (facet.rs2 - facet.rp2));
-        let (c, s) = (facet.cross.re, facet.cross.im);
+        // F_fres = [[A, B, 0, 0], [B, A, 0, 0], [0, 0, C, S], [0, 0, −S, C]] with the facet scale
+        // folded in: A, B = (|r_s|² ± |r_p|²)/2, C + iS = r_s* r_p.
+        let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
+        let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
+        let c = facet.cross.re * facet.scale;
+        let s = facet.cross.im * facet.scale;
         // L(−η_r) F_fres L(η_i) multiplied out (DESIGN §1.3).
-        let mut m = Mueller::new(
-            a,
+        Mueller::new(
+            a + self.rho_d * FRAC_1_PI,
             b * ci,
             b * si,
             0.0,
@@ -286,9 +270,7 @@ impl Pbrdf {
             -s * si,
             s * ci,
             c,
-        ) * facet.scale;
-        m[(0, 0)] += self.rho_d * FRAC_1_PI;
-        m
+        )
     }
 
     /// First column F_j0 (sr⁻¹): the Stokes BRDF for unpolarized illumination, the only part that
@@ -300,12 +282,13 @@ impl Pbrdf {
         };
         let facet = self.facet_reflection(
             geometry.cos_theta,
+            geometry.tan2_theta,
             geometry.cos_i,
             geometry.cos_r,
             geometry.cos_beta,
             None,
         );
-        let (cr, sr) = geometry.scattered_rotation(scattered);
+        let (cr, sr) = double_angle(facet_axis_in_scattered_frame(incident, scattered));
         let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
         let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
         Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
