@@ -29,7 +29,8 @@ impl RefractiveIndex {
 ///
 /// With k ≥ 0, Im(ε − sin²β) = 2nk ≥ 0, so the principal square root has Re ≥ 0 and Im ≥ 0: the
 /// transmitted wave decays into the substrate, which is the physical branch for metals too.
-/// Kept as fractions so that the Mueller coefficients need no complex division.
+/// Kept as fractions so that the Mueller coefficients need no complex division; numerators and
+/// denominators carry a common positive factor (see [`FresnelFractions::with_cos2`]).
 #[derive(Clone, Copy, Debug)]
 pub struct FresnelFractions {
     pub s_num: Complex64,
@@ -41,14 +42,24 @@ pub struct FresnelFractions {
 impl FresnelFractions {
     #[inline]
     pub fn new(cos_beta: f64, permittivity: Complex64) -> Self {
-        let sin2 = 1.0 - cos_beta * cos_beta;
-        let w = principal_sqrt(permittivity - sin2);
-        let eps_cos = permittivity * cos_beta;
+        Self::with_cos2(cos_beta, cos_beta * cos_beta, permittivity)
+    }
+
+    /// [`FresnelFractions::new`] given cos²β as well: a caller that has cos²β before cos β (the
+    /// pBRDF has |ω_i + ω_r|² = 4cos²β before its square root) starts w = √(ε − sin²β) sooner.
+    ///
+    /// The fractions are multiplied through by t, where √z = (t, Im z/(2t)) or (|Im z|/(2t), ±t)
+    /// (see [`scaled_principal_sqrt`]): t·w needs no division, and the ratios are unchanged.
+    #[inline]
+    pub fn with_cos2(cos_beta: f64, cos2_beta: f64, permittivity: Complex64) -> Self {
+        let (scaled_w, t) = scaled_principal_sqrt(permittivity - (1.0 - cos2_beta));
+        let scaled_cos = cos_beta * t;
+        let scaled_eps_cos = permittivity * scaled_cos;
         FresnelFractions {
-            s_num: cos_beta - w,
-            s_den: cos_beta + w,
-            p_num: eps_cos - w,
-            p_den: eps_cos + w,
+            s_num: scaled_cos - scaled_w,
+            s_den: scaled_cos + scaled_w,
+            p_num: scaled_eps_cos - scaled_w,
+            p_den: scaled_eps_cos + scaled_w,
         }
     }
 
@@ -71,22 +82,27 @@ impl FresnelFractions {
     }
 }
 
-/// Principal square root (Re ≥ 0) in algebraic form. num-complex's `sqrt` goes through the polar
-/// form (atan2, hypot, sin, cos) and costs about four times as much; this is on the hot path of
-/// every BRDF evaluation.
+/// The principal square root (Re ≥ 0) of z in algebraic form, returned as (t·√z, t) with t > 0:
+/// √z = (t, Im z/(2t)) with t = √((|z| + Re z)/2) when Re z ≥ 0, else (|Im z|/(2t), ±t) with
+/// t = √((|z| − Re z)/2) — the forms without cancellation. Scaled by t, √z needs no division.
+/// num-complex's `sqrt` goes through the polar form (atan2, hypot, sin, cos) and costs about four
+/// times as much; this is on the hot path of every BRDF evaluation. At z = 0 it returns (0, 1).
 #[inline]
-fn principal_sqrt(z: Complex64) -> Complex64 {
+fn scaled_principal_sqrt(z: Complex64) -> (Complex64, f64) {
     // |z| without hypot's overflow guard: here |z| ≤ |ε| + 1, far from overflow, and hypot is slow.
     let modulus = (z.re * z.re + z.im * z.im).sqrt();
     if z.re >= 0.0 {
-        let t = (0.5 * (modulus + z.re)).sqrt();
-        if t == 0.0 {
-            return Complex64::new(0.0, 0.0);
+        let t2 = 0.5 * (modulus + z.re);
+        if t2 == 0.0 {
+            return (Complex64::new(0.0, 0.0), 1.0);
         }
-        Complex64::new(t, 0.5 * z.im / t)
+        (Complex64::new(t2, 0.5 * z.im), t2.sqrt())
     } else {
-        let t = (0.5 * (modulus - z.re)).sqrt();
-        Complex64::new(0.5 * z.im.abs() / t, t.copysign(z.im))
+        let t2 = 0.5 * (modulus - z.re);
+        (
+            Complex64::new(0.5 * z.im.abs(), t2.copysign(z.im)),
+            t2.sqrt(),
+        )
     }
 }
 
@@ -142,7 +158,7 @@ mod tests {
     }
 
     #[test]
-    fn principal_sqrt_matches_num_complex() {
+    fn scaled_principal_sqrt_matches_num_complex() {
         for &(re, im) in &[
             (2.0, 0.5),
             (-3.0, 0.2),
@@ -153,11 +169,26 @@ mod tests {
             (3600.0, 1200.0), // a metal's ε − sin²β; |z| stays far from under/overflow
         ] {
             let z = Complex64::new(re, im);
+            let (scaled, t) = scaled_principal_sqrt(z);
+            assert!(t > 0.0);
             assert!(
-                (principal_sqrt(z) - z.sqrt()).norm() <= 1e-15 * z.norm().sqrt(),
+                (scaled / t - z.sqrt()).norm() <= 1e-15 * z.norm().sqrt(),
                 "{z}"
             );
         }
+    }
+
+    #[test]
+    fn critical_angle_of_a_thinner_medium_reflects_everything() {
+        // n = 0.5, k = 0: ε − sin²β = 0 exactly at cos²β = 3/4, where √ of zero must not divide
+        // by zero.
+        let (rs, rp) = FresnelFractions::with_cos2(0.75f64.sqrt(), 0.75, Complex64::new(0.25, 0.0))
+            .amplitudes();
+        assert!((rs.norm_sqr() - 1.0).abs() < 1e-12 && (rp.norm_sqr() - 1.0).abs() < 1e-12);
+        assert_eq!(
+            scaled_principal_sqrt(Complex64::new(0.0, 0.0)),
+            (Complex64::new(0.0, 0.0), 1.0)
+        );
     }
 
     #[test]

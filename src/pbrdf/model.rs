@@ -34,13 +34,15 @@ struct FacetReflection {
 }
 
 /// The cosines of a direction pair and its facet: θ_i, θ_r, facet tilt θ (and tan²θ), local
-/// incidence β.
+/// incidence β (and cos²β, which is ready before cos β).
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct FacetGeometry {
     cos_i: f64,
     cos_r: f64,
     cos_theta: f64,
     tan2_theta: f64,
     cos_beta: f64,
+    cos2_beta: f64,
 }
 
 impl FacetGeometry {
@@ -56,13 +58,15 @@ impl FacetGeometry {
         // vector form, regular at θ = 0 and β = 0). tan²θ comes straight from the components of
         // ω_i + ω_r: the facet density then waits for one division, not a square root and two.
         let sum = w_i + w_r;
-        let sum_norm = sum.norm();
+        let sum_norm2 = sum.norm_squared();
+        let sum_norm = sum_norm2.sqrt();
         Some(FacetGeometry {
             cos_i,
             cos_r,
             cos_theta: sum.z / sum_norm,
             tan2_theta: (sum.x * sum.x + sum.y * sum.y) / (sum.z * sum.z),
             cos_beta: 0.5 * sum_norm,
+            cos2_beta: 0.25 * sum_norm2,
         })
     }
 }
@@ -74,25 +78,17 @@ impl FacetGeometry {
 /// [`Pbrdf::mueller_for_geometry`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ScatteringGeometry {
-    cos_i: f64,
-    cos_r: f64,
-    cos_theta: f64,
-    tan2_theta: f64,
-    cos_beta: f64,
+    facet: FacetGeometry,
     incident_rotation: (f64, f64),
     scattered_rotation: (f64, f64),
 }
 
 impl ScatteringGeometry {
     /// `None` when either direction is at or below the horizon, where the BRDF is zero.
+    #[inline]
     pub fn new(incident: &Direction, scattered: &Direction) -> Option<ScatteringGeometry> {
-        let facet = FacetGeometry::new(incident, scattered)?;
         Some(ScatteringGeometry {
-            cos_i: facet.cos_i,
-            cos_r: facet.cos_r,
-            cos_theta: facet.cos_theta,
-            tan2_theta: facet.tan2_theta,
-            cos_beta: facet.cos_beta,
+            facet: FacetGeometry::new(incident, scattered)?,
             incident_rotation: double_angle(facet_axis_in_incident_frame(incident, scattered)),
             scattered_rotation: double_angle(facet_axis_in_scattered_frame(incident, scattered)),
         })
@@ -100,12 +96,12 @@ impl ScatteringGeometry {
 
     /// cos θ_i, the argument of the incident direction's [`Pbrdf::masking`].
     pub fn cos_incident(&self) -> f64 {
-        self.cos_i
+        self.facet.cos_i
     }
 
     /// cos θ_r, the argument of the scattered direction's [`Pbrdf::masking`].
     pub fn cos_scattered(&self) -> f64 {
-        self.cos_r
+        self.facet.cos_r
     }
 }
 
@@ -168,16 +164,20 @@ impl Pbrdf {
 
     /// Distribution, shadowing and Fresnel part shared by the full and fast paths. `masking`
     /// holds the [`Pbrdf::masking`] factors of ω_i and ω_r, or `None` to compute them here.
-    #[inline]
+    #[inline(always)]
     fn facet_reflection(
         &self,
-        cos_theta: f64,
-        tan2_theta: f64,
-        cos_i: f64,
-        cos_r: f64,
-        cos_beta: f64,
+        geometry: &FacetGeometry,
         masking: Option<[f64; 2]>,
     ) -> FacetReflection {
+        let FacetGeometry {
+            cos_i,
+            cos_r,
+            cos_theta,
+            tan2_theta,
+            cos_beta,
+            cos2_beta,
+        } = *geometry;
         // P(θ)/(4 cosθ cosθ_i cosθ_r) = D(θ)/(4 cosθ_i cosθ_r) with D = P/cosθ.
         let ndf = self.prepared.normal_distribution(tan2_theta);
         let g = match masking {
@@ -189,8 +189,8 @@ impl Pbrdf {
                 .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta),
         };
         let scale = ndf * g / (4.0 * cos_i * cos_r);
-        let (rs2, rp2, cross) =
-            FresnelFractions::new(cos_beta, self.permittivity).reflectances_and_cross();
+        let (rs2, rp2, cross) = FresnelFractions::with_cos2(cos_beta, cos2_beta, self.permittivity)
+            .reflectances_and_cross();
         FacetReflection {
             scale,
             rs2,
@@ -201,6 +201,7 @@ impl Pbrdf {
 
     /// The full 4×4 Mueller BRDF (sr⁻¹) from `incident` (ω_i, toward the source) to `scattered`
     /// (ω_r, toward the viewer), in the psps frames of both (DESIGN §1.3). Zero below the horizon.
+    #[inline]
     pub fn mueller(&self, incident: &Direction, scattered: &Direction) -> Mueller {
         match ScatteringGeometry::new(incident, scattered) {
             Some(geometry) => self.mueller_at(&geometry, None),
@@ -236,14 +237,7 @@ impl Pbrdf {
 
     #[inline]
     fn mueller_at(&self, geometry: &ScatteringGeometry, masking: Option<[f64; 2]>) -> Mueller {
-        let facet = self.facet_reflection(
-            geometry.cos_theta,
-            geometry.tan2_theta,
-            geometry.cos_i,
-            geometry.cos_r,
-            geometry.cos_beta,
-            masking,
-        );
+        let facet = self.facet_reflection(&geometry.facet, masking);
         let (ci, si) = geometry.incident_rotation;
         let (cr, sr) = geometry.scattered_rotation;
         // F_fres = [[A, B, 0, 0], [B, A, 0, 0], [0, 0, C, S], [0, 0, −S, C]] with the facet scale
@@ -280,14 +274,7 @@ impl Pbrdf {
         let Some(geometry) = FacetGeometry::new(incident, scattered) else {
             return Stokes::zeros();
         };
-        let facet = self.facet_reflection(
-            geometry.cos_theta,
-            geometry.tan2_theta,
-            geometry.cos_i,
-            geometry.cos_r,
-            geometry.cos_beta,
-            None,
-        );
+        let facet = self.facet_reflection(&geometry, None);
         let (cr, sr) = double_angle(facet_axis_in_scattered_frame(incident, scattered));
         let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
         let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
