@@ -65,8 +65,9 @@ impl SlopeDistribution {
                 let a = 2.0 * sigma * sigma;
                 PreparedDistribution::Cauchy {
                     a,
+                    inverse_a: 1.0 / a,
                     q,
-                    norm: (q - 1.0) * a.powf(q - 1.0) / PI,
+                    norm: (q - 1.0) / (PI * a),
                     // Γ(q−½)/(Γ(q−1)√π); only meaningful (and only used) for q > 3/2.
                     smith_prefactor: if q > 1.5 {
                         (ln_gamma(q - 0.5) - ln_gamma(q - 1.0)).exp() / PI.sqrt()
@@ -89,7 +90,9 @@ impl SlopeDistribution {
 pub(crate) enum PreparedDistribution {
     Cauchy {
         a: f64,
+        inverse_a: f64,
         q: f64,
+        /// (q − 1)/(π a): p(m) = norm (1 + m²/a)^(−q).
         norm: f64,
         smith_prefactor: f64,
     },
@@ -105,10 +108,14 @@ impl PreparedDistribution {
     #[inline]
     pub(crate) fn slope_pdf(&self, slope2: f64) -> f64 {
         match *self {
-            PreparedDistribution::Cauchy { a, q, norm, .. } => {
-                // exp(−q ln x) rather than powf: glibc's correctly rounded pow took half of
-                // a BRDF evaluation; the relative error here is ~q |ln x| 1e-16 < 1e-12.
-                norm * (-q * (slope2 + a).ln()).exp()
+            PreparedDistribution::Cauchy {
+                inverse_a, q, norm, ..
+            } => {
+                // (q−1)a^(q−1)/π (m² + a)^(−q) as (q−1)/(πa) (1 + m²/a)^(−q): neither factor
+                // under- or overflows for small a and large q (a^(q−1) alone underflows to 0 at
+                // σ = 1e-5, q = 40). exp(−q ln x) rather than powf: glibc's correctly rounded
+                // pow took half of a BRDF evaluation; the relative error is ~q |ln x| 1e-16.
+                norm * (-q * (1.0 + slope2 * inverse_a).ln()).exp()
             }
             PreparedDistribution::Gaussian {
                 inv_two_sigma2,
@@ -218,6 +225,20 @@ mod tests {
             let tan2 = (1.0 - c * c) / (c * c);
             let ggx = alpha2 / (PI * c.powi(4) * (alpha2 + tan2).powi(2));
             assert!((dist.normal_distribution(tan2) / ggx - 1.0).abs() < 1e-13);
+        }
+    }
+
+        /// Narrow, nearly Gaussian Cauchy lobes: a^(q−1) alone underflows at σ = 1e-5, q = 40, but
+    /// the density must stay finite and exact, p(m) = (q−1)/(πa) (1 + m²/a)^(−q).
+    #[test]
+    fn narrow_heavy_exponent_density_stays_finite() {
+        let (sigma, q) = (1e-5, 40.0);
+        let a = 2.0 * sigma * sigma;
+        let dist = SlopeDistribution::Cauchy { sigma, q }.prepare();
+        for m in [0.0, sigma, 5.0 * sigma] {
+            let expect = (q - 1.0) / (PI * a) * (1.0 + m * m / a).powf(-q);
+            let got = dist.slope_pdf(m * m);
+            assert!((got / expect - 1.0).abs() < 1e-13, "m={m}: {got} vs {expect}");
         }
     }
 
