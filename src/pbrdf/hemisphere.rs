@@ -207,7 +207,7 @@ impl Pbrdf {
         );
 
         // The scattered direction's shadowing factor is the same for every facet.
-        let masking_r = self.masking(cos_r);
+        let masking_r = self.quadrature_masking(cos_r);
         let mut add_facet = |u: f64, delta: f64, weight: f64| {
             let (sin_d, cos_d) = delta.sin_cos();
             let sec_h = (1.0 + u * u).sqrt();
@@ -223,7 +223,7 @@ impl Pbrdf {
                 cos_i,
                 cos_r,
                 cos_beta,
-                [self.masking(cos_i), masking_r],
+                [self.quadrature_masking(cos_i), masking_r],
             );
             let fresnel = FresnelFractions::new(cos_beta, permittivity);
             let rs2 = fresnel.s_num.norm_sqr() / fresnel.s_den.norm_sqr();

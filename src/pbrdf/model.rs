@@ -2,7 +2,7 @@
 //! F(ω_i→ω_r) = P(θ) G M(β, η_i, η_r) / (4 cosθ cosθ_i cosθ_r) + (ρ_d/π) diag(1,0,0,0),
 //! M = L(−η_r) F_fres(β) L(η_i).
 
-use super::distribution::PreparedDistribution;
+use super::distribution::{CauchySmithTable, PreparedDistribution};
 use super::geometry::{
     double_angle, facet_axis_in_incident_frame, facet_axis_in_scattered_frame, Direction,
 };
@@ -10,6 +10,7 @@ use super::{ModelError, Shadowing, SlopeDistribution};
 use crate::optics::{FresnelFractions, Mueller, RefractiveIndex, Stokes};
 use num_complex::Complex64;
 use std::f64::consts::FRAC_1_PI;
+use std::sync::OnceLock;
 
 /// A validated pBRDF model. Construct with [`Pbrdf::new`]; the parameters are read-only so that
 /// the constants derived from them stay consistent.
@@ -21,6 +22,9 @@ pub struct Pbrdf {
     rho_d: f64,
     prepared: PreparedDistribution,
     permittivity: Complex64,
+    /// Built on the first hemispherical quadrature with Smith–Cauchy (see
+    /// [`Pbrdf::quadrature_masking`]); `None` inside for the other models.
+    quadrature_lambda: OnceLock<Option<CauchySmithTable>>,
 }
 
 /// What one facet reflection contributes: the specular scale P G/(4 cosθ cosθ_i cosθ_r) and the
@@ -134,6 +138,7 @@ impl Pbrdf {
             rho_d,
             prepared: distribution.prepare(),
             permittivity: index.permittivity(),
+            quadrature_lambda: OnceLock::new(),
         })
     }
 
@@ -160,6 +165,22 @@ impl Pbrdf {
     /// angle and passes it to [`Pbrdf::mueller_with_masking`].
     pub fn masking(&self, cos_theta: f64) -> f64 {
         self.shadowing.masking(&self.prepared, cos_theta)
+    }
+
+    /// [`Pbrdf::masking`] for quadratures that need it at thousands of directions: Smith's Cauchy
+    /// Λ comes from a table built on first use (~0.1 ms; G1 within 2e-9 of the exact one, far
+    /// below the quadrature's 1e-5), everything else is exact.
+    pub(crate) fn quadrature_masking(&self, cos_theta: f64) -> f64 {
+        if self.shadowing != Shadowing::Smith {
+            return 1.0;
+        }
+        let table = self
+            .quadrature_lambda
+            .get_or_init(|| self.prepared.smith_lambda_table());
+        match table {
+            Some(table) => 1.0 / (1.0 + table.lambda(cos_theta)),
+            None => self.masking(cos_theta),
+        }
     }
 
     /// Distribution, shadowing and Fresnel part shared by the full and fast paths. `masking`
