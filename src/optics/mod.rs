@@ -5,7 +5,7 @@ mod fresnel;
 mod planck;
 mod polarization;
 
-pub use fresnel::{fresnel_amplitudes, fresnel_reflectances, FresnelFractions, RefractiveIndex};
+pub use fresnel::{fresnel_amplitudes, FresnelFractions, RefractiveIndex};
 pub use planck::{Band, OpticsError};
 pub use polarization::{
     fresnel_mueller, jones_to_mueller, rotate_stokes, stokes_rotator, Mueller, Stokes,

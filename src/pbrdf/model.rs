@@ -7,7 +7,7 @@ use super::geometry::{
     double_angle, facet_axis_in_incident_frame, facet_axis_in_scattered_frame, Direction,
 };
 use super::{ModelError, Shadowing, SlopeDistribution};
-use crate::optics::{fresnel_reflectances, FresnelFractions, Mueller, RefractiveIndex, Stokes};
+use crate::optics::{FresnelFractions, Mueller, RefractiveIndex, Stokes};
 use num_complex::Complex64;
 use std::f64::consts::FRAC_1_PI;
 use std::sync::OnceLock;
@@ -25,6 +25,16 @@ pub struct Pbrdf {
     /// Built on the first hemispherical quadrature with Smith–Cauchy (see
     /// [`Pbrdf::quadrature_masking`]); `None` inside for the other models.
     quadrature_lambda: OnceLock<Option<CauchySmithTable>>,
+}
+
+/// What one facet reflection contributes: the specular scale P G/(4 cosθ cosθ_i cosθ_r) and the
+/// Fresnel terms at the local incidence angle.
+struct FacetReflection {
+    scale: f64,
+    /// |r_s|², |r_p|² and r_s* r_p.
+    rs2: f64,
+    rp2: f64,
+    cross: Complex64,
 }
 
 /// The cosines of a direction pair and its facet: θ_i, θ_r, facet tilt θ (and tan²θ), local
@@ -173,18 +183,21 @@ impl Pbrdf {
         }
     }
 
-    /// The specular scale P G/(4 cosθ cosθ_i cosθ_r) that multiplies the facet's Fresnel Mueller
-    /// matrix, shared by the full and fast paths. `masking` holds the [`Pbrdf::masking`] factors
-    /// of ω_i and ω_r, or `None` to compute them here.
+    /// Distribution, shadowing and Fresnel part shared by the full and fast paths. `masking`
+    /// holds the [`Pbrdf::masking`] factors of ω_i and ω_r, or `None` to compute them here.
     #[inline(always)]
-    fn facet_scale(&self, geometry: &FacetGeometry, masking: Option<[f64; 2]>) -> f64 {
+    fn facet_reflection(
+        &self,
+        geometry: &FacetGeometry,
+        masking: Option<[f64; 2]>,
+    ) -> FacetReflection {
         let FacetGeometry {
             cos_i,
             cos_r,
             cos_theta,
             tan2_theta,
             cos_beta,
-            ..
+            cos2_beta,
         } = *geometry;
         // P(θ)/(4 cosθ cosθ_i cosθ_r) = D(θ)/(4 cosθ_i cosθ_r) with D = P/cosθ.
         let ndf = self.prepared.normal_distribution(tan2_theta);
@@ -196,7 +209,15 @@ impl Pbrdf {
                 .shadowing
                 .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta),
         };
-        ndf * g / (4.0 * cos_i * cos_r)
+        let scale = ndf * g / (4.0 * cos_i * cos_r);
+        let (rs2, rp2, cross) = FresnelFractions::with_cos2(cos_beta, cos2_beta, self.permittivity)
+            .reflectances_and_cross();
+        FacetReflection {
+            scale,
+            rs2,
+            rp2,
+            cross,
+        }
     }
 
     /// The full 4×4 Mueller BRDF (sr⁻¹) from `incident` (ω_i, toward the source) to `scattered`
@@ -237,19 +258,15 @@ impl Pbrdf {
 
     #[inline]
     fn mueller_at(&self, geometry: &ScatteringGeometry, masking: Option<[f64; 2]>) -> Mueller {
-        let facet = &geometry.facet;
-        let scale = self.facet_scale(facet, masking);
-        let (rs2, rp2, cross) =
-            FresnelFractions::with_cos2(facet.cos_beta, facet.cos2_beta, self.permittivity)
-                .reflectances_and_cross();
+        let facet = self.facet_reflection(&geometry.facet, masking);
         let (ci, si) = geometry.incident_rotation;
         let (cr, sr) = geometry.scattered_rotation;
         // F_fres = [[A, B, 0, 0], [B, A, 0, 0], [0, 0, C, S], [0, 0, −S, C]] with the facet scale
         // folded in: A, B = (|r_s|² ± |r_p|²)/2, C + iS = r_s* r_p.
-        let a = 0.5 * (rs2 + rp2) * scale;
-        let b = 0.5 * (rs2 - rp2) * scale;
-        let c = cross.re * scale;
-        let s = cross.im * scale;
+        let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
+        let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
+        let c = facet.cross.re * facet.scale;
+        let s = facet.cross.im * facet.scale;
         // L(−η_r) F_fres L(η_i) multiplied out (DESIGN §1.3).
         Mueller::new(
             a + self.rho_d * FRAC_1_PI,
@@ -278,12 +295,10 @@ impl Pbrdf {
         let Some(geometry) = FacetGeometry::new(incident, scattered) else {
             return Stokes::zeros();
         };
-        let scale = self.facet_scale(&geometry, None);
-        let (rs2, rp2) =
-            fresnel_reflectances(geometry.cos_beta, geometry.cos2_beta, self.permittivity);
+        let facet = self.facet_reflection(&geometry, None);
         let (cr, sr) = double_angle(facet_axis_in_scattered_frame(incident, scattered));
-        let a = 0.5 * (rs2 + rp2) * scale;
-        let b = 0.5 * (rs2 - rp2) * scale;
+        let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
+        let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
         Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
     }
 }
