@@ -1,7 +1,7 @@
 //! Speed of the physics core: one full 4×4 Mueller evaluation, the first-column fast path, and an
 //! emissivity table 0°–89° in 1° steps at the default (1e-5) accuracy.
 
-use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use irpol::optics::RefractiveIndex;
 use irpol::pbrdf::{Direction, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
 
@@ -45,6 +45,41 @@ fn mueller(c: &mut Criterion) {
     });
 }
 
+/// The same evaluations over 1000 different geometries in a loop, as the fit and the renderer call
+/// them: consecutive evaluations are independent, so the core overlaps their latency chains.
+/// Criterion reports the time per 1000 and the throughput in evaluations per second.
+fn mueller_loop(c: &mut Criterion) {
+    let geometries: Vec<(Direction, Direction)> = (0..1000)
+        .map(|j| {
+            let t = j as f64 / 1000.0;
+            (
+                Direction::from_angles(0.2 + 1.2 * t, 0.0),
+                Direction::from_angles(1.3 - 1.1 * t, 0.5 + 5.0 * t),
+            )
+        })
+        .collect();
+    let model = paper_paint(Shadowing::None);
+    let mut group = c.benchmark_group("loop_1000_cauchy_none");
+    group.throughput(Throughput::Elements(geometries.len() as u64));
+    group.bench_function("mueller_4x4", |b| {
+        b.iter(|| {
+            geometries
+                .iter()
+                .map(|(i, r)| model.mueller(i, r)[(1, 1)])
+                .sum::<f64>()
+        })
+    });
+    group.bench_function("first_column", |b| {
+        b.iter(|| {
+            geometries
+                .iter()
+                .map(|(i, r)| model.first_column(i, r)[1])
+                .sum::<f64>()
+        })
+    });
+    group.finish();
+}
+
 fn emissivity(c: &mut Criterion) {
     let thetas: Vec<f64> = (0..90).map(|t| (t as f64).to_radians()).collect();
     let quadrature = HemisphereQuadrature::default();
@@ -74,5 +109,5 @@ fn emissivity(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, mueller, emissivity);
+criterion_group!(benches, mueller, mueller_loop, emissivity);
 criterion_main!(benches);
