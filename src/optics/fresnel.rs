@@ -30,7 +30,7 @@ impl RefractiveIndex {
 /// With k ≥ 0, Im(ε − sin²β) = 2nk ≥ 0, so the principal square root has Re ≥ 0 and Im ≥ 0: the
 /// transmitted wave decays into the substrate, which is the physical branch for metals too.
 /// Kept as fractions so that the Mueller coefficients need no complex division; numerators and
-/// denominators carry a common positive factor (see [`FresnelFractions::with_cos2`]).
+/// denominators carry a common positive factor (see [`FresnelFractions::from_cos2`]).
 #[derive(Clone, Copy, Debug)]
 pub struct FresnelFractions {
     pub s_num: Complex64,
@@ -42,18 +42,19 @@ pub struct FresnelFractions {
 impl FresnelFractions {
     #[inline]
     pub fn new(cos_beta: f64, permittivity: Complex64) -> Self {
-        Self::with_cos2(cos_beta, cos_beta * cos_beta, permittivity)
+        Self::from_cos2(cos_beta * cos_beta, permittivity)
     }
 
-    /// [`FresnelFractions::new`] given cos²β as well: a caller that has cos²β before cos β (the
-    /// pBRDF has |ω_i + ω_r|² = 4cos²β before its square root) starts w = √(ε − sin²β) sooner.
+    /// [`FresnelFractions::new`] from cos²β: the pBRDF has |ω_i + ω_r|² = 4cos²β, and cos β itself
+    /// would cost a square root.
     ///
     /// The fractions are multiplied through by t, where √z = (t, Im z/(2t)) or (|Im z|/(2t), ±t)
-    /// (see [`scaled_principal_sqrt`]): t·w needs no division, and the ratios are unchanged.
+    /// (see [`scaled_principal_sqrt`]): t·w needs no division, t cosβ = √(t² cos²β) one square
+    /// root, and the ratios are unchanged.
     #[inline]
-    pub fn with_cos2(cos_beta: f64, cos2_beta: f64, permittivity: Complex64) -> Self {
-        let (scaled_w, t) = scaled_principal_sqrt(permittivity - (1.0 - cos2_beta));
-        let scaled_cos = cos_beta * t;
+    pub fn from_cos2(cos2_beta: f64, permittivity: Complex64) -> Self {
+        let (scaled_w, t2) = scaled_principal_sqrt(permittivity - (1.0 - cos2_beta));
+        let scaled_cos = (t2 * cos2_beta).sqrt();
         let scaled_eps_cos = permittivity * scaled_cos;
         FresnelFractions {
             s_num: scaled_cos - scaled_w,
@@ -82,11 +83,12 @@ impl FresnelFractions {
     }
 }
 
-/// The principal square root (Re ≥ 0) of z in algebraic form, returned as (t·√z, t) with t > 0:
+/// The principal square root (Re ≥ 0) of z in algebraic form, returned as (t·√z, t²) with t > 0:
 /// √z = (t, Im z/(2t)) with t = √((|z| + Re z)/2) when Re z ≥ 0, else (|Im z|/(2t), ±t) with
-/// t = √((|z| − Re z)/2) — the forms without cancellation. Scaled by t, √z needs no division.
-/// num-complex's `sqrt` goes through the polar form (atan2, hypot, sin, cos) and costs about four
-/// times as much; this is on the hot path of every BRDF evaluation. At z = 0 it returns (0, 1).
+/// t = √((|z| − Re z)/2) — the forms without cancellation. Scaled by t, √z needs neither a
+/// division nor the square root of t². num-complex's `sqrt` goes through the polar form (atan2,
+/// hypot, sin, cos) and costs about four times as much; this is on the hot path of every BRDF
+/// evaluation. At z = 0 it returns (0, 1).
 #[inline]
 fn scaled_principal_sqrt(z: Complex64) -> (Complex64, f64) {
     // |z| without hypot's overflow guard: here |z| ≤ |ε| + 1, far from overflow, and hypot is slow.
@@ -96,13 +98,10 @@ fn scaled_principal_sqrt(z: Complex64) -> (Complex64, f64) {
         if t2 == 0.0 {
             return (Complex64::new(0.0, 0.0), 1.0);
         }
-        (Complex64::new(t2, 0.5 * z.im), t2.sqrt())
+        (Complex64::new(t2, 0.5 * z.im), t2)
     } else {
         let t2 = 0.5 * (modulus - z.re);
-        (
-            Complex64::new(0.5 * z.im.abs(), t2.copysign(z.im)),
-            t2.sqrt(),
-        )
+        (Complex64::new(0.5 * z.im.abs(), t2.copysign(z.im)), t2)
     }
 }
 
@@ -169,10 +168,10 @@ mod tests {
             (3600.0, 1200.0), // a metal's ε − sin²β; |z| stays far from under/overflow
         ] {
             let z = Complex64::new(re, im);
-            let (scaled, t) = scaled_principal_sqrt(z);
-            assert!(t > 0.0);
+            let (scaled, t2) = scaled_principal_sqrt(z);
+            assert!(t2 > 0.0);
             assert!(
-                (scaled / t - z.sqrt()).norm() <= 1e-15 * z.norm().sqrt(),
+                (scaled / t2.sqrt() - z.sqrt()).norm() <= 1e-15 * z.norm().sqrt(),
                 "{z}"
             );
         }
@@ -182,8 +181,7 @@ mod tests {
     fn critical_angle_of_a_thinner_medium_reflects_everything() {
         // n = 0.5, k = 0: ε − sin²β = 0 exactly at cos²β = 3/4, where √ of zero must not divide
         // by zero.
-        let (rs, rp) = FresnelFractions::with_cos2(0.75f64.sqrt(), 0.75, Complex64::new(0.25, 0.0))
-            .amplitudes();
+        let (rs, rp) = FresnelFractions::from_cos2(0.75, Complex64::new(0.25, 0.0)).amplitudes();
         assert!((rs.norm_sqr() - 1.0).abs() < 1e-12 && (rp.norm_sqr() - 1.0).abs() < 1e-12);
         assert_eq!(
             scaled_principal_sqrt(Complex64::new(0.0, 0.0)),

@@ -219,10 +219,9 @@ impl Pbrdf {
                 return; // rounding at the horizon cut
             }
             let g = self.shadowing().factor_with_masking(
-                1.0 / sec_h,
                 cos_i,
                 cos_r,
-                cos_beta,
+                cos_beta * cos_beta,
                 [self.quadrature_masking(cos_i), masking_r],
             );
             let fresnel = FresnelFractions::new(cos_beta, permittivity);

@@ -37,15 +37,13 @@ struct FacetReflection {
     cross: Complex64,
 }
 
-/// The cosines of a direction pair and its facet: θ_i, θ_r, facet tilt θ (and tan²θ), local
-/// incidence β (and cos²β, which is ready before cos β).
+/// A direction pair and its facet as the model needs them: cos θ_i, cos θ_r, tan²θ of the facet
+/// tilt and cos²β of the local incidence — squares, so that none costs a square root.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct FacetGeometry {
     cos_i: f64,
     cos_r: f64,
-    cos_theta: f64,
     tan2_theta: f64,
-    cos_beta: f64,
     cos2_beta: f64,
 }
 
@@ -62,15 +60,11 @@ impl FacetGeometry {
         // vector form, regular at θ = 0 and β = 0). tan²θ comes straight from the components of
         // ω_i + ω_r: the facet density then waits for one division, not a square root and two.
         let sum = w_i + w_r;
-        let sum_norm2 = sum.norm_squared();
-        let sum_norm = sum_norm2.sqrt();
         Some(FacetGeometry {
             cos_i,
             cos_r,
-            cos_theta: sum.z / sum_norm,
             tan2_theta: (sum.x * sum.x + sum.y * sum.y) / (sum.z * sum.z),
-            cos_beta: 0.5 * sum_norm,
-            cos2_beta: 0.25 * sum_norm2,
+            cos2_beta: 0.25 * sum.norm_squared(),
         })
     }
 }
@@ -194,9 +188,7 @@ impl Pbrdf {
         let FacetGeometry {
             cos_i,
             cos_r,
-            cos_theta,
             tan2_theta,
-            cos_beta,
             cos2_beta,
         } = *geometry;
         // P(θ)/(4 cosθ cosθ_i cosθ_r) = D(θ)/(4 cosθ_i cosθ_r) with D = P/cosθ.
@@ -204,14 +196,14 @@ impl Pbrdf {
         let g = match masking {
             Some(masking) => self
                 .shadowing
-                .factor_with_masking(cos_theta, cos_i, cos_r, cos_beta, masking),
+                .factor_with_masking(cos_i, cos_r, cos2_beta, masking),
             None => self
                 .shadowing
-                .factor(&self.prepared, cos_theta, cos_i, cos_r, cos_beta),
+                .factor(&self.prepared, cos_i, cos_r, cos2_beta),
         };
         let scale = ndf * g / (4.0 * cos_i * cos_r);
-        let (rs2, rp2, cross) = FresnelFractions::with_cos2(cos_beta, cos2_beta, self.permittivity)
-            .reflectances_and_cross();
+        let (rs2, rp2, cross) =
+            FresnelFractions::from_cos2(cos2_beta, self.permittivity).reflectances_and_cross();
         FacetReflection {
             scale,
             rs2,

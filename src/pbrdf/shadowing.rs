@@ -33,21 +33,22 @@ impl Shadowing {
         }
     }
 
-    /// G for facet tilt θ, incidence θ_i, reflection θ_r and local incidence β (all as cosines).
+    /// G for incidence θ_i and reflection θ_r (as cosines) off the facet that mirrors one into the
+    /// other, at local incidence β. The facet enters only through cos²β: V-grooves need
+    /// 2cosθ/cosβ = (cosθ_i + cosθ_r)/cos²β, as ω_i + ω_r = 2cosβ h.
     #[inline]
     pub(crate) fn factor(
         &self,
         distribution: &PreparedDistribution,
-        cos_theta: f64,
         cos_i: f64,
         cos_r: f64,
-        cos_beta: f64,
+        cos2_beta: f64,
     ) -> f64 {
         let masking = [
             self.masking(distribution, cos_i),
             self.masking(distribution, cos_r),
         ];
-        self.factor_with_masking(cos_theta, cos_i, cos_r, cos_beta, masking)
+        self.factor_with_masking(cos_i, cos_r, cos2_beta, masking)
     }
 
     /// The part of G that depends on one direction only: Smith's G1(θ) = 1/(1+Λ(θ)); 1 for the
@@ -65,16 +66,15 @@ impl Shadowing {
     #[inline]
     pub(crate) fn factor_with_masking(
         &self,
-        cos_theta: f64,
         cos_i: f64,
         cos_r: f64,
-        cos_beta: f64,
+        cos2_beta: f64,
         [masking_i, masking_r]: [f64; 2],
     ) -> f64 {
         match self {
             Shadowing::None => 1.0,
             Shadowing::TorranceSparrow => {
-                let scale = 2.0 * cos_theta / cos_beta;
+                let scale = (cos_i + cos_r) / cos2_beta;
                 1.0f64.min(scale * cos_i).min(scale * cos_r)
             }
             Shadowing::Smith => masking_i * masking_r,
