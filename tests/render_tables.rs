@@ -108,55 +108,29 @@ fn brute_force(pbrdf: &Pbrdf, theta_r: f64, env: impl Fn(&Vector3<f64>) -> f64) 
     sum.map(|s| s / total)
 }
 
-/// The materials of the car scene (measurements/README.md truths) and the inline asphalt.
-fn materials() -> Vec<(&'static str, Pbrdf)> {
+/// The materials of the car scene (the shipped measurements' truths) and the inline asphalt.
+fn materials() -> Vec<(String, Pbrdf)> {
     let m =
         |d, n, k, rho| Pbrdf::new(d, Shadowing::Smith, RefractiveIndex::new(n, k), rho).unwrap();
-    vec![
-        (
-            "smooth_glass σ0.03",
-            m(
-                SlopeDistribution::Cauchy {
-                    sigma: 0.03,
-                    q: 3.0,
-                },
-                2.2,
-                0.1,
-                0.0,
-            ),
+    let mut materials: Vec<(String, Pbrdf)> = common::shipped_truths()
+        .into_iter()
+        .map(|(name, distribution, n, k, rho_d, _)| {
+            (
+                format!("{name} σ{}", distribution.sigma()),
+                m(distribution, n, k, rho_d),
+            )
+        })
+        .collect();
+    materials.push((
+        "asphalt σ0.5".into(),
+        m(
+            SlopeDistribution::Cauchy { sigma: 0.5, q: 2.0 },
+            1.6,
+            0.1,
+            0.05,
         ),
-        (
-            "paper_paint σ0.1",
-            m(
-                SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
-                1.2,
-                0.2,
-                0.0,
-            ),
-        ),
-        (
-            "anodized σ0.15",
-            m(SlopeDistribution::Gaussian { sigma: 0.15 }, 3.0, 1.0, 0.01),
-        ),
-        (
-            "rough_paint σ0.3",
-            m(
-                SlopeDistribution::Cauchy { sigma: 0.3, q: 2.5 },
-                1.55,
-                0.05,
-                0.03,
-            ),
-        ),
-        (
-            "asphalt σ0.5",
-            m(
-                SlopeDistribution::Cauchy { sigma: 0.5, q: 2.0 },
-                1.6,
-                0.1,
-                0.05,
-            ),
-        ),
-    ]
+    ));
+    materials
 }
 
 /// Surface orientations (tilt from world up, θ_r, azimuth of ω_r from uphill), degrees: a

@@ -224,9 +224,8 @@ impl Pbrdf {
                 cos_beta * cos_beta,
                 [self.quadrature_masking(cos_i), masking_r],
             );
-            let fresnel = FresnelFractions::new(cos_beta, permittivity);
-            let rs2 = fresnel.s_num.norm_sqr() / fresnel.s_den.norm_sqr();
-            let rp2 = fresnel.p_num.norm_sqr() / fresnel.p_den.norm_sqr();
+            let (rs2, rp2, _) =
+                FresnelFractions::new(cos_beta, permittivity).reflectances_and_cross();
             // Facet s axis ω_i × h against the psps frame of ω_r (η_r of DESIGN §1.3).
             let facet_s = w_i.cross(&h);
             let (c, s) = (facet_s.dot(&s_axis), facet_s.dot(&p_axis));

@@ -69,8 +69,8 @@ impl FacetGeometry {
     }
 }
 
-/// The model-independent part of one (ω_i, ω_r) pair (DESIGN §1.1, §1.3): the cosines of θ_i,
-/// θ_r, the facet tilt θ and the local incidence β, and the rotations (cos 2η, sin 2η) of the
+/// The model-independent part of one (ω_i, ω_r) pair (DESIGN §1.1, §1.3): the facet geometry
+/// (cos θ_i, cos θ_r, tan²θ, cos²β), and the rotations (cos 2η, sin 2η) of the
 /// facet s/p frame against the psps frames of the incident and the scattered light. A caller
 /// that evaluates many models on the same directions (a fit) builds it once per pair and calls
 /// [`Pbrdf::mueller_for_geometry`].

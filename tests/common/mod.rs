@@ -5,10 +5,10 @@ use irpol::material::{Material, ModelSpec};
 use irpol::pbrdf::{Shadowing, SlopeDistribution};
 use std::path::Path;
 
-/// Writes the materials of the shipped synthetic measurements (their generating "truth"
-/// parameters, measurements/README.md) as a material library, standing in for `fits/`.
-pub fn write_truth_library(dir: &Path) {
-    let materials = [
+/// The generating "truth" of each shipped synthetic measurement (measurements/README.md):
+/// (name, distribution, n, k, ρ_d, wavelength µm), all with Smith shadowing.
+pub fn shipped_truths() -> [(&'static str, SlopeDistribution, f64, f64, f64, f64); 4] {
+    [
         (
             "paper_paint",
             SlopeDistribution::Cauchy {
@@ -50,8 +50,12 @@ pub fn write_truth_library(dir: &Path) {
             0.01,
             9.925,
         ),
-    ];
-    for (name, distribution, n, k, rho_d, wavelength_um) in materials {
+    ]
+}
+
+/// Writes the [`shipped_truths`] as a material library, standing in for `fits/`.
+pub fn write_truth_library(dir: &Path) {
+    for (name, distribution, n, k, rho_d, wavelength_um) in shipped_truths() {
         let material = Material {
             name: name.into(),
             tool_version: "test".into(),
