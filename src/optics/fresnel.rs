@@ -48,13 +48,16 @@ impl FresnelFractions {
     /// [`FresnelFractions::new`] from cos²β: the pBRDF has |ω_i + ω_r|² = 4cos²β, and cos β itself
     /// would cost a square root.
     ///
-    /// The fractions are multiplied through by t, where √z = (t, Im z/(2t)) or (|Im z|/(2t), ±t)
-    /// (see [`scaled_principal_sqrt`]): t·w needs no division, t cosβ = √(t² cos²β) one square
-    /// root, and the ratios are unchanged.
+    /// The fractions are multiplied through by s > 0, where s√z = (|z| + Re z, Im z) or
+    /// (|Im z|, ±(|z| − Re z)) (see [`scaled_principal_sqrt`]): s·w needs no division,
+    /// s cosβ = √(s² cos²β) one square root, and the ratios are unchanged. This is the hot path of
+    /// every BRDF evaluation, so the chain from cos²β to the fractions is kept short: z is formed
+    /// with one addition from ε − 1, which does not wait for cos²β.
     #[inline]
     pub fn from_cos2(cos2_beta: f64, permittivity: Complex64) -> Self {
-        let (scaled_w, t2) = scaled_principal_sqrt(permittivity - (1.0 - cos2_beta));
-        let scaled_cos = (t2 * cos2_beta).sqrt();
+        let z = Complex64::new((permittivity.re - 1.0) + cos2_beta, permittivity.im);
+        let (scaled_w, half_s2) = scaled_principal_sqrt(z);
+        let scaled_cos = (half_s2 * (2.0 * cos2_beta)).sqrt();
         let scaled_eps_cos = permittivity * scaled_cos;
         FresnelFractions {
             s_num: scaled_cos - scaled_w,
@@ -72,36 +75,48 @@ impl FresnelFractions {
     /// (|r_s|², |r_p|², r_s* r_p): what the Mueller matrix of the reflection needs.
     #[inline]
     pub fn reflectances_and_cross(&self) -> (f64, f64, Complex64) {
+        let (rs2, rp2, cross, inverse) = self.reflectances_and_cross_unnormalized();
+        (rs2 * inverse, rp2 * inverse, cross * inverse)
+    }
+
+    /// [`FresnelFractions::reflectances_and_cross`] times the common denominator
+    /// |s_den|² |p_den|², and its inverse last: a caller that scales the three anyway folds the
+    /// inverse into its own factor, one multiplication after the division instead of one each.
+    #[inline]
+    pub fn reflectances_and_cross_unnormalized(&self) -> (f64, f64, Complex64, f64) {
         let (s_den2, p_den2) = (self.s_den.norm_sqr(), self.p_den.norm_sqr());
         // One division for all three (divisions dominate this hot path).
         let inverse = 1.0 / (s_den2 * p_den2);
-        let rs2 = self.s_num.norm_sqr() * p_den2 * inverse;
-        let rp2 = self.p_num.norm_sqr() * s_den2 * inverse;
         // r_s* r_p = (s_num* p_num)(s_den p_den*) / (|s_den|² |p_den|²)
-        let cross = self.s_num.conj() * self.p_num * (self.s_den * self.p_den.conj()) * inverse;
-        (rs2, rp2, cross)
+        let cross = self.s_num.conj() * self.p_num * (self.s_den * self.p_den.conj());
+        (
+            self.s_num.norm_sqr() * p_den2,
+            self.p_num.norm_sqr() * s_den2,
+            cross,
+            inverse,
+        )
     }
 }
 
-/// The principal square root (Re ≥ 0) of z in algebraic form, returned as (t·√z, t²) with t > 0:
-/// √z = (t, Im z/(2t)) with t = √((|z| + Re z)/2) when Re z ≥ 0, else (|Im z|/(2t), ±t) with
-/// t = √((|z| − Re z)/2) — the forms without cancellation. Scaled by t, √z needs neither a
-/// division nor the square root of t². num-complex's `sqrt` goes through the polar form (atan2,
-/// hypot, sin, cos) and costs about four times as much; this is on the hot path of every BRDF
-/// evaluation. At z = 0 it returns (0, 1).
+/// The principal square root (Re ≥ 0) of z in algebraic form, returned as (s√z, s²/2) with
+/// s = 2t > 0: √z = (t, Im z/(2t)) with 2t² = |z| + Re z when Re z ≥ 0, else (|Im z|/(2t), ±t)
+/// with 2t² = |z| − Re z — the forms without cancellation. Scaled by s, √z needs neither a
+/// division nor the square root of t², and neither half. num-complex's `sqrt` goes through the
+/// polar form (atan2, hypot, sin, cos) and costs about four times as much; this is on the hot path
+/// of every BRDF evaluation. At z = 0 it returns (0, ½), i.e. s = 1.
 #[inline]
 fn scaled_principal_sqrt(z: Complex64) -> (Complex64, f64) {
     // |z| without hypot's overflow guard: here |z| ≤ |ε| + 1, far from overflow, and hypot is slow.
     let modulus = (z.re * z.re + z.im * z.im).sqrt();
     if z.re >= 0.0 {
-        let t2 = 0.5 * (modulus + z.re);
-        if t2 == 0.0 {
-            return (Complex64::new(0.0, 0.0), 1.0);
+        let half_s2 = modulus + z.re;
+        if half_s2 == 0.0 {
+            return (Complex64::new(0.0, 0.0), 0.5);
         }
-        (Complex64::new(t2, 0.5 * z.im), t2)
+        (Complex64::new(half_s2, z.im), half_s2)
     } else {
-        let t2 = 0.5 * (modulus - z.re);
-        (Complex64::new(0.5 * z.im.abs(), t2.copysign(z.im)), t2)
+        let half_s2 = modulus - z.re;
+        (Complex64::new(z.im.abs(), half_s2.copysign(z.im)), half_s2)
     }
 }
 
@@ -168,10 +183,10 @@ mod tests {
             (3600.0, 1200.0), // a metal's ε − sin²β; |z| stays far from under/overflow
         ] {
             let z = Complex64::new(re, im);
-            let (scaled, t2) = scaled_principal_sqrt(z);
-            assert!(t2 > 0.0);
+            let (scaled, half_s2) = scaled_principal_sqrt(z);
+            assert!(half_s2 > 0.0);
             assert!(
-                (scaled / t2.sqrt() - z.sqrt()).norm() <= 1e-15 * z.norm().sqrt(),
+                (scaled / (2.0 * half_s2).sqrt() - z.sqrt()).norm() <= 1e-15 * z.norm().sqrt(),
                 "{z}"
             );
         }
@@ -185,7 +200,7 @@ mod tests {
         assert!((rs.norm_sqr() - 1.0).abs() < 1e-12 && (rp.norm_sqr() - 1.0).abs() < 1e-12);
         assert_eq!(
             scaled_principal_sqrt(Complex64::new(0.0, 0.0)),
-            (Complex64::new(0.0, 0.0), 1.0)
+            (Complex64::new(0.0, 0.0), 0.5)
         );
     }
 
