@@ -1,5 +1,6 @@
 //! Facet slope distributions (DESIGN §1.2) and their Smith Λ functions (DESIGN §1.3).
 
+use super::exponential::inline_exp;
 use super::ModelError;
 use serde::{Deserialize, Serialize};
 use statrs::function::{beta::beta_reg, erf::erfc, gamma::ln_gamma};
@@ -107,6 +108,13 @@ impl PreparedDistribution {
     /// Slope-space density p(m) at |m|² = `slope2` (∫ p d²m = 1).
     #[inline]
     pub(crate) fn slope_pdf(&self, slope2: f64) -> f64 {
+        let (exponent, norm) = self.slope_pdf_exponent_and_factor(slope2);
+        norm * inline_exp(exponent)
+    }
+
+    /// (E, c) with p(m) = c e^E at |m|² = `slope2`.
+    #[inline]
+    fn slope_pdf_exponent_and_factor(&self, slope2: f64) -> (f64, f64) {
         match *self {
             PreparedDistribution::Cauchy {
                 inverse_a, q, norm, ..
@@ -115,22 +123,25 @@ impl PreparedDistribution {
                 // under- or overflows for small a and large q (a^(q−1) alone underflows to 0 at
                 // σ = 1e-5, q = 40). exp(−q ln x) rather than powf: glibc's correctly rounded
                 // pow took half of a BRDF evaluation; the relative error is ~q |ln x| 1e-16.
-                norm * (-q * (1.0 + slope2 * inverse_a).ln()).exp()
+                (-q * (1.0 + slope2 * inverse_a).ln(), norm)
             }
             PreparedDistribution::Gaussian {
                 inv_two_sigma2,
                 norm,
                 ..
-            } => norm * (-slope2 * inv_two_sigma2).exp(),
+            } => (-slope2 * inv_two_sigma2, norm),
         }
     }
 
     /// The microfacet normal distribution D(θ) = P(θ)/cosθ = p(tanθ)/cos⁴θ of a facet tilted by
-    /// θ, from tan²θ (P is the paper's eq. 3 density per solid angle; ∫ D cosθ dΩ = 1).
+    /// θ, from tan²θ (P is the paper's eq. 3 density per solid angle; ∫ D cosθ dΩ = 1), as
+    /// (E, c) with D = c e^E. The BRDF multiplies its other factors into c while the exponent is
+    /// computed, so that the exponential is the last factor on its chain.
     #[inline]
-    pub(crate) fn normal_distribution(&self, tan2_theta: f64) -> f64 {
+    pub(crate) fn normal_distribution_exponent_and_factor(&self, tan2_theta: f64) -> (f64, f64) {
+        let (exponent, norm) = self.slope_pdf_exponent_and_factor(tan2_theta);
         let inverse_cos2 = 1.0 + tan2_theta;
-        self.slope_pdf(tan2_theta) * inverse_cos2 * inverse_cos2
+        (exponent, norm * inverse_cos2 * inverse_cos2)
     }
 
     /// Smith Λ(θ) for a direction at zenith angle θ, μ = cot θ (DESIGN §1.3).
@@ -307,7 +318,8 @@ mod tests {
             let c = deg.to_radians().cos();
             let tan2 = (1.0 - c * c) / (c * c);
             let ggx = alpha2 / (PI * c.powi(4) * (alpha2 + tan2).powi(2));
-            assert!((dist.normal_distribution(tan2) / ggx - 1.0).abs() < 1e-13);
+            let (exponent, factor) = dist.normal_distribution_exponent_and_factor(tan2);
+            assert!((factor * exponent.exp() / ggx - 1.0).abs() < 1e-13);
         }
     }
 

@@ -5,6 +5,7 @@
 
 mod distribution;
 mod error;
+mod exponential;
 mod geometry;
 mod hemisphere;
 mod model;

@@ -3,6 +3,7 @@
 //! M = L(−η_r) F_fres(β) L(η_i).
 
 use super::distribution::{CauchySmithTable, PreparedDistribution};
+use super::exponential::inline_exp;
 use super::geometry::{
     double_angle, facet_axis_in_incident_frame, facet_axis_in_scattered_frame, Direction,
 };
@@ -27,11 +28,12 @@ pub struct Pbrdf {
     quadrature_lambda: OnceLock<Option<CauchySmithTable>>,
 }
 
-/// What one facet reflection contributes: the specular scale P G/(4 cosθ cosθ_i cosθ_r) and the
-/// Fresnel terms at the local incidence angle.
+/// What one facet reflection contributes: P G/(4 cosθ cosθ_i cosθ_r) (|r_s|², |r_p|², r_s* r_p)
+/// = `scale` (`rs2`, `rp2`, `cross`). The Fresnel terms are kept unnormalized (see
+/// [`FresnelFractions::reflectances_and_cross_unnormalized`]) and their common denominator is
+/// folded into `scale`.
 struct FacetReflection {
     scale: f64,
-    /// |r_s|², |r_p|² and r_s* r_p.
     rs2: f64,
     rp2: f64,
     cross: Complex64,
@@ -191,8 +193,6 @@ impl Pbrdf {
             tan2_theta,
             cos2_beta,
         } = *geometry;
-        // P(θ)/(4 cosθ cosθ_i cosθ_r) = D(θ)/(4 cosθ_i cosθ_r) with D = P/cosθ.
-        let ndf = self.prepared.normal_distribution(tan2_theta);
         let g = match masking {
             Some(masking) => self
                 .shadowing
@@ -201,9 +201,17 @@ impl Pbrdf {
                 .shadowing
                 .factor(&self.prepared, cos_i, cos_r, cos2_beta),
         };
-        let scale = ndf * g / (4.0 * cos_i * cos_r);
-        let (rs2, rp2, cross) =
-            FresnelFractions::from_cos2(cos2_beta, self.permittivity).reflectances_and_cross();
+        // P(θ)/(4 cosθ cosθ_i cosθ_r) = D(θ)/(4 cosθ_i cosθ_r) with D = P/cosθ = c e^E.
+        let (density_exponent, density_factor) = self
+            .prepared
+            .normal_distribution_exponent_and_factor(tan2_theta);
+        let (rs2, rp2, cross, fresnel_inverse) =
+            FresnelFractions::from_cos2(cos2_beta, self.permittivity)
+                .reflectances_and_cross_unnormalized();
+        // Two long chains, the density's log and exp and the Fresnel square roots and division,
+        // meet in the last multiplications; every other factor is ready before them.
+        let scale = inline_exp(density_exponent)
+            * (density_factor * g / (4.0 * cos_i * cos_r) * fresnel_inverse);
         FacetReflection {
             scale,
             rs2,
