@@ -7,7 +7,8 @@ use nalgebra::Vector3;
 /// A unit direction pointing away from the surface, with the horizontal axis ê_φ = unit(ẑ × ω) =
 /// (−sin φ, cos φ, 0) that fixes its psps frame, and ê_θ = ê_φ × ω = (cosθ cosφ, cosθ sinφ, −sinθ).
 /// The axes are kept explicitly so that θ = 0 takes the limit θ → 0⁺ along the given azimuth φ
-/// (SCATMECH's choice), where ẑ × ω itself vanishes.
+/// (SCATMECH's choice), where ẑ × ω itself vanishes. Light leaving along ω (k = ω) has its psps
+/// s axis unit(ẑ × k) = ê_φ; light arriving from ω (k = −ω) has s = −ê_φ; p = k × s in both cases.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Direction {
     pub vector: Vector3<f64>,
@@ -72,43 +73,34 @@ impl Direction {
     pub fn cos_theta(&self) -> f64 {
         self.vector.z
     }
-
-    /// The psps s axis of light leaving along this direction (k = ω): s = unit(ẑ × k) = ê_φ.
-    /// Light arriving from this direction (k = −ω) has s = −ê_φ. p = k × s in both cases.
-    #[inline]
-    pub fn outgoing_s_axis(&self) -> Vector3<f64> {
-        self.azimuthal_axis
-    }
 }
 
 /// The facet s axis ω_i × h ∝ ω_i × ω_r (h × k_in, ⊥ to both propagation directions) in the psps
-/// frame of the light incident from `incident`: (cos η_i, sin η_i) up to a common positive factor.
-/// There k = −ω_i, s = −ê_φ, p = k × s = −ê_θ, so with the triple-product identities
+/// frame of the light incident from `incident`, with `scattered` = ω_r: (cos η_i, sin η_i) up to a
+/// common positive factor. There k = −ω_i, s = −ê_φ, p = k × s = −ê_θ, so with the triple-product identities
 /// cos η ∝ (ω_i × ω_r)·(−ê_φ) = −ω_r·ê_θ and sin η ∝ (ω_i × ω_r)·(−ê_θ) = ω_r·ê_φ.
 #[inline]
 pub(crate) fn facet_axis_in_incident_frame(
     incident: &Direction,
-    scattered: &Direction,
+    scattered: &Vector3<f64>,
 ) -> (f64, f64) {
-    let w_r = &scattered.vector;
     (
-        -w_r.dot(&incident.polar_axis),
-        w_r.dot(&incident.azimuthal_axis),
+        -scattered.dot(&incident.polar_axis),
+        scattered.dot(&incident.azimuthal_axis),
     )
 }
 
-/// The facet s axis ω_i × ω_r in the psps frame of the light scattered along `scattered`
-/// (k = ω_r, s = ê_φ, p = −ê_θ): cos η ∝ −ω_i·ê_θ, sin η ∝ −ω_i·ê_φ (see
+/// The facet s axis ω_i × ω_r in the psps frame of the light scattered along `scattered`, with
+/// `incident` = ω_i (k = ω_r, s = ê_φ, p = −ê_θ): cos η ∝ −ω_i·ê_θ, sin η ∝ −ω_i·ê_φ (see
 /// [`facet_axis_in_incident_frame`]).
 #[inline]
 pub(crate) fn facet_axis_in_scattered_frame(
-    incident: &Direction,
+    incident: &Vector3<f64>,
     scattered: &Direction,
 ) -> (f64, f64) {
-    let w_i = &incident.vector;
     (
-        -w_i.dot(&scattered.polar_axis),
-        -w_i.dot(&scattered.azimuthal_axis),
+        -incident.dot(&scattered.polar_axis),
+        -incident.dot(&scattered.azimuthal_axis),
     )
 }
 

@@ -16,7 +16,7 @@
 //! angles instead of 1e-5.
 //! The diffuse term (ρ_d/π) ∫ L cosθ_i dΩ_i uses a cosine-weighted (projected disk) rule.
 
-use super::geometry::Direction;
+use super::geometry::{double_angle, facet_axis_in_scattered_frame, Direction};
 use super::{ModelError, Pbrdf};
 use crate::optics::{FresnelFractions, Stokes};
 use gauss_quad::legendre::GaussLegendre;
@@ -187,8 +187,6 @@ impl Pbrdf {
         let sin_r = (1.0 - cos_r * cos_r).max(0.0).sqrt();
         let tangential = scattered.azimuthal_axis;
         let radial = tangential.cross(&Vector3::z());
-        let s_axis = scattered.outgoing_s_axis();
-        let p_axis = w_r.cross(&s_axis);
         let distribution = self.prepared_distribution();
         let permittivity = self.index().permittivity();
 
@@ -226,15 +224,8 @@ impl Pbrdf {
             );
             let (rs2, rp2, _) =
                 FresnelFractions::new(cos_beta, permittivity).reflectances_and_cross();
-            // Facet s axis ω_i × h against the psps frame of ω_r (η_r of DESIGN §1.3).
-            let facet_s = w_i.cross(&h);
-            let (c, s) = (facet_s.dot(&s_axis), facet_s.dot(&p_axis));
-            let norm2 = c * c + s * s;
-            let (cos2, sin2) = if norm2 > 1e-30 {
-                ((c * c - s * s) / norm2, 2.0 * c * s / norm2)
-            } else {
-                (1.0, 0.0)
-            };
+            // Facet s axis against the psps frame of ω_r (η_r of DESIGN §1.3).
+            let (cos2, sin2) = double_angle(facet_axis_in_scattered_frame(&w_i, scattered));
             let f = weight * g * cos_beta * sec_h / cos_r;
             let half_diff = 0.5 * (rs2 - rp2) * f;
             visit(

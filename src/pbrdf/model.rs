@@ -39,6 +39,18 @@ struct FacetReflection {
     cross: Complex64,
 }
 
+impl FacetReflection {
+    /// The elements A = (|r_s|² + |r_p|²)/2 and B = (|r_s|² − |r_p|²)/2 of F_fres (DESIGN §1.3),
+    /// times the facet scale: all that the first column needs.
+    #[inline(always)]
+    fn scaled_a_and_b(&self) -> (f64, f64) {
+        (
+            0.5 * (self.rs2 + self.rp2) * self.scale,
+            0.5 * (self.rs2 - self.rp2) * self.scale,
+        )
+    }
+}
+
 /// A direction pair and its facet as the model needs them: cos θ_i, cos θ_r, tan²θ of the facet
 /// tilt and cos²β of the local incidence — squares, so that none costs a square root.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,8 +101,14 @@ impl ScatteringGeometry {
     pub fn new(incident: &Direction, scattered: &Direction) -> Option<ScatteringGeometry> {
         Some(ScatteringGeometry {
             facet: FacetGeometry::new(incident, scattered)?,
-            incident_rotation: double_angle(facet_axis_in_incident_frame(incident, scattered)),
-            scattered_rotation: double_angle(facet_axis_in_scattered_frame(incident, scattered)),
+            incident_rotation: double_angle(facet_axis_in_incident_frame(
+                incident,
+                &scattered.vector,
+            )),
+            scattered_rotation: double_angle(facet_axis_in_scattered_frame(
+                &incident.vector,
+                scattered,
+            )),
         })
     }
 
@@ -263,8 +281,7 @@ impl Pbrdf {
         let (cr, sr) = geometry.scattered_rotation;
         // F_fres = [[A, B, 0, 0], [B, A, 0, 0], [0, 0, C, S], [0, 0, −S, C]] with the facet scale
         // folded in: A, B = (|r_s|² ± |r_p|²)/2, C + iS = r_s* r_p.
-        let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
-        let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
+        let (a, b) = facet.scaled_a_and_b();
         let c = facet.cross.re * facet.scale;
         let s = facet.cross.im * facet.scale;
         // L(−η_r) F_fres L(η_i) multiplied out (DESIGN §1.3).
@@ -296,9 +313,8 @@ impl Pbrdf {
             return Stokes::zeros();
         };
         let facet = self.facet_reflection(&geometry, None);
-        let (cr, sr) = double_angle(facet_axis_in_scattered_frame(incident, scattered));
-        let a = 0.5 * (facet.rs2 + facet.rp2) * facet.scale;
-        let b = 0.5 * (facet.rs2 - facet.rp2) * facet.scale;
+        let (cr, sr) = double_angle(facet_axis_in_scattered_frame(&incident.vector, scattered));
+        let (a, b) = facet.scaled_a_and_b();
         Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
     }
 }
