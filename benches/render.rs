@@ -6,6 +6,7 @@
 mod common;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use irpol::progress::Silent;
 use irpol::render::render;
 use irpol::scene::load_scene;
 
@@ -18,7 +19,7 @@ fn car(c: &mut Criterion) {
         let path = common::car_scene_with_shipped_fits(&scene_dir, w, h, "pixel");
         let scene = load_scene(&path).unwrap();
         group.bench_function(format!("{w}x{h}"), |b| {
-            b.iter(|| render(&scene, false).unwrap())
+            b.iter(|| render(&scene, &Silent).unwrap())
         });
     }
     group.finish();

@@ -1,17 +1,20 @@
 //! The `irpol` command line: parse, call the library, print. Errors are one clear line and a
 //! non-zero exit, never a panic.
 
+mod cli;
+
 use clap::{Args, Parser, Subcommand};
+use cli::progress::TerminalProgress;
 use irpol::commands::evaluate::{
     read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
 };
+use irpol::commands::render::{default_output_dir, render_scene};
 use irpol::commands::{parse_sweep, ModelArgs};
 use irpol::fit::{
     fit_files, parse_parameter_list, parse_parameter_values, DistributionKind, FitOptions,
     FitOutcome, Optimizer, RobustLoss,
 };
 use irpol::pbrdf::Shadowing;
-use irpol::render::{default_output_dir, render_scene};
 use irpol::report::fit_report::{rebuild_report, write_fit_report};
 use irpol::report::index::write_library_index;
 use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
@@ -380,7 +383,7 @@ fn significant(value: f64, digits: i32) -> String {
 
 fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| default_output_dir(scene));
-    let summary = render_scene(scene, &out, true)?;
+    let summary = render_scene(scene, &out, &TerminalProgress::new())?;
     let temperature = summary
         .apparent_temperature_k
         .as_ref()

@@ -3,8 +3,10 @@
 
 mod common;
 
+use irpol::commands::render::render_scene;
 use irpol::optics::Band;
-use irpol::render::{render, render_scene, BACKGROUND};
+use irpol::progress::Silent;
+use irpol::render::{render, BACKGROUND};
 use irpol::scene::car::sedan;
 use irpol::scene::load_scene;
 use irpol::scene::obj::parse_obj;
@@ -45,7 +47,7 @@ fn car_renders_with_warm_hood_and_cool_glass() {
     let dir = tempfile::tempdir().unwrap();
     let path = common::car_scene(dir.path(), 320, 240, "pixel");
     let out = dir.path().join("out");
-    let summary = render_scene(&path, &out, false).unwrap();
+    let summary = render_scene(&path, &out, &Silent).unwrap();
     for file in &summary.files {
         assert!(out.join(file).is_file(), "{file}");
     }
@@ -54,7 +56,7 @@ fn car_renders_with_warm_hood_and_cool_glass() {
         std::fs::rename(&out, keep).unwrap();
     }
     let scene = load_scene(&path).unwrap();
-    let image = render(&scene, false).unwrap().image;
+    let image = render(&scene, &Silent).unwrap().image;
     let band = Band::lwir();
     let t = |part: &str| {
         band.brightness_temperature(part_mean(&scene, &image, part))
@@ -76,7 +78,7 @@ fn gouraud_car_is_close_to_per_pixel() {
     let mean_s0 = |shading: &str| {
         let path = common::car_scene(&dir.path().join(shading), 160, 120, shading);
         let scene = load_scene(&path).unwrap();
-        let image = render(&scene, false).unwrap().image;
+        let image = render(&scene, &Silent).unwrap().image;
         ["hood", "body", "windshield", "ground"].map(|p| part_mean(&scene, &image, p))
     };
     let (pixel, gouraud) = (mean_s0("pixel"), mean_s0("gouraud"));

@@ -4,7 +4,8 @@
 mod common;
 
 use common::*;
-use irpol::render::render_scene;
+use irpol::commands::render::render_scene;
+use irpol::progress::Silent;
 use std::path::Path;
 
 const TRIANGLE_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 0 0 1\ng panel\nf 1 2 3\n";
@@ -28,7 +29,7 @@ fn refuse(scene: &str, extra_files: &[(&str, &str)]) -> String {
     }
     let path = write_scene(dir.path(), scene);
     let out = dir.path().join("out");
-    let err = render_scene(&path, &out, false).expect_err("the scene should be refused");
+    let err = render_scene(&path, &out, &Silent).expect_err("the scene should be refused");
     assert!(!out.exists(), "something was written for a bad scene");
     let text = err.to_string();
     println!("{text}");
@@ -47,7 +48,7 @@ fn a_valid_mesh_scene_renders() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("panel.obj"), TRIANGLE_OBJ).unwrap();
     let path = write_scene(dir.path(), &scene_with_mesh("panel.obj", ""));
-    render_scene(&path, &dir.path().join("out"), false).unwrap();
+    render_scene(&path, &dir.path().join("out"), &Silent).unwrap();
     assert!(dir.path().join("out/summary.json").is_file());
 }
 
@@ -184,7 +185,7 @@ fn output_folder_is_untouched_on_failure() {
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("S0.tif"), b"old").unwrap();
     let path = write_scene(dir.path(), &scene_with_mesh("missing.obj", ""));
-    assert!(render_scene(&path, &out, false).is_err());
+    assert!(render_scene(&path, &out, &Silent).is_err());
     assert_eq!(std::fs::read(out.join("S0.tif")).unwrap(), b"old");
     assert!(Path::new(&out).read_dir().unwrap().count() == 1);
 }

@@ -6,9 +6,12 @@
 mod common;
 
 use common::*;
+use irpol::commands::render::render_scene;
 use irpol::optics::{Band, RefractiveIndex};
+use irpol::output::Channel;
 use irpol::pbrdf::{HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
-use irpol::render::{render, render_scene, Channel, BACKGROUND};
+use irpol::progress::Silent;
+use irpol::render::{render, BACKGROUND};
 use irpol::scene::load_scene;
 use std::io::Cursor;
 
@@ -34,8 +37,8 @@ fn files_hold_the_rendered_channels() {
     );
     let path = write_scene(dir.path(), &text);
     let out = dir.path().join("out");
-    let summary = render_scene(&path, &out, false).unwrap();
-    let image = render(&load_scene(&path).unwrap(), false).unwrap().image;
+    let summary = render_scene(&path, &out, &Silent).unwrap();
+    let image = render(&load_scene(&path).unwrap(), &Silent).unwrap().image;
 
     let mut stacks = Vec::new();
     for channel in Channel::ALL {
@@ -136,7 +139,7 @@ fn ply_vertex_temperatures_are_interpolated_in_perspective() {
         material_toml(0.2, 2.5, 1.5, 0.1, 0.0),
     );
     let scene = load_scene(&write_scene(dir.path(), &text)).unwrap();
-    let image = render(&scene, false).unwrap().image;
+    let image = render(&scene, &Silent).unwrap().image;
     let pbrdf = Pbrdf::new(
         SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 },
         Shadowing::Smith,
@@ -187,7 +190,7 @@ fn atmosphere_blends_toward_path_radiance_with_range() {
         material_toml(0.2, 2.5, 1.5, 0.1, 0.0),
     );
     let scene = load_scene(&write_scene(dir.path(), &text)).unwrap();
-    let image = render(&scene, false).unwrap().image;
+    let image = render(&scene, &Silent).unwrap().image;
     let path = Band::lwir().radiance(300.0);
     // The plate's +z normal turned −70° about x.
     let normal = nalgebra::Vector3::new(0.0, 70f64.to_radians().sin(), 70f64.to_radians().cos());
@@ -232,7 +235,7 @@ fn netd_noise_has_its_stated_size_and_is_seeded() {
     let run = |seed: u64| {
         render(
             &load_scene(&write_scene(dir.path(), &make(seed))).unwrap(),
-            false,
+            &Silent,
         )
         .unwrap()
         .image

@@ -8,6 +8,7 @@ mod common;
 use common::*;
 use irpol::optics::{Band, RefractiveIndex};
 use irpol::pbrdf::{HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
+use irpol::progress::Silent;
 use irpol::render::{render, StokesImage, BACKGROUND};
 use irpol::scene::{load_scene, Scene};
 use nalgebra::Vector3;
@@ -16,7 +17,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 fn render_text(text: &str) -> (Scene, StokesImage) {
     let dir = tempfile::tempdir().unwrap();
     let scene = load_scene(&write_scene(dir.path(), text)).unwrap();
-    let image = render(&scene, false).unwrap().image;
+    let image = render(&scene, &Silent).unwrap().image;
     (scene, image)
 }
 
@@ -59,7 +60,7 @@ fn projected_angle(scene: &Scene, v: &Vector3<f64>, w_r: &Vector3<f64>) -> f64 {
     v.dot(&y_pix).atan2(v.dot(&x_pix))
 }
 
-fn dolp_aop(s: [f64; 3]) -> (f64, f64) {
+fn dolp_aop(s: [f64; 4]) -> (f64, f64) {
     (s[1].hypot(s[2]) / s[0], 0.5 * s[2].atan2(s[1]))
 }
 

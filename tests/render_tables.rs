@@ -11,10 +11,10 @@ mod common;
 
 use irpol::optics::{Band, RefractiveIndex};
 use irpol::pbrdf::{Direction, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
-use irpol::render::kernel::{specular_kernel, KernelQuadrature};
-use irpol::render::tables::{MaterialTables, TableResolution};
 use irpol::scene::config::{EnvironmentConfig, GroundConfig, SkyConfig};
 use irpol::scene::environment::Environment;
+use irpol::transport::kernel::{specular_kernel, KernelQuadrature};
+use irpol::transport::tables::{MaterialTables, TableResolution};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 

@@ -16,8 +16,8 @@
 //! angles instead of 1e-5.
 //! The diffuse term (ρ_d/π) ∫ L cosθ_i dΩ_i uses a cosine-weighted (projected disk) rule.
 
-use super::geometry::{double_angle, facet_axis_in_scattered_frame, Direction};
 use super::{ModelError, Pbrdf};
+use crate::optics::frame::{double_angle, facet_axis_in_scattered_frame, Direction};
 use crate::optics::{FresnelFractions, Stokes};
 use gauss_quad::legendre::GaussLegendre;
 use nalgebra::Vector3;

@@ -11,9 +11,9 @@ mod hemisphere;
 mod model;
 mod shadowing;
 
+pub use crate::optics::Direction;
 pub use distribution::SlopeDistribution;
 pub use error::ModelError;
-pub use geometry::Direction;
 pub use hemisphere::HemisphereQuadrature;
 pub use model::{Pbrdf, ScatteringGeometry};
 pub use shadowing::Shadowing;

@@ -4,10 +4,10 @@
 
 use super::distribution::{CauchySmithTable, PreparedDistribution};
 use super::exponential::inline_exp;
-use super::geometry::{
+use super::{ModelError, Shadowing, SlopeDistribution};
+use crate::optics::frame::{
     double_angle, facet_axis_in_incident_frame, facet_axis_in_scattered_frame, Direction,
 };
-use super::{ModelError, Shadowing, SlopeDistribution};
 use crate::optics::{FresnelFractions, Mueller, RefractiveIndex, Stokes};
 use num_complex::Complex64;
 use std::f64::consts::FRAC_1_PI;

@@ -9,8 +9,8 @@
 //! S2 = I45 − I135, so their noise is correlated exactly as in a real instrument. Seeded
 //! (ChaCha8, one stream per image row), so a render is reproducible whatever the thread count.
 
-use super::shading::polarizer;
-use crate::scene::Atmosphere;
+use super::film::polarizer;
+use crate::scene::{Atmosphere, Sensor};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
@@ -18,16 +18,17 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 /// Atmospheric transmission and path emission for one pixel at `range` metres.
 #[inline]
 pub fn through_atmosphere(
-    s: [f64; 3],
+    s: [f64; 4],
     range: f64,
     atmosphere: &Atmosphere,
     path_radiance: f64,
-) -> [f64; 3] {
+) -> [f64; 4] {
     let tau = (-atmosphere.extinction_per_m * range).exp();
     [
         tau * s[0] + (1.0 - tau) * path_radiance,
         tau * s[1],
         tau * s[2],
+        tau * s[3],
     ]
 }
 
@@ -38,8 +39,20 @@ pub struct Noise {
 }
 
 impl Noise {
+    /// The sensor's noise: σ_I = ½ NETD dL_bb/dT at the reference temperature.
+    pub fn of_sensor(sensor: &Sensor) -> Noise {
+        Noise {
+            sigma_polarizer: 0.5
+                * sensor.netd_mk
+                * 1e-3
+                * sensor.band.radiance_derivative(sensor.netd_reference_k),
+            seed: sensor.seed,
+        }
+    }
+
     /// Adds polarizer-image noise to a row of Stokes vectors and re-estimates them.
-    pub fn apply_to_row(&self, row: usize, stokes: &mut [[f64; 3]]) {
+    /// S3 is not measured by linear polarizers and is left as it is.
+    pub fn apply_to_row(&self, row: usize, stokes: &mut [[f64; 4]]) {
         if self.sigma_polarizer <= 0.0 {
             return;
         }
@@ -49,7 +62,12 @@ impl Noise {
             let i = [0.0, FRAC_PI_4, FRAC_PI_2, 3.0 * FRAC_PI_4].map(|alpha| {
                 polarizer(*s, alpha) + self.sigma_polarizer * standard_normal(&mut rng)
             });
-            *s = [0.5 * (i[0] + i[1] + i[2] + i[3]), i[0] - i[2], i[1] - i[3]];
+            *s = [
+                0.5 * (i[0] + i[1] + i[2] + i[3]),
+                i[0] - i[2],
+                i[1] - i[3],
+                s[3],
+            ];
         }
     }
 }
@@ -71,10 +89,11 @@ mod tests {
             extinction_per_m: 1e-3,
             temperature_k: 280.0,
         };
-        let s = through_atmosphere([10.0, 1.0, -1.0], 1000.0, &atm, 4.0);
+        let s = through_atmosphere([10.0, 1.0, -1.0, 0.5], 1000.0, &atm, 4.0);
         let tau = (-1.0f64).exp();
         assert!((s[0] - (10.0 * tau + 4.0 * (1.0 - tau))).abs() < 1e-12);
         assert!((s[1] - tau).abs() < 1e-12 && (s[2] + tau).abs() < 1e-12);
+        assert!((s[3] - 0.5 * tau).abs() < 1e-12);
     }
 
     #[test]
@@ -83,9 +102,9 @@ mod tests {
             sigma_polarizer: 0.01,
             seed: 7,
         };
-        let mut row = vec![[5.0, 0.2, -0.1]; 20_000];
+        let mut row = vec![[5.0, 0.2, -0.1, 0.0]; 20_000];
         noise.apply_to_row(3, &mut row);
-        let mut again = vec![[5.0, 0.2, -0.1]; 20_000];
+        let mut again = vec![[5.0, 0.2, -0.1, 0.0]; 20_000];
         noise.apply_to_row(3, &mut again);
         assert_eq!(row, again);
         let n = row.len() as f64;
@@ -96,7 +115,7 @@ mod tests {
         assert!((mean0 - 5.0).abs() < 3e-4);
         assert!((var0.sqrt() / 0.01 - 1.0).abs() < 0.03, "{}", var0.sqrt());
         assert!((var1.sqrt() / (0.01 * 2f64.sqrt()) - 1.0).abs() < 0.03);
-        let mut other = vec![[5.0, 0.2, -0.1]; 10];
+        let mut other = vec![[5.0, 0.2, -0.1, 0.0]; 10];
         noise.apply_to_row(4, &mut other);
         assert_ne!(other[0], row[0]);
     }

@@ -120,7 +120,40 @@ pub struct ShadedMesh {
     pub triangle_surface: Vec<u32>,
 }
 
+/// A point on a triangle of a [`ShadedMesh`], with its interpolated attributes.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    pub triangle: usize,
+    /// (b0, b1, b2), b0 = 1 − b1 − b2.
+    pub barycentric: [f64; 3],
+    pub point: Vector3<f64>,
+    /// Interpolated shading normal, unit length.
+    pub normal: Vector3<f64>,
+    /// (p1 − p0) × (p2 − p0): the winding's normal, not normalized.
+    pub geometric_normal: Vector3<f64>,
+    pub temperature: f64,
+}
+
 impl ShadedMesh {
+    /// The point of triangle `t` at barycentric coordinates (1 − b1 − b2, b1, b2) with its
+    /// interpolated normal and temperature (per-vertex values interpolated, paper §4).
+    #[inline]
+    pub fn interpolate(&self, t: usize, b1: f64, b2: f64) -> SurfaceHit {
+        let [i0, i1, i2] = self.triangles[t].map(|v| v as usize);
+        let b0 = 1.0 - b1 - b2;
+        let p = &self.positions;
+        let n = &self.normals;
+        let temperature = &self.temperatures;
+        SurfaceHit {
+            triangle: t,
+            barycentric: [b0, b1, b2],
+            point: p[i0] * b0 + p[i1] * b1 + p[i2] * b2,
+            normal: (n[i0] * b0 + n[i1] * b1 + n[i2] * b2).normalize(),
+            geometric_normal: (p[i1] - p[i0]).cross(&(p[i2] - p[i0])),
+            temperature: temperature[i0] * b0 + temperature[i1] * b1 + temperature[i2] * b2,
+        }
+    }
+
     /// Appends `other`, offsetting its vertex indices.
     pub fn append(&mut self, other: ShadedMesh) {
         let offset = self.positions.len() as u32;

@@ -96,6 +96,14 @@ pub struct Scene {
     pub mesh: ShadedMesh,
 }
 
+impl Scene {
+    /// The material index of triangle `t` of the mesh.
+    #[inline]
+    pub fn triangle_material(&self, t: usize) -> usize {
+        self.surfaces[self.mesh.triangle_surface[t] as usize].material
+    }
+}
+
 /// Reads and resolves a scene file: meshes, materials, environment. Nothing is written.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
     let text = std::fs::read_to_string(path)

@@ -5,12 +5,11 @@
 //! Text is drawn with plotters using the embedded DejaVu Sans font.
 
 use super::colormap::{cyclic, ColorMap, Lut, DIVERGING, MASKED, SEQUENTIAL, THERMAL};
-use super::shading::dolp_aop;
-use super::tables::TemperatureLookup;
-use super::{StokesImage, BACKGROUND};
+use crate::render::film::{dolp_aop, StokesImage, BACKGROUND};
 use crate::report::{register_fonts, FONT};
 use crate::scene::config::Shading;
 use crate::scene::Scene;
+use crate::transport::tables::TemperatureLookup;
 use image::ImageEncoder;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -47,7 +46,7 @@ pub struct Previews {
 impl Previews {
     pub fn new(scene: &Scene, image: &StokesImage) -> Previews {
         let any_object = image.surface.iter().any(|&o| o != BACKGROUND);
-        let pick = |f: &(dyn Fn([f64; 3]) -> f64 + Sync)| -> Vec<f64> {
+        let pick = |f: &(dyn Fn([f64; 4]) -> f64 + Sync)| -> Vec<f64> {
             image
                 .stokes
                 .par_iter()

@@ -3,13 +3,15 @@
 //! Fig. 5 layout) and `summary.json`. Each file is encoded in memory and written atomically
 //! (temporary sibling + rename); `summary.json` comes last, so its presence marks a complete set.
 
-use super::figure;
-use super::shading::{dolp_aop, polarizer};
-use super::tables::{TableResolution, TemperatureLookup};
-use super::{RenderError, Rendered, StokesImage, Timings, BACKGROUND};
+pub mod colormap;
+pub mod figure;
+
 use crate::material::write_atomically;
+use crate::render::film::{dolp_aop, polarizer, StokesImage, BACKGROUND};
+use crate::render::{RenderError, Rendered, Timings};
 use crate::scene::config::Shading;
 use crate::scene::Scene;
+use crate::transport::tables::{TableResolution, TemperatureLookup};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -68,7 +70,7 @@ impl Channel {
 
     /// The channel's value for a pixel-frame Stokes vector.
     #[inline]
-    pub fn value(self, s: [f64; 3]) -> f64 {
+    pub fn value(self, s: [f64; 4]) -> f64 {
         use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
         match self {
             Channel::S0 => s[0],
