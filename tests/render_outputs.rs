@@ -50,9 +50,11 @@ fn files_hold_the_rendered_channels() {
     // Channel identities (DESIGN §1.6): I0 + I90 = I45 + I135 = S0, I0 − I90 = S1, DoLP, AoP.
     for i in 0..64 * 48 {
         let pixel: Vec<f64> = stacks.iter().map(|channel| channel[i] as f64).collect();
-        let [s0, s1, s2, dolp, aop, i0, i45, i90, i135] = pixel[..] else {
-            unreachable!("nine channels")
+        let [s0, s1, s2, s3, dolp, aop, i0, i45, i90, i135] = pixel[..] else {
+            unreachable!("ten channels")
         };
+        // A lone convex sphere in an unpolarized environment: no circular polarization.
+        assert!(s3.abs() < 1e-9 * s0);
         assert!((i0 + i90 - s0).abs() < 1e-5 * s0 && (i45 + i135 - s0).abs() < 1e-5 * s0);
         assert!((i0 - i90 - s1).abs() < 1e-4 && (i45 - i135 - s2).abs() < 1e-4);
         assert!((dolp - s1.hypot(s2) / s0).abs() < 1e-6);
@@ -114,11 +116,20 @@ fn files_hold_the_rendered_channels() {
         image.surface.iter().filter(|&&s| s != BACKGROUND).count()
     );
     assert_eq!(json["pixels"]["per_part"]["ball/surface"], object);
-    assert_eq!(json["channels"].as_array().unwrap().len(), 9);
+    assert_eq!(json["channels"].as_array().unwrap().len(), 10);
+    // A lone convex sphere: nothing occludes it, so the path integrator adds nothing and
+    // reports no Monte Carlo error.
+    assert_eq!(json["transport"]["open_world"], false);
+    assert_eq!(json["transport"]["bounces"], 3);
+    let s0_error = &json["channels"][0]["relative_standard_error"];
+    assert_eq!(s0_error["mean"].as_f64(), Some(0.0));
+    let (_, _, stderr) = read_tiff(&out.join("stderr_S0.tif"));
+    assert!(stderr.iter().all(|&e| e == 0.0));
     let t = &json["apparent_temperature_k"];
     assert!(t["min"].as_f64().unwrap() < t["mean"].as_f64().unwrap());
     assert!(t["max"].as_f64().unwrap() < 300.0 && t["min"].as_f64().unwrap() > 270.0);
-    assert_eq!(summary.files.len(), 17);
+    // 10 channel TIFFs, stderr_S0.tif, the EXR, 5 previews, the composite and the summary.
+    assert_eq!(summary.files.len(), 19);
     assert!(json["timings_s"]["total"].as_f64().unwrap() > 0.0);
 }
 

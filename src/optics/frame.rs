@@ -109,6 +109,8 @@ pub(crate) fn double_angle((c, s): (f64, f64)) -> (f64, f64) {
 #[derive(Clone, Copy, Debug)]
 pub struct OutgoingFrame {
     pub normal: Vector3<f64>,
+    /// ω itself (unit, world).
+    pub omega: Vector3<f64>,
     /// Uphill tangent e_x; (e_x, n × e_x, n) is right-handed.
     pub uphill: Vector3<f64>,
     /// n · ω.
@@ -147,6 +149,7 @@ impl OutgoingFrame {
         };
         OutgoingFrame {
             normal: n,
+            omega: *omega,
             uphill: e_x,
             cos_theta,
             cos_tilt,

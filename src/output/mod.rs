@@ -10,7 +10,7 @@ use crate::material::write_atomically;
 use crate::render::film::{dolp_aop, polarizer, StokesImage, BACKGROUND};
 use crate::render::{RenderError, Rendered, Timings};
 use crate::scene::config::Shading;
-use crate::scene::Scene;
+use crate::scene::{Scene, Transport};
 use crate::transport::tables::{TableResolution, TemperatureLookup};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -25,6 +25,7 @@ pub enum Channel {
     S0,
     S1,
     S2,
+    S3,
     Dolp,
     Aop,
     I0,
@@ -34,10 +35,11 @@ pub enum Channel {
 }
 
 impl Channel {
-    pub const ALL: [Channel; 9] = [
+    pub const ALL: [Channel; 10] = [
         Channel::S0,
         Channel::S1,
         Channel::S2,
+        Channel::S3,
         Channel::Dolp,
         Channel::Aop,
         Channel::I0,
@@ -51,6 +53,7 @@ impl Channel {
             Channel::S0 => "S0",
             Channel::S1 => "S1",
             Channel::S2 => "S2",
+            Channel::S3 => "S3",
             Channel::Dolp => "DoLP",
             Channel::Aop => "AoP",
             Channel::I0 => "I0",
@@ -76,6 +79,7 @@ impl Channel {
             Channel::S0 => s[0],
             Channel::S1 => s[1],
             Channel::S2 => s[2],
+            Channel::S3 => s[3],
             Channel::Dolp => dolp_aop(s).0,
             Channel::Aop => dolp_aop(s).1,
             Channel::I0 => polarizer(s, 0.0),
@@ -132,6 +136,28 @@ pub struct ChannelSummary {
     pub unit: &'static str,
     /// Over object pixels; null when the camera sees no object.
     pub object_pixels: Option<Stats>,
+    /// Monte Carlo standard error of a Stokes channel relative to S0, over object pixels
+    /// (absent for derived channels).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub relative_standard_error: Option<ErrorSummary>,
+}
+
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ErrorSummary {
+    pub mean: f64,
+    pub p99: f64,
+}
+
+/// How light was transported (DESIGN §1.7, §2.6).
+#[derive(Clone, Debug, Serialize)]
+pub struct TransportSummary {
+    pub open_world: bool,
+    pub bounces: Option<u32>,
+    pub samples: Option<u32>,
+    pub seed: Option<u64>,
+    /// Sun elevation, azimuth (degrees) and band irradiance (W m⁻²), if the scene has a sun above
+    /// the horizon.
+    pub sun: Option<[f64; 3]>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -164,6 +190,7 @@ pub struct RenderSummary {
     pub channels: Vec<ChannelSummary>,
     /// Brightness temperature of S0 over object pixels (K).
     pub apparent_temperature_k: Option<Stats>,
+    pub transport: TransportSummary,
     pub materials: Vec<MaterialSummary>,
     pub timings_s: Timings,
     pub files: Vec<String>,
@@ -188,11 +215,13 @@ pub fn write_outputs(
     // Encode everything in memory, in parallel; write only when every encoding succeeded.
     enum Job {
         Tiff(usize),
+        StandardError,
         Exr,
         Panel(usize),
         Composite,
     }
     let mut jobs: Vec<Job> = (0..channels.len()).map(Job::Tiff).collect();
+    jobs.push(Job::StandardError);
     jobs.push(Job::Exr);
     jobs.extend((0..previews.len()).map(Job::Panel));
     jobs.push(Job::Composite);
@@ -203,6 +232,10 @@ pub fn write_outputs(
                 Job::Tiff(i) => {
                     let (channel, data) = &channels[*i];
                     (format!("{}.tif", channel.name()), encode_tiff(w, h, data))
+                }
+                Job::StandardError => {
+                    let data: Vec<f32> = image.standard_error.iter().map(|e| e[0] as f32).collect();
+                    ("stderr_S0.tif".to_owned(), encode_tiff(w, h, &data))
                 }
                 Job::Exr => ("stokes.exr".to_owned(), encode_exr(w, h, &channels)),
                 Job::Panel(i) => (previews.file_name(*i).to_owned(), previews.panel_png(*i)),
@@ -229,6 +262,7 @@ pub fn write_outputs(
             name: c.name(),
             unit: c.unit(),
             object_pixels: image.object_stats(data),
+            relative_standard_error: stokes_index(*c).and_then(|j| image.relative_error(j)),
         })
         .collect();
     let apparent = image.object_stats(&channels[0].1).map(|s| {
@@ -277,6 +311,7 @@ pub fn write_outputs(
         },
         channels: summary_stats,
         apparent_temperature_k: apparent,
+        transport: transport_summary(scene),
         materials: scene
             .materials
             .iter()
@@ -297,6 +332,65 @@ pub fn write_outputs(
     let path = out_dir.join("summary.json");
     write_atomically(&path, &json).map_err(|source| RenderError::Write { path, source })?;
     Ok(summary)
+}
+
+/// The Stokes component a channel is, if it is one.
+fn stokes_index(channel: Channel) -> Option<usize> {
+    match channel {
+        Channel::S0 => Some(0),
+        Channel::S1 => Some(1),
+        Channel::S2 => Some(2),
+        Channel::S3 => Some(3),
+        _ => None,
+    }
+}
+
+fn transport_summary(scene: &Scene) -> TransportSummary {
+    let sun = scene.sun.map(|sun| {
+        let d = sun.direction;
+        let elevation = d.z.clamp(-1.0, 1.0).asin().to_degrees();
+        let azimuth = d.x.atan2(d.y).to_degrees().rem_euclid(360.0);
+        [elevation, azimuth, sun.irradiance]
+    });
+    match scene.transport {
+        Transport::OpenWorld => TransportSummary {
+            open_world: true,
+            bounces: None,
+            samples: None,
+            seed: None,
+            sun: None,
+        },
+        Transport::Path(settings) => TransportSummary {
+            open_world: false,
+            bounces: Some(settings.bounces),
+            samples: Some(settings.samples),
+            seed: Some(settings.seed),
+            sun,
+        },
+    }
+}
+
+impl StokesImage {
+    /// Mean and 99th percentile of the standard error of Stokes component `j` relative to S0,
+    /// over object pixels with S0 > 0.
+    pub fn relative_error(&self, j: usize) -> Option<ErrorSummary> {
+        let mut values: Vec<f64> = self
+            .stokes
+            .iter()
+            .zip(&self.standard_error)
+            .zip(&self.surface)
+            .filter(|((s, _), &o)| o != BACKGROUND && s[0] > 0.0)
+            .map(|((s, e), _)| e[j] / s[0])
+            .filter(|v| v.is_finite())
+            .collect();
+        if values.is_empty() {
+            return None;
+        }
+        values.sort_by(f64::total_cmp);
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        let p99 = values[((values.len() - 1) as f64 * 0.99).round() as usize];
+        Some(ErrorSummary { mean, p99 })
+    }
 }
 
 /// Single-channel 32-bit IEEE float TIFF (SampleFormat = 3), uncompressed.

@@ -9,6 +9,7 @@ mod exponential;
 mod geometry;
 mod hemisphere;
 mod model;
+mod sample;
 mod shadowing;
 
 pub use crate::optics::Direction;

@@ -181,10 +181,10 @@ impl Pbrdf {
         self.shadowing.masking(&self.prepared, cos_theta)
     }
 
-    /// [`Pbrdf::masking`] for quadratures that need it at thousands of directions: Smith's Cauchy
+    /// [`Pbrdf::masking`] for quadratures and renderers that need it at thousands of directions: Smith's Cauchy
     /// Λ comes from a table built on first use (~0.1 ms; G1 within 2e-9 of the exact one, far
     /// below the quadrature's 1e-5), everything else is exact.
-    pub(crate) fn quadrature_masking(&self, cos_theta: f64) -> f64 {
+    pub fn quadrature_masking(&self, cos_theta: f64) -> f64 {
         if self.shadowing != Shadowing::Smith {
             return 1.0;
         }

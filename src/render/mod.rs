@@ -11,10 +11,16 @@ pub mod sensor;
 use crate::pbrdf::ModelError;
 use crate::progress::Progress;
 use crate::scene::config::Shading;
-use crate::scene::{Scene, SceneError};
+use crate::scene::mesh::SurfaceHit;
+use crate::scene::{Scene, SceneError, Transport};
+use crate::transport::accel::Accelerator;
 use crate::transport::kernel::KernelQuadrature;
 use crate::transport::open_world::OpenWorld;
+use crate::transport::path::{PathTracer, Vertex};
 use crate::transport::tables::{MaterialTables, RadianceTable, TableResolution};
+use nalgebra::Vector3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 use raster::{rasterize, FragmentBuffer, NO_TRIANGLE};
 use rayon::prelude::*;
 use sensor::{through_atmosphere, Noise};
@@ -90,7 +96,16 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
         tables: &tables,
         radiance: &radiance,
     };
-    let image = shade_image(scene, &open_world, &fragments, &tick);
+    let accel;
+    let tracer = match scene.transport {
+        Transport::OpenWorld => None,
+        Transport::Path(settings) => {
+            accel = Accelerator::new(mesh, mesh_extent(&mesh.positions))
+                .map_err(|e| RenderError::Scene(SceneError::new(&scene.path, e)))?;
+            Some(PathTracer::new(scene, &open_world, &accel, settings))
+        }
+    };
+    let image = shade_image(scene, &open_world, tracer.as_ref(), &fragments, &tick);
     progress.end();
     timings.shade = shade_start.elapsed().as_secs_f64();
     timings.total = start.elapsed().as_secs_f64();
@@ -170,29 +185,107 @@ fn vertex_stokes(scene: &Scene, open_world: &OpenWorld) -> Vec<[f64; 4]> {
         .collect()
 }
 
+/// What shading a pixel needs besides the pixel itself.
+struct PixelShader<'a> {
+    scene: &'a Scene,
+    open_world: &'a OpenWorld<'a>,
+    tracer: Option<&'a PathTracer<'a>>,
+    /// Gouraud: the open-world Stokes vector at each vertex (empty for per-pixel shading).
+    vertex_stokes: Vec<[f64; 4]>,
+    path_radiance: Option<f64>,
+}
+
+impl PixelShader<'_> {
+    /// (Stokes, standard error) of the visible point at barycentric (b1, b2) of triangle `t`,
+    /// through the atmosphere; `pixel` indexes the pixel's random stream.
+    fn shade(&self, t: usize, b1: f64, b2: f64, pixel: u64) -> ([f64; 4], [f64; 4]) {
+        let scene = self.scene;
+        let hit = scene.mesh.interpolate(t, b1, b2);
+        let to_camera = scene.camera.position - hit.point;
+        let (mut s, mut error) = match self.tracer {
+            None => (self.open_world_value(t, &hit, &to_camera), [0.0; 4]),
+            Some(tracer) => {
+                let omega = to_camera.normalize();
+                let vertex = Vertex::seen_from(hit, &omega);
+                let mut rng = ChaCha8Rng::seed_from_u64(tracer.settings.seed);
+                rng.set_stream(pixel);
+                let e = tracer.estimate(&vertex, &omega, &scene.camera.right, &mut rng);
+                let base = match scene.shading {
+                    Shading::Pixel => e.open_world,
+                    Shading::Gouraud => self.open_world_value(t, &hit, &to_camera).into(),
+                };
+                let total = base + e.correction;
+                (total.into(), e.standard_error.into())
+            }
+        };
+        if let (Some(atmosphere), Some(path)) = (&scene.atmosphere, self.path_radiance) {
+            let range = to_camera.norm();
+            s = through_atmosphere(s, range, atmosphere, path);
+            let tau = atmosphere.transmittance(range);
+            error = error.map(|e| e * tau);
+        }
+        (s, error)
+    }
+
+    /// The open-world value: Gouraud-interpolated from the vertices, or shaded at the point.
+    fn open_world_value(&self, t: usize, hit: &SurfaceHit, to_camera: &Vector3<f64>) -> [f64; 4] {
+        let scene = self.scene;
+        match scene.shading {
+            Shading::Gouraud => {
+                let [a, b, c] = scene.mesh.triangles[t].map(|v| self.vertex_stokes[v as usize]);
+                let [b0, b1, b2] = hit.barycentric;
+                [0, 1, 2, 3].map(|j| a[j] * b0 + b[j] * b1 + c[j] * b2)
+            }
+            Shading::Pixel => {
+                // The back of a face is seen when its winding and its interpolated normal both
+                // face away (a silhouette of a closed mesh has only the latter; a mesh whose
+                // winding disagrees with its normals only the former).
+                let back =
+                    hit.geometric_normal.dot(to_camera) < 0.0 && hit.normal.dot(to_camera) < 0.0;
+                self.open_world.toward_camera(
+                    &scene.camera,
+                    scene.triangle_material(t),
+                    &hit.point,
+                    &hit.normal,
+                    back,
+                    hit.temperature,
+                )
+            }
+        }
+    }
+}
+
 /// Shades every pixel (per-pixel or Gouraud), adds the background, the atmosphere and the noise.
 fn shade_image(
     scene: &Scene,
     open_world: &OpenWorld,
+    tracer: Option<&PathTracer>,
     fragments: &FragmentBuffer,
     tick: &(dyn Fn() + Sync),
 ) -> StokesImage {
     let (width, height) = (fragments.width, fragments.height);
-    let vertex_stokes = match scene.shading {
-        Shading::Pixel => Vec::new(),
-        Shading::Gouraud => vertex_stokes(scene, open_world),
+    let shader = PixelShader {
+        scene,
+        open_world,
+        tracer,
+        vertex_stokes: match scene.shading {
+            Shading::Pixel => Vec::new(),
+            Shading::Gouraud => vertex_stokes(scene, open_world),
+        },
+        path_radiance: scene
+            .atmosphere
+            .map(|a| scene.sensor.band.radiance(a.temperature_k)),
     };
-    let path_radiance = scene
-        .atmosphere
-        .map(|a| scene.sensor.band.radiance(a.temperature_k));
     let noise = Noise::of_sensor(&scene.sensor);
     let mut stokes = vec![[0.0f64; 4]; width * height];
+    let mut standard_error = vec![[0.0f64; 4]; width * height];
     let mut surface = vec![BACKGROUND; width * height];
     stokes
         .par_chunks_mut(width)
+        .zip(standard_error.par_chunks_mut(width))
         .zip(surface.par_chunks_mut(width))
         .enumerate()
-        .for_each(|(y, (row, row_surface))| {
+        .for_each(|(y, ((row, row_error), row_surface))| {
             for x in 0..width {
                 let fragment = fragments.fragments[y * width + x];
                 if fragment.triangle == NO_TRIANGLE {
@@ -202,37 +295,9 @@ fn shade_image(
                     continue;
                 }
                 let t = fragment.triangle as usize;
-                let hit = scene
-                    .mesh
-                    .interpolate(t, fragment.b1 as f64, fragment.b2 as f64);
-                let mut s = match scene.shading {
-                    Shading::Gouraud => {
-                        let [a, b, c] = scene.mesh.triangles[t].map(|v| vertex_stokes[v as usize]);
-                        let [b0, b1, b2] = hit.barycentric;
-                        [0, 1, 2, 3].map(|j| a[j] * b0 + b[j] * b1 + c[j] * b2)
-                    }
-                    Shading::Pixel => {
-                        // The back of a face is seen when its winding and its interpolated normal
-                        // both face away (a silhouette of a closed mesh has only the latter; a
-                        // mesh whose winding disagrees with its normals only the former).
-                        let to_camera = scene.camera.position - hit.point;
-                        let back = hit.geometric_normal.dot(&to_camera) < 0.0
-                            && hit.normal.dot(&to_camera) < 0.0;
-                        open_world.toward_camera(
-                            &scene.camera,
-                            scene.triangle_material(t),
-                            &hit.point,
-                            &hit.normal,
-                            back,
-                            hit.temperature,
-                        )
-                    }
-                };
-                if let (Some(atmosphere), Some(path)) = (&scene.atmosphere, path_radiance) {
-                    let range = (hit.point - scene.camera.position).norm();
-                    s = through_atmosphere(s, range, atmosphere, path);
-                }
-                row[x] = s;
+                let pixel = (y * width + x) as u64;
+                (row[x], row_error[x]) =
+                    shader.shade(t, fragment.b1 as f64, fragment.b2 as f64, pixel);
                 row_surface[x] = scene.mesh.triangle_surface[t];
             }
             noise.apply_to_row(y, row);
@@ -241,8 +306,8 @@ fn shade_image(
     StokesImage {
         width,
         height,
-        standard_error: vec![[0.0; 4]; stokes.len()],
         stokes,
+        standard_error,
         surface,
     }
 }

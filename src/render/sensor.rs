@@ -23,7 +23,7 @@ pub fn through_atmosphere(
     atmosphere: &Atmosphere,
     path_radiance: f64,
 ) -> [f64; 4] {
-    let tau = (-atmosphere.extinction_per_m * range).exp();
+    let tau = atmosphere.transmittance(range);
     [
         tau * s[0] + (1.0 - tau) * path_radiance,
         tau * s[1],

@@ -31,6 +31,16 @@
 //! [render]                            # optional
 //! shading = "pixel"                   # or "gouraud"
 //! aop_mask_dolp = 0.002               # AoP preview masked where DoLP is below this
+//! bounces = 3                         # surface hits followed (occlusion, inter-reflection)
+//! samples = 16                        # paths per pixel for the occluded correction
+//! seed = 1
+//! open_world = false                  # true: the paper's model (no occlusion, no sun)
+//!
+//! [sun]                               # optional
+//! elevation_deg = 35.0
+//! azimuth_deg = 200.0                 # clockwise from north (+y) toward east (+x)
+//! irradiance_w_m2 = 1.6               # optional band irradiance; default τ Ω L_bb(5772 K)
+//! transmittance = 0.8                 # τ for the default
 //!
 //! [materials.asphalt]                 # inline materials, referred to by name
 //! distribution = "cauchy"
@@ -69,6 +79,7 @@ pub struct SceneConfig {
     pub atmosphere: Option<AtmosphereConfig>,
     #[serde(default)]
     pub render: RenderConfig,
+    pub sun: Option<SunConfig>,
     /// Inline material definitions by name.
     #[serde(default)]
     pub materials: BTreeMap<String, InlineMaterialConfig>,
@@ -178,6 +189,42 @@ pub struct RenderConfig {
     pub shading: Shading,
     #[serde(default = "default_aop_mask")]
     pub aop_mask_dolp: f64,
+    /// Surface hits followed by the path integrator (DESIGN §1.7, §2.4).
+    #[serde(default = "default_bounces")]
+    pub bounces: u32,
+    /// Paths per pixel for the occluded correction.
+    #[serde(default = "default_samples")]
+    pub samples: u32,
+    #[serde(default = "default_render_seed")]
+    pub seed: u64,
+    /// The paper's model (no occlusion, no sun): today's images exactly.
+    #[serde(default)]
+    pub open_world: bool,
+}
+
+fn default_bounces() -> u32 {
+    3
+}
+
+fn default_samples() -> u32 {
+    16
+}
+
+fn default_render_seed() -> u64 {
+    1
+}
+
+/// `[sun]` (DESIGN §2.4): a direction and an optional band irradiance.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunConfig {
+    pub elevation_deg: Option<f64>,
+    /// Clockwise from north (+y) toward east (+x).
+    pub azimuth_deg: Option<f64>,
+    /// Band irradiance on a surface facing the sun (W m⁻²); default τ Ω L_bb(5772 K).
+    pub irradiance_w_m2: Option<f64>,
+    /// τ of the default irradiance.
+    pub transmittance: Option<f64>,
 }
 
 fn default_aop_mask() -> f64 {
@@ -189,6 +236,10 @@ impl Default for RenderConfig {
         RenderConfig {
             shading: Shading::default(),
             aop_mask_dolp: default_aop_mask(),
+            bounces: default_bounces(),
+            samples: default_samples(),
+            seed: default_render_seed(),
+            open_world: false,
         }
     }
 }

@@ -14,6 +14,7 @@ pub mod obj;
 pub mod ply;
 pub mod procedural;
 
+use crate::emitter::sun::{sun_direction, sun_solid_angle, Sun};
 use crate::material::Material;
 use crate::optics::{Band, RefractiveIndex};
 use crate::pbrdf::{Pbrdf, SlopeDistribution};
@@ -35,7 +36,7 @@ pub struct SceneError {
 
 impl SceneError {
     /// Messages are kept to one line (some parsers format theirs over several).
-    fn new(file: &Path, message: impl Into<String>) -> SceneError {
+    pub fn new(file: &Path, message: impl Into<String>) -> SceneError {
         SceneError {
             file: file.to_owned(),
             message: message
@@ -80,6 +81,35 @@ pub struct Atmosphere {
     pub temperature_k: f64,
 }
 
+impl Atmosphere {
+    /// τ = exp(−β·range) over `range` metres.
+    #[inline]
+    pub fn transmittance(&self, range: f64) -> f64 {
+        (-self.extinction_per_m * range).exp()
+    }
+}
+
+/// Monte Carlo settings of the path integrator (`[render]`, DESIGN §2.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct PathSettings {
+    /// Vertex k (0 = the camera's visible point) traces its correction while k ≤ `bounces`:
+    /// 0 still occludes the visible point's environment (a blocked direction delivers the
+    /// blocker's open-world value); 3 follows three inter-reflections.
+    pub bounces: u32,
+    /// Paths per pixel.
+    pub samples: u32,
+    pub seed: u64,
+}
+
+/// How light reaches the visible points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Transport {
+    /// The paper's model (DESIGN §1.5): every point sees the whole sky and ground; no sun.
+    OpenWorld,
+    /// Occlusion, inter-reflection and the sun (DESIGN §1.7).
+    Path(PathSettings),
+}
+
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub path: PathBuf,
@@ -90,6 +120,9 @@ pub struct Scene {
     pub atmosphere: Option<Atmosphere>,
     pub shading: Shading,
     pub aop_mask_dolp: f64,
+    pub transport: Transport,
+    /// Above the horizon only (a sun below it lights nothing).
+    pub sun: Option<Sun>,
     pub materials: Vec<SceneMaterial>,
     pub object_names: Vec<String>,
     pub surfaces: Vec<Surface>,
@@ -189,6 +222,11 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
     if config.objects.is_empty() {
         return Err(fail("the scene has no [[objects]]".into()));
     }
+    let transport = transport_settings(&config.render).map_err(&fail)?;
+    let sun = match &config.sun {
+        Some(sun) => resolve_sun(sun, &band).map_err(&fail)?,
+        None => None,
+    };
 
     let library = dir.join(config.material_library.as_deref().unwrap_or("fits"));
     let mut materials = MaterialResolver {
@@ -238,12 +276,81 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         atmosphere,
         shading: config.render.shading,
         aop_mask_dolp: mask,
+        transport,
+        sun,
         materials: materials.resolved,
         object_names,
         surfaces,
         mesh,
     })
 }
+
+/// The `[render]` transport keys, checked.
+fn transport_settings(render: &config::RenderConfig) -> Result<Transport, String> {
+    if render.open_world {
+        return Ok(Transport::OpenWorld);
+    }
+    if render.samples == 0 {
+        return Err(
+            "render.samples = 0: give at least 1 path per pixel (or open_world = true)".into(),
+        );
+    }
+    if render.bounces > MAX_BOUNCES {
+        return Err(format!(
+            "render.bounces = {} is more than {MAX_BOUNCES}",
+            render.bounces
+        ));
+    }
+    Ok(Transport::Path(PathSettings {
+        bounces: render.bounces,
+        samples: render.samples,
+        seed: render.seed,
+    }))
+}
+
+/// Deeper chains change nothing measurable in thermal scenes (each bounce multiplies by a
+/// reflectance well below 1) and only cost time.
+const MAX_BOUNCES: u32 = 64;
+
+/// The `[sun]` table: its direction (given, or from place and time) and band irradiance (given,
+/// or τ Ω L_bb(5772 K) over the sensor band). A sun at or below the horizon is no sun.
+fn resolve_sun(config: &config::SunConfig, band: &Band) -> Result<Option<Sun>, String> {
+    let (elevation, azimuth) = match (config.elevation_deg, config.azimuth_deg) {
+        (Some(e), Some(a)) => (e, a),
+        _ => return Err("[sun] needs elevation_deg and azimuth_deg".into()),
+    };
+    if !(elevation.is_finite() && (-90.0..=90.0).contains(&elevation)) {
+        return Err(format!(
+            "sun.elevation_deg = {elevation} must be within [−90, 90]"
+        ));
+    }
+    if !azimuth.is_finite() {
+        return Err(format!("sun.azimuth_deg = {azimuth} must be finite"));
+    }
+    let transmittance = config.transmittance.unwrap_or(DEFAULT_SUN_TRANSMITTANCE);
+    if !(transmittance.is_finite() && (0.0..=1.0).contains(&transmittance)) {
+        return Err(format!(
+            "sun.transmittance = {transmittance} must be within [0, 1]"
+        ));
+    }
+    let irradiance = match config.irradiance_w_m2 {
+        Some(e) if e.is_finite() && e >= 0.0 => e,
+        Some(e) => return Err(format!("sun.irradiance_w_m2 = {e} must be finite and ≥ 0")),
+        None => transmittance * sun_solid_angle() * band.radiance(SUN_TEMPERATURE_K),
+    };
+    if elevation <= 0.0 {
+        return Ok(None);
+    }
+    Ok(Some(Sun {
+        direction: sun_direction(elevation, azimuth),
+        irradiance,
+    }))
+}
+
+/// Effective temperature of the solar photosphere (K).
+const SUN_TEMPERATURE_K: f64 = 5772.0;
+/// Atmospheric transmittance of the default solar irradiance (a clear LWIR window).
+const DEFAULT_SUN_TRANSMITTANCE: f64 = 0.8;
 
 /// Loads an object's mesh, checks its parts against the scene, resolves part materials and
 /// temperatures, and returns its world-space shading mesh.

@@ -1,0 +1,292 @@
+//! The path integrator (DESIGN §1.7): occlusion, polarized inter-reflection and the sun, as a
+//! correction to the exact open-world value.
+//!
+//! The Stokes vector leaving a point x along ω_o is
+//!
+//!   S(x, ω_o) = S_open(x, ω_o) + S_sun(x, ω_o)
+//!             + ∫ F(ω_i→ω_o) [S_in(ω_i) − L_env(ω_i) e₀] cosθ_i dΩ_i,
+//!
+//! where S_open is the open-world table value (emission plus the unoccluded sky and ground), and
+//! the integrand of the correction vanishes wherever the ray escapes (S_in = L_env there). Only
+//! directions that hit geometry contribute, so an unoccluded point gets no correction and no
+//! noise (a control variate with exact expectation). The correction is estimated by importance
+//! sampling the pBRDF ([`Pbrdf::sample_incident`]); at a hit y the incident Stokes vector is the
+//! full vector leaving y toward x, computed by the same formula one level deeper and rotated from
+//! y's outgoing psps frame into x's incident psps frame (full 4×4 Mueller chains, so circular
+//! polarization appears after two conductor bounces). Vertex k (the camera's visible point is
+//! k = 0) traces its correction while k ≤ `bounces`; deeper hits take the open-world value.
+//!
+//! The sun (see [`super::sun`]) is added at every vertex as next-event estimation: the disc
+//! integral of F times a shadow-ray visibility. It is not part of the control variate (the
+//! open-world tables hold no sun), and escaped correction rays never count it, so it is not
+//! counted twice.
+
+use super::accel::Accelerator;
+use super::open_world::OpenWorld;
+use crate::emitter::sun::{DiscQuadrature, Sun};
+use crate::optics::{
+    rotate_stokes, rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame,
+    Stokes,
+};
+use crate::pbrdf::Pbrdf;
+use crate::scene::mesh::SurfaceHit;
+use crate::scene::{PathSettings, Scene};
+use nalgebra::Vector3;
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+/// A surface point seen from a given side: the hit, its normal turned toward the viewer, and the
+/// geometric normal on the same side (for ray offsets and the true horizon).
+#[derive(Clone, Copy, Debug)]
+pub struct Vertex {
+    pub hit: SurfaceHit,
+    pub normal: Vector3<f64>,
+    pub geometric_normal: Vector3<f64>,
+}
+
+impl Vertex {
+    /// The side of `hit` seen from direction `toward_viewer` (unit, from the point to the
+    /// viewer). The back is shaded when the winding and the interpolated normal both face away
+    /// (the camera's rule; a silhouette of a closed mesh has only the latter).
+    pub fn seen_from(hit: SurfaceHit, toward_viewer: &Vector3<f64>) -> Vertex {
+        let geometric_front = hit.geometric_normal.dot(toward_viewer) >= 0.0;
+        let back = !geometric_front && hit.normal.dot(toward_viewer) < 0.0;
+        let unit = hit.geometric_normal.normalize();
+        Vertex {
+            hit,
+            normal: if back { -hit.normal } else { hit.normal },
+            geometric_normal: if geometric_front { unit } else { -unit },
+        }
+    }
+}
+
+/// One pixel's estimate in the pixel frame: the exact open-world value, the mean of the
+/// correction (occlusion, inter-reflection, sun) and the correction's standard error.
+pub struct Estimate {
+    pub open_world: Stokes,
+    pub correction: Stokes,
+    pub standard_error: Stokes,
+}
+
+/// Everything the path integrator shares across pixels.
+pub struct PathTracer<'a> {
+    pub scene: &'a Scene,
+    pub open_world: &'a OpenWorld<'a>,
+    pub accel: &'a Accelerator<'a>,
+    pub settings: PathSettings,
+    /// The sun and its disc quadrature per material.
+    pub sun: Option<(Sun, Vec<DiscQuadrature>)>,
+}
+
+impl PathTracer<'_> {
+    pub fn new<'a>(
+        scene: &'a Scene,
+        open_world: &'a OpenWorld<'a>,
+        accel: &'a Accelerator<'a>,
+        settings: PathSettings,
+    ) -> PathTracer<'a> {
+        let sun = scene.sun.map(|sun| {
+            let rules = scene
+                .materials
+                .iter()
+                .map(|m| sun.quadrature(&m.pbrdf))
+                .collect();
+            (sun, rules)
+        });
+        PathTracer {
+            scene,
+            open_world,
+            accel,
+            settings,
+            sun,
+        }
+    }
+
+    /// The Stokes vector leaving the visible point `vertex` toward the camera along `omega`, in
+    /// the pixel frame (image right `image_right`, DESIGN §1.6), averaged over
+    /// `settings.samples` paths; `rng` is the pixel's own stream.
+    pub fn estimate(
+        &self,
+        vertex: &Vertex,
+        omega: &Vector3<f64>,
+        image_right: &Vector3<f64>,
+        rng: &mut ChaCha8Rng,
+    ) -> Estimate {
+        let frame = OutgoingFrame::new(&vertex.normal, omega);
+        let to_pixel = |s: &Stokes| stokes_to_camera_frame(s, &frame.s_axis, omega, image_right);
+        let material = self.scene.triangle_material(vertex.hit.triangle);
+        let exact = self
+            .open_world
+            .leaving(material, &frame, vertex.hit.temperature);
+        let n = self.settings.samples.max(1);
+        let sun = self.sun_integral(vertex, &frame, material);
+        let (mut sum, mut sum2) = (Stokes::zeros(), Stokes::zeros());
+        for s in 0..n {
+            let stratum = (s as f64 + rng.random::<f64>()) / n as f64;
+            let mut x = self.correction(vertex, &frame, material, 0, stratum, rng);
+            if let Some(integral) = sun {
+                x += integral * self.sun_visibility(vertex, stratum, rng);
+            }
+            let x = to_pixel(&x);
+            sum += x;
+            sum2 += x.component_mul(&x);
+        }
+        let mean = sum / n as f64;
+        let variance = (sum2 / n as f64 - mean.component_mul(&mean)).map(|v| v.max(0.0));
+        let standard_error = if n > 1 {
+            (variance / (n - 1) as f64).map(f64::sqrt)
+        } else {
+            Stokes::zeros()
+        };
+        Estimate {
+            open_world: to_pixel(&exact),
+            correction: mean,
+            standard_error,
+        }
+    }
+
+    /// One-sample estimate of the Stokes vector leaving `vertex` along `omega` at depth `depth`,
+    /// in the psps frame of `omega` (s axis returned with it).
+    fn leaving(
+        &self,
+        vertex: &Vertex,
+        omega: &Vector3<f64>,
+        depth: u32,
+        rng: &mut ChaCha8Rng,
+    ) -> (Stokes, Vector3<f64>) {
+        let frame = OutgoingFrame::new(&vertex.normal, omega);
+        let material = self.scene.triangle_material(vertex.hit.triangle);
+        let mut s = self
+            .open_world
+            .leaving(material, &frame, vertex.hit.temperature);
+        if let Some(integral) = self.sun_integral(vertex, &frame, material) {
+            let stratum = rng.random::<f64>();
+            s += integral * self.sun_visibility(vertex, stratum, rng);
+        }
+        if depth <= self.settings.bounces {
+            let stratum = rng.random::<f64>();
+            s += self.correction(vertex, &frame, material, depth, stratum, rng);
+        }
+        (s, frame.s_axis)
+    }
+
+    /// One sample of ∫ F (S_in − L_env e₀) cosθ_i dΩ_i at `vertex` (depth `depth`), in the psps
+    /// frame of `frame`; `stratum` ∈ [0, 1) stratifies the lobe's radial coordinate.
+    fn correction(
+        &self,
+        vertex: &Vertex,
+        frame: &OutgoingFrame,
+        material: usize,
+        depth: u32,
+        stratum: f64,
+        rng: &mut ChaCha8Rng,
+    ) -> Stokes {
+        let pbrdf = &self.scene.materials[material].pbrdf;
+        let w_o = frame.to_local(&frame.omega);
+        if w_o.z <= 0.0 {
+            return Stokes::zeros();
+        }
+        let u = [rng.random::<f64>(), stratum, rng.random::<f64>()];
+        let Some((w_i, pdf)) = pbrdf.sample_incident(&w_o, u) else {
+            return Stokes::zeros();
+        };
+        let direction = frame.to_world(&w_i);
+        // Below the true (geometric) surface: an artefact of interpolated normals, not light.
+        if direction.dot(&vertex.geometric_normal) <= 0.0 {
+            return Stokes::zeros();
+        }
+        let origin = vertex.hit.point + vertex.geometric_normal * self.accel.offset;
+        let Some(hit) = self.accel.closest_hit(&origin, &direction) else {
+            return Stokes::zeros();
+        };
+        let toward_x = -direction;
+        let next = Vertex::seen_from(hit, &toward_x);
+        let (leaving, s_from) = self.leaving(&next, &toward_x, depth + 1, rng);
+        // Incident frame at x: k = −ω_i, s = −ê_φ(ω_i) in the local frame (DESIGN §1.3).
+        let incident = Direction::from_unit_vector(w_i);
+        let s_incident = -frame.to_world(&incident.azimuthal_axis);
+        let eta = rotation_between_frames(&s_from, &s_incident, &toward_x);
+        let mut s_in = rotate_stokes(&leaving, eta);
+        s_in[0] -= self.scene.environment.radiance(&direction);
+        let scattered = Direction::from_unit_vector(w_o);
+        let mueller = pbrdf.mueller_with_masking(
+            &incident,
+            &scattered,
+            pbrdf.quadrature_masking(w_i.z),
+            pbrdf.quadrature_masking(w_o.z),
+        );
+        let local = mueller * s_in * (w_i.z / pdf);
+        self.to_outgoing_frame(&local, &scattered, frame)
+    }
+
+    /// A Stokes vector in the psps frame of local `scattered` re-expressed with `frame.s_axis`.
+    fn to_outgoing_frame(
+        &self,
+        local: &Stokes,
+        scattered: &Direction,
+        frame: &OutgoingFrame,
+    ) -> Stokes {
+        let s_local = frame.to_world(&scattered.azimuthal_axis);
+        let omega = frame.to_world(&scattered.vector);
+        rotate_stokes(
+            local,
+            rotation_between_frames(&s_local, &frame.s_axis, &omega),
+        )
+    }
+
+    /// ∫_disc F_j0(ω→ω_o) cosθ dΩ L_sun = E_sun Σ w_k F_j0(ω_k→ω_o) cosθ_k, in `frame`; `None`
+    /// without a sun or where no node is above the local horizon.
+    fn sun_integral(
+        &self,
+        vertex: &Vertex,
+        frame: &OutgoingFrame,
+        material: usize,
+    ) -> Option<Stokes> {
+        let (sun, rules) = self.sun.as_ref()?;
+        if sun.direction.dot(&vertex.geometric_normal) <= 0.0 {
+            return None;
+        }
+        let w_o = frame.to_local(&frame.omega);
+        if w_o.z <= 0.0 {
+            return None;
+        }
+        let pbrdf: &Pbrdf = &self.scene.materials[material].pbrdf;
+        let scattered = Direction::from_unit_vector(w_o);
+        let masking_o = pbrdf.quadrature_masking(w_o.z);
+        let mut sum = Stokes::zeros();
+        let mut any = false;
+        for (node, weight) in &rules[material].nodes {
+            let w_i = frame.to_local(node);
+            if w_i.z <= 0.0 {
+                continue;
+            }
+            any = true;
+            let incident = Direction::from_unit_vector(w_i);
+            let mueller = pbrdf.mueller_with_masking(
+                &incident,
+                &scattered,
+                pbrdf.quadrature_masking(w_i.z),
+                masking_o,
+            );
+            sum += mueller.column(0) * (weight * w_i.z);
+        }
+        any.then(|| self.to_outgoing_frame(&(sum * sun.irradiance), &scattered, frame))
+    }
+
+    /// 1 if a shadow ray from `vertex` to the disc point of area fraction `stratum` escapes.
+    fn sun_visibility(&self, vertex: &Vertex, stratum: f64, rng: &mut ChaCha8Rng) -> f64 {
+        let Some((sun, _)) = self.sun.as_ref() else {
+            return 0.0;
+        };
+        let direction = sun.disc_point(stratum, rng.random::<f64>());
+        if direction.dot(&vertex.geometric_normal) <= 0.0 {
+            return 0.0;
+        }
+        let origin = vertex.hit.point + vertex.geometric_normal * self.accel.offset;
+        if self.accel.occluded(&origin, &direction) {
+            0.0
+        } else {
+            1.0
+        }
+    }
+}
