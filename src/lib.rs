@@ -5,6 +5,7 @@
 //! [`scene`] → [`render`]. The physics lives in [`optics`] and [`pbrdf`]; everything else calls it.
 
 pub mod commands;
+pub mod emitter;
 pub mod fit;
 pub mod material;
 pub mod measure;
