@@ -2,6 +2,7 @@
 //! selection from flags or a material file, angle sweeps, geometry CSVs and CSV output.
 
 pub mod evaluate;
+pub mod sun;
 
 use crate::material::Material;
 use crate::optics::RefractiveIndex;
