@@ -9,7 +9,9 @@ use irpol::commands::evaluate::{
     read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
 };
 use irpol::commands::render::{default_output_dir, render_scene};
+use irpol::commands::sun::{read_times_file, write_sun_csv};
 use irpol::commands::{parse_sweep, ModelArgs};
+use irpol::emitter::parse_time_utc;
 use irpol::fit::{
     fit_files, parse_parameter_list, parse_parameter_values, DistributionKind, FitOptions,
     FitOutcome, Optimizer, RobustLoss,
@@ -117,6 +119,26 @@ enum Command {
         /// Output folder (default out/<scene stem>/).
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+    /// Apparent sun position (NREL SPA, standard atmosphere, sea level) at a site, as CSV on stdout:
+    /// time_utc,elevation_deg,azimuth_deg (azimuth clockwise from north).
+    Sun {
+        /// Latitude (°, north positive).
+        #[arg(long, allow_negative_numbers = true)]
+        latitude: f64,
+        /// Longitude (°, east positive).
+        #[arg(long, allow_negative_numbers = true)]
+        longitude: f64,
+        /// An RFC 3339 instant, e.g. 2026-06-21T10:00:00Z.
+        #[arg(
+            long,
+            required_unless_present = "times_file",
+            conflicts_with = "times_file"
+        )]
+        time_utc: Option<String>,
+        /// A file of RFC 3339 instants, one per line (blank lines and # comments skipped).
+        #[arg(long)]
+        times_file: Option<PathBuf>,
     },
     /// A table of the materials in a library folder.
     Library {
@@ -296,6 +318,21 @@ fn run(command: Command) -> anyhow::Result<()> {
             );
         }
         Command::Render { scene, out } => render_and_summarize(&scene, out)?,
+        Command::Sun {
+            latitude,
+            longitude,
+            time_utc,
+            times_file,
+        } => {
+            let times = match (time_utc, times_file) {
+                (Some(text), None) => vec![parse_time_utc(&text)?],
+                (None, Some(path)) => read_times_file(&path)?,
+                _ => anyhow::bail!("give either --time-utc RFC3339 or --times-file FILE"),
+            };
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            write_sun_csv(latitude, longitude, &times, &mut out)?;
+            out.flush()?;
+        }
         Command::Library { dir } => print_library(&dir)?,
         Command::Demo => demo()?,
     }

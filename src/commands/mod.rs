@@ -3,6 +3,7 @@
 
 pub mod evaluate;
 pub mod render;
+pub mod sun;
 
 use crate::material::Material;
 use crate::optics::RefractiveIndex;

@@ -1,4 +1,19 @@
-//! Light sources beyond the surfaces themselves: the sun (DESIGN §1.7). The sky and ground of the
-//! environment model are in `scene::environment`.
+//! Light sources that are not scene surfaces (DESIGN §1.7): the sun, its position, its disc
+//! radiance and the disc quadrature the renderer integrates reflected sunlight with. (Today's sky and ground environment still lives in `scene::environment`; DESIGN §3 plans
+//! it here as `sky.rs`.)
+//!
+//! World frame everywhere in this module (DESIGN §1.7): z up, north +y, east +x; azimuth clockwise
+//! from north (+y) toward east (+x), elevation above the xy-plane. Angles are in degrees and say so
+//! in their names, because they come straight from scene files, weather files and the CLI.
 
+pub mod disc;
 pub mod sun;
+
+pub use disc::{DiscQuadrature, Sun};
+
+pub use sun::{
+    default_band_irradiance, disc_radiance, format_time_utc, parse_time_utc, sun_direction,
+    sun_position, sun_position_with, validate_irradiance, validate_sun_angles,
+    validate_transmittance, Atmosphere, SpaOptions, SunError, SunPosition,
+    SUN_ANGULAR_DIAMETER_DEG, SUN_HALF_ANGLE_DEG, SUN_SOLID_ANGLE_SR, SUN_TEMPERATURE_K,
+};

@@ -37,7 +37,7 @@
 //! open_world = false                  # true: the paper's model (no occlusion, no sun)
 //!
 //! [sun]                               # optional
-//! elevation_deg = 35.0
+//! elevation_deg = 35.0                # or: latitude_deg, longitude_deg, time_utc = "…Z"
 //! azimuth_deg = 200.0                 # clockwise from north (+y) toward east (+x)
 //! irradiance_w_m2 = 1.6               # optional band irradiance; default τ Ω L_bb(5772 K)
 //! transmittance = 0.8                 # τ for the default
@@ -221,6 +221,11 @@ pub struct SunConfig {
     pub elevation_deg: Option<f64>,
     /// Clockwise from north (+y) toward east (+x).
     pub azimuth_deg: Option<f64>,
+    /// Instead of elevation and azimuth: the place and the instant (RFC 3339, e.g.
+    /// "2026-06-21T10:00:00Z"); the position comes from NREL's SPA (apparent elevation).
+    pub latitude_deg: Option<f64>,
+    pub longitude_deg: Option<f64>,
+    pub time_utc: Option<String>,
     /// Band irradiance on a surface facing the sun (W m⁻²); default τ Ω L_bb(5772 K).
     pub irradiance_w_m2: Option<f64>,
     /// τ of the default irradiance.

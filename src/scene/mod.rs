@@ -14,7 +14,10 @@ pub mod obj;
 pub mod ply;
 pub mod procedural;
 
-use crate::emitter::sun::{sun_direction, sun_solid_angle, Sun};
+use crate::emitter::{
+    default_band_irradiance, parse_time_utc, sun_direction, sun_position, validate_irradiance,
+    validate_sun_angles, validate_transmittance, Sun,
+};
 use crate::material::Material;
 use crate::optics::{Band, RefractiveIndex};
 use crate::pbrdf::{Pbrdf, SlopeDistribution};
@@ -315,28 +318,33 @@ const MAX_BOUNCES: u32 = 64;
 /// The `[sun]` table: its direction (given, or from place and time) and band irradiance (given,
 /// or τ Ω L_bb(5772 K) over the sensor band). A sun at or below the horizon is no sun.
 fn resolve_sun(config: &config::SunConfig, band: &Band) -> Result<Option<Sun>, String> {
-    let (elevation, azimuth) = match (config.elevation_deg, config.azimuth_deg) {
-        (Some(e), Some(a)) => (e, a),
-        _ => return Err("[sun] needs elevation_deg and azimuth_deg".into()),
+    let key = |key: &str, e: crate::emitter::SunError| format!("sun.{key}: {e}");
+    let place = (config.latitude_deg, config.longitude_deg, &config.time_utc);
+    let (elevation, azimuth) = match (config.elevation_deg, config.azimuth_deg, place) {
+        (Some(e), Some(a), (None, None, None)) => (e, a),
+        (None, None, (Some(latitude), Some(longitude), Some(time))) => {
+            let time = parse_time_utc(time).map_err(|e| key("time_utc", e))?;
+            let p = sun_position(latitude, longitude, &time)
+                .map_err(|e| key("latitude_deg/longitude_deg", e))?;
+            (p.elevation_deg, p.azimuth_deg)
+        }
+        _ => {
+            return Err(
+                "[sun] needs elevation_deg and azimuth_deg, or latitude_deg, \
+                 longitude_deg and time_utc"
+                    .into(),
+            )
+        }
     };
-    if !(elevation.is_finite() && (-90.0..=90.0).contains(&elevation)) {
-        return Err(format!(
-            "sun.elevation_deg = {elevation} must be within [−90, 90]"
-        ));
-    }
-    if !azimuth.is_finite() {
-        return Err(format!("sun.azimuth_deg = {azimuth} must be finite"));
-    }
+    validate_sun_angles(elevation, azimuth).map_err(|e| key("elevation_deg/azimuth_deg", e))?;
     let transmittance = config.transmittance.unwrap_or(DEFAULT_SUN_TRANSMITTANCE);
-    if !(transmittance.is_finite() && (0.0..=1.0).contains(&transmittance)) {
-        return Err(format!(
-            "sun.transmittance = {transmittance} must be within [0, 1]"
-        ));
-    }
+    validate_transmittance(transmittance).map_err(|e| key("transmittance", e))?;
     let irradiance = match config.irradiance_w_m2 {
-        Some(e) if e.is_finite() && e >= 0.0 => e,
-        Some(e) => return Err(format!("sun.irradiance_w_m2 = {e} must be finite and ≥ 0")),
-        None => transmittance * sun_solid_angle() * band.radiance(SUN_TEMPERATURE_K),
+        Some(e) => {
+            validate_irradiance(e).map_err(|err| key("irradiance_w_m2", err))?;
+            e
+        }
+        None => default_band_irradiance(band, transmittance),
     };
     if elevation <= 0.0 {
         return Ok(None);
@@ -347,8 +355,6 @@ fn resolve_sun(config: &config::SunConfig, band: &Band) -> Result<Option<Sun>, S
     }))
 }
 
-/// Effective temperature of the solar photosphere (K).
-const SUN_TEMPERATURE_K: f64 = 5772.0;
 /// Atmospheric transmittance of the default solar irradiance (a clear LWIR window).
 const DEFAULT_SUN_TRANSMITTANCE: f64 = 0.8;
 

@@ -23,7 +23,7 @@
 
 use super::accel::Accelerator;
 use super::open_world::OpenWorld;
-use crate::emitter::sun::{DiscQuadrature, Sun};
+use crate::emitter::{DiscQuadrature, Sun};
 use crate::optics::{
     rotate_stokes, rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame,
     Stokes,

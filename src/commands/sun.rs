@@ -1,0 +1,137 @@
+//! `irpol sun`: the apparent sun position (SPA, standard atmosphere; see `emitter::sun`) at one site
+//! for one instant or a file of them, as CSV. The batch form exists so that a cross-check over a
+//! year of hours runs one process, not thousands.
+
+use crate::emitter::{format_time_utc, parse_time_utc, sun_position, SunPosition};
+use anyhow::Context;
+use chrono::{DateTime, Utc};
+use std::io::Write;
+use std::path::Path;
+
+pub const SUN_HEADER: &str = "time_utc,elevation_deg,azimuth_deg";
+
+/// One RFC 3339 instant per line; blank lines and lines starting with `#` are skipped. A bad line is
+/// refused as `FILE:LINE: …`.
+pub fn read_times_file(path: &Path) -> anyhow::Result<Vec<DateTime<Utc>>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let mut times = Vec::new();
+    for (index, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let time =
+            parse_time_utc(line).with_context(|| format!("{}:{}", path.display(), index + 1))?;
+        times.push(time);
+    }
+    if times.is_empty() {
+        anyhow::bail!(
+            "{}: no times (expected one RFC 3339 instant per line, e.g. 2026-06-21T10:00:00Z)",
+            path.display()
+        );
+    }
+    Ok(times)
+}
+
+/// The sun position at every instant, or the first error (nothing is returned half-done).
+pub fn sun_table(
+    latitude_deg: f64,
+    longitude_deg: f64,
+    times: &[DateTime<Utc>],
+) -> anyhow::Result<Vec<(DateTime<Utc>, SunPosition)>> {
+    times
+        .iter()
+        .map(|time| Ok((*time, sun_position(latitude_deg, longitude_deg, time)?)))
+        .collect()
+}
+
+/// Writes `time_utc,elevation_deg,azimuth_deg` and one line per instant, the angles in degrees to
+/// full (round-trip) precision. Every position is computed before anything is written.
+pub fn write_sun_csv(
+    latitude_deg: f64,
+    longitude_deg: f64,
+    times: &[DateTime<Utc>],
+    out: &mut impl Write,
+) -> anyhow::Result<()> {
+    let table = sun_table(latitude_deg, longitude_deg, times)?;
+    writeln!(out, "{SUN_HEADER}")?;
+    for (time, position) in table {
+        writeln!(
+            out,
+            "{},{},{}",
+            format_time_utc(&time),
+            position.elevation_deg,
+            position.azimuth_deg
+        )?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_has_the_header_and_one_line_per_instant() {
+        let times = [
+            parse_time_utc("2026-06-21T10:00:00Z").unwrap(),
+            parse_time_utc("2026-12-21T10:00:00+01:00").unwrap(),
+        ];
+        let mut out = Vec::new();
+        write_sun_csv(48.14, 11.58, &times, &mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 3);
+        assert_eq!(lines[0], SUN_HEADER);
+        assert!(
+            lines[1].starts_with("2026-06-21T10:00:00Z,"),
+            "{}",
+            lines[1]
+        );
+        assert!(
+            lines[2].starts_with("2026-12-21T09:00:00Z,"),
+            "{}",
+            lines[2]
+        );
+        let fields: Vec<f64> = lines[1]
+            .split(',')
+            .skip(1)
+            .map(|f| f.parse().unwrap())
+            .collect();
+        let expected = sun_position(48.14, 11.58, &times[0]).unwrap();
+        assert_eq!(fields, vec![expected.elevation_deg, expected.azimuth_deg]);
+    }
+
+    #[test]
+    fn times_files_skip_blanks_and_comments_and_name_bad_lines() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = dir.path().join("good.txt");
+        std::fs::write(
+            &good,
+            "# instants\n2026-06-21T10:00:00Z\n\n  2026-06-21T11:00:00Z  \n",
+        )
+        .unwrap();
+        assert_eq!(read_times_file(&good).unwrap().len(), 2);
+        let bad = dir.path().join("bad.txt");
+        std::fs::write(&bad, "2026-06-21T10:00:00Z\n2026-06-21 11:00\n").unwrap();
+        let error = format!("{:#}", read_times_file(&bad).unwrap_err());
+        assert!(
+            error.contains("bad.txt:2:") && error.contains("RFC 3339"),
+            "{error}"
+        );
+        let empty = dir.path().join("empty.txt");
+        std::fs::write(&empty, "# nothing\n").unwrap();
+        assert!(format!("{:#}", read_times_file(&empty).unwrap_err()).contains("no times"));
+        assert!(read_times_file(&dir.path().join("missing.txt")).is_err());
+    }
+
+    #[test]
+    fn a_bad_site_writes_nothing() {
+        let times = [parse_time_utc("2026-06-21T10:00:00Z").unwrap()];
+        let mut out = Vec::new();
+        let error = write_sun_csv(95.0, 0.0, &times, &mut out).unwrap_err();
+        assert!(error.to_string().contains("latitude"), "{error}");
+        assert!(out.is_empty());
+    }
+}

@@ -1,0 +1,122 @@
+//! `irpol sun` end to end: one instant, a file of instants, and one-line errors for bad input.
+
+use std::process::Command;
+
+fn irpol(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .args(args)
+        .output()
+        .expect("run irpol");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn one_instant_is_one_csv_line_after_the_header() {
+    // Sydney at local noon in June: the winter sun stands due north, 90° − (33.87° + 23.44°) high.
+    let (ok, stdout, stderr) = irpol(&[
+        "sun",
+        "--latitude",
+        "-33.87",
+        "--longitude",
+        "151.21",
+        "--time-utc",
+        "2026-06-21T02:00:00Z",
+    ]);
+    assert!(ok, "{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    assert_eq!(lines[0], "time_utc,elevation_deg,azimuth_deg");
+    let fields: Vec<&str> = lines[1].split(',').collect();
+    assert_eq!(fields[0], "2026-06-21T02:00:00Z");
+    let elevation: f64 = fields[1].parse().unwrap();
+    let azimuth: f64 = fields[2].parse().unwrap();
+    assert!(
+        (elevation - (90.0 - 33.87 - 23.44)).abs() < 0.3,
+        "{elevation}"
+    );
+    // Due north: within 5° of 0° on the circle.
+    let off_north = (azimuth + 180.0).rem_euclid(360.0) - 180.0;
+    assert!(off_north.abs() < 5.0, "{azimuth}");
+}
+
+#[test]
+fn a_times_file_gives_one_line_per_instant_in_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("times.txt");
+    std::fs::write(
+        &file,
+        "# Munich, 21 June\n2026-06-21T06:00:00Z\n2026-06-21T11:00:00Z\n2026-06-21T16:00:00Z\n",
+    )
+    .unwrap();
+    let (ok, stdout, stderr) = irpol(&[
+        "sun",
+        "--latitude",
+        "48.14",
+        "--longitude",
+        "11.58",
+        "--times-file",
+        file.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let rows: Vec<Vec<String>> = stdout
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    let times: Vec<&str> = rows.iter().map(|r| r[0].as_str()).collect();
+    assert_eq!(
+        times,
+        [
+            "2026-06-21T06:00:00Z",
+            "2026-06-21T11:00:00Z",
+            "2026-06-21T16:00:00Z"
+        ]
+    );
+    // Morning sun in the east, midday in the south and highest, evening in the west.
+    let azimuth: Vec<f64> = rows.iter().map(|r| r[2].parse().unwrap()).collect();
+    let elevation: Vec<f64> = rows.iter().map(|r| r[1].parse().unwrap()).collect();
+    assert!(azimuth[0] < 100.0 && (azimuth[1] - 180.0).abs() < 10.0 && azimuth[2] > 260.0);
+    assert!(elevation[1] > elevation[0] && elevation[1] > elevation[2]);
+}
+
+#[test]
+fn bad_input_is_one_clear_line() {
+    let base = ["sun", "--latitude", "48.14", "--longitude", "11.58"];
+    for (extra, needle) in [
+        (vec!["--time-utc", "2026-06-21T10:00:00"], "RFC 3339"),
+        (vec!["--time-utc", "21/06/2026"], "RFC 3339"),
+        (
+            vec!["--times-file", "/nonexistent/times.txt"],
+            "cannot read",
+        ),
+    ] {
+        let args: Vec<&str> = base.iter().copied().chain(extra).collect();
+        let (ok, stdout, stderr) = irpol(&args);
+        assert!(!ok && stdout.is_empty(), "{args:?}: {stdout}");
+        assert!(
+            stderr.starts_with("irpol: error:") && stderr.contains(needle),
+            "{args:?}: {stderr}"
+        );
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+    let (ok, stdout, stderr) = irpol(&[
+        "sun",
+        "--latitude",
+        "95",
+        "--longitude",
+        "0",
+        "--time-utc",
+        "2026-06-21T10:00:00Z",
+    ]);
+    assert!(
+        !ok && stdout.is_empty() && stderr.contains("latitude"),
+        "{stderr}"
+    );
+    // One of --time-utc and --times-file, not both, not neither (clap's usage error).
+    assert!(!irpol(&base).0);
+}
