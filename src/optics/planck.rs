@@ -120,10 +120,10 @@ impl Band {
             .iter()
             .map(|&(lambda, weight)| {
                 let x = C2 / (lambda * temperature_k);
-                let ex = x.exp();
-                // d/dT [C1L λ⁻⁵ / (eˣ − 1)] = B_λ · x eˣ / ((eˣ − 1) T)
-                weight * spectral_radiance(lambda, temperature_k) * x * ex
-                    / ((ex - 1.0) * temperature_k)
+                // d/dT [C1L λ⁻⁵ / (eˣ − 1)] = B_λ · x eˣ / ((eˣ − 1) T) = B_λ x / ((1 − e⁻ˣ) T):
+                // the second form stays finite where eˣ overflows (B_λ → 0 at a few kelvin).
+                weight * spectral_radiance(lambda, temperature_k) * x
+                    / ((1.0 - (-x).exp()) * temperature_k)
             })
             .sum()
     }

@@ -18,18 +18,22 @@ impl Pbrdf {
     }
 
     /// Draws ω_i (local frame, macro normal ẑ) for light scattered along unit `scattered` from
-    /// the mixture of the facet-lobe and cosine densities, with uniforms `u` ∈ [0, 1)³ (u[0]
-    /// chooses the lobe). Returns ω_i and its mixture pdf (sr⁻¹), or `None` for a direction below
-    /// the horizon (such samples carry zero BRDF; they count as drawn).
+    /// the mixture of the facet-lobe and cosine densities, with uniforms `u` ∈ [0, 1)². u[0] both
+    /// chooses the lobe (below the lobe's weight w) and, rescaled to [0, 1), gives the radial
+    /// coordinate within it; u[1] gives the azimuth. Stratifying u[0] over a pixel's samples
+    /// therefore allocates the two lobes in proportion (Veach's multi-sample estimator with the
+    /// balance heuristic is then exactly f/pdf_mixture per sample) and stratifies each lobe
+    /// radially. Returns ω_i and its mixture pdf (sr⁻¹), or `None` for a direction below the
+    /// horizon (such samples carry zero BRDF; they count as drawn).
     pub fn sample_incident(
         &self,
         scattered: &Vector3<f64>,
-        u: [f64; 3],
+        u: [f64; 2],
     ) -> Option<(Vector3<f64>, f64)> {
         let weight = self.specular_sampling_weight();
+        let phi = 2.0 * PI * u[1];
         let incident = if u[0] < weight {
-            let tan2 = self.distribution().slope_quantile(u[1]).powi(2);
-            let phi = 2.0 * PI * u[2];
+            let tan2 = self.distribution().slope_quantile(u[0] / weight).powi(2);
             let cos_h = 1.0 / (1.0 + tan2).sqrt();
             let sin_h = tan2.sqrt() * cos_h;
             let h = Vector3::new(sin_h * phi.cos(), sin_h * phi.sin(), cos_h);
@@ -40,9 +44,9 @@ impl Pbrdf {
             h * (2.0 * cos_beta) - scattered
         } else {
             // Malley: a uniform point on the disc lifted to the hemisphere.
-            let r = u[1].sqrt();
-            let phi = 2.0 * PI * u[2];
-            Vector3::new(r * phi.cos(), r * phi.sin(), (1.0 - u[1]).max(0.0).sqrt())
+            let r2 = ((u[0] - weight) / (1.0 - weight)).clamp(0.0, 1.0);
+            let r = r2.sqrt();
+            Vector3::new(r * phi.cos(), r * phi.sin(), (1.0 - r2).sqrt())
         };
         if incident.z <= 0.0 {
             return None;
@@ -104,7 +108,7 @@ mod tests {
             let n = 400_000;
             let mut inside = 0usize;
             for _ in 0..n {
-                let u = [rng.random(), rng.random(), rng.random()];
+                let u = [rng.random(), rng.random()];
                 if let Some((w, _)) = pbrdf.sample_incident(&w_r, u) {
                     inside += (w.dot(&axis) > cap) as usize;
                 }

@@ -41,11 +41,13 @@ pub struct Noise {
 impl Noise {
     /// The sensor's noise: σ_I = ½ NETD dL_bb/dT at the reference temperature.
     pub fn of_sensor(sensor: &Sensor) -> Noise {
+        let sigma_polarizer = if sensor.netd_mk > 0.0 {
+            0.5 * sensor.netd_mk * 1e-3 * sensor.band.radiance_derivative(sensor.netd_reference_k)
+        } else {
+            0.0
+        };
         Noise {
-            sigma_polarizer: 0.5
-                * sensor.netd_mk
-                * 1e-3
-                * sensor.band.radiance_derivative(sensor.netd_reference_k),
+            sigma_polarizer,
             seed: sensor.seed,
         }
     }

@@ -120,7 +120,9 @@ impl PathTracer<'_> {
             .leaving(material, &frame, vertex.hit.temperature);
         let n = self.settings.samples.max(1);
         let sun = self.sun_integral(vertex, &frame, material);
-        let (mut sum, mut sum2) = (Stokes::zeros(), Stokes::zeros());
+        // Sums of the samples' differences from the first one: the variance is then exactly zero
+        // when every sample is the same (an unoccluded, fully lit or fully shadowed point).
+        let (mut first, mut sum, mut sum2) = (None, Stokes::zeros(), Stokes::zeros());
         for s in 0..n {
             let stratum = (s as f64 + rng.random::<f64>()) / n as f64;
             let mut x = self.correction(vertex, &frame, material, 0, stratum, rng);
@@ -128,11 +130,13 @@ impl PathTracer<'_> {
                 x += integral * self.sun_visibility(vertex, stratum, rng);
             }
             let x = to_pixel(&x);
-            sum += x;
-            sum2 += x.component_mul(&x);
+            let d = x - *first.get_or_insert(x);
+            sum += d;
+            sum2 += d.component_mul(&d);
         }
-        let mean = sum / n as f64;
-        let variance = (sum2 / n as f64 - mean.component_mul(&mean)).map(|v| v.max(0.0));
+        let shift = sum / n as f64;
+        let mean = first.unwrap_or_default() + shift;
+        let variance = (sum2 / n as f64 - shift.component_mul(&shift)).map(|v| v.max(0.0));
         let standard_error = if n > 1 {
             (variance / (n - 1) as f64).map(f64::sqrt)
         } else {
@@ -171,7 +175,8 @@ impl PathTracer<'_> {
     }
 
     /// One sample of ∫ F (S_in − L_env e₀) cosθ_i dΩ_i at `vertex` (depth `depth`), in the psps
-    /// frame of `frame`; `stratum` ∈ [0, 1) stratifies the lobe's radial coordinate.
+    /// frame of `frame`; `stratum` ∈ [0, 1) chooses the lobe and its radial coordinate
+    /// ([`Pbrdf::sample_incident`]), stratified over a pixel's samples.
     fn correction(
         &self,
         vertex: &Vertex,
@@ -186,7 +191,7 @@ impl PathTracer<'_> {
         if w_o.z <= 0.0 {
             return Stokes::zeros();
         }
-        let u = [rng.random::<f64>(), stratum, rng.random::<f64>()];
+        let u = [stratum, rng.random::<f64>()];
         let Some((w_i, pdf)) = pbrdf.sample_incident(&w_o, u) else {
             return Stokes::zeros();
         };
