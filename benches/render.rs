@@ -1,6 +1,8 @@
 //! Rendering benchmarks: the shipped car scene with the shipped material library (`fits/`),
-//! per-pixel shading, at 640×480 and 1920×1080. Each iteration is a whole render in
-//! memory: per-material tables, rasterization, shading, noise (file writing excluded).
+//! per-pixel shading, at 640×480 and 1920×1080, with occlusion, inter-reflection and the sun (the
+//! scene as shipped) and in the open world (`open_world = true`, the paper's model). Each
+//! iteration is a whole render in memory: per-material tables, ray-tracing hierarchy,
+//! rasterization, shading, noise (file writing excluded).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -15,12 +17,24 @@ fn car(c: &mut Criterion) {
     let mut group = c.benchmark_group("render_car_pixel");
     group.sample_size(10);
     for (w, h) in [(640, 480), (1920, 1080)] {
-        let scene_dir = dir.path().join(format!("{w}x{h}"));
-        let path = common::car_scene_with_shipped_fits(&scene_dir, w, h, "pixel");
-        let scene = load_scene(&path).unwrap();
-        group.bench_function(format!("{w}x{h}"), |b| {
-            b.iter(|| render(&scene, &Silent).unwrap())
-        });
+        for open_world in [false, true] {
+            let name = if open_world {
+                "open_world"
+            } else {
+                "sun_occlusion"
+            };
+            let scene_dir = dir.path().join(format!("{w}x{h}_{name}"));
+            let path = common::car_scene_with_shipped_fits(&scene_dir, w, h, "pixel");
+            if open_world {
+                let text = std::fs::read_to_string(&path).unwrap();
+                let text = text.replace("samples = 16 ", "open_world = true\nsamples = 16 ");
+                std::fs::write(&path, text).unwrap();
+            }
+            let scene = load_scene(&path).unwrap();
+            group.bench_function(format!("{name}_{w}x{h}"), |b| {
+                b.iter(|| render(&scene, &Silent).unwrap())
+            });
+        }
     }
     group.finish();
 }

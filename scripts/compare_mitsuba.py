@@ -171,12 +171,17 @@ material = "metal"
 temperature_k = {SCENE["object_temperature_k"]!r}
 translate = {f(s["center"])}
 
+""" + ("" if not plane_enabled() else f"""
 [[objects]]
 name = "ground"
 shape = {{ kind = "plane", size = {f(p["size"])}, divisions = [1, 1] }}
 material = "ground"
 temperature_k = {SCENE["object_temperature_k"]!r}
-"""
+""")
+
+
+def plane_enabled():
+    return min(SCENE["plane"]["size"]) > 0.0
 
 
 def icosphere(radius, subdivisions):
@@ -391,16 +396,16 @@ def mitsuba_scene(mi, work, width, height, bounces, spp):
             "fov_axis": "y",
             "to_world": T().look_at(origin=c["position"], target=c["look_at"], up=c["up"]),
             "film": {"type": "hdrfilm", "width": width, "height": height,
-                     "rfilter": {"type": "box"}},
+                     "rfilter": {"type": "box"}, "pixel_format": "luminance"},
             "sampler": {"type": "independent", "sample_count": spp},
         },
         "sky": {"type": "envmap", "bitmap": envmap_bitmap(mi),
                 "to_world": T().rotate([1.0, 0.0, 0.0], 90.0)},
         "sphere": {"type": "ply", "filename": str(ply), "face_normals": False,
                    "bsdf": rough_conductor(s["material"])},
-        "ground": {"type": "rectangle",
-                   "to_world": T().scale([p["size"][0] / 2.0, p["size"][1] / 2.0, 1.0]),
-                   "bsdf": rough_conductor(p["material"])},
+        **({"ground": {"type": "rectangle",
+                       "to_world": T().scale([p["size"][0] / 2.0, p["size"][1] / 2.0, 1.0]),
+                       "bsdf": rough_conductor(p["material"])}} if plane_enabled() else {}),
     })
 
 
@@ -421,25 +426,24 @@ def mitsuba_stokes(mi, scene, spp, seed):
 
 def mueller_brdf_mitsuba(mi, material, w_i, w_r):
     """Mitsuba's roughconductor as a Mueller BRDF (sr⁻¹) in irpol's psps frames (DESIGN §1.3)."""
+    vec = lambda v: mi.Vector3f(*[float(x) for x in v])
+    w_i, w_r = np.asarray(w_i, float), np.asarray(w_r, float)
     bsdf = mi.load_dict(rough_conductor(material))
     si = mi.SurfaceInteraction3f()
-    si.sh_frame = mi.Frame3f(mi.Vector3f(0.0, 0.0, 1.0))
+    si.sh_frame = mi.Frame3f(vec([0.0, 0.0, 1.0]))
     si.n = mi.Normal3f(0.0, 0.0, 1.0)
-    si.wi = mi.Vector3f(*w_r)  # toward the camera (irpol's ω_r)
-    wo = mi.Vector3f(*w_i)     # toward the light (irpol's ω_i); light travels along −wo
-    m = bsdf.eval(mi.BSDFContext(), si, wo)
+    si.wi = vec(w_r)  # toward the camera (irpol's ω_r)
+    # Toward the light (irpol's ω_i); the light travels along −ω_i.
+    m = bsdf.eval(mi.BSDFContext(), si, vec(w_i))
     z = np.array([0.0, 0.0, 1.0])
-    s_in = np.cross(z, -np.asarray(w_i))
-    s_out = np.cross(z, np.asarray(w_r))
+    s_in = np.cross(z, -w_i)   # psps: s = unit(ẑ × k), k_in = −ω_i, k_out = ω_r
+    s_out = np.cross(z, w_r)
     m = mi.mueller.rotate_mueller_basis(
-        m, mi.Vector3f(*(-np.asarray(w_i))), mi.mueller.stokes_basis(mi.Vector3f(*(-np.asarray(w_i)))),
-        mi.Vector3f(*(s_in / np.linalg.norm(s_in))),
-        mi.Vector3f(*w_r), mi.mueller.stokes_basis(mi.Vector3f(*w_r)),
-        mi.Vector3f(*(s_out / np.linalg.norm(s_out))))
-    arr = np.array(m, dtype=np.float64).reshape(-1)[:16] if np.size(np.array(m)) == 16 else None
-    if arr is None:
-        arr = np.array([[float(np.array(m[r][c]).ravel()[0]) for c in range(4)] for r in range(4)])
-    return arr.reshape(4, 4) / w_i[2]  # bsdf.eval includes cos θ of the light direction
+        m, vec(-w_i), mi.mueller.stokes_basis(vec(-w_i)), vec(s_in / np.linalg.norm(s_in)),
+        vec(w_r), mi.mueller.stokes_basis(vec(w_r)), vec(s_out / np.linalg.norm(s_out)))
+    arr = np.array([[np.asarray(m[r, c]).ravel()[0] for c in range(4)] for r in range(4)],
+                   np.float64)
+    return arr / w_i[2]  # bsdf.eval includes cos θ of the light direction
 
 
 def direction(theta_deg, phi_deg):
@@ -526,17 +530,38 @@ def dolp(stokes):
         return np.sqrt(stokes[1] ** 2 + stokes[2] ** 2) / stokes[0]
 
 
+CHANNELS = ["S0", "S1", "S2", "S3", "S2 odd", "S3 odd", "DoLP"]
+
+
 def region_stats(passes, mask):
-    """Region means of S0..S3 and DoLP, with standard errors (DoLP: jackknife over passes)."""
+    """Region means of S0..S3, of the mirror-odd parts of S2 and S3, and of DoLP, with standard
+    errors (DoLP: jackknife over the passes).
+
+    The scene is mirror-symmetric about the vertical plane through the camera and the sphere's axis
+    (up to the square ground's far edges), which projects onto the image's centre column; a mirror
+    flips S2 and S3, so their region means vanish by symmetry and only their odd parts
+    ⟨S · sgn(column − centre)⟩, over pixels whose mirror image is in the region too, test them."""
     mean, var = combine(passes)
     n = mask.sum()
     means = [mean[j][mask].mean() for j in range(4)]
     errors = [math.sqrt(var[j][mask].sum()) / n for j in range(4)]
-    d = dolp(mean)[mask].mean()
+    width = mask.shape[1]
+    side = np.sign(np.arange(width) - (width - 1) / 2.0)[None, :] * np.ones_like(mean[0])
+    sym = mask & mask[:, ::-1]
+    n_sym = max(sym.sum(), 1)
+    for j in (2, 3):
+        means.append((mean[j] * side)[sym].mean() if sym.any() else 0.0)
+        errors.append(math.sqrt(var[j][sym].sum()) / n_sym)
+    means.append(dolp(mean)[mask].mean())
     k = len(passes)
     jack = [dolp(np.delete(passes, i, axis=0).mean(axis=0))[mask].mean() for i in range(k)]
-    d_err = math.sqrt((k - 1) / k * np.sum((np.array(jack) - np.mean(jack)) ** 2))
-    return means + [d], errors + [d_err], var[0][mask]
+    errors.append(math.sqrt((k - 1) / k * np.sum((np.array(jack) - np.mean(jack)) ** 2)))
+    return means, errors, var[0][mask]
+
+
+def block_mean(image, n):
+    h, w = image.shape[-2] // n, image.shape[-1] // n
+    return image.reshape(image.shape[:-2] + (h, n, w, n)).mean(axis=(-3, -1))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -552,12 +577,20 @@ def main():
     parser.add_argument("--height", type=int, default=96)
     parser.add_argument("--bounces", type=int, default=16)
     parser.add_argument("--passes", type=int, default=8, help="independent passes per renderer")
-    parser.add_argument("--irpol-samples", type=int, default=128, help="irpol samples per pass")
-    parser.add_argument("--mitsuba-spp", type=int, default=256, help="Mitsuba spp per pass")
+    parser.add_argument("--irpol-samples", type=int, default=512, help="irpol samples per pass")
+    parser.add_argument("--mitsuba-spp", type=int, default=2048, help="Mitsuba spp per pass")
+    parser.add_argument("--irpol-supersample", type=int, default=1, metavar="N",
+                        help="diagnostic: render irpol at N× the resolution (samples/N² each) and "
+                             "average N×N blocks, i.e. a box-filtered pixel like Mitsuba's")
+    parser.add_argument("--sphere-only", action="store_true",
+                        help="diagnostic: leave out the ground plane (irpol is then its exact "
+                             "open-world tables, noise-free)")
     parser.add_argument("--variant", default=None, help="Mitsuba variant (default: best available)")
     parser.add_argument("--tolerance", type=float, default=0.01, help="S0 relative tolerance")
     args = parser.parse_args()
 
+    if args.sphere_only:
+        SCENE["plane"]["size"] = [0.0, 0.0]
     irpol = args.irpol
     if not os.access(irpol, os.X_OK):
         print(f"irpol binary not found at {irpol}", file=sys.stderr)
@@ -572,26 +605,32 @@ def main():
     variant = choose_variant(mi, args.variant)
     print(f"Mitsuba {mi.__version__}, variant {variant}; irpol {irpol}")
     if "spectral" in variant:
-        print("  note: spectral variant: the envmap is RGB-upsampled and D65-weighted; background "
-              "pixels calibrate the scale")
+        print("  note: spectral variant: the envmap is RGB-upsampled and D65-weighted; compare the "
+              "background rows to see the scale")
     ground = irpol_ground_radiance()
     print(f"Environment: sky table {SCENE['sky_radiance']} at {SCENE['sky_elevation_deg']}°, "
           f"ground below the horizon {ground:.6f} W m-2 sr-1 "
           f"(= (1 − {SCENE['ground_emissivity']}) E_sky/π, L_bb(1 K) = 0)")
 
     sign, brdf_dev = brdf_check(mi, irpol, work)
+    if sign == 0:
+        print("S3 sign relation inconsistent between geometries: S3 not compared", file=sys.stderr)
 
     # irpol passes.
+    n_sup = args.irpol_supersample
+    samples = max(1, args.irpol_samples // (n_sup * n_sup))
     ir_passes, ir_stderr, ir_times = [], [], []
     for seed in range(1, args.passes + 1):
-        s, e, t, summary = irpol_pass(irpol, work, width, height, args.bounces,
-                                      args.irpol_samples, seed)
-        ir_passes.append(s)
-        ir_stderr.append(e)
+        s, e, t, summary = irpol_pass(irpol, work, width * n_sup, height * n_sup, args.bounces,
+                                      samples, seed)
+        ir_passes.append(block_mean(s, n_sup))
+        ir_stderr.append(np.sqrt(block_mean(e ** 2, n_sup) / (n_sup * n_sup)))
         ir_times.append(t)
-    print(f"irpol: {args.passes} passes × {args.irpol_samples} samples, bounces {args.bounces}: "
-          f"{sum(ir_times):.2f} s (processes; per pass {min(ir_times):.2f}–{max(ir_times):.2f} s, "
-          f"irpol's own shade time {summary['timings_s']['shade']:.2f} s in the last)")
+    sup = f" at {n_sup}×{n_sup} subpixels" if n_sup > 1 else ""
+    print(f"irpol: {args.passes} passes × {samples} samples{sup}, bounces {args.bounces}: "
+          f"{sum(ir_times):.2f} s (whole processes; per pass {min(ir_times):.2f}–"
+          f"{max(ir_times):.2f} s; irpol's own timings in the last: "
+          + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()) + ")")
 
     # Mitsuba passes.
     t0 = time.perf_counter()
@@ -603,14 +642,14 @@ def main():
         mi_passes.append(s)
         mi_times.append(t)
     print(f"Mitsuba: {args.passes} passes × {args.mitsuba_spp} spp, path max_depth "
-          f"{args.bounces + 2}: {sum(mi_times):.2f} s (first pass {mi_times[0]:.2f} s incl. JIT, "
-          f"others {np.mean(mi_times[1:]) if len(mi_times) > 1 else float('nan'):.2f} s; "
-          f"scene load {t_load:.2f} s)")
+          f"{args.bounces + 2}: {sum(mi_times):.2f} s (mi.render; first pass {mi_times[0]:.2f} s "
+          f"incl. JIT, others {np.mean(mi_times[1:]) if len(mi_times) > 1 else float('nan'):.2f} s;"
+          f" scene load {t_load:.2f} s)")
 
     # Into irpol's pixel frame.
     psi = mitsuba_to_pixel_frame_angle(width, height)
     mi_passes = rotate_stokes(np.array(mi_passes), psi)
-    mi_passes[:, 3] *= sign if sign != 0 else -1.0
+    mi_passes[:, 3] *= sign if sign != 0 else 0.0
     ir_passes = np.array(ir_passes)
     print(f"Frame rotation Mitsuba → irpol: |ψ| up to {np.degrees(np.abs(psi)).max():.3f}° "
           f"(0 on the image's centre row and column); S3 multiplied by {sign:+.0f}")
@@ -619,12 +658,12 @@ def main():
     # A cross-check of the noise estimate: irpol's own stderr_S0 (per pass) against the spread.
     own = np.sqrt(np.mean(np.array(ir_stderr) ** 2, axis=0) / args.passes)
 
-    names = ["S0", "S1", "S2", "S3", "DoLP"]
     print()
-    print("Region means (irpol pixel frame, W m-2 sr-1; ± standard error of the mean)")
-    failures = 0
-    rows = []
+    print("Region means in irpol's pixel frame (W m-2 sr-1), ± standard error of the mean; "
+          "Δ = irpol − Mitsuba")
+    checks, failures = 0, 0
     var_ir_all, var_mi_all = [], []
+    summary_rows = []
     for region in REGIONS:
         mask = masks[region]
         if mask.sum() == 0:
@@ -636,59 +675,73 @@ def main():
             var_ir_all.append(v_ir)
             var_mi_all.append(v_mi)
         print(f"  {region} ({mask.sum()} px)")
-        for j, name in enumerate(names):
+        for j, name in enumerate(CHANNELS):
             diff = m_ir[j] - m_mi[j]
             sig = math.hypot(e_ir[j], e_mi[j])
-            z = diff / sig if sig > 0 else float("inf") if diff else 0.0
-            rel = diff / m_mi[0]  # relative to S0 for every channel
-            if j == 0:
+            z = diff / sig if sig > 0 else (math.inf if diff else 0.0)
+            if name == "DoLP":
+                ok, note = True, f"{diff:+9.5f} abs."
+            elif name == "S0":
                 ok = abs(diff / m_mi[0]) <= args.tolerance
-            elif j <= 3:
-                ok = abs(z) <= 4.0 or abs(rel) <= 0.002
+                note = f"{100 * diff / m_mi[0]:+7.3f} %     "
             else:
-                ok = True
-            failures += not ok
-            rel_text = f"{100 * diff / m_mi[0]:+7.3f} % of S0" if j else \
-                f"{100 * diff / m_mi[0]:+7.3f} %      "
-            if j == 4:
-                rel_text = f"{diff:+8.5f} abs.     "
-            print(f"    {name:4} irpol {m_ir[j]:11.5f} ± {e_ir[j]:.5f}   mitsuba {m_mi[j]:11.5f} ± "
-                  f"{e_mi[j]:.5f}   Δ {diff:+9.5f} ({rel_text}, {z:+6.1f} σ) "
-                  f"{'' if ok else '  <-- outside tolerance'}")
-            rows.append((region, name, m_ir[j], e_ir[j], m_mi[j], e_mi[j], diff, z))
+                if name.startswith("S3") and sign == 0:
+                    continue
+                ok = abs(z) <= 4.0 or abs(diff / m_mi[0]) <= 0.002
+                note = f"{100 * diff / m_mi[0]:+7.3f} % S0  "
+            if name != "DoLP":
+                checks += 1
+                failures += not ok
+            print(f"    {name:6} irpol {m_ir[j]:10.5f} ± {e_ir[j]:.5f}   Mitsuba {m_mi[j]:10.5f} ± "
+                  f"{e_mi[j]:.5f}   Δ {diff:+9.5f}  {note} {z:+7.1f} σ"
+                  f"{'' if ok else '   <-- outside tolerance'}")
+            summary_rows.append(dict(region=region, channel=name, irpol=m_ir[j], irpol_se=e_ir[j],
+                                     mitsuba=m_mi[j], mitsuba_se=e_mi[j], diff=diff, z=z))
         if region in ("sphere upper", "sphere lower", "ground near"):
-            print(f"         irpol's stderr_S0 over the region: "
-                  f"{math.sqrt((own[mask] ** 2).sum()) / mask.sum():.5f} (pass-spread: {e_ir[0]:.5f})")
+            print(f"           irpol's own stderr_S0 for this mean: "
+                  f"{math.sqrt((own[mask] ** 2).sum()) / mask.sum():.5f} "
+                  f"(from the pass spread: {e_ir[0]:.5f})")
 
     # Noise and time.
     var_ir = np.concatenate(var_ir_all).mean()
     var_mi = np.concatenate(var_mi_all).mean()
     t_ir, t_mi = sum(ir_times), sum(mi_times)
     print()
-    print("Noise (per-pixel standard error of S0 over the surface regions, RMS): "
+    print("Noise: RMS per-pixel standard error of S0 over the four surface regions: "
           f"irpol {math.sqrt(var_ir):.4f}, Mitsuba {math.sqrt(var_mi):.4f} W m-2 sr-1")
-    print(f"Time: irpol {t_ir:.2f} s, Mitsuba {t_mi:.2f} s (renders; + {t_load:.2f} s load): "
-          f"ratio Mitsuba/irpol = {t_mi / t_ir:.2f}")
-    print(f"At equal noise (T σ²): Mitsuba/irpol = {(t_mi * var_mi) / (t_ir * var_ir):.1f}")
+    for region in REGIONS[:4]:
+        mask = masks[region]
+        if mask.any():
+            print(f"  {region:13}: irpol {math.sqrt(combine(ir_passes)[1][0][mask].mean()):.4f}, "
+                  f"Mitsuba {math.sqrt(combine(mi_passes)[1][0][mask].mean()):.4f}")
+    print(f"Time: irpol {t_ir:.2f} s, Mitsuba {t_mi:.2f} s: Mitsuba/irpol = {t_mi / t_ir:.2f}")
+    print(f"At equal noise (T σ² over the surface regions): Mitsuba/irpol = "
+          f"{(t_mi * var_mi) / (t_ir * var_ir):.2f}")
 
-    figure(np.array(ir_passes).mean(axis=0), np.array(mi_passes).mean(axis=0),
-           combine(ir_passes)[1], combine(mi_passes)[1], masks, args.png)
+    figure(ir_passes.mean(axis=0), mi_passes.mean(axis=0), combine(ir_passes)[1],
+           combine(mi_passes)[1], masks, args.png, variant)
     print(f"Figure: {args.png}")
     np.savez_compressed(work / "compare.npz", irpol=ir_passes, mitsuba=mi_passes, psi=psi,
                         **{k.replace(" ", "_").replace("(", "").replace(")", ""): v
                            for k, v in masks.items()})
+    (work / "compare.json").write_text(json.dumps(dict(
+        rows=summary_rows, irpol_seconds=t_ir, mitsuba_seconds=t_mi, mitsuba_load_seconds=t_load,
+        irpol_rms_se_s0=math.sqrt(var_ir), mitsuba_rms_se_s0=math.sqrt(var_mi), s3_sign=sign,
+        brdf_max_deviation=brdf_dev, variant=variant), indent=1, default=float))
+    checks += 1
     failures += brdf_dev > 0.02
-    print(f"{len(rows) // 5 * 4 - failures} passed, {failures} failed")
+    print(f"{checks - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 
-def figure(ir, mit, var_ir, var_mi, masks, path):
+def figure(ir, mit, var_ir, var_mi, masks, path, variant):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(3, 3, figsize=(13, 9.2), constrained_layout=True)
-    sigma = np.sqrt(var_ir + var_mi)
+    # A floor keeps noise-free pixels (the environment, unoccluded ground in irpol) readable.
+    sigma = np.sqrt(var_ir + var_mi + (1e-4 * np.abs(mit[0]) + 1e-6) ** 2)
     outline = np.zeros(ir.shape[1:], float)
     for i, name in enumerate(REGIONS[:4]):
         outline[masks[name]] = i + 1
@@ -722,7 +775,7 @@ def figure(ir, mit, var_ir, var_mi, masks, path):
     for ax in axes.ravel():
         ax.set_xticks([])
         ax.set_yticks([])
-    fig.suptitle("irpol vs Mitsuba 3 (llvm_ad_mono_polarized path): sphere N = 3+20i σ = 0.15, "
+    fig.suptitle(f"irpol vs Mitsuba 3 ({variant}, path): sphere N = 3+20i σ = 0.15, "
                  "ground N = 1.5+0.1i σ = 0.2; contours: compared regions")
     fig.savefig(path, dpi=90)
     plt.close(fig)

@@ -189,3 +189,61 @@ fn output_folder_is_untouched_on_failure() {
     assert_eq!(std::fs::read(out.join("S0.tif")).unwrap(), b"old");
     assert!(Path::new(&out).read_dir().unwrap().count() == 1);
 }
+
+/// `[render]` transport keys and `[sun]` are checked with messages naming the key.
+#[test]
+fn bad_transport_and_sun_settings() {
+    let base = scene_with_mesh("panel.obj", "");
+    let files = [("panel.obj", TRIANGLE_OBJ)];
+    for (extra, pieces) in [
+        ("[render]\nsamples = 0\n", &["render.samples = 0"][..]),
+        ("[render]\nbounces = 1000\n", &["render.bounces = 1000"][..]),
+        ("[render]\nbounce = 2\n", &["unknown field `bounce`"][..]),
+        (
+            "[sun]\nelevation_deg = 30.0\nazimuth_deg = 10.0\nirradiance_w_m2 = -1.0\n",
+            &["sun.irradiance_w_m2"][..],
+        ),
+        (
+            "[sun]\nelevation_deg = nan\nazimuth_deg = 10.0\n",
+            &["sun.elevation_deg"][..],
+        ),
+        (
+            "[sun]\nelevation_deg = 30.0\nazimuth_deg = inf\n",
+            &["sun.elevation_deg/azimuth_deg"][..],
+        ),
+        (
+            "[sun]\nelevation_deg = 30.0\n",
+            &["[sun] needs elevation_deg and azimuth_deg"][..],
+        ),
+        (
+            "[sun]\nelevation_deg = 30.0\nazimuth_deg = 10.0\ntransmittance = 1.5\n",
+            &["sun.transmittance"][..],
+        ),
+        (
+            "[sun]\nlatitude_deg = 48.1\nlongitude_deg = 11.6\ntime_utc = \"noon\"\n",
+            &["sun.time_utc", "noon"][..],
+        ),
+        (
+            "[sun]\nelevation = 30.0\n",
+            &["unknown field `elevation`"][..],
+        ),
+    ] {
+        let text = refuse(&format!("{extra}{base}"), &files);
+        expect(&text, &["scene.toml"]);
+        expect(&text, pieces);
+    }
+}
+
+/// A sun below the horizon is allowed: it simply adds nothing.
+#[test]
+fn a_sun_below_the_horizon_renders_without_a_sun_term() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("panel.obj"), TRIANGLE_OBJ).unwrap();
+    let scene = format!(
+        "[sun]\nelevation_deg = -5.0\nazimuth_deg = 10.0\n{}",
+        scene_with_mesh("panel.obj", "")
+    );
+    let path = write_scene(dir.path(), &scene);
+    let summary = render_scene(&path, &dir.path().join("out"), &Silent).unwrap();
+    assert!(summary.transport.sun.is_none());
+}

@@ -8,7 +8,7 @@ use super::colormap::{cyclic, ColorMap, Lut, DIVERGING, MASKED, SEQUENTIAL, THER
 use crate::render::film::{dolp_aop, StokesImage, BACKGROUND};
 use crate::report::{register_fonts, FONT};
 use crate::scene::config::Shading;
-use crate::scene::Scene;
+use crate::scene::{Scene, Transport};
 use crate::transport::tables::TemperatureLookup;
 use image::ImageEncoder;
 use plotters::prelude::*;
@@ -85,6 +85,21 @@ impl Previews {
         };
         let (s1_colors, s1_max) = symmetric(1);
         let (s2_colors, s2_max) = symmetric(2);
+        // S3 only where light was transported between surfaces (the open world has none).
+        let s3_panel = matches!(scene.transport, Transport::Path(_)).then(|| {
+            let (colors, m) = symmetric(3);
+            Panel {
+                file: "S3.png",
+                title: "S3 (W·m⁻²·sr⁻¹)".into(),
+                colors,
+                bar: Bar::Linear {
+                    map: &DIVERGING,
+                    lo: -m,
+                    hi: m,
+                    format: format_signed,
+                },
+            }
+        });
 
         let dolp = pick(&|s| dolp_aop(s).0);
         let (_, d_hi) = robust_range(dolp, 0.0, 0.99);
@@ -119,14 +134,28 @@ impl Previews {
             Shading::Pixel => "per-pixel",
             Shading::Gouraud => "Gouraud",
         };
-        let caption = format!(
+        let mut caption = format!(
             "{stem}: {}×{}, {shading} shading, {lo_um}–{hi_um} µm, air {:.2} K",
             image.width, image.height, scene.air_temperature_k
         );
+        if let Transport::Path(settings) = scene.transport {
+            caption += &format!(
+                ", occlusion: {} bounces, {} paths/pixel",
+                settings.bounces, settings.samples
+            );
+            if let Some(sun) = scene.sun {
+                let d = sun.direction;
+                caption += &format!(
+                    ", sun at {:.0}° elevation, {:.0}° azimuth",
+                    d.z.asin().to_degrees(),
+                    d.x.atan2(d.y).to_degrees().rem_euclid(360.0)
+                );
+            }
+        }
         Previews {
             width: image.width,
             height: image.height,
-            panels: vec![
+            panels: [
                 Panel {
                     file: "S0.png",
                     title: "S0 — apparent temperature (K)".into(),
@@ -180,7 +209,10 @@ impl Previews {
                     colors: aop_colors,
                     bar: Bar::Cyclic,
                 },
-            ],
+            ]
+            .into_iter()
+            .chain(s3_panel)
+            .collect(),
             caption,
         }
     }
@@ -220,9 +252,11 @@ impl Previews {
             ((self.width as f64 * scale).round() as usize).max(1),
             ((self.height as f64 * scale).round() as usize).max(1),
         );
+        // S0, S1, S2, DoLP, AoP (the paper's Fig. 5); S3 has its own preview only.
         let cells: Vec<Canvas> = self
             .panels
             .iter()
+            .take(5)
             .map(|p| draw_panel(p, self.width, self.height, img_w, img_h))
             .collect::<io::Result<_>>()?;
         let (cell_w, cell_h) = (cells[0].width, cells[0].height);

@@ -145,6 +145,7 @@ pub struct ChannelSummary {
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct ErrorSummary {
     pub mean: f64,
+    pub median: f64,
     pub p99: f64,
 }
 
@@ -371,7 +372,7 @@ fn transport_summary(scene: &Scene) -> TransportSummary {
 }
 
 impl StokesImage {
-    /// Mean and 99th percentile of the standard error of Stokes component `j` relative to S0,
+    /// Mean, median and 99th percentile of the standard error of Stokes component `j` relative to S0,
     /// over object pixels with S0 > 0.
     pub fn relative_error(&self, j: usize) -> Option<ErrorSummary> {
         let mut values: Vec<f64> = self
@@ -388,8 +389,12 @@ impl StokesImage {
         }
         values.sort_by(f64::total_cmp);
         let mean = values.iter().sum::<f64>() / values.len() as f64;
-        let p99 = values[((values.len() - 1) as f64 * 0.99).round() as usize];
-        Some(ErrorSummary { mean, p99 })
+        let quantile = |p: f64| values[((values.len() - 1) as f64 * p).round() as usize];
+        Some(ErrorSummary {
+            mean,
+            median: quantile(0.5),
+            p99: quantile(0.99),
+        })
     }
 }
 

@@ -35,6 +35,9 @@ use nalgebra::Vector3;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
+/// Shadow rays toward the sun per visible point (stratified over the disc's area).
+const SHADOW_RAYS_PER_PIXEL: u32 = 4;
+
 /// A surface point seen from a given side: the hit, its normal turned toward the viewer, and the
 /// geometric normal on the same side (for ray offsets and the true horizon).
 #[derive(Clone, Copy, Debug)]
@@ -123,11 +126,24 @@ impl PathTracer<'_> {
         // Sums of the samples' differences from the first one: the variance is then exactly zero
         // when every sample is the same (an unoccluded, fully lit or fully shadowed point).
         let (mut first, mut sum, mut sum2) = (None, Stokes::zeros(), Stokes::zeros());
+        // Visibility of the disc by a few stratified shadow rays, reused cyclically: a lit or
+        // shadowed point needs one answer, only penumbrae need more, and each sample still
+        // carries one of them so that the standard error sees the penumbra's spread.
+        let shadow_rays = n.min(SHADOW_RAYS_PER_PIXEL);
+        let visibility: Vec<f64> = match sun {
+            Some(_) => (0..shadow_rays)
+                .map(|s| {
+                    let stratum = (s as f64 + rng.random::<f64>()) / shadow_rays as f64;
+                    self.sun_visibility(vertex, stratum, rng)
+                })
+                .collect(),
+            None => Vec::new(),
+        };
         for s in 0..n {
             let stratum = (s as f64 + rng.random::<f64>()) / n as f64;
             let mut x = self.correction(vertex, &frame, material, 0, stratum, rng);
             if let Some(integral) = sun {
-                x += integral * self.sun_visibility(vertex, stratum, rng);
+                x += integral * visibility[s as usize % visibility.len()];
             }
             let x = to_pixel(&x);
             let d = x - *first.get_or_insert(x);
