@@ -101,6 +101,7 @@ fn files_hold_the_rendered_channels() {
         "S2.png",
         "DoLP.png",
         "AoP.png",
+        "S3.png",
         "composite.png",
     ] {
         let decoded = image::load_from_memory(&std::fs::read(out.join(png)).unwrap()).unwrap();
@@ -128,8 +129,9 @@ fn files_hold_the_rendered_channels() {
     let t = &json["apparent_temperature_k"];
     assert!(t["min"].as_f64().unwrap() < t["mean"].as_f64().unwrap());
     assert!(t["max"].as_f64().unwrap() < 300.0 && t["min"].as_f64().unwrap() > 270.0);
-    // 10 channel TIFFs, stderr_S0.tif, the EXR, 5 previews, the composite and the summary.
-    assert_eq!(summary.files.len(), 19);
+    // 10 channel TIFFs, stderr_S0.tif, the EXR, 6 previews (S3 with transport), the composite
+    // and the summary.
+    assert_eq!(summary.files.len(), 20);
     assert!(json["timings_s"]["total"].as_f64().unwrap() > 0.0);
 }
 
