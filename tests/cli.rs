@@ -1,19 +1,10 @@
 //! The `irpol` binary end to end: outputs that carry physics, and clear one-line errors (no panics)
 //! for bad input.
 
-use std::process::Command;
+mod common;
 
-fn irpol(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_irpol"))
-        .args(args)
-        .output()
-        .expect("run irpol");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::irpol;
+
 
 fn column(csv: &str, name: &str) -> Vec<f64> {
     let mut lines = csv.lines();

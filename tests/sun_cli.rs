@@ -1,18 +1,9 @@
 //! `irpol sun` end to end: one instant, a file of instants, and one-line errors for bad input.
 
-use std::process::Command;
+mod common;
 
-fn irpol(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_irpol"))
-        .args(args)
-        .output()
-        .expect("run irpol");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::irpol;
+
 
 #[test]
 fn one_instant_is_one_csv_line_after_the_header() {

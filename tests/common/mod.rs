@@ -161,3 +161,16 @@ pub fn material_toml(sigma: f64, q: f64, n: f64, k: f64, rho_d: f64) -> String {
          rho_d = {rho_d}\nshadowing = \"smith\"\n"
     )
 }
+
+/// Runs the `irpol` binary with `args`: (success, stdout, stderr).
+pub fn irpol(args: &[&str]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .args(args)
+        .output()
+        .expect("run irpol");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
