@@ -16,6 +16,7 @@ use irpol::fit::{
     fit_files, parse_parameter_list, parse_parameter_values, DistributionKind, FitOptions,
     FitOutcome, Optimizer, RobustLoss,
 };
+use irpol::output::staged_folder::staging_folder;
 use irpol::pbrdf::Shadowing;
 use irpol::report::fit_report::{rebuild_report, write_fit_report};
 use irpol::report::index::write_library_index;
@@ -420,6 +421,7 @@ fn significant(value: f64, digits: i32) -> String {
 
 fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| default_output_dir(scene));
+    cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())]);
     let summary = render_scene(scene, &out, &TerminalProgress::new())?;
     let temperature = summary
         .apparent_temperature_k

@@ -1,12 +1,13 @@
 //! Render outputs (DESIGN §4 `irpol render`): one 32-bit float single-channel TIFF per channel,
 //! `stokes.exr` with every channel, PNG previews with colour bars, `composite.png` (the paper's
-//! Fig. 5 layout) and `summary.json`. Each file is encoded in memory and written atomically
-//! (temporary sibling + rename); `summary.json` comes last, so its presence marks a complete set.
+//! Fig. 5 layout) and `summary.json`. Every file is encoded in memory first; the set is then
+//! written into a staging folder and swapped with the output folder in one step
+//! ([`staged_folder`]), so the folder holds the complete old set or the complete new one.
 
 pub mod colormap;
 pub mod figure;
+pub mod staged_folder;
 
-use crate::material::write_atomically;
 use crate::render::film::{dolp_aop, polarizer, StokesImage, BACKGROUND};
 use crate::render::{RenderError, Rendered, Timings};
 use crate::scene::config::Shading;
@@ -14,6 +15,7 @@ use crate::scene::{Scene, Transport};
 use crate::transport::tables::{TableResolution, TemperatureLookup};
 use rayon::prelude::*;
 use serde::Serialize;
+use staged_folder::StagedFolder;
 use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::Path;
@@ -250,10 +252,19 @@ pub fn write_outputs(
                 })
         })
         .collect::<Result<_, _>>()?;
+    let write_error = |source| RenderError::Write {
+        path: out_dir.to_owned(),
+        source,
+    };
+    let staged = StagedFolder::begin(out_dir).map_err(write_error)?;
     let mut files = Vec::with_capacity(encoded.len() + 1);
     for (name, bytes) in encoded {
-        let path = out_dir.join(&name);
-        write_atomically(&path, &bytes).map_err(|source| RenderError::Write { path, source })?;
+        staged
+            .write(&name, &bytes)
+            .map_err(|source| RenderError::Write {
+                path: out_dir.join(&name),
+                source,
+            })?;
         files.push(name);
     }
 
@@ -330,9 +341,35 @@ pub fn write_outputs(
         path: out_dir.join("summary.json"),
         source: std::io::Error::other(e),
     })?;
-    let path = out_dir.join("summary.json");
-    write_atomically(&path, &json).map_err(|source| RenderError::Write { path, source })?;
+    staged
+        .write("summary.json", &json)
+        .map_err(|source| RenderError::Write {
+            path: out_dir.join("summary.json"),
+            source,
+        })?;
+    let earlier = earlier_outputs(out_dir);
+    staged
+        .commit(&|name| earlier.iter().any(|f| f == name))
+        .map_err(write_error)?;
     Ok(summary)
+}
+
+/// The files an earlier render listed in `out_dir/summary.json` (they are replaced as a set;
+/// anything else in the folder is the user's and is kept).
+fn earlier_outputs(out_dir: &Path) -> Vec<String> {
+    let Ok(text) = std::fs::read(out_dir.join("summary.json")) else {
+        return Vec::new();
+    };
+    let summary: serde_json::Value = serde_json::from_slice(&text).unwrap_or_default();
+    summary["files"]
+        .as_array()
+        .map(|files| {
+            files
+                .iter()
+                .filter_map(|f| f.as_str().map(str::to_owned))
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// The Stokes component a channel is, if it is one.

@@ -1,0 +1,183 @@
+//! An output folder replaced as a whole (issue 15: a render's outputs change together or not at
+//! all). Files are written into a hidden staging folder beside the target,
+//! `.<name>.irpol-staging-<pid>`, and the finished folder is swapped with the target in one
+//! `renameat2(RENAME_EXCHANGE)` (Linux; a plain rename where there is no target yet), so a reader
+//! or a killed run sees the complete old set or the complete new one, never a mix. Entries of the
+//! target that belong to no set (a user's notes: neither written now nor listed by the caller as
+//! an earlier output) are carried over first, files by hard link.
+//! The staging folder is removed when the set is dropped uncommitted (an error), by the binary's
+//! SIGINT/SIGTERM handler ([`staging_folder`] names it), and, after a SIGKILL, by the next run
+//! into the same target.
+
+use std::fs;
+use std::io;
+use std::path::{Path, PathBuf};
+
+/// The staging folder of process `pid` for `target`.
+pub fn staging_folder(target: &Path, pid: u32) -> PathBuf {
+    parent_of(target).join(format!("{}{pid}", staging_prefix(target)))
+}
+
+/// `.<name>.irpol-staging-`: what every staging folder of `target` is named before its pid.
+fn staging_prefix(target: &Path) -> String {
+    let name = target
+        .file_name()
+        .map_or("out".into(), |n| n.to_string_lossy().into_owned());
+    format!(".{name}.irpol-staging-")
+}
+
+fn parent_of(path: &Path) -> &Path {
+    path.parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+}
+
+/// A folder being written; [`StagedFolder::commit`] swaps it into place.
+pub struct StagedFolder {
+    target: PathBuf,
+    staging: PathBuf,
+    committed: bool,
+}
+
+impl StagedFolder {
+    /// Starts a fresh staging folder for `target` (removing those left by killed runs).
+    pub fn begin(target: &Path) -> io::Result<StagedFolder> {
+        fs::create_dir_all(parent_of(target))?;
+        remove_stale_staging(target);
+        let staging = staging_folder(target, std::process::id());
+        if staging.exists() {
+            fs::remove_dir_all(&staging)?;
+        }
+        fs::create_dir(&staging)?;
+        Ok(StagedFolder {
+            target: target.to_owned(),
+            staging,
+            committed: false,
+        })
+    }
+
+    /// Writes one file of the set.
+    pub fn write(&self, name: &str, bytes: &[u8]) -> io::Result<()> {
+        fs::write(self.staging.join(name), bytes)
+    }
+
+    /// Puts the set in place of the target in one step and removes the old set. `earlier_output`
+    /// tells which names in the target an earlier run wrote (they go with the old set).
+    pub fn commit(mut self, earlier_output: &dyn Fn(&str) -> bool) -> io::Result<()> {
+        if !self.target.exists() {
+            fs::rename(&self.staging, &self.target)?;
+            self.committed = true;
+            return Ok(());
+        }
+        if !self.target.is_dir() {
+            return Err(io::Error::other(format!(
+                "{} exists and is not a folder",
+                self.target.display()
+            )));
+        }
+        self.carry_over_foreign_files(earlier_output)?;
+        rustix::fs::renameat_with(
+            rustix::fs::CWD,
+            &self.staging,
+            rustix::fs::CWD,
+            &self.target,
+            rustix::fs::RenameFlags::EXCHANGE,
+        )?;
+        self.committed = true;
+        // The staging path now holds the old set.
+        fs::remove_dir_all(&self.staging)
+    }
+
+    /// Hard-links into the staging folder every entry of the target that is neither written now
+    /// nor an earlier output.
+    fn carry_over_foreign_files(&self, earlier_output: &dyn Fn(&str) -> bool) -> io::Result<()> {
+        for entry in fs::read_dir(&self.target)? {
+            let entry = entry?;
+            let staged = self.staging.join(entry.file_name());
+            if staged.exists() || earlier_output(&entry.file_name().to_string_lossy()) {
+                continue;
+            }
+            if entry.file_type()?.is_dir() {
+                // Folders move in the same step as the swap would: renamed just before it.
+                fs::rename(entry.path(), staged)?;
+            } else {
+                fs::hard_link(entry.path(), staged)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Drop for StagedFolder {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = fs::remove_dir_all(&self.staging);
+        }
+    }
+}
+
+/// Removes staging folders of `target` whose process no longer runs (a SIGKILL mid-write).
+fn remove_stale_staging(target: &Path) {
+    let prefix = staging_prefix(target);
+    let Ok(entries) = fs::read_dir(parent_of(target)) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(pid) = name
+            .strip_prefix(&prefix)
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        let alive = Path::new("/proc").join(pid.to_string()).exists();
+        if !alive || pid == std::process::id() {
+            let _ = fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_committed_set_replaces_the_old_one_and_keeps_foreign_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out");
+        let first = StagedFolder::begin(&target).unwrap();
+        first.write("a.txt", b"1").unwrap();
+        first.write("b.txt", b"1").unwrap();
+        first.commit(&|_| false).unwrap();
+        fs::write(target.join("notes.md"), b"mine").unwrap();
+        let second = StagedFolder::begin(&target).unwrap();
+        second.write("a.txt", b"2").unwrap();
+        second.commit(&|name| name.ends_with(".txt")).unwrap();
+        assert_eq!(fs::read(target.join("a.txt")).unwrap(), b"2");
+        assert!(
+            !target.join("b.txt").exists(),
+            "the old set is gone as a whole"
+        );
+        assert_eq!(fs::read(target.join("notes.md")).unwrap(), b"mine");
+        let leftovers: Vec<_> = fs::read_dir(dir.path()).unwrap().flatten().collect();
+        assert_eq!(leftovers.len(), 1, "no staging folder left");
+    }
+
+    #[test]
+    fn an_uncommitted_set_changes_nothing_and_stale_staging_is_cleared() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out");
+        fs::create_dir(&target).unwrap();
+        fs::write(target.join("a.txt"), b"old").unwrap();
+        // A folder left by a killed process (pid 4294967295 is never alive).
+        let stale = staging_folder(&target, u32::MAX);
+        fs::create_dir(&stale).unwrap();
+        {
+            let set = StagedFolder::begin(&target).unwrap();
+            set.write("a.txt", b"new").unwrap();
+            assert!(!stale.exists());
+        }
+        assert_eq!(fs::read(target.join("a.txt")).unwrap(), b"old");
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+}

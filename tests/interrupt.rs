@@ -1,0 +1,103 @@
+//! Interrupting `irpol render` (issue 15): SIGTERM or SIGKILL at any moment leaves the output
+//! folder holding the complete old set or the complete new one, and SIGTERM leaves no temporary
+//! folder (a SIGKILLed run's staging folder is removed by the next run).
+
+mod common;
+
+use common::*;
+use std::path::Path;
+use std::process::Command;
+use std::time::Duration;
+
+fn scene_text(temperature: f64) -> String {
+    format!(
+        "{}{}{}[render]\nsamples = 8\n{}\
+         [[objects]]\nname = \"floor\"\nshape = {{ kind = \"plane\", size = [6.0, 6.0], divisions = [4, 4] }}\n\
+         material = \"m\"\ntemperature_k = 290.0\ntranslate = [0.0, 0.0, -1.0]\n",
+        camera_toml(160),
+        AUTUMN_ENVIRONMENT,
+        material_toml(0.2, 2.0, 1.5, 0.1, 0.05),
+        sphere_toml(4, temperature),
+    )
+}
+
+/// Every file the folder's summary lists is there, and S0.tif is the one of the run that wrote
+/// the summary (`a` or `b`, told apart by their sizes being equal but their bytes not).
+fn complete_set(out: &Path, old_s0: &[u8], new_s0: &[u8]) -> bool {
+    let Ok(summary) = std::fs::read(out.join("summary.json")) else {
+        return false;
+    };
+    let summary: serde_json::Value = serde_json::from_slice(&summary).unwrap();
+    let all_there = summary["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|f| out.join(f.as_str().unwrap()).is_file());
+    let s0 = std::fs::read(out.join("S0.tif")).unwrap_or_default();
+    all_there && (s0 == old_s0 || s0 == new_s0)
+}
+
+#[test]
+fn an_interrupted_render_leaves_the_old_or_the_new_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let (old_scene, new_scene) = (dir.path().join("old.toml"), dir.path().join("new.toml"));
+    std::fs::write(&old_scene, scene_text(300.0)).unwrap();
+    std::fs::write(&new_scene, scene_text(310.0)).unwrap();
+    let out = dir.path().join("out");
+    let render = |scene: &Path| {
+        let (ok, _, err) = irpol(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        std::fs::read(out.join("S0.tif")).unwrap()
+    };
+    let new_s0 = render(&new_scene);
+    let old_s0 = render(&old_scene);
+    for (k, signal) in ["TERM", "KILL", "TERM", "KILL", "TERM", "TERM"]
+        .iter()
+        .enumerate()
+    {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_irpol"))
+            .args([
+                "render",
+                new_scene.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        // Spread the interrupts over loading, rendering and writing.
+        std::thread::sleep(Duration::from_millis(40 + 90 * k as u64));
+        Command::new("kill")
+            .args([&format!("-{signal}"), &child.id().to_string()])
+            .status()
+            .unwrap();
+        child.wait().unwrap();
+        assert!(
+            complete_set(&out, &old_s0, &new_s0),
+            "after SIG{signal} #{k}"
+        );
+        let staging: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.contains("irpol-staging"))
+            .collect();
+        if *signal == "TERM" {
+            assert!(staging.is_empty(), "left {staging:?} after SIGTERM #{k}");
+        }
+        // Back to the old set for the next round (this run also clears a SIGKILL's leftovers).
+        render(&old_scene);
+    }
+    let leftovers = std::fs::read_dir(dir.path())
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().contains("irpol-staging"))
+        .count();
+    assert_eq!(leftovers, 0);
+}
