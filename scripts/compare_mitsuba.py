@@ -44,16 +44,34 @@ How the two are made to describe the same thing:
   evaluates both BRDFs (`irpol eval` and Mitsuba's bsdf.eval, rotated into the psps frames) at a few
   geometries, including +45° linear light specularly reflected off the metal.
 
+Regions: sphere upper and lower half, ground within 1.8 R of the sphere's axis ("near": its shadow,
+its reflection and the inter-reflection), ground beyond 3.5 R ("far"), and, as a check of the
+environment map, the sky and the environment's ground seen directly. Only pixels wholly inside a
+region count. A mirror (the scene is symmetric about the vertical plane through the camera and the
+sphere's axis, which projects onto the image's centre column) flips S2 and S3, so their region
+means vanish by symmetry; the rows "S2 odd" and "S3 odd" compare ⟨S · sgn(column − centre)⟩ instead.
+
 Noise and timing: each renderer runs `--passes` independent passes (irpol: one process per seed;
 Mitsuba: one mi.render per seed). Per-pixel standard errors come from the spread between passes, and a
 region mean's standard error from their sum (pixels are independent). irpol is timed as whole
 processes; Mitsuba as its mi.render calls (scene loading reported apart; the first pass includes JIT
-compilation in the llvm variants). The time ratio is given raw and at equal noise
-(T σ² per renderer, σ² the mean per-pixel S0 variance over the compared regions).
+compilation in the llvm variants), both in wall-clock and CPU seconds (on a shared machine the CPU
+time is the steadier). The time ratio is given raw and at equal noise (T σ² per renderer, σ² the
+mean per-pixel S0 variance over the four surface regions).
+
+Diagnostics (not needed for the comparison itself):
+- `--irpol-supersample N` renders irpol at N× the resolution and averages N×N blocks, a box-filtered
+  pixel like Mitsuba's. irpol shades each pixel's centre; where a Stokes component varies quickly
+  (S3 and S2 near the sphere's silhouette) region means then differ by more than the noise.
+- `--sphere-only` leaves out the ground: irpol is then its open-world tables alone (noise-free).
+- `--quadrature K` integrates the exact open-world value (scripts/pbrdf_numpy.py's BRDF, exact
+  Smith) at K pixels of each region where no irpol correction ray hit geometry, and prints irpol
+  (its tables) and Mitsuba against it, with the effect of Mitsuba's approximate Smith G1.
 
 Output: a table on stdout, /tmp/mitsuba_compare.png (S0, DoLP and S3 of both and their difference)
 and the images under --work. Exit 0 when S0 region means agree within --tolerance (relative, default
-1 %) and S1, S2, S3 region means within 4 combined standard errors (or 0.2 % of S0), 1 otherwise.
+1 %) and S1, S2, S3 region means and the odd parts within 4 combined standard errors (or 0.2 % of
+S0), 1 otherwise (or when the irpol binary changed during the run).
 """
 
 import argparse
@@ -410,12 +428,12 @@ def mitsuba_scene(mi, work, width, height, bounces, spp):
 
 
 def mitsuba_stokes(mi, scene, spp, seed):
-    """One pass: (4, H, W) float64 Stokes in Mitsuba's sensor basis, and its wall time."""
-    start = time.perf_counter()
+    """One pass: (4, H, W) float64 Stokes in Mitsuba's sensor basis, and its (wall, CPU) time."""
+    start, cpu = time.perf_counter(), time.process_time()
     mi.render(scene, spp=spp, seed=seed)
     film = scene.sensors()[0].film()
     bitmap = film.bitmap(raw=False)
-    elapsed = time.perf_counter() - start
+    elapsed = (time.perf_counter() - start, time.process_time() - cpu)
     channels = dict(bitmap.split())
     out = []
     for j in range(4):
@@ -503,14 +521,138 @@ def irpol_pass(irpol, work, width, height, bounces, samples, seed):
     scene = work / f"irpol_scene_seed{seed}.toml"
     scene.write_text(scene_toml(width, height, bounces, samples, seed))
     out = work / f"irpol_seed{seed}"
+    import resource
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     subprocess.run([irpol, "render", str(scene), "--out", str(out)], check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    elapsed = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
+    elapsed = (time.perf_counter() - start, cpu)
     stokes = np.array([tifffile.imread(out / f"S{j}.tif") for j in range(4)], np.float64)
     stderr_s0 = tifffile.imread(out / "stderr_S0.tif").astype(np.float64)
     summary = json.loads((out / "summary.json").read_text())
     return stokes, stderr_s0, elapsed, summary
+
+
+# ----------------------------------------------------------------------------------------------
+# Diagnostic: the exact open-world value by quadrature (--quadrature).
+
+def hit_sphere_mesh(origin, d, mesh):
+    """Closest hit of one ray with the icosphere: point and irpol's interpolated normal."""
+    verts, norms, faces = mesh
+    v0, v1, v2 = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
+    e1, e2 = v1 - v0, v2 - v0
+    pv = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, pv)
+    tv = origin - v0
+    u = np.einsum("ij,ij->i", tv, pv) / det
+    qv = np.cross(tv, e1)
+    v = (qv @ d) / det
+    t = np.einsum("ij,ij->i", e2, qv) / det
+    ok = (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
+    i = int(np.argmin(np.where(ok, t, np.inf)))
+    n = norms[faces[i, 0]] * (1 - u[i] - v[i]) + norms[faces[i, 1]] * u[i] + norms[faces[i, 2]] * v[i]
+    return origin + t[i] * d, n / np.linalg.norm(n)
+
+
+def walter_g1(cos_theta, alpha):
+    """Mitsuba's Beckmann Smith G1 (microfacet.h): Walter et al.'s rational approximation."""
+    tan = np.sqrt(np.maximum(1.0 - cos_theta ** 2, 0.0)) / cos_theta
+    with np.errstate(divide="ignore"):
+        a = 1.0 / (alpha * tan)
+    g = np.where(a >= 1.6, 1.0, (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a))
+    return np.where(tan == 0.0, 1.0, g)
+
+
+def open_world_quadrature(width, height, pixels, material, sphere, n_theta=250, n_phi=500):
+    """S_j = ∫ F_j0(ω_i→ω_r) L_env(ω_i) cosθ_i dΩ_i (j = 0, 1, 2; irpol's pixel frame) at the pixel
+    centres, with the exact BRDF of scripts/pbrdf_numpy.py (checked against SCATMECH) on a
+    Gauss–Legendre × uniform grid over the local hemisphere (250 × 500 nodes: per pixel within
+    ~0.03 % of 800 × 1600); also S0 with Mitsuba's approximate Smith G1 in place of the exact one."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import pbrdf_numpy as pb
+    origin, _, right, _ = camera_frame()
+    x, w = np.polynomial.legendre.leggauss(n_theta)
+    theta = (x + 1.0) * math.pi / 4.0
+    phi = (np.arange(n_phi) + 0.5) * 2.0 * math.pi / n_phi
+    th, ph = (a.ravel() for a in np.meshgrid(theta, phi, indexing="ij"))
+    weight = np.repeat(w * math.pi / 4.0, n_phi) * (2.0 * math.pi / n_phi) * np.sin(th) * np.cos(th)
+    w_i = pb.direction(th, ph)
+    sigma, alpha = material["sigma"], math.sqrt(2.0) * material["sigma"]
+    g1_ratio_i = walter_g1(np.cos(th), alpha) / pb.smith_g1(th, "gaussian", sigma, 0.0)
+    mesh = None
+    if sphere:
+        s = SCENE["sphere"]
+        v, n, f = icosphere(s["radius"], s["subdivisions"])
+        mesh = (v + np.array(s["center"]), n, f)
+    out = []
+    for y, x_ in pixels:
+        d = ray_directions(width, height, np.array(x_ + 0.5), np.array(y + 0.5))
+        if sphere:
+            _, n = hit_sphere_mesh(origin, d, mesh)
+        else:
+            n = np.array([0.0, 0.0, 1.0])
+        w_r = -d
+        e_x = np.array([0.0, 0.0, 1.0]) - n * n[2]
+        e_x = e_x / np.linalg.norm(e_x) if np.linalg.norm(e_x) > 1e-9 else \
+            (w_r - n * (w_r @ n)) / np.linalg.norm(w_r - n * (w_r @ n))
+        e_y = np.cross(n, e_x)
+        local = np.array([w_r @ e_x, w_r @ e_y, w_r @ n])
+        t_r, p_r = math.degrees(math.acos(local[2])), math.degrees(math.atan2(local[1], local[0]))
+        m = pb.mueller_brdf(np.degrees(th), np.degrees(ph), t_r, p_r, distribution="gaussian",
+                            sigma=sigma, n=material["n"], k=material["k"], shadowing="smith")
+        radiance = irpol_env_radiance(w_i @ np.array([e_x[2], e_y[2], n[2]])) * weight
+        s0, s1, s2 = (m[:, j, 0] @ radiance for j in range(3))
+        g1_ratio_r = (walter_g1(np.array([local[2]]), alpha)
+                      / pb.smith_g1(np.radians([t_r]), "gaussian", sigma, 0.0))[0]
+        s0_walter = (m[:, 0, 0] * g1_ratio_i) @ radiance * g1_ratio_r
+        # psps s axis unit(n × ω_r) into the pixel frame: rotate_stokes(S, −ψ).
+        s_axis = np.cross(n, w_r)
+        s_axis /= np.linalg.norm(s_axis)
+        x_pix = right - w_r * (right @ w_r)
+        x_pix /= np.linalg.norm(x_pix)
+        psi = math.atan2(s_axis @ np.cross(w_r, x_pix), s_axis @ x_pix)
+        c, s_ = math.cos(-2 * psi), math.sin(-2 * psi)
+        out.append((s0, c * s1 + s_ * s2, -s_ * s1 + c * s2, s0_walter))
+    return np.array(out)
+
+
+def quadrature_report(width, height, ir_passes, ir_stderr, mi_passes, masks, count, seed=5):
+    """irpol and Mitsuba against the exact open-world value, on pixels where irpol's correction never
+    hit geometry (stderr_S0 = 0 in every pass: the value is its open-world tables alone)."""
+    print()
+    print("Quadrature check (exact open-world value at pixel centres; pixels where no irpol correction "
+          "ray hit geometry)")
+    rng = np.random.default_rng(seed)
+    unhit = np.all(np.array(ir_stderr) == 0.0, axis=0)
+    ir_mean, mi_mean = ir_passes.mean(axis=0), mi_passes.mean(axis=0)
+    mi_var = combine(mi_passes)[1]
+    for region in REGIONS[:4]:
+        mask = masks[region] & unhit
+        if mask.sum() < 10:
+            continue
+        ys, xs = np.nonzero(mask)
+        pick = np.arange(len(ys)) if count < 0 or count >= len(ys) else \
+            np.sort(rng.choice(len(ys), count, replace=False))
+        material = SCENE["sphere" if region.startswith("sphere") else "plane"]["material"]
+        t0 = time.perf_counter()
+        q = open_world_quadrature(width, height, list(zip(ys[pick], xs[pick])), material,
+                                  region.startswith("sphere"))
+        ir = ir_mean[:3, ys[pick], xs[pick]].T
+        mi = mi_mean[:3, ys[pick], xs[pick]].T
+        mi_se = np.sqrt(mi_var[:3, ys[pick], xs[pick]].sum(axis=1)) / len(pick)
+        rel = ir[:, 0] / q[:, 0] - 1.0
+        print(f"  {region} ({len(pick)} of {mask.sum()} px, {time.perf_counter() - t0:.0f} s): "
+              f"S0 exact {q[:, 0].mean():.5f}, irpol {ir[:, 0].mean():.5f} "
+              f"({100 * (ir[:, 0].mean() / q[:, 0].mean() - 1):+.3f} %; per pixel "
+              f"{100 * rel.min():+.2f} … {100 * rel.max():+.2f} %, RMS {100 * np.sqrt(np.mean(rel ** 2)):.2f} %), "
+              f"Mitsuba {mi[:, 0].mean():.5f} ± {mi_se[0]:.5f} "
+              f"({100 * (mi[:, 0].mean() / q[:, 0].mean() - 1):+.3f} %; its Smith G1 alone: "
+              f"{100 * (q[:, 3].mean() / q[:, 0].mean() - 1):+.3f} %)")
+        for j in (1, 2):
+            print(f"      S{j}: exact {q[:, j].mean():+.5f}, irpol {ir[:, j].mean():+.5f}, Mitsuba "
+                  f"{mi[:, j].mean():+.5f} ± {mi_se[j]:.5f}")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -577,7 +719,7 @@ def main():
     parser.add_argument("--height", type=int, default=96)
     parser.add_argument("--bounces", type=int, default=16)
     parser.add_argument("--passes", type=int, default=8, help="independent passes per renderer")
-    parser.add_argument("--irpol-samples", type=int, default=512, help="irpol samples per pass")
+    parser.add_argument("--irpol-samples", type=int, default=1024, help="irpol samples per pass")
     parser.add_argument("--mitsuba-spp", type=int, default=2048, help="Mitsuba spp per pass")
     parser.add_argument("--irpol-supersample", type=int, default=1, metavar="N",
                         help="diagnostic: render irpol at N× the resolution (samples/N² each) and "
@@ -585,6 +727,9 @@ def main():
     parser.add_argument("--sphere-only", action="store_true",
                         help="diagnostic: leave out the ground plane (irpol is then its exact "
                              "open-world tables, noise-free)")
+    parser.add_argument("--quadrature", type=int, default=0, metavar="K",
+                        help="diagnostic: exact open-world values by quadrature at K pixels of each "
+                             "region where irpol is its tables alone (−1: all; ~0.2 s a pixel)")
     parser.add_argument("--variant", default=None, help="Mitsuba variant (default: best available)")
     parser.add_argument("--tolerance", type=float, default=0.01, help="S0 relative tolerance")
     args = parser.parse_args()
@@ -603,7 +748,10 @@ def main():
         os.environ["DRJIT_LIBLLVM_PATH"] = find_libllvm()
     import mitsuba as mi
     variant = choose_variant(mi, args.variant)
-    print(f"Mitsuba {mi.__version__}, variant {variant}; irpol {irpol}")
+    binary_mtime = os.stat(irpol).st_mtime
+    version = subprocess.run([irpol, "--version"], capture_output=True, text=True).stdout.strip()
+    print(f"Mitsuba {mi.__version__}, variant {variant}; {version} at {irpol} (built "
+          f"{time.strftime('%Y-%m-%d %H:%M:%S', time.localtime(binary_mtime))})")
     if "spectral" in variant:
         print("  note: spectral variant: the envmap is RGB-upsampled and D65-weighted; compare the "
               "background rows to see the scale")
@@ -628,8 +776,9 @@ def main():
         ir_times.append(t)
     sup = f" at {n_sup}×{n_sup} subpixels" if n_sup > 1 else ""
     print(f"irpol: {args.passes} passes × {samples} samples{sup}, bounces {args.bounces}: "
-          f"{sum(ir_times):.2f} s (whole processes; per pass {min(ir_times):.2f}–"
-          f"{max(ir_times):.2f} s; irpol's own timings in the last: "
+          f"{sum(t for t, _ in ir_times):.2f} s wall, {sum(c for _, c in ir_times):.2f} s CPU "
+          f"(whole processes; per pass {min(t for t, _ in ir_times):.2f}–"
+          f"{max(t for t, _ in ir_times):.2f} s; irpol's own timings in the last: "
           + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()) + ")")
 
     # Mitsuba passes.
@@ -642,8 +791,9 @@ def main():
         mi_passes.append(s)
         mi_times.append(t)
     print(f"Mitsuba: {args.passes} passes × {args.mitsuba_spp} spp, path max_depth "
-          f"{args.bounces + 2}: {sum(mi_times):.2f} s (mi.render; first pass {mi_times[0]:.2f} s "
-          f"incl. JIT, others {np.mean(mi_times[1:]) if len(mi_times) > 1 else float('nan'):.2f} s;"
+          f"{args.bounces + 2}: {sum(t for t, _ in mi_times):.2f} s wall, "
+          f"{sum(c for _, c in mi_times):.2f} s CPU (mi.render; first pass {mi_times[0][0]:.2f} s "
+          f"incl. JIT, others {np.mean([t for t, _ in mi_times[1:]]) if len(mi_times) > 1 else float('nan'):.2f} s;"
           f" scene load {t_load:.2f} s)")
 
     # Into irpol's pixel frame.
@@ -677,7 +827,8 @@ def main():
         print(f"  {region} ({mask.sum()} px)")
         for j, name in enumerate(CHANNELS):
             diff = m_ir[j] - m_mi[j]
-            sig = math.hypot(e_ir[j], e_mi[j])
+            # Floor: float32 images (and Mitsuba's float32 envmap) agree to ~1e-5 at best.
+            sig = math.hypot(e_ir[j], e_mi[j], 1e-5 * abs(m_mi[0]))
             z = diff / sig if sig > 0 else (math.inf if diff else 0.0)
             if name == "DoLP":
                 ok, note = True, f"{diff:+9.5f} abs."
@@ -705,7 +856,8 @@ def main():
     # Noise and time.
     var_ir = np.concatenate(var_ir_all).mean()
     var_mi = np.concatenate(var_mi_all).mean()
-    t_ir, t_mi = sum(ir_times), sum(mi_times)
+    t_ir, t_mi = sum(t for t, _ in ir_times), sum(t for t, _ in mi_times)
+    c_ir, c_mi = sum(c for _, c in ir_times), sum(c for _, c in mi_times)
     print()
     print("Noise: RMS per-pixel standard error of S0 over the four surface regions: "
           f"irpol {math.sqrt(var_ir):.4f}, Mitsuba {math.sqrt(var_mi):.4f} W m-2 sr-1")
@@ -714,9 +866,13 @@ def main():
         if mask.any():
             print(f"  {region:13}: irpol {math.sqrt(combine(ir_passes)[1][0][mask].mean()):.4f}, "
                   f"Mitsuba {math.sqrt(combine(mi_passes)[1][0][mask].mean()):.4f}")
-    print(f"Time: irpol {t_ir:.2f} s, Mitsuba {t_mi:.2f} s: Mitsuba/irpol = {t_mi / t_ir:.2f}")
+    print(f"Time: irpol {t_ir:.2f} s, Mitsuba {t_mi:.2f} s wall: Mitsuba/irpol = {t_mi / t_ir:.2f}"
+          f" (CPU {c_ir:.2f} s and {c_mi:.2f} s: {c_mi / c_ir:.2f})")
     print(f"At equal noise (T σ² over the surface regions): Mitsuba/irpol = "
-          f"{(t_mi * var_mi) / (t_ir * var_ir):.2f}")
+          f"{(t_mi * var_mi) / (t_ir * var_ir):.2f} wall, {(c_mi * var_mi) / (c_ir * var_ir):.2f} CPU")
+
+    if args.quadrature:
+        quadrature_report(width, height, ir_passes, ir_stderr, mi_passes, masks, args.quadrature)
 
     figure(ir_passes.mean(axis=0), mi_passes.mean(axis=0), combine(ir_passes)[1],
            combine(mi_passes)[1], masks, args.png, variant)
@@ -726,8 +882,12 @@ def main():
                            for k, v in masks.items()})
     (work / "compare.json").write_text(json.dumps(dict(
         rows=summary_rows, irpol_seconds=t_ir, mitsuba_seconds=t_mi, mitsuba_load_seconds=t_load,
+        irpol_cpu_seconds=c_ir, mitsuba_cpu_seconds=c_mi,
         irpol_rms_se_s0=math.sqrt(var_ir), mitsuba_rms_se_s0=math.sqrt(var_mi), s3_sign=sign,
         brdf_max_deviation=brdf_dev, variant=variant), indent=1, default=float))
+    if os.stat(irpol).st_mtime != binary_mtime:
+        print("warning: the irpol binary changed during the run; run again", file=sys.stderr)
+        failures += 1
     checks += 1
     failures += brdf_dev > 0.02
     print(f"{checks - failures} passed, {failures} failed")

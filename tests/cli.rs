@@ -5,7 +5,6 @@ mod common;
 
 use common::irpol;
 
-
 fn column(csv: &str, name: &str) -> Vec<f64> {
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();

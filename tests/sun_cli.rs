@@ -4,7 +4,6 @@ mod common;
 
 use common::irpol;
 
-
 #[test]
 fn one_instant_is_one_csv_line_after_the_header() {
     // Sydney at local noon in June: the winter sun stands due north, 90° − (33.87° + 23.44°) high.
