@@ -13,3 +13,4 @@ pub mod pbrdf;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod text;

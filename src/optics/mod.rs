@@ -6,7 +6,7 @@ mod planck;
 mod polarization;
 
 pub use fresnel::{fresnel_amplitudes, FresnelFractions, RefractiveIndex};
-pub use planck::{Band, OpticsError};
+pub use planck::{Band, OpticsError, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
 pub use polarization::{
     fresnel_mueller, jones_to_mueller, rotate_stokes, stokes_rotator, Mueller, Stokes,
 };
