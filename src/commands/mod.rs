@@ -2,6 +2,8 @@
 //! selection from flags or a material file, angle sweeps, geometry CSVs and CSV output.
 
 pub mod evaluate;
+pub mod fit;
+pub mod output_set;
 
 use crate::material::Material;
 use crate::optics::RefractiveIndex;
