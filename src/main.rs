@@ -8,17 +8,18 @@ use cli::progress::TerminalProgress;
 use irpol::commands::evaluate::{
     read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
 };
+use irpol::commands::fit::fit_and_write;
 use irpol::commands::render::{default_output_dir, render_scene};
 use irpol::commands::sun::{read_times_file, write_sun_csv};
 use irpol::commands::{parse_sweep, ModelArgs};
 use irpol::emitter::parse_time_utc;
 use irpol::fit::{
-    fit_files, parse_parameter_list, parse_parameter_values, DistributionKind, FitOptions,
-    FitOutcome, Optimizer, RobustLoss,
+    parse_parameter_list, parse_parameter_values, DistributionKind, FitOptions, Optimizer,
+    RobustLoss,
 };
 use irpol::output::staged_folder::staging_folder;
 use irpol::pbrdf::Shadowing;
-use irpol::report::fit_report::{rebuild_report, write_fit_report};
+use irpol::report::fit_report::rebuild_report;
 use irpol::report::index::write_library_index;
 use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
 use std::io::Write;
@@ -302,8 +303,7 @@ fn run(command: Command) -> anyhow::Result<()> {
                 seed,
                 robust,
             )?;
-            let outcomes = fit_and_summarize(&inputs, &options, &out)?;
-            write_reports(&outcomes, &out, &reports)?;
+            fit_and_summarize(&inputs, &options, &out, &reports)?;
         }
         Command::Report { material, reports } => {
             for path in rebuild_report(&material, &reports)? {
@@ -374,14 +374,16 @@ fn fit_options(
     Ok(options)
 }
 
-/// Fits, writes the library entries and prints one line per material.
+/// Fits, writes the library entries, reports and index (all or nothing) and prints one line per
+/// material and where the reports went.
 fn fit_and_summarize(
     inputs: &[PathBuf],
     options: &FitOptions,
     fits_dir: &Path,
-) -> anyhow::Result<Vec<FitOutcome>> {
-    let outcomes = fit_files(inputs, options, fits_dir, true)?;
-    for outcome in &outcomes {
+    reports_dir: &Path,
+) -> anyhow::Result<()> {
+    let written = fit_and_write(inputs, options, fits_dir, reports_dir, true)?;
+    for (outcome, entry) in written.outcomes.iter().zip(&written.entries) {
         let chosen = &outcome.chosen;
         let parameters: Vec<String> = chosen
             .free
@@ -402,12 +404,14 @@ fn fit_and_summarize(
             chosen.distribution.name(),
             parameters.join(" "),
             chosen.reduced_chi2,
-            fits_dir
-                .join(format!("{}.toml", outcome.material.name))
-                .display()
+            entry.display()
         );
     }
-    Ok(outcomes)
+    for report in &written.reports {
+        say!("  report {}", report.display());
+    }
+    say!("  index  {}", written.index.display());
+    Ok(())
 }
 
 /// `value` to `digits` significant digits in plain notation (0.0000061 stays readable as such).
@@ -441,23 +445,6 @@ fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()
     for file in &summary.files {
         say!("  {file}");
     }
-    Ok(())
-}
-
-/// A report per fitted material and the library's index page.
-fn write_reports(
-    outcomes: &[FitOutcome],
-    fits_dir: &Path,
-    reports_dir: &Path,
-) -> anyhow::Result<()> {
-    for outcome in outcomes {
-        let paths = write_fit_report(&outcome.material, &outcome.measurement, reports_dir)?;
-        say!("  report {}", paths[0].display());
-    }
-    say!(
-        "  index  {}",
-        write_library_index(fits_dir, reports_dir)?.display()
-    );
     Ok(())
 }
 
@@ -517,8 +504,7 @@ fn demo() -> anyhow::Result<()> {
         "irpol demo: fit the shipped measurements in {}",
         measurements.display()
     );
-    let outcomes = fit_and_summarize(&[measurements], &FitOptions::default(), &fits)?;
-    write_reports(&outcomes, &fits, &reports)?;
+    fit_and_summarize(&[measurements], &FitOptions::default(), &fits, &reports)?;
     say!("the paper's model figures:");
     for figure in [PaperFigure::Fig2, PaperFigure::Fig3] {
         for path in write_paper_figure(figure, &reports)? {

@@ -2,6 +2,8 @@
 //! selection from flags or a material file, angle sweeps, geometry CSVs and CSV output.
 
 pub mod evaluate;
+pub mod fit;
+pub mod output_set;
 pub mod render;
 pub mod sun;
 
@@ -33,9 +35,24 @@ impl ModelArgs {
             None => None,
         };
         if let Some(path) = &self.material {
-            if self.sigma.is_some() || self.q.is_some() || self.n.is_some() || self.k.is_some() {
+            // The material defines every model parameter: a flag beside it would be silently
+            // ignored (only --shadowing overrides the material's, by design).
+            let given: Vec<&str> = [
+                ("--distribution", self.distribution.is_some()),
+                ("--sigma", self.sigma.is_some()),
+                ("--q", self.q.is_some()),
+                ("--n", self.n.is_some()),
+                ("--k", self.k.is_some()),
+                ("--rho", self.rho.is_some()),
+            ]
+            .into_iter()
+            .filter_map(|(flag, set)| set.then_some(flag))
+            .collect();
+            if !given.is_empty() {
                 anyhow::bail!(
-                    "give either --material or model parameters (--sigma --q --n --k), not both"
+                    "give either --material or model parameters (--distribution --sigma --q --n --k \
+                     --rho), not both (got {} with --material)",
+                    given.join(" ")
                 );
             }
             let mut spec = Material::load(path)?.model;
@@ -72,7 +89,11 @@ impl ModelArgs {
     }
 }
 
-/// Parses `START:STOP:STEP` (inclusive of STOP within rounding) or a single value.
+/// Most values one `START:STOP:STEP` sweep may hold.
+pub const MAX_SWEEP_VALUES: usize = 1_000_000;
+
+/// Parses `START:STOP:STEP` (inclusive of STOP within rounding) or a single value. A sweep holds
+/// at least one value and at most [`MAX_SWEEP_VALUES`].
 pub fn parse_sweep(text: &str, name: &str) -> anyhow::Result<Vec<f64>> {
     let parts: Vec<&str> = text.split(':').collect();
     let number = |s: &str| -> anyhow::Result<f64> {
@@ -95,10 +116,20 @@ pub fn parse_sweep(text: &str, name: &str) -> anyhow::Result<Vec<f64>> {
                     "--{name}: need STEP > 0 and STOP ≥ START in START:STOP:STEP, got '{text}'"
                 );
             }
-            let count = ((stop - start) / step + 1e-9).floor() as usize + 1;
-            if count > 1_000_000 {
-                anyhow::bail!("--{name}: '{text}' asks for {count} values; at most 1000000");
+            // Counted in floating point first: a tiny step (1e-300) makes the quotient overflow
+            // any integer, and a saturated count + 1 would wrap to an empty sweep.
+            let steps = ((stop - start) / step + 1e-9).floor();
+            if !steps.is_finite() || steps >= MAX_SWEEP_VALUES as f64 {
+                anyhow::bail!(
+                    "--{name}: '{text}' asks for {} values; at most {MAX_SWEEP_VALUES}",
+                    if steps.is_finite() {
+                        crate::text::number(steps + 1.0)
+                    } else {
+                        "infinitely many".to_owned()
+                    }
+                );
             }
+            let count = steps as usize + 1;
             Ok((0..count).map(|i| start + i as f64 * step).collect())
         }
         _ => anyhow::bail!("--{name}: expected a number or START:STOP:STEP, got '{text}'"),
@@ -117,7 +148,16 @@ mod tests {
         );
         assert_eq!(parse_sweep("0:89:1", "theta").unwrap().len(), 90);
         assert_eq!(parse_sweep("42", "theta").unwrap(), vec![42.0]);
-        for bad in ["0:10:0", "10:0:1", "a:1:1", "1:2", "nan", "0:1e9:1e-3"] {
+        for bad in [
+            "0:10:0",
+            "10:0:1",
+            "a:1:1",
+            "1:2",
+            "nan",
+            "0:1e9:1e-3",
+            "0:89:1e-300",
+            "-1e308:1e308:1",
+        ] {
             assert!(parse_sweep(bad, "theta").is_err(), "{bad}");
         }
     }
@@ -138,5 +178,22 @@ mod tests {
         args.shadowing = None;
         args.material = Some("x.toml".into());
         assert!(args.build().unwrap_err().to_string().contains("not both"));
+        for flags in [
+            ModelArgs {
+                rho: Some(0.5),
+                ..Default::default()
+            },
+            ModelArgs {
+                distribution: Some("gaussian".into()),
+                ..Default::default()
+            },
+        ] {
+            let args = ModelArgs {
+                material: Some("x.toml".into()),
+                ..flags
+            };
+            let message = args.build().unwrap_err().to_string();
+            assert!(message.contains("not both"), "{message}");
+        }
     }
 }

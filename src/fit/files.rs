@@ -24,6 +24,23 @@ pub fn fit_files(
     fits_dir: &Path,
     progress: bool,
 ) -> Result<Vec<FitOutcome>, FitError> {
+    let outcomes = fit_inputs(inputs, options, fits_dir, progress)?;
+    for outcome in &outcomes {
+        let path = fits_dir.join(format!("{}.toml", outcome.material.name));
+        outcome.material.save(&path)?;
+    }
+    Ok(outcomes)
+}
+
+/// [`fit_files`] without writing: every outcome, for a caller that writes the library entries
+/// together with other outputs (`irpol fit` adds reports and an index). `fits_dir` only names
+/// the target of a duplicate material in the error.
+pub fn fit_inputs(
+    inputs: &[PathBuf],
+    options: &FitOptions,
+    fits_dir: &Path,
+    progress: bool,
+) -> Result<Vec<FitOutcome>, FitError> {
     let sets = read_all(inputs)?;
     validate_options(options)?;
     check_unique_materials(&sets, fits_dir)?;
@@ -53,10 +70,6 @@ pub fn fit_files(
     }
     if let Some(bar) = &bar {
         bar.finish_and_clear();
-    }
-    for outcome in &outcomes {
-        let path = fits_dir.join(format!("{}.toml", outcome.material.name));
-        outcome.material.save(&path)?;
     }
     Ok(outcomes)
 }

@@ -6,6 +6,7 @@ use super::robust::RobustLoss;
 use super::stages::Optimizer;
 use super::FitError;
 use crate::pbrdf::Shadowing;
+use crate::text::shown;
 use std::collections::BTreeMap;
 
 /// Options of [`super::fit_measurement`].
@@ -92,10 +93,14 @@ impl FitOptions {
 pub fn parse_parameter_list(text: &str) -> Result<Vec<Parameter>, String> {
     let mut list = Vec::new();
     for name in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let parameter = Parameter::parse(name)
-            .ok_or_else(|| format!("unknown parameter '{name}' (use sigma, q, n, k, rho_d)"))?;
+        let parameter = Parameter::parse(name).ok_or_else(|| {
+            format!(
+                "unknown parameter '{}' (use sigma, q, n, k, rho_d)",
+                shown(name)
+            )
+        })?;
         if list.contains(&parameter) {
-            return Err(format!("parameter '{name}' is listed twice"));
+            return Err(format!("parameter '{}' is listed twice", shown(name)));
         }
         list.push(parameter);
     }
@@ -111,11 +116,11 @@ pub fn parse_parameter_values(text: &str) -> Result<BTreeMap<Parameter, f64>, St
     for pair in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let (name, value) = pair
             .split_once('=')
-            .ok_or_else(|| format!("'{pair}' is not name=value (e.g. k=0.1)"))?;
+            .ok_or_else(|| format!("'{}' is not name=value (e.g. k=0.1)", shown(pair)))?;
         let parameter = Parameter::parse(name).ok_or_else(|| {
             format!(
                 "unknown parameter '{}' (use sigma, q, n, k, rho_d)",
-                name.trim()
+                shown(name.trim())
             )
         })?;
         let value: f64 = value
@@ -124,8 +129,12 @@ pub fn parse_parameter_values(text: &str) -> Result<BTreeMap<Parameter, f64>, St
             .ok()
             .filter(|v: &f64| v.is_finite())
             .ok_or_else(|| {
-                format!("the value of {parameter} in '{pair}' is not a finite number")
+                format!(
+                    "the value of {parameter} in '{}' is not a finite number",
+                    shown(pair)
+                )
             })?;
+        parameter.check(value)?;
         if values.insert(parameter, value).is_some() {
             return Err(format!("{parameter} is given twice"));
         }
@@ -171,6 +180,10 @@ mod tests {
         assert!(parse_parameter_values("k=abc").is_err());
         assert!(parse_parameter_values("k=inf").is_err());
         assert!(parse_parameter_values("k=1,k=2").is_err());
+        assert!(parse_parameter_values("sigma=1e308")
+            .unwrap_err()
+            .contains("sigma = 1e308 is outside"));
+        assert!(parse_parameter_values("q=0.5").is_err());
         assert_eq!(parse_parameter_values("n=2.2").unwrap()[&Parameter::N], 2.2);
     }
 }

@@ -17,7 +17,8 @@
 //! a bound. The Smith Λ of the Cauchy distribution diverges for q ≤ 3/2 (DESIGN §1.3), hence the
 //! raised lower bound of q with Smith shadowing.
 
-use crate::pbrdf::{Shadowing, SlopeDistribution};
+use crate::pbrdf::{limits, Shadowing, SlopeDistribution};
+use crate::text::number;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -73,6 +74,35 @@ impl Parameter {
     /// Position in [`Parameter::ALL`].
     pub fn index(&self) -> usize {
         *self as usize
+    }
+
+    /// The values a model accepts ([`crate::pbrdf::limits`]): (lowest, highest, whether the
+    /// lowest itself is excluded). q > 1 is open: the distribution is not normalizable at 1.
+    pub fn domain(&self) -> (f64, f64, bool) {
+        match self {
+            Parameter::Sigma => (limits::MIN_SIGMA, limits::MAX_SIGMA, false),
+            Parameter::Q => (1.0, limits::MAX_Q, true),
+            Parameter::N => (limits::MIN_N, limits::MAX_N, false),
+            Parameter::K => (0.0, limits::MAX_K, false),
+            Parameter::RhoD => (0.0, 1.0, false),
+        }
+    }
+
+    /// Refuses a value outside [`Parameter::domain`] (or not finite), naming the range.
+    pub fn check(&self, value: f64) -> Result<(), String> {
+        let (low, high, open) = self.domain();
+        let above_low = if open { value > low } else { value >= low };
+        if value.is_finite() && above_low && value <= high {
+            Ok(())
+        } else {
+            let bracket = if open { '(' } else { '[' };
+            Err(format!(
+                "{self} = {} is outside {bracket}{}, {}], the values a model accepts",
+                number(value),
+                number(low),
+                number(high)
+            ))
+        }
     }
 
     /// Value used when the parameter is neither free nor given a value: a moderately rough
@@ -238,18 +268,13 @@ impl ParameterBounds {
         bounds
     }
 
-    /// Checks that every interval is finite, ordered and inside the parameter's domain (σ > 0,
-    /// q > 1, n > 0, k ≥ 0, 0 ≤ ρ_d ≤ 1).
+    /// Checks that every interval is finite, ordered and inside the parameter's
+    /// [`Parameter::domain`].
     pub fn validate(&self) -> Result<(), String> {
         for parameter in Parameter::ALL {
             let Interval { lower, upper } = self.get(parameter);
-            let domain_ok = match parameter {
-                Parameter::Sigma | Parameter::N => lower > 0.0,
-                Parameter::Q => lower > 1.0,
-                Parameter::K => lower >= 0.0,
-                Parameter::RhoD => lower >= 0.0 && upper <= 1.0,
-            };
-            if !(lower.is_finite() && upper.is_finite() && lower < upper && domain_ok) {
+            let domain_ok = parameter.check(lower).is_ok() && parameter.check(upper).is_ok();
+            if !(lower < upper && domain_ok) {
                 return Err(format!(
                     "the bounds [{lower}, {upper}] of {parameter} are invalid (finite, lower < upper, inside the parameter's domain)"
                 ));
@@ -331,6 +356,15 @@ mod tests {
         bad = bounds;
         bad.rho_d = Interval::new(0.0, 1.5);
         assert!(bad.validate().is_err());
+        bad = bounds;
+        bad.sigma = Interval::new(0.01, 1e308);
+        assert!(bad.validate().is_err());
+        assert!(Parameter::Sigma
+            .check(1e308)
+            .unwrap_err()
+            .contains("[0.0001, 10]"));
+        assert!(Parameter::Q.check(1.0).unwrap_err().contains("(1, 100]"));
+        assert!(Parameter::Q.check(100.0).is_ok() && Parameter::K.check(0.0).is_ok());
     }
 
     #[test]

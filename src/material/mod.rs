@@ -1,8 +1,9 @@
 //! The material library: one TOML file per material (DESIGN §2.2) holding the pBRDF model, how it
 //! was fitted, and its uncertainties. Written atomically; read by `render` and `report`.
 
-use crate::optics::RefractiveIndex;
+use crate::optics::{RefractiveIndex, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
 use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};
+use crate::text::{number, shown, shown_at_most};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -29,8 +30,11 @@ pub enum MaterialError {
     },
 }
 
-/// The pBRDF parameters of a material (DESIGN §1.3) at one wavelength.
+/// The pBRDF parameters of a material (DESIGN §1.3) at one wavelength. Read through
+/// [`RawModelSpec`], which refuses unknown keys: serde cannot deny them on a struct with a
+/// flattened field, and a typo such as `rho = 0.5` must not silently give ρ_d = 0.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawModelSpec")]
 pub struct ModelSpec {
     #[serde(flatten)]
     pub distribution: SlopeDistribution,
@@ -40,6 +44,64 @@ pub struct ModelSpec {
     #[serde(default)]
     pub rho_d: f64,
     pub wavelength_um: f64,
+}
+
+/// The distribution names of [`SlopeDistribution`] as written in a material file.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum DistributionName {
+    Cauchy,
+    Gaussian,
+}
+
+/// [`ModelSpec`] as written in a material file: flat, every key known.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawModelSpec {
+    distribution: DistributionName,
+    sigma: f64,
+    q: Option<f64>,
+    shadowing: Shadowing,
+    n: f64,
+    k: f64,
+    #[serde(default)]
+    rho_d: f64,
+    wavelength_um: f64,
+}
+
+impl TryFrom<RawModelSpec> for ModelSpec {
+    type Error = String;
+
+    fn try_from(raw: RawModelSpec) -> Result<ModelSpec, String> {
+        let distribution = match (raw.distribution, raw.q) {
+            (DistributionName::Cauchy, Some(q)) => SlopeDistribution::Cauchy {
+                sigma: raw.sigma,
+                q,
+            },
+            (DistributionName::Cauchy, None) => {
+                return Err("the cauchy distribution needs q".into())
+            }
+            (DistributionName::Gaussian, None) => SlopeDistribution::Gaussian { sigma: raw.sigma },
+            (DistributionName::Gaussian, Some(_)) => {
+                return Err("q applies to the cauchy distribution only".into())
+            }
+        };
+        let lambda = raw.wavelength_um;
+        if !(lambda.is_finite() && (MIN_WAVELENGTH_UM..=MAX_WAVELENGTH_UM).contains(&lambda)) {
+            return Err(format!(
+                "wavelength_um = {} is outside 0.1–1000 µm, the wavelengths irpol models",
+                number(lambda)
+            ));
+        }
+        Ok(ModelSpec {
+            distribution,
+            shadowing: raw.shadowing,
+            n: raw.n,
+            k: raw.k,
+            rho_d: raw.rho_d,
+            wavelength_um: lambda,
+        })
+    }
 }
 
 impl ModelSpec {
@@ -55,6 +117,7 @@ impl ModelSpec {
 
 /// How a material was fitted (DESIGN §2.2): provenance, optimizer, quality and uncertainties.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FitRecord {
     /// The measurement file, as given to `irpol fit`, and the SHA-256 of its bytes.
     pub source: PathBuf,
@@ -102,6 +165,7 @@ pub struct FitRecord {
 
 /// The other distribution's best fit on the same data (model comparison by AIC/BIC).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct AlternativeFit {
     pub model: ModelSpec,
     pub cost: f64,
@@ -112,6 +176,7 @@ pub struct AlternativeFit {
 
 /// One entry of the material library.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Material {
     pub name: String,
     pub tool_version: String,
@@ -125,10 +190,25 @@ impl Material {
             path: path.to_owned(),
             source,
         })?;
-        let material: Material = toml::from_str(&text).map_err(|e| MaterialError::Parse {
+        Material::from_toml(&text, path)
+    }
+
+    /// [`Material::load`] of a file's text; `path` names it in messages.
+    pub fn from_toml(text: &str, path: &Path) -> Result<Material, MaterialError> {
+        let material: Material = toml::from_str(text).map_err(|e| MaterialError::Parse {
             path: path.to_owned(),
-            message: e.to_string(),
+            message: toml_error_message(text, &e),
         })?;
+        // The name is printed by `library` and in messages: it must not act on the terminal.
+        if material.name.chars().any(char::is_control) {
+            return Err(MaterialError::Parse {
+                path: path.to_owned(),
+                message: format!(
+                    "name '{}' contains a control character",
+                    shown(&material.name)
+                ),
+            });
+        }
         material
             .model
             .pbrdf()
@@ -143,18 +223,47 @@ impl Material {
         self.model.pbrdf()
     }
 
+    /// The TOML text of the library entry (what [`Material::save`] writes); `path` only names
+    /// the file in the error.
+    pub fn to_toml(&self, path: &Path) -> Result<String, MaterialError> {
+        toml::to_string_pretty(self).map_err(|e| MaterialError::Write {
+            path: path.to_owned(),
+            source: std::io::Error::other(e),
+        })
+    }
+
     /// Writes the TOML atomically: a temporary file in the same folder, then a rename, so a failed
     /// run never leaves a half-written library entry.
     pub fn save(&self, path: &Path) -> Result<(), MaterialError> {
-        let text = toml::to_string_pretty(self).map_err(|e| MaterialError::Write {
-            path: path.to_owned(),
-            source: std::io::Error::other(e),
-        })?;
+        let text = self.to_toml(path)?;
         write_atomically(path, text.as_bytes()).map_err(|source| MaterialError::Write {
             path: path.to_owned(),
             source,
         })
     }
+}
+
+/// Characters of the TOML parser's message kept in ours.
+const PARSER_MESSAGE_CHARS: usize = 200;
+
+/// A TOML error as one line, `line L, column C: what is wrong`: the parser's own rendering spans
+/// several lines and quotes the whole offending line (control characters, megabytes and all).
+pub fn toml_error_message(text: &str, error: &toml::de::Error) -> String {
+    let at = error.span().map_or(String::new(), |span| {
+        let before = text.get(..span.start).unwrap_or(text);
+        let line = before.matches('\n').count() + 1;
+        let column = before[before.rfind('\n').map_or(0, |i| i + 1)..]
+            .chars()
+            .count()
+            + 1;
+        format!("line {line}, column {column}: ")
+    });
+    let message = error
+        .message()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    format!("{at}{}", shown_at_most(&message, PARSER_MESSAGE_CHARS))
 }
 
 /// The file of material `name` in the library folder `dir`.
@@ -268,5 +377,52 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("not a valid material"));
+    }
+
+    #[test]
+    fn unknown_keys_wrong_wavelengths_and_stray_q_are_refused_on_one_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.toml");
+        let good = toml::to_string(&sample()).unwrap();
+        let cases = [
+            (
+                good.replace("rho_d = 0.0", "rho = 0.5"),
+                "unknown field `rho`",
+            ),
+            (
+                good.replace("wavelength_um = 9.925", "wavelength_um = -1.0"),
+                "wavelength_um = -1 is outside",
+            ),
+            (
+                good.replace("wavelength_um = 9.925", "wavelength_um = nan"),
+                "wavelength_um = NaN is outside",
+            ),
+            (
+                good.replace("distribution = \"cauchy\"", "distribution = \"gaussian\""),
+                "q applies to the cauchy distribution only",
+            ),
+            (format!("{good}\nextra = 1\n"), "unknown field `extra`"),
+            (
+                good.replace("name = \"paper_paint\"", "name = \"a\\u0007b\""),
+                "name 'a\\u{7}b' contains a control character",
+            ),
+            (
+                good.replace("name = ", "\"\\u001b[2J\" = 1\nname = "),
+                "unknown field `\\u{1b}[2J`",
+            ),
+            (
+                good.replace("name = ", "\"\u{1b}[2J\" = 1\nname = "),
+                "line 1, column",
+            ),
+        ];
+        for (text, needle) in cases {
+            std::fs::write(&path, &text).unwrap();
+            let message = Material::load(&path).unwrap_err().to_string();
+            assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+            assert!(
+                !message.contains('\n') && !message.contains('\u{1b}'),
+                "{message:?}"
+            );
+        }
     }
 }

@@ -2,9 +2,10 @@
 //! Required: theta_i_deg, theta_r_deg, m00. Optional: phi_i_deg, phi_r_deg, wavelength_um, any of
 //! m01…m33 and their uncertainties u_m00…u_m33. Names are case-sensitive.
 
-use super::error::{shown, Delimiter, MeasureErrorKind, Refusal};
+use super::error::{Delimiter, MeasureErrorKind, Refusal};
 use super::fields::Field;
 use super::MUELLER_ELEMENT_NAMES;
+use crate::text::shown;
 
 const THETA_I: &str = "theta_i_deg";
 const PHI_I: &str = "phi_i_deg";

@@ -10,10 +10,11 @@ use std::path::Path;
 use sha2::{Digest, Sha256};
 
 use super::columns::{parse_header_row, wrong_delimiter, Layout, Quantity};
-use super::error::{shown, MeasureError, MeasureErrorKind, Refusal};
+use super::error::{MeasureError, MeasureErrorKind, Refusal};
 use super::fields::{split_fields, Field};
-use super::metadata::{split_metadata_line, HeaderWavelength, Metadata};
+use super::metadata::{split_metadata_line, wavelength_in_range, HeaderWavelength, Metadata};
 use super::{MeasurementPoint, MeasurementSet};
+use crate::text::shown;
 
 /// Default azimuths when the columns are absent: the plane of incidence, with the receiver on
 /// the specular side (φ_r = φ_i + 180°, DESIGN §1.1).
@@ -151,6 +152,20 @@ fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
     if points.is_empty() {
         return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
     }
+    // A file of zeros has no lobe: every model with ρ_d = 0 and σ anywhere fits it perfectly, so
+    // a "fit" would report arbitrary parameters with χ² = 0.
+    if points.iter().all(|p| p.values[0] == 0.0) {
+        let m00_column = header_fields
+            .iter()
+            .zip(&layout.quantities)
+            .find(|(_, q)| **q == Quantity::Element(0))
+            .map_or(1, |(field, _)| field.column);
+        return Err(Refusal::new(
+            header_line,
+            m00_column,
+            MeasureErrorKind::AllM00Zero,
+        ));
+    }
     let wavelength_um = match wavelength {
         WavelengthCheck::AgainstHeader(header) => header.um,
         // With a wavelength column and at least one row, the first row has set it.
@@ -278,8 +293,8 @@ fn parse_row(
             Quantity::PhiI => point.phi_i_deg = value,
             Quantity::PhiR => point.phi_r_deg = value,
             Quantity::Wavelength => {
-                if value <= 0.0 {
-                    return refuse(MeasureErrorKind::NonPositiveWavelength { value: shown(text) });
+                if let Some(kind) = wavelength_refusal(value, text) {
+                    return refuse(kind);
                 }
                 wavelength.check(line_number, field.column, value, text)?;
             }
@@ -305,6 +320,20 @@ fn parse_row(
         }
     }
     Ok(point)
+}
+
+/// Why a wavelength_um field's (finite) value is not a wavelength irpol models, if it is not.
+fn wavelength_refusal(value: f64, text: &str) -> Option<MeasureErrorKind> {
+    if value <= 0.0 {
+        Some(MeasureErrorKind::NonPositiveWavelength { value: shown(text) })
+    } else if !wavelength_in_range(value) {
+        Some(MeasureErrorKind::WavelengthOutOfRange {
+            place: "column 'wavelength_um'".to_string(),
+            value: shown(text),
+        })
+    } else {
+        None
+    }
 }
 
 /// A finite number, or why the field is not one.
@@ -447,5 +476,28 @@ mod tests {
                 Err(MeasureErrorKind::NotANumber { .. })
             ));
         }
+    }
+
+    #[test]
+    fn wavelengths_beyond_the_modelled_range_and_files_of_zeros_are_refused() {
+        let message = |text: &str| parse(text).unwrap_err().to_string();
+        assert_eq!(
+            message("# wavelength_um: 1e-300\ntheta_i_deg,theta_r_deg,m00\n30,30,0.1\n"),
+            "mem/sample.csv:1:18: header 'wavelength_um': 1e-300 µm is outside 0.1–1000 µm, \
+             the wavelengths irpol models"
+        );
+        assert_eq!(
+            message("theta_i_deg,theta_r_deg,m00,wavelength_um\n30,30,0.1,2e6\n"),
+            "mem/sample.csv:2:11: column 'wavelength_um': 2e6 µm is outside 0.1–1000 µm, \
+             the wavelengths irpol models"
+        );
+        assert_eq!(
+            message("# wavelength_um: 10\ntheta_i_deg,theta_r_deg, m00\n30,30,0\n40,40,0.0\n"),
+            "mem/sample.csv:2:26: column 'm00' is 0 on every row: there is no reflection to fit"
+        );
+        assert!(
+            parse("# wavelength_um: 10\ntheta_i_deg,theta_r_deg,m00\n30,30,0\n40,40,1e-9\n")
+                .is_ok()
+        );
     }
 }

@@ -100,6 +100,10 @@ pub enum MeasureErrorKind {
     NonPositiveUncertainty { column: String, value: String },
     #[error("column 'wavelength_um': {value} is not a positive wavelength")]
     NonPositiveWavelength { value: String },
+    #[error("{place}: {value} µm is outside 0.1–1000 µm, the wavelengths irpol models")]
+    WavelengthOutOfRange { place: String, value: String },
+    #[error("column 'm00' is 0 on every row: there is no reflection to fit")]
+    AllM00Zero,
     #[error(
         "column 'wavelength_um': {value} disagrees with the header '# wavelength_um: {header}' (line {header_line})"
     )]
@@ -169,23 +173,4 @@ impl Refusal {
             kind: self.kind,
         }
     }
-}
-
-/// A file's text as it may be quoted in a message: control characters escaped (so a stray
-/// carriage return or NUL is visible) and long values cut, so one message stays one short line.
-pub(crate) fn shown(text: &str) -> String {
-    const MAX_CHARS: usize = 40;
-    let mut out = String::new();
-    for (i, c) in text.chars().enumerate() {
-        if i == MAX_CHARS {
-            out.push('…');
-            break;
-        }
-        if c.is_control() {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    out
 }

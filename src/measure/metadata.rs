@@ -4,7 +4,9 @@
 
 use std::collections::BTreeMap;
 
-use super::error::{shown, MeasureErrorKind, Refusal};
+use super::error::{MeasureErrorKind, Refusal};
+use crate::optics::{MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
+use crate::text::shown;
 
 const MATERIAL: &str = "material";
 const WAVELENGTH: &str = "wavelength_um";
@@ -88,6 +90,12 @@ impl Metadata {
                 self.material = Some(value.to_string());
             }
             WAVELENGTH => match value.parse::<f64>() {
+                Ok(um) if um.is_finite() && um > 0.0 && !wavelength_in_range(um) => {
+                    return refuse(MeasureErrorKind::WavelengthOutOfRange {
+                        place: "header 'wavelength_um'".to_string(),
+                        value: shown(value),
+                    });
+                }
                 Ok(um) if um.is_finite() && um > 0.0 => {
                     self.wavelength = Some(HeaderWavelength {
                         um,
@@ -113,6 +121,12 @@ impl Metadata {
         self.entries.insert(key.to_string(), value.to_string());
         Ok(())
     }
+}
+
+/// Whether a positive wavelength is one irpol models ([`crate::optics::MIN_WAVELENGTH_UM`] to
+/// [`crate::optics::MAX_WAVELENGTH_UM`]).
+pub(crate) fn wavelength_in_range(um: f64) -> bool {
+    (MIN_WAVELENGTH_UM..=MAX_WAVELENGTH_UM).contains(&um)
 }
 
 /// Why a material name cannot become `fits/<material>.toml` (DESIGN §2.2), if it cannot: a

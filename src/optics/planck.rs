@@ -1,6 +1,7 @@
 //! Planck band radiance over a sensor band with an optional spectral response, and its inverse
 //! (apparent / brightness temperature). CODATA 2018 exact constants (DESIGN §1.5).
 
+use crate::text::number;
 use gauss_quad::legendre::GaussLegendre;
 use std::num::NonZeroUsize;
 
@@ -18,9 +19,16 @@ const C2: f64 = PLANCK_H * SPEED_OF_LIGHT / BOLTZMANN_K;
 const POINTS_PER_PANEL: usize = 8;
 const MAX_PANEL_UM: f64 = 0.5;
 
+/// Shortest wavelength irpol accepts anywhere (sensor bands, materials, measurements): the near
+/// ultraviolet, far below any thermal-infrared use.
+pub const MIN_WAVELENGTH_UM: f64 = 0.1;
+/// Longest wavelength accepted: the far infrared's end. It also bounds a band's quadrature to
+/// 2000 panels (an 8 µm–1 km band asked for 2·10⁹).
+pub const MAX_WAVELENGTH_UM: f64 = 1000.0;
+
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum OpticsError {
-    #[error("sensor band {lo_um}–{hi_um} µm is invalid: need 0 < lower < upper (finite)")]
+    #[error("sensor band {}–{} µm is invalid: need 0.1 ≤ lower < upper ≤ 1000 µm", number(*.lo_um), number(*.hi_um))]
     InvalidBand { lo_um: f64, hi_um: f64 },
     #[error("spectral response table is invalid: {0}")]
     InvalidResponse(String),
@@ -51,7 +59,9 @@ impl Band {
         hi_um: f64,
         response: Option<Vec<(f64, f64)>>,
     ) -> Result<Band, OpticsError> {
-        if !(lo_um.is_finite() && hi_um.is_finite() && lo_um > 0.0 && lo_um < hi_um) {
+        let inside =
+            |um: f64| um.is_finite() && (MIN_WAVELENGTH_UM..=MAX_WAVELENGTH_UM).contains(&um);
+        if !(inside(lo_um) && inside(hi_um) && lo_um < hi_um) {
             return Err(OpticsError::InvalidBand { lo_um, hi_um });
         }
         if let Some(table) = &response {
@@ -86,7 +96,9 @@ impl Band {
         }
         if nodes.iter().all(|&(_, w)| w == 0.0) {
             return Err(OpticsError::InvalidResponse(format!(
-                "the response is zero everywhere in {lo_um}–{hi_um} µm"
+                "the response is zero everywhere in {}–{} µm",
+                number(lo_um),
+                number(hi_um)
             )));
         }
         Ok(Band {
@@ -191,15 +203,18 @@ fn validate_response(table: &[(f64, f64)]) -> Result<(), OpticsError> {
     for (i, &(w, r)) in table.iter().enumerate() {
         if !(w.is_finite() && w > 0.0 && r.is_finite() && r >= 0.0) {
             return Err(OpticsError::InvalidResponse(format!(
-                "row {}: ({w} µm, {r}) needs a positive wavelength and a finite response ≥ 0",
-                i + 1
+                "row {}: ({} µm, {}) needs a positive wavelength and a finite response ≥ 0",
+                i + 1,
+                number(w),
+                number(r)
             )));
         }
         if i > 0 && w <= table[i - 1].0 {
             return Err(OpticsError::InvalidResponse(format!(
-                "row {}: wavelengths must increase ({w} µm after {} µm)",
+                "row {}: wavelengths must increase ({} µm after {} µm)",
                 i + 1,
-                table[i - 1].0
+                number(w),
+                number(table[i - 1].0)
             )));
         }
     }
@@ -288,6 +303,10 @@ mod tests {
         assert!(Band::new(14.0, 8.0, None).is_err());
         assert!(Band::new(0.0, 8.0, None).is_err());
         assert!(Band::new(8.0, f64::NAN, None).is_err());
+        // The documented range: 0.1–1000 µm, an 8 µm–1 km band is refused before any allocation.
+        assert!(Band::new(8.0, 1e9, None).is_err());
+        assert!(Band::new(1e-300, 14.0, None).is_err());
+        assert!(Band::new(0.1, 1000.0, None).is_ok());
         assert!(Band::new(8.0, 14.0, Some(vec![(9.0, 1.0)])).is_err());
         assert!(Band::new(8.0, 14.0, Some(vec![(9.0, 1.0), (9.0, 1.0)])).is_err());
         assert!(Band::new(8.0, 14.0, Some(vec![(15.0, 1.0), (16.0, 1.0)])).is_err());

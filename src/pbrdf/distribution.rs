@@ -1,6 +1,7 @@
 //! Facet slope distributions (DESIGN §1.2) and their Smith Λ functions (DESIGN §1.3).
 
 use super::exponential::inline_exp;
+use super::limits::{within, MAX_Q, MAX_SIGMA, MIN_SIGMA};
 use super::ModelError;
 use serde::{Deserialize, Serialize};
 use statrs::function::{beta::beta_reg, erf::erfc, gamma::ln_gamma};
@@ -46,13 +47,14 @@ impl SlopeDistribution {
         tan2.max(0.0).sqrt()
     }
 
+    /// Refuses parameters outside the ranges of [`super::limits`].
     pub fn validate(&self) -> Result<(), ModelError> {
         let sigma = self.sigma();
-        if !(sigma.is_finite() && sigma > 0.0) {
+        if !within(sigma, MIN_SIGMA, MAX_SIGMA) {
             return Err(ModelError::Sigma(sigma));
         }
         if let SlopeDistribution::Cauchy { q, .. } = *self {
-            if !(q.is_finite() && q > 1.0) {
+            if !(within(q, 1.0, MAX_Q) && q > 1.0) {
                 return Err(ModelError::Q(q));
             }
         }
@@ -458,5 +460,17 @@ mod tests {
         }
         .validate()
         .is_err());
+        // The documented limits: inclusive ends pass, a step beyond fails.
+        for (sigma, q, ok) in [
+            (MIN_SIGMA, MAX_Q, true),
+            (MAX_SIGMA, 1.0 + 1e-9, true),
+            (1e-300, 2.0, false),
+            (MAX_SIGMA * 1.01, 2.0, false),
+            (0.2, 1e308, false),
+            (0.2, MAX_Q * 1.01, false),
+        ] {
+            let result = SlopeDistribution::Cauchy { sigma, q }.validate();
+            assert_eq!(result.is_ok(), ok, "σ = {sigma}, q = {q}: {result:?}");
+        }
     }
 }

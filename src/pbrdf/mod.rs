@@ -8,6 +8,7 @@ mod error;
 mod exponential;
 mod geometry;
 mod hemisphere;
+pub mod limits;
 mod model;
 mod sample;
 mod shadowing;

@@ -4,6 +4,7 @@
 
 use super::distribution::{CauchySmithTable, PreparedDistribution};
 use super::exponential::inline_exp;
+use super::limits::{within, MAX_K, MAX_N, MIN_N};
 use super::{ModelError, Shadowing, SlopeDistribution};
 use crate::optics::frame::{
     double_angle, facet_axis_in_incident_frame, facet_axis_in_scattered_frame, Direction,
@@ -136,10 +137,10 @@ impl Pbrdf {
                 return Err(ModelError::SmithNeedsQ(q));
             }
         }
-        if !(index.n.is_finite() && index.n > 0.0) {
+        if !within(index.n, MIN_N, MAX_N) {
             return Err(ModelError::RealIndex(index.n));
         }
-        if !(index.k.is_finite() && index.k >= 0.0) {
+        if !within(index.k, 0.0, MAX_K) {
             return Err(ModelError::ExtinctionIndex(index.k));
         }
         if !(rho_d.is_finite() && (0.0..=1.0).contains(&rho_d)) {

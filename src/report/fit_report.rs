@@ -49,12 +49,34 @@ const LINEAR_BLOCK: [usize; 8] = [1, 2, 4, 5, 6, 8, 9, 10];
 /// on the rings, where they carry information.
 const ZERO_IN_PLANE: [usize; 4] = [2, 6, 8, 9];
 
+/// A fit report encoded in memory, not yet written: the PNG and SVG files and their bytes.
+pub struct EncodedReport {
+    pub files: Vec<(PathBuf, Vec<u8>)>,
+}
+
 /// Writes `<out_dir>/<material>.png` and `.svg`; returns their paths.
 pub fn write_fit_report(
     material: &Material,
     set: &MeasurementSet,
     out_dir: &Path,
 ) -> Result<Vec<PathBuf>, ReportError> {
+    let report = encode_fit_report(material, set, out_dir)?;
+    for (path, bytes) in &report.files {
+        write_atomically(path, bytes).map_err(|source| ReportError::Write {
+            path: path.clone(),
+            source,
+        })?;
+    }
+    Ok(report.files.into_iter().map(|(path, _)| path).collect())
+}
+
+/// Draws the report of `material` against `set` as `<out_dir>/<material>.png` and `.svg`, in
+/// memory, so that a caller writing several outputs can write none of them if one fails.
+pub fn encode_fit_report(
+    material: &Material,
+    set: &MeasurementSet,
+    out_dir: &Path,
+) -> Result<EncodedReport, ReportError> {
     let stem = report_stem(&material.name)?;
     let png = out_dir.join(format!("{stem}.png"));
     let svg = out_dir.join(format!("{stem}.svg"));
@@ -76,13 +98,9 @@ pub fn write_fit_report(
         draw_report(&root, material, set, &data).map_err(|e| draw_error(&svg, &e))?;
     }
     let png_bytes = encode_png(&rgb, width, height).map_err(|e| draw_error(&png, &e))?;
-    for (path, bytes) in [(&png, png_bytes.as_slice()), (&svg, svg_text.as_bytes())] {
-        write_atomically(path, bytes).map_err(|source| ReportError::Write {
-            path: path.clone(),
-            source,
-        })?;
-    }
-    Ok(vec![png, svg])
+    Ok(EncodedReport {
+        files: vec![(png, png_bytes), (svg, svg_text.into_bytes())],
+    })
 }
 
 /// Rebuilds the report of a library entry from its recorded source CSV (`irpol report

@@ -20,7 +20,7 @@ pub fn write_library_index(library_dir: &Path, reports_dir: &Path) -> Result<Pat
         path: reports_dir.to_owned(),
         source,
     })?;
-    let html = library_page(library_dir, reports_dir, &materials);
+    let html = library_index_html(library_dir, reports_dir, &materials, &[]);
     write_atomically(&index, html.as_bytes()).map_err(|source| ReportError::Write {
         path: index.clone(),
         source,
@@ -69,10 +69,33 @@ fn percent_encode(segment: &str) -> String {
     out
 }
 
-/// `target` relative to the folder `from`, both resolved on disk; the absolute target when
-/// they share no root (another drive) or cannot be resolved.
+/// `path` resolved on disk as far as it exists, the rest appended: a fit writes the index before
+/// the library entries and folders it links to exist.
+fn resolved(path: &Path) -> std::io::Result<PathBuf> {
+    let mut existing = path;
+    let mut rest = Vec::new();
+    loop {
+        match existing.canonicalize() {
+            Ok(base) => return Ok(rest.iter().rev().fold(base, |p, c| p.join(c))),
+            Err(error) => match (existing.parent(), existing.file_name()) {
+                (Some(parent), Some(name)) => {
+                    rest.push(name.to_owned());
+                    existing = if parent.as_os_str().is_empty() {
+                        Path::new(".")
+                    } else {
+                        parent
+                    };
+                }
+                _ => return Err(error),
+            },
+        }
+    }
+}
+
+/// `target` relative to the folder `from`, both resolved on disk ([`resolved`]); the absolute
+/// target when they share no root (another drive) or cannot be resolved.
 fn relative_to(from: &Path, target: &Path) -> PathBuf {
-    let (Ok(from), Ok(target)) = (from.canonicalize(), target.canonicalize()) else {
+    let (Ok(from), Ok(target)) = (resolved(from), resolved(target)) else {
         return target.to_owned();
     };
     let from: Vec<Component> = from.components().collect();
@@ -145,10 +168,14 @@ img.report { width: 100%; height: auto; border: 1px solid #ddd; margin-top: 12px
 code { font-family: 'DejaVu Sans Mono', Menlo, Consolas, monospace; font-size: 0.92em; }
 ";
 
-fn library_page(
+/// The index page of `materials` (library entries and their files), not written. Materials named
+/// in `new_reports` have a report figure although it is not on disk yet (a fit writes the page and
+/// the figures together), the others have one when `<reports_dir>/<name>.png` exists.
+pub fn library_index_html(
     library_dir: &Path,
     reports_dir: &Path,
     materials: &[(PathBuf, Material)],
+    new_reports: &[&str],
 ) -> String {
     let mut html = String::new();
     let _ = write!(
@@ -168,7 +195,9 @@ fn library_page(
     }
     summary_table(&mut html, materials);
     for (path, material) in materials {
-        material_section(&mut html, reports_dir, path, material);
+        let has_report = new_reports.contains(&material.name.as_str())
+            || reports_dir.join(format!("{}.png", material.name)).is_file();
+        material_section(&mut html, reports_dir, path, material, has_report);
     }
     let _ = write!(
         html,
@@ -223,7 +252,13 @@ fn summary_table(html: &mut String, materials: &[(PathBuf, Material)]) {
     html.push_str("</table>\n");
 }
 
-fn material_section(html: &mut String, reports_dir: &Path, path: &Path, material: &Material) {
+fn material_section(
+    html: &mut String,
+    reports_dir: &Path,
+    path: &Path,
+    material: &Material,
+    has_report: bool,
+) {
     let model = &material.model;
     let name = escape_html(&material.name);
     let _ = write!(
@@ -317,7 +352,7 @@ fn material_section(html: &mut String, reports_dir: &Path, path: &Path, material
     html.push_str("</div>\n");
 
     let png = format!("{}.png", material.name);
-    if reports_dir.join(&png).is_file() {
+    if has_report {
         let svg = format!("{}.svg", material.name);
         let _ = writeln!(
             html,

@@ -7,6 +7,7 @@
 //! a vertex shared by two groups gets the average of their temperatures.
 
 use super::mesh::{FaceOrigin, RawFace, RawMesh};
+use crate::text::shown;
 use nalgebra::Vector3;
 use std::fmt::Write as _;
 
@@ -52,40 +53,17 @@ pub fn parse_obj(text: &str) -> Result<RawMesh, String> {
                     .push(Vector3::new(numbers[0], numbers[1], numbers[2]));
             }
             "f" => {
-                let corners = fields
-                    .map(|field| parse_corner(field, &mesh))
-                    .collect::<Result<Vec<_>, _>>()
-                    .map_err(at)?;
-                if corners.len() < 3 {
-                    return Err(at(format!(
-                        "a face needs at least 3 vertices, got {}",
-                        corners.len()
-                    )));
-                }
-                let with_normals = corners.iter().filter(|c| c.1.is_some()).count();
-                if with_normals != 0 && with_normals != corners.len() {
-                    return Err(at(
-                        "some corners of the face have normals and some do not".into()
-                    ));
-                }
                 let part = *part.get_or_insert_with(|| mesh.part_index("default"));
-                for i in 1..corners.len() - 1 {
-                    let picked = [corners[0], corners[i], corners[i + 1]];
-                    mesh.faces.push(RawFace {
-                        vertices: picked.map(|c| c.0),
-                        normals: (with_normals > 0).then(|| picked.map(|c| c.1.unwrap_or(0))),
-                        part,
-                        origin: FaceOrigin::Line(line_no),
-                    });
-                }
+                push_face(&mut mesh, fields, part, line_no).map_err(at)?;
             }
             "g" | "o" => {
                 let name = fields.collect::<Vec<_>>().join(" ");
+                check_part_name(&name).map_err(at)?;
                 let name = if name.is_empty() { "default" } else { &name };
                 part = Some(mesh.part_index(name));
             }
             other if IGNORED.contains(&other) => {}
-            other => return Err(at(format!("unsupported OBJ statement '{other}'"))),
+            other => return Err(at(format!("unsupported OBJ statement '{}'", shown(other)))),
         }
     }
     if mesh.faces.is_empty() {
@@ -94,11 +72,64 @@ pub fn parse_obj(text: &str) -> Result<RawMesh, String> {
     Ok(mesh)
 }
 
+/// Splits an `f` statement's polygon into a triangle fan of part `part`.
+fn push_face<'a>(
+    mesh: &mut RawMesh,
+    fields: impl Iterator<Item = &'a str>,
+    part: u32,
+    line_no: usize,
+) -> Result<(), String> {
+    let corners = fields
+        .map(|field| parse_corner(field, mesh))
+        .collect::<Result<Vec<_>, _>>()?;
+    if corners.len() < 3 {
+        return Err(format!(
+            "a face needs at least 3 vertices, got {}",
+            corners.len()
+        ));
+    }
+    let with_normals = corners.iter().filter(|c| c.1.is_some()).count();
+    if with_normals != 0 && with_normals != corners.len() {
+        return Err("some corners of the face have normals and some do not".into());
+    }
+    for i in 1..corners.len() - 1 {
+        let picked = [corners[0], corners[i], corners[i + 1]];
+        mesh.faces.push(RawFace {
+            vertices: picked.map(|c| c.0),
+            normals: (with_normals > 0).then(|| picked.map(|c| c.1.unwrap_or(0))),
+            part,
+            origin: FaceOrigin::Line(line_no),
+        });
+    }
+    Ok(())
+}
+
+/// Longest group name accepted: part names reach the scene file's part tables and messages.
+const MAX_PART_NAME_CHARS: usize = 256;
+
+/// A group name must be text a scene file can name: no control characters, not a whole line of
+/// binary junk.
+fn check_part_name(name: &str) -> Result<(), String> {
+    if name.chars().any(char::is_control) {
+        return Err(format!(
+            "group name '{}' contains a control character",
+            shown(name)
+        ));
+    }
+    if name.chars().count() > MAX_PART_NAME_CHARS {
+        return Err(format!(
+            "group name '{}' is longer than {MAX_PART_NAME_CHARS} characters",
+            shown(name)
+        ));
+    }
+    Ok(())
+}
+
 fn parse_numbers<'a>(fields: impl Iterator<Item = &'a str>) -> Result<Vec<f64>, String> {
     fields
         .map(|f| {
             f.parse::<f64>()
-                .map_err(|_| format!("'{f}' is not a number"))
+                .map_err(|_| format!("'{}' is not a number", shown(f)))
         })
         .collect()
 }
@@ -119,7 +150,7 @@ fn parse_corner(field: &str, mesh: &RawMesh) -> Result<(u32, Option<u32>), Strin
 fn resolve_index(text: &str, defined: usize, what: &str) -> Result<u32, String> {
     let index: i64 = text
         .parse()
-        .map_err(|_| format!("'{text}' is not a {what} index"))?;
+        .map_err(|_| format!("'{}' is not a {what} index", shown(text)))?;
     let resolved = if index > 0 {
         index - 1
     } else {
@@ -197,6 +228,14 @@ mod tests {
                 "line 2: unsupported OBJ statement 'bogus'",
             ),
             ("v 0 0 0\n", "the mesh has no faces"),
+            (
+                "v 0 0 0\n\u{1b}[2J 1\n",
+                "line 2: unsupported OBJ statement '\\u{1b}[2J'",
+            ),
+            (
+                "g a\u{7}b\n",
+                "line 1: group name 'a\\u{7}b' contains a control",
+            ),
         ];
         for (text, expected) in cases {
             let err = parse_obj(text).unwrap_err();

@@ -2,25 +2,39 @@
 //! nx, ny, nz and an optional per-vertex `temperature` (K; DESIGN §2.3), and `face` elements with
 //! a `vertex_indices` (or `vertex_index`) list. A PLY has no groups: all faces form one part,
 //! named `surface`.
+//!
+//! The header is read and checked before the payload: the parser reserves and fills one element
+//! per declared item, so a few hundred bytes declaring 4 294 967 295 faces would otherwise exhaust
+//! memory. Each element's count must fit in the bytes that follow the header (every item takes at
+//! least its fixed-size properties in binary, a digit and a separator per property in ASCII) and
+//! stay within [`MAX_PLY_ITEMS`].
 
 use super::mesh::{FaceOrigin, RawFace, RawMesh};
+use crate::text::{shown, shown_at_most};
 use nalgebra::Vector3;
-use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{DefaultElement, Property};
+use ply_rs_bw::parser::{Parser, Reader};
+use ply_rs_bw::ply::{
+    DefaultElement, ElementDef, Encoding, Header, Payload, Property, PropertyType, ScalarType,
+};
 
 /// The single part of a PLY mesh.
 pub const PLY_PART: &str = "surface";
 
-pub fn parse_ply(mut bytes: &[u8]) -> Result<RawMesh, String> {
-    let ply = Parser::<DefaultElement>::new()
-        .read_ply(&mut bytes)
-        .map_err(|e| format!("not a readable PLY file: {e}"))?;
-    let vertices = ply
-        .payload
+/// Most items (vertices, faces, or items of any other element) a PLY element may declare. The
+/// parser keeps every item as a map of named properties, a few hundred bytes each, so this keeps
+/// a mesh's memory to a few GB; 10 million triangles is far beyond what a scene of this renderer
+/// needs.
+pub const MAX_PLY_ITEMS: usize = 10_000_000;
+
+/// Characters of the parser's own message kept in ours (it quotes whole input lines).
+const PARSER_MESSAGE_CHARS: usize = 160;
+
+pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
+    let payload = read_checked(bytes)?;
+    let vertices = payload
         .get("vertex")
         .ok_or("the PLY file has no 'vertex' element")?;
-    let faces = ply
-        .payload
+    let faces = payload
         .get("face")
         .ok_or("the PLY file has no 'face' element")?;
 
@@ -94,6 +108,89 @@ pub fn parse_ply(mut bytes: &[u8]) -> Result<RawMesh, String> {
     Ok(mesh)
 }
 
+/// Reads the header, checks it against the bytes that follow ([`check_header`]), then reads the
+/// payload.
+fn read_checked(bytes: &[u8]) -> Result<Payload<DefaultElement>, String> {
+    let unreadable = |e: &dyn std::fmt::Display| {
+        format!(
+            "not a readable PLY file: {}",
+            shown_at_most(&e.to_string(), PARSER_MESSAGE_CHARS)
+        )
+    };
+    let parser = Parser::<DefaultElement>::new();
+    let mut reader = Reader::new(bytes);
+    let header = parser
+        .read_header(&mut reader)
+        .map_err(|e| unreadable(&e))?;
+    // The reader advances through the slice, so what it still holds is the payload.
+    check_header(&header, reader.get_ref().len())?;
+    parser
+        .read_payload(&mut reader, &header)
+        .map_err(|e| unreadable(&e))
+}
+
+/// Refuses versions other than 1.0 (the only PLY standard) and element counts that the payload's
+/// `payload_bytes` cannot hold or that exceed [`MAX_PLY_ITEMS`].
+fn check_header(header: &Header, payload_bytes: usize) -> Result<(), String> {
+    let version = header.version;
+    if (version.major, version.minor) != (1, 0) {
+        return Err(format!(
+            "PLY version {version} is not supported (only 1.0 exists)"
+        ));
+    }
+    let mut needed: u128 = 0;
+    for element in header.elements.values() {
+        let name = shown(&element.name);
+        if element.count > MAX_PLY_ITEMS {
+            return Err(format!(
+                "element '{name}' declares {} items; at most {MAX_PLY_ITEMS} are read",
+                element.count
+            ));
+        }
+        let per_item = least_item_bytes(element, header.encoding);
+        if per_item == 0 && element.count > 0 {
+            return Err(format!(
+                "element '{name}' declares {} items but no properties",
+                element.count
+            ));
+        }
+        needed += element.count as u128 * per_item as u128;
+    }
+    // An ASCII file may end without its last line break.
+    let slack = u128::from(header.encoding == Encoding::Ascii);
+    if needed > payload_bytes as u128 + slack {
+        return Err(format!(
+            "the header declares items that need at least {needed} bytes, but only \
+             {payload_bytes} bytes follow it (a truncated file or a wrong element count)"
+        ));
+    }
+    Ok(())
+}
+
+/// The fewest bytes one item of `element` takes: its fixed-size scalars and list counts in binary
+/// (a list may be empty); in ASCII one digit and one separator or line break per property.
+fn least_item_bytes(element: &ElementDef, encoding: Encoding) -> usize {
+    element
+        .properties
+        .values()
+        .map(|property| match (encoding, &property.data_type) {
+            (Encoding::Ascii, _) => 2,
+            (_, PropertyType::Scalar(scalar) | PropertyType::List(scalar, _)) => {
+                scalar_bytes(scalar)
+            }
+        })
+        .sum()
+}
+
+fn scalar_bytes(scalar: &ScalarType) -> usize {
+    match scalar {
+        ScalarType::Char | ScalarType::UChar => 1,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    }
+}
+
 fn scalar_value(property: &Property) -> Option<f64> {
     Some(match *property {
         Property::Char(v) => v as f64,
@@ -154,5 +251,49 @@ mod tests {
         let err = parse_ply(nan.as_bytes()).unwrap_err();
         assert!(err.contains("vertex 2") || err.contains("PLY"), "{err}");
         assert!(parse_ply(b"not a ply").is_err());
+    }
+
+    #[test]
+    fn counts_the_payload_cannot_hold_are_refused_before_reading() {
+        let header = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+            property float y\nproperty float z\nelement face 4294967295\n\
+            property list uchar int vertex_indices\nend_header\n";
+        let mut bytes = header.as_bytes().to_vec();
+        bytes.extend(std::iter::repeat_n(0u8, 36 + 13));
+        let err = parse_ply(&bytes).unwrap_err();
+        assert!(err.contains("at most 10000000"), "{err}");
+        let declared = header.replace("4294967295", "1000");
+        let mut bytes = declared.as_bytes().to_vec();
+        bytes.extend(std::iter::repeat_n(0u8, 36 + 13));
+        let err = parse_ply(&bytes).unwrap_err();
+        assert!(err.contains("only 49 bytes follow"), "{err}");
+        let empty_element =
+            TRIANGLE.replace("element face 1\n", "element junk 5\nelement face 1\n");
+        let err = parse_ply(empty_element.as_bytes()).unwrap_err();
+        assert!(
+            err.contains("'junk' declares 5 items but no properties"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn only_version_1_0_is_read_and_a_missing_last_line_break_is_fine() {
+        let err = parse_ply(TRIANGLE.replace("ascii 1.0", "ascii 7.5").as_bytes()).unwrap_err();
+        assert!(err.contains("PLY version 7.5 is not supported"), "{err}");
+        let unterminated = TRIANGLE.trim_end();
+        assert_eq!(parse_ply(unterminated.as_bytes()).unwrap().faces.len(), 2);
+    }
+
+    #[test]
+    fn parser_messages_are_one_short_line() {
+        let bad = TRIANGLE.replace(
+            "0 0 0 300",
+            &format!("0 0 \u{1b}[31m{} 300", "9".repeat(5000)),
+        );
+        let err = parse_ply(bad.as_bytes()).unwrap_err();
+        assert!(
+            !err.contains('\u{1b}') && !err.contains('\n') && err.len() < 400,
+            "{err}"
+        );
     }
 }

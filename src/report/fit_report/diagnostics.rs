@@ -3,8 +3,8 @@
 
 use super::data::{ReportData, Residual};
 use super::style::{
-    draw_legend_column, draw_legend_top_right, draw_note, log_tick, DrawResult, LegendEntry,
-    LineKind, Marker, AXIS_DESC_SIZE, CAPTION_SIZE, GREY, LEGEND_SIZE, TICK_SIZE,
+    draw_legend_column, draw_legend_top_right, draw_note, log_tick, sane_log_range, DrawResult,
+    LegendEntry, LineKind, Marker, AXIS_DESC_SIZE, CAPTION_SIZE, GREY, LEGEND_SIZE, TICK_SIZE,
 };
 use crate::material::FitRecord;
 use crate::report::FONT;
@@ -260,7 +260,7 @@ pub fn draw_convergence<DB: DrawingBackend>(
     // χ² ≈ degrees of freedom marks a fit at the noise level; a robust cost Σρ(r) has no such mark.
     let robust = super::table::robust_loss(fit);
     let show_dof = robust.is_none() && dof > 0.0 && dof > low / 100.0;
-    let (low, high) = (low.min(if show_dof { dof } else { low }) / 1.6, high * 1.6);
+    let (low, high) = sane_log_range(low.min(if show_dof { dof } else { low }) / 1.6, high * 1.6);
     let last = (fit.convergence.len() - 1) as f64;
     let mut chart = chart_builder(area, caption)
         .build_cartesian_2d(0.0..last.max(1.0), (low..high).log_scale())?;

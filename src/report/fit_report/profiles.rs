@@ -4,8 +4,8 @@
 
 use super::data::{ModelSweep, PointView, ReportData};
 use super::style::{
-    incidence_color, log_tick, DrawResult, Marker, YAxis, AXIS_DESC_SIZE, CAPTION_SIZE,
-    SMALL_CAPTION_SIZE, SMALL_TICK_SIZE, TICK_SIZE,
+    incidence_color, log_tick, sane_linear_range, sane_log_range, DrawResult, Marker, YAxis,
+    AXIS_DESC_SIZE, CAPTION_SIZE, MAX_LOG_DECADES, SMALL_CAPTION_SIZE, SMALL_TICK_SIZE, TICK_SIZE,
 };
 use crate::measure::MUELLER_ELEMENT_NAMES;
 use crate::optics::Mueller;
@@ -258,9 +258,11 @@ pub fn profile_series(data: &ReportData, quantity: Quantity, domain: Domain) -> 
 const MIN_LOG_DECADES: f64 = 2.0;
 
 /// A log axis spanning the measured values with their error bars and the chosen model at the
-/// measured geometries (so a poor fit shows both); `None` when nothing positive is measured.
+/// measured geometries (so a poor fit shows both); `None` when nothing positive is measured. When
+/// they span more than a readable number of decades (an m00 of 1e308 among values of 0.1), the
+/// axis covers the decades that hold most of them instead.
 pub fn log_axis(series: &[ProfileSeries]) -> Option<YAxis> {
-    let (mut low, mut high) = (f64::INFINITY, 0.0f64);
+    let mut values = Vec::new();
     for p in series.iter().flat_map(|s| &s.points) {
         let sigma = p.sigma.unwrap_or(0.0);
         for (bottom, top) in [(p.value - sigma, p.value + sigma), (p.value, p.value)]
@@ -268,14 +270,12 @@ pub fn log_axis(series: &[ProfileSeries]) -> Option<YAxis> {
             .chain(p.model.map(|m| (m, m)))
         {
             if top > 0.0 {
-                high = high.max(top);
-                low = low.min(if bottom > 0.0 { bottom } else { top });
+                values.push(top);
+                values.push(if bottom > 0.0 { bottom } else { top });
             }
         }
     }
-    if !(high > 0.0 && low.is_finite()) {
-        return None;
-    }
+    let (low, high) = densest_decades(&mut values, MAX_LOG_DECADES - MIN_LOG_DECADES)?;
     let (mut low, mut high) = (low / 1.5, high * 1.5);
     let shortfall = MIN_LOG_DECADES - (high / low).log10();
     if shortfall > 0.0 {
@@ -283,7 +283,29 @@ pub fn log_axis(series: &[ProfileSeries]) -> Option<YAxis> {
         low /= widen;
         high *= widen;
     }
+    let (low, high) = sane_log_range(low, high);
     Some(YAxis::Log { low, high })
+}
+
+/// The smallest and largest of the positive `values` (which it sorts), or, when they span more
+/// than `decades`, of those in the `decades`-wide window that holds the most of them.
+fn densest_decades(values: &mut [f64], decades: f64) -> Option<(f64, f64)> {
+    values.sort_by(f64::total_cmp);
+    let (&low, &high) = (values.first()?, values.last()?);
+    let ratio = 10f64.powf(decades);
+    if high / low <= ratio {
+        return Some((low, high));
+    }
+    let (mut best, mut start) = ((0, 0), 0);
+    for end in 0..values.len() {
+        while values[end] / values[start] > ratio {
+            start += 1;
+        }
+        if end - start > best.1 - best.0 {
+            best = (start, end);
+        }
+    }
+    Some((values[best.0], values[best.1]))
 }
 
 /// A linear axis spanning data, error bars and both models, padded by 8 %, within ±`limit`.
@@ -311,10 +333,13 @@ pub fn linear_axis(series: &[ProfileSeries], limit: f64) -> YAxis {
         };
     }
     let pad = ((high - low) * 0.08).max(0.01);
-    YAxis::Linear {
-        low: (low - pad).max(-limit),
-        high: (high + pad).min(limit),
-    }
+    // Data all beyond ±limit would clamp to a reversed range.
+    let (low, high) = sane_linear_range(
+        (low - pad).max(-limit),
+        (high + pad).min(limit),
+        (-limit, limit),
+    );
+    YAxis::Linear { low, high }
 }
 
 /// A data-versus-model panel.
@@ -513,6 +538,30 @@ mod tests {
             panic!("log axis expected")
         };
         assert!(((high / low).log10() - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_absurd_value_does_not_empty_the_log_axis() {
+        let at = |x: f64, value: f64| ProfilePoint {
+            x,
+            value,
+            sigma: None,
+            model: Some(0.1),
+        };
+        let series = |points| ProfileSeries {
+            color: BLACK,
+            marker: Marker::FilledCircle,
+            points,
+            chosen: vec![],
+            alternative: None,
+        };
+        for outlier in [1e308, 1e-320] {
+            let points = vec![at(0.0, 0.2), at(1.0, 0.05), at(2.0, outlier)];
+            let YAxis::Log { low, high } = log_axis(&[series(points)]).unwrap() else {
+                panic!("log axis expected")
+            };
+            assert!(low <= 0.05 && high >= 0.2 && high.is_finite() && low.is_normal());
+        }
     }
 
     #[test]

@@ -352,6 +352,46 @@ impl YAxis {
     }
 }
 
+/// Widest log axis, in decades: a reader cannot use more, and plotters lays out one bold line
+/// per decade.
+pub const MAX_LOG_DECADES: f64 = 30.0;
+/// Ends of any log axis: normal, finite numbers, with room for the 1.5× margins.
+const LOG_AXIS_FLOOR: f64 = 1e-300;
+const LOG_AXIS_CEILING: f64 = 1e300;
+
+/// A log-axis range that plotters can lay out: finite, positive, normal ends, low < high, at most
+/// [`MAX_LOG_DECADES`] decades. Plotters counts the decades into an integer and walks them, so
+/// an infinite end (a measured m00 of 1e308 times the 1.5 margin) or a subnormal one (1e-320)
+/// made it loop for ever. Data outside the range are left out of the panel as any other
+/// out-of-range point; when the range must be cut, its top is kept (a BRDF's peak, the start of
+/// a convergence history).
+pub fn sane_log_range(low: f64, high: f64) -> (f64, f64) {
+    // NaN or ≤ 0 has no place on a log axis: fall back to a unit top.
+    let high = if high > 0.0 {
+        high.min(LOG_AXIS_CEILING)
+    } else {
+        1.0
+    };
+    let high = high.max(LOG_AXIS_FLOOR * 100.0);
+    let floor = (high / 10f64.powf(MAX_LOG_DECADES)).max(LOG_AXIS_FLOOR);
+    let low = if low > 0.0 && low < high {
+        low.max(floor)
+    } else {
+        // Degenerate (low ≥ high, NaN, ≤ 0): two decades below the top.
+        high / 100.0
+    };
+    (low, high)
+}
+
+/// A linear-axis range with finite ends and low < high, else `fallback`.
+pub fn sane_linear_range(low: f64, high: f64, fallback: (f64, f64)) -> (f64, f64) {
+    if low.is_finite() && high.is_finite() && low < high {
+        (low, high)
+    } else {
+        fallback
+    }
+}
+
 /// Tick labels of a log axis: decimals from 0.001 to 1000 ("0.01", "10"), else "1e-4".
 pub fn log_tick(value: &f64) -> String {
     if (1e-3..1e4).contains(value) {
@@ -401,6 +441,37 @@ mod tests {
         );
         assert_eq!(pieces[1], vec![(3.0, 1e-3), (3.0, 1e-2), (4.0, 0.1)]);
         assert!(log.clip(&[(0.0, 5.0), (1.0, 7.0)]).is_empty());
+    }
+
+    #[test]
+    fn absurd_log_ranges_fall_back_to_ones_plotters_can_lay_out() {
+        let ok = |(low, high): (f64, f64)| {
+            low.is_normal()
+                && high.is_finite()
+                && low > 0.0
+                && low < high
+                && (high / low).log10() <= MAX_LOG_DECADES + 1e-9
+        };
+        for (low, high) in [
+            (1e-3, f64::INFINITY),
+            (1e-320, 1.0),
+            (0.0, 0.0),
+            (f64::NAN, f64::NAN),
+            (5.0, 5.0),
+            (2.0, 1.0),
+            (1e-300, 1e300),
+            (-1.0, 1e-310),
+        ] {
+            let range = sane_log_range(low, high);
+            assert!(ok(range), "({low}, {high}) → {range:?}");
+        }
+        assert_eq!(
+            sane_log_range(1e-3, 10.0),
+            (1e-3, 10.0),
+            "sane ranges are kept"
+        );
+        assert_eq!(sane_linear_range(2.0, 1.0, (-1.0, 1.0)), (-1.0, 1.0));
+        assert_eq!(sane_linear_range(0.0, 0.5, (-1.0, 1.0)), (0.0, 0.5));
     }
 
     #[test]

@@ -1,0 +1,100 @@
+//! `irpol fit` as a whole: fit every input, then write the library entries (`fits/*.toml`), the
+//! fit reports and the library index as one [`OutputSet`]. Everything is encoded in memory
+//! before the first byte is written, so a fit or a report that fails leaves the library and the
+//! reports exactly as they were; the library entries are renamed into place last.
+
+use super::output_set::OutputSet;
+use crate::fit::{fit_inputs, FitOptions, FitOutcome};
+use crate::material::{list_library, Material};
+use crate::report::fit_report::encode_fit_report;
+use crate::report::index::library_index_html;
+use crate::report::ReportError;
+use anyhow::Context;
+use std::path::{Path, PathBuf};
+
+/// What a fit wrote.
+pub struct FitWritten {
+    pub outcomes: Vec<FitOutcome>,
+    /// Each material's library entry.
+    pub entries: Vec<PathBuf>,
+    /// Each material's report figure (PNG; an SVG lies beside it).
+    pub reports: Vec<PathBuf>,
+    pub index: PathBuf,
+}
+
+/// Fits `inputs` and writes `<fits_dir>/<material>.toml`, `<reports_dir>/<material>.png|svg` and
+/// `<reports_dir>/index.html`, all or nothing.
+pub fn fit_and_write(
+    inputs: &[PathBuf],
+    options: &FitOptions,
+    fits_dir: &Path,
+    reports_dir: &Path,
+    progress: bool,
+) -> anyhow::Result<FitWritten> {
+    let outcomes = fit_inputs(inputs, options, fits_dir, progress)?;
+    let mut entries = Vec::new();
+    let mut report_files = Vec::new();
+    let mut reports = Vec::new();
+    for outcome in &outcomes {
+        let path = entry_path(fits_dir, &outcome.material);
+        let text = outcome.material.to_toml(&path)?;
+        entries.push((path, text));
+        let report = encode_fit_report(&outcome.material, &outcome.measurement, reports_dir)?;
+        reports.extend(report.files.first().map(|(path, _)| path.clone()));
+        report_files.extend(report.files);
+    }
+    let index = reports_dir.join("index.html");
+    let html = index_html(&outcomes, fits_dir, reports_dir)?;
+
+    let mut set = OutputSet::new();
+    let stage = |set: &mut OutputSet, path: &Path, bytes: &[u8]| {
+        set.stage(path, bytes)
+            .with_context(|| format!("{}: cannot write", path.display()))
+    };
+    for (path, bytes) in &report_files {
+        stage(&mut set, path, bytes)?;
+    }
+    stage(&mut set, &index, html.as_bytes())?;
+    for (path, text) in &entries {
+        stage(&mut set, path, text.as_bytes())?;
+    }
+    set.commit()
+        .with_context(|| format!("{}: cannot write the fit's outputs", fits_dir.display()))?;
+    Ok(FitWritten {
+        outcomes,
+        entries: entries.into_iter().map(|(path, _)| path).collect(),
+        reports,
+        index,
+    })
+}
+
+fn entry_path(fits_dir: &Path, material: &Material) -> PathBuf {
+    fits_dir.join(format!("{}.toml", material.name))
+}
+
+/// The index of the library as it will be once the new entries are in: the entries on disk,
+/// with the fitted ones added or replaced.
+fn index_html(
+    outcomes: &[FitOutcome],
+    fits_dir: &Path,
+    reports_dir: &Path,
+) -> Result<String, ReportError> {
+    let mut materials = if fits_dir.is_dir() {
+        list_library(fits_dir)?
+    } else {
+        Vec::new()
+    };
+    for outcome in outcomes {
+        let path = entry_path(fits_dir, &outcome.material);
+        materials.retain(|(existing, _)| *existing != path);
+        materials.push((path, outcome.material.clone()));
+    }
+    materials.sort_by(|a, b| a.0.cmp(&b.0));
+    let fitted: Vec<&str> = outcomes.iter().map(|o| o.material.name.as_str()).collect();
+    Ok(library_index_html(
+        fits_dir,
+        reports_dir,
+        &materials,
+        &fitted,
+    ))
+}

@@ -1,0 +1,113 @@
+//! An output set written as a whole. Every file is first written to a temporary sibling; only when
+//! all of them are on disk are they renamed over their targets, in the order staged (a command
+//! stages the files that others point to, such as library entries, last). A failure before the
+//! renames leaves every target as it was, and the temporaries and any folders made for them are
+//! removed.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Files staged for one output set; dropped without [`OutputSet::commit`], it removes them.
+#[derive(Default)]
+pub struct OutputSet {
+    /// (temporary file, target) in staging order.
+    staged: Vec<(PathBuf, PathBuf)>,
+    /// Folders this set created, outermost first.
+    created_dirs: Vec<PathBuf>,
+}
+
+impl OutputSet {
+    pub fn new() -> OutputSet {
+        OutputSet::default()
+    }
+
+    /// Writes `bytes` to a temporary file beside `target` (creating its folder), synced to disk.
+    pub fn stage(&mut self, target: &Path, bytes: &[u8]) -> std::io::Result<()> {
+        let dir = target
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        self.create_dir(dir)?;
+        let file_name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let temp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
+        self.staged.push((temp.clone(), target.to_owned()));
+        let mut file = std::fs::File::create(&temp)?;
+        file.write_all(bytes)?;
+        file.sync_all()
+    }
+
+    /// Creates `dir` and its missing ancestors, remembering which were missing.
+    fn create_dir(&mut self, dir: &Path) -> std::io::Result<()> {
+        let missing: Vec<PathBuf> = dir
+            .ancestors()
+            .filter(|a| !a.as_os_str().is_empty())
+            .take_while(|a| !a.exists())
+            .map(Path::to_owned)
+            .collect();
+        std::fs::create_dir_all(dir)?;
+        self.created_dirs.extend(missing.into_iter().rev());
+        Ok(())
+    }
+
+    /// Renames every staged file over its target, in staging order.
+    pub fn commit(mut self) -> std::io::Result<()> {
+        let staged = std::mem::take(&mut self.staged);
+        let mut renames = staged.iter();
+        for (temp, target) in renames.by_ref() {
+            if let Err(error) = std::fs::rename(temp, target) {
+                // The rest stays unrenamed: put their temporaries back for the drop to remove.
+                self.staged = renames.cloned().collect();
+                self.staged.push((temp.clone(), target.clone()));
+                self.created_dirs.clear();
+                return Err(error);
+            }
+        }
+        self.created_dirs.clear();
+        Ok(())
+    }
+}
+
+impl Drop for OutputSet {
+    fn drop(&mut self) {
+        for (temp, _) in &self.staged {
+            let _ = std::fs::remove_file(temp);
+        }
+        // Innermost first; a folder that holds anything else stays.
+        for dir in self.created_dirs.iter().rev() {
+            let _ = std::fs::remove_dir(dir);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nothing_changes_until_commit_and_an_abandoned_set_leaves_no_trace() {
+        let dir = tempfile::tempdir().unwrap();
+        let old = dir.path().join("a.txt");
+        std::fs::write(&old, "old").unwrap();
+        let new_dir = dir.path().join("new/deeper");
+        {
+            let mut set = OutputSet::new();
+            set.stage(&old, b"new").unwrap();
+            set.stage(&new_dir.join("b.txt"), b"b").unwrap();
+            assert_eq!(std::fs::read_to_string(&old).unwrap(), "old");
+        }
+        assert_eq!(std::fs::read_to_string(&old).unwrap(), "old");
+        assert!(!dir.path().join("new").exists());
+        let entries = std::fs::read_dir(dir.path()).unwrap().count();
+        assert_eq!(entries, 1, "temporaries removed");
+
+        let mut set = OutputSet::new();
+        set.stage(&old, b"new").unwrap();
+        set.stage(&new_dir.join("b.txt"), b"b").unwrap();
+        set.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&old).unwrap(), "new");
+        assert_eq!(std::fs::read_to_string(new_dir.join("b.txt")).unwrap(), "b");
+    }
+}

@@ -1,0 +1,69 @@
+//! User text quoted in error messages. Every reader (measurement CSV, OBJ, PLY, eval geometry CSV,
+//! material TOML) quotes the offending text through [`shown`] or [`shown_at_most`], so that a stray
+//! control character (a carriage return, an escape sequence, a NUL) is visible in the message
+//! instead of acting on the user's terminal, and a multi-megabyte line cannot become a
+//! multi-megabyte message: one message stays one short line.
+
+/// Characters of a quoted value kept before it is cut with '…': enough for any number, column
+/// name or keyword a user would recognise, short enough for a one-line message.
+pub const SHOWN_CHARS: usize = 40;
+
+/// `text` as it may be quoted in a message: control characters escaped and at most
+/// [`SHOWN_CHARS`] characters.
+pub fn shown(text: &str) -> String {
+    shown_at_most(text, SHOWN_CHARS)
+}
+
+/// [`shown`] with another length limit, for longer texts such as a parser's own message.
+pub fn shown_at_most(text: &str, max_chars: usize) -> String {
+    let mut out = String::new();
+    for (i, c) in text.chars().enumerate() {
+        if i == max_chars {
+            out.push('…');
+            break;
+        }
+        if is_hidden(c) {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// A number as a message shows it: plainly within 1e-4 ≤ |x| < 1e6 (and 0, NaN, ±inf), in
+/// exponent form beyond, where Rust's plain form of 1e308 is 309 digits long.
+pub fn number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Characters that a terminal acts on or that reorder the text around them: C0/C1 controls and
+/// the Unicode bidirectional marks, embeddings, overrides and isolates.
+fn is_hidden(c: char) -> bool {
+    c.is_control()
+        || matches!(c, '\u{200E}' | '\u{200F}' | '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn controls_are_escaped_and_long_text_is_cut() {
+        assert_eq!(shown("a\rb\u{1b}[31m\0"), "a\\rb\\u{1b}[31m\\u{0}");
+        assert_eq!(shown("x\u{202E}y"), "x\\u{202e}y");
+        let long = "é".repeat(1000);
+        assert_eq!(shown(&long), format!("{}…", "é".repeat(SHOWN_CHARS)));
+        assert_eq!(shown_at_most("abcdef", 3), "abc…");
+        assert_eq!(shown("plain, text"), "plain, text");
+        assert_eq!(number(1e308), "1e308");
+        assert_eq!(number(-1e-300), "-1e-300");
+        assert_eq!(number(-0.1), "-0.1");
+        assert_eq!(number(f64::NAN), "NaN");
+        assert_eq!(number(2.0), "2");
+    }
+}
