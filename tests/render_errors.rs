@@ -247,3 +247,45 @@ fn a_sun_below_the_horizon_renders_without_a_sun_term() {
     let summary = render_scene(&path, &dir.path().join("out"), &Silent).unwrap();
     assert!(summary.transport.sun.is_none());
 }
+
+/// Arrays of the wrong length and temperatures beyond finite radiance are refused, not cut or
+/// turned into NaN statistics (issue 15).
+#[test]
+fn wrong_lengths_and_absurd_temperatures() {
+    let files = [("panel.obj", TRIANGLE_OBJ)];
+    let base = scene_with_mesh("panel.obj", "");
+    let cases: [(String, &[&str]); 6] = [
+        (
+            base.replace(
+                "look_at = [0.0, 0.0, 0.0]",
+                "look_at = [0.0, 0.0, 0.0, 9.0]",
+            ),
+            &["invalid length 4, expected 3 numbers"],
+        ),
+        (
+            base.replace("resolution = [16, 16]", "resolution = [16, 16, 3]"),
+            &["invalid length 3, expected 2 numbers"],
+        ),
+        (
+            base.replace("temperature_k = 300.0", "temperature_k = 1e308"),
+            &["temperature_k = 1e308 must be within [0, 10000] K"],
+        ),
+        (
+            format!("[sensor]\nnetd_reference_k = inf\n{base}"),
+            &["sensor.netd_reference_k = inf"],
+        ),
+        (
+            format!("[sensor]\nresponse = [[8.0, 1.0, 3.0], [14.0, 1.0]]\n{base}"),
+            &["a pair [wavelength_um, response]"],
+        ),
+        (
+            base.replace("air_temperature_k = 283.15", "air_temperature_k = 1e300"),
+            &["environment.air_temperature_k = 1e300"],
+        ),
+    ];
+    for (scene, pieces) in cases {
+        assert_ne!(scene, base, "the case did not change the scene");
+        let text = refuse(&scene, &files);
+        expect(&text, pieces);
+    }
+}

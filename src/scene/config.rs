@@ -63,8 +63,39 @@
 //! temperature_k = 320.0
 //! ```
 
-use serde::Deserialize;
+use serde::{Deserialize, Deserializer};
 use std::collections::BTreeMap;
+
+/// A fixed-length array that refuses any other length (serde's arrays let the TOML reader drop
+/// extra items: `look_at = [0, 0, 1, 9]` was silently read as three numbers).
+fn exactly<'de, D, T, const N: usize>(deserializer: D) -> Result<[T; N], D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let items = Vec::<T>::deserialize(deserializer)?;
+    let len = items.len();
+    items
+        .try_into()
+        .map_err(|_| serde::de::Error::invalid_length(len, &format!("{N} numbers").as_str()))
+}
+
+/// An optional list of (x, y) pairs, each exactly two numbers.
+fn optional_pairs<'de, D>(deserializer: D) -> Result<Option<Vec<[f64; 2]>>, D::Error>
+where
+    D: Deserializer<'de>,
+{
+    let rows = Vec::<Vec<f64>>::deserialize(deserializer)?;
+    rows.into_iter()
+        .map(|row| {
+            let len = row.len();
+            row.try_into().map_err(|_| {
+                serde::de::Error::invalid_length(len, &"a pair [wavelength_um, response]")
+            })
+        })
+        .collect::<Result<Vec<[f64; 2]>, _>>()
+        .map(Some)
+}
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -90,11 +121,14 @@ pub struct SceneConfig {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraConfig {
+    #[serde(deserialize_with = "exactly")]
     pub position: [f64; 3],
+    #[serde(deserialize_with = "exactly")]
     pub look_at: [f64; 3],
-    #[serde(default = "world_up")]
+    #[serde(default = "world_up", deserialize_with = "exactly")]
     pub up: [f64; 3],
     pub fov_deg: f64,
+    #[serde(deserialize_with = "exactly")]
     pub resolution: [u32; 2],
 }
 
@@ -105,9 +139,10 @@ fn world_up() -> [f64; 3] {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SensorConfig {
-    #[serde(default = "lwir_band")]
+    #[serde(default = "lwir_band", deserialize_with = "exactly")]
     pub band_um: [f64; 2],
     /// Spectral response (wavelength µm, relative response), piecewise linear.
+    #[serde(default, deserialize_with = "optional_pairs")]
     pub response: Option<Vec<[f64; 2]>>,
     /// Noise-equivalent temperature difference of each polarizer image, mK; 0 = no noise.
     #[serde(default)]
@@ -274,9 +309,9 @@ pub struct ObjectConfig {
     /// Default material and temperature of every part not listed in `parts`.
     pub material: Option<String>,
     pub temperature_k: Option<f64>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exactly")]
     pub translate: [f64; 3],
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exactly")]
     pub rotate_deg: [f64; 3],
     #[serde(default = "unit_scale")]
     pub scale: f64,
@@ -309,5 +344,10 @@ pub enum ShapeConfig {
     /// Icosphere: the icosahedron subdivided `subdivisions` times (20·4^n faces), smooth normals.
     Sphere { radius: f64, subdivisions: u32 },
     /// Square grid in the xy plane facing +z, `size` metres wide, `divisions` cells a side.
-    Plane { size: [f64; 2], divisions: [u32; 2] },
+    Plane {
+        #[serde(deserialize_with = "exactly")]
+        size: [f64; 2],
+        #[serde(deserialize_with = "exactly")]
+        divisions: [u32; 2],
+    },
 }

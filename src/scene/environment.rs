@@ -6,7 +6,9 @@
 //! diffusely, E_sky/π = 2 ∫₀¹ L_sky(u) u du with u = sin(elevation).
 
 use super::config::{EnvironmentConfig, GroundConfig, SkyConfig};
+use super::{valid_temperature, MAX_TEMPERATURE_K};
 use crate::optics::Band;
+use crate::text::number;
 use nalgebra::Vector3;
 
 /// Samples of the sky radiance over u = sin(elevation) ∈ [0, 1]. The window model is smooth and a
@@ -24,9 +26,10 @@ impl Environment {
     /// Builds the environment for a sensor band. Errors name the offending key.
     pub fn new(config: &EnvironmentConfig, band: &Band) -> Result<Environment, String> {
         let air = config.air_temperature_k;
-        if !(air.is_finite() && air >= 0.0) {
+        if !valid_temperature(air) {
             return Err(format!(
-                "environment.air_temperature_k = {air} must be finite and ≥ 0"
+                "environment.air_temperature_k = {} must be within [0, {MAX_TEMPERATURE_K}] K",
+                number(air)
             ));
         }
         let sky_at = sky_model(&config.sky, air, band)?;
@@ -210,9 +213,10 @@ fn interpolate(knots: &[(f64, f64)], x: f64) -> f64 {
 
 fn ground_radiance(ground: &GroundConfig, sky: &[f64], band: &Band) -> Result<f64, String> {
     let (t, e) = (ground.temperature_k, ground.emissivity);
-    if !(t.is_finite() && t >= 0.0) {
+    if !valid_temperature(t) {
         return Err(format!(
-            "environment.ground.temperature_k = {t} must be finite and ≥ 0"
+            "environment.ground.temperature_k = {} must be within [0, {MAX_TEMPERATURE_K}] K",
+            number(t)
         ));
     }
     if !(e.is_finite() && (0.0..=1.0).contains(&e)) {

@@ -270,12 +270,13 @@ fn vertex_temperatures(
     if let Some(temperatures) = &raw.vertex_temperatures {
         if let Some(i) = temperatures
             .iter()
-            .position(|t| !(t.is_finite() && *t >= 0.0))
+            .position(|t| !super::valid_temperature(*t))
         {
             return Err(format!(
-                "vertex {} has temperature {} K: temperatures must be finite and ≥ 0",
+                "vertex {} has temperature {} K: temperatures must be within [0, {}] K",
                 i + 1,
-                temperatures[i]
+                crate::text::number(temperatures[i]),
+                super::MAX_TEMPERATURE_K
             ));
         }
         return Ok(temperatures.clone());

@@ -21,6 +21,7 @@ use crate::emitter::{
 use crate::material::Material;
 use crate::optics::{Band, RefractiveIndex};
 use crate::pbrdf::{Pbrdf, SlopeDistribution};
+use crate::text::number;
 use camera::Camera;
 use config::{InlineMaterialConfig, ObjectConfig, SceneConfig, Shading, ShapeConfig};
 use environment::Environment;
@@ -28,6 +29,15 @@ use mesh::{ObjectShading, RawMesh, ShadedMesh, Transform};
 use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+
+/// The hottest temperature a scene may give (K): far above any thermal scene, and low enough that
+/// band radiances and their statistics stay finite (1e308 K overflowed them to NaN).
+pub const MAX_TEMPERATURE_K: f64 = 1e4;
+
+/// Whether `t` is a temperature a scene may hold: finite, in [0, [`MAX_TEMPERATURE_K`]].
+pub fn valid_temperature(t: f64) -> bool {
+    t.is_finite() && (0.0..=MAX_TEMPERATURE_K).contains(&t)
+}
 
 /// A scene or one of its files is unusable; `file` is the file at fault.
 #[derive(Debug, thiserror::Error)]
@@ -188,9 +198,13 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
     if !(s.netd_mk.is_finite() && s.netd_mk >= 0.0) {
         return Err(fail(format!("sensor.netd_mk = {} must be ≥ 0", s.netd_mk)));
     }
-    if !(netd_reference_k.is_finite() && netd_reference_k > 0.0) && s.netd_mk > 0.0 {
+    // An explicit reference is checked here; the default (the air) by the environment below.
+    if s.netd_reference_k.is_some()
+        && !(valid_temperature(netd_reference_k) && netd_reference_k > 0.0)
+    {
         return Err(fail(format!(
-            "sensor.netd_reference_k = {netd_reference_k} must be > 0 when there is noise"
+            "sensor.netd_reference_k = {} must be within (0, {MAX_TEMPERATURE_K}] K",
+            number(netd_reference_k)
         )));
     }
     let environment = Environment::new(&config.environment, &band).map_err(&fail)?;
@@ -205,9 +219,10 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
                     a.extinction_per_km
                 )));
             }
-            if !(temperature_k.is_finite() && temperature_k >= 0.0) {
+            if !valid_temperature(temperature_k) {
                 return Err(fail(format!(
-                    "atmosphere.temperature_k = {temperature_k} must be finite and ≥ 0"
+                    "atmosphere.temperature_k = {} must be within [0, {MAX_TEMPERATURE_K}] K",
+                    number(temperature_k)
                 )));
             }
             Some(Atmosphere {
@@ -390,11 +405,12 @@ fn build_object(
     }
     let has_vertex_temperatures = raw.vertex_temperatures.is_some();
     let check_temperature = |t: f64, what: &str| {
-        if t.is_finite() && t >= 0.0 {
+        if valid_temperature(t) {
             Ok(t)
         } else {
             Err(fail(format!(
-                "{what}temperature_k = {t} must be finite and ≥ 0"
+                "{what}temperature_k = {} must be within [0, {MAX_TEMPERATURE_K}] K",
+                number(t)
             )))
         }
     };
