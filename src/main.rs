@@ -10,6 +10,7 @@ use irpol::commands::evaluate::{
 };
 use irpol::commands::fit::fit_and_write;
 use irpol::commands::render::{default_output_dir, render_scene};
+use irpol::commands::scene_init::write_starter_scene;
 use irpol::commands::sun::{read_times_file, write_sun_csv};
 use irpol::commands::{parse_sweep, ModelArgs};
 use irpol::emitter::parse_time_utc;
@@ -122,6 +123,11 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Scene files (docs/scenes.md describes the format).
+    Scene {
+        #[command(subcommand)]
+        command: SceneCommand,
+    },
     /// Apparent sun position (NREL SPA, standard atmosphere, sea level) at a site, as CSV on stdout:
     /// time_utc,elevation_deg,azimuth_deg (azimuth clockwise from north).
     Sun {
@@ -149,6 +155,17 @@ enum Command {
     },
     /// Runs the main job on shipped defaults and prints where everything went.
     Demo,
+}
+
+#[derive(Subcommand)]
+enum SceneCommand {
+    /// Writes a commented starter scene (a sphere on a plane, no other file needed) to render
+    /// and edit; an existing file is never overwritten.
+    Init {
+        /// The scene file to write.
+        #[arg(long, default_value = "scene.toml")]
+        out: PathBuf,
+    },
 }
 
 #[derive(Args)]
@@ -319,6 +336,15 @@ fn run(command: Command) -> anyhow::Result<()> {
             );
         }
         Command::Render { scene, out } => render_and_summarize(&scene, out)?,
+        Command::Scene {
+            command: SceneCommand::Init { out },
+        } => {
+            write_starter_scene(&out)?;
+            say!(
+                "wrote {0}: a sphere on a plane under a clear sky; render it with `irpol render {0}`",
+                out.display()
+            );
+        }
         Command::Sun {
             latitude,
             longitude,

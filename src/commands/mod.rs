@@ -5,6 +5,7 @@ pub mod evaluate;
 pub mod fit;
 pub mod output_set;
 pub mod render;
+pub mod scene_init;
 pub mod sun;
 
 use crate::material::Material;

@@ -1,0 +1,91 @@
+//! `irpol scene init`: writes a commented starter scene (issue 16: the scene format was
+//! undiscoverable). The scene is a procedural sphere on a procedural plane with inline materials,
+//! so it renders as written from whatever folder it lands in, with no mesh or material library.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The starter scene's text (docs/scenes.md describes every key it uses).
+pub fn starter_scene() -> &'static str {
+    include_str!("starter_scene.toml")
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SceneInitError {
+    #[error(
+        "{} already exists; irpol scene init never overwrites a file (remove it or give \
+         --out another name)",
+        .0.display()
+    )]
+    Exists(PathBuf),
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// Writes [`starter_scene`] to `path`, creating its folder. An existing file (or folder) at
+/// `path` is refused, and the file appears complete or not at all.
+pub fn write_starter_scene(path: &Path) -> Result<(), SceneInitError> {
+    // `symlink_metadata` so that a dangling symbolic link also counts as taken.
+    if path.symlink_metadata().is_ok() {
+        return Err(SceneInitError::Exists(path.to_owned()));
+    }
+    write_new_file(path, starter_scene().as_bytes()).map_err(|source| {
+        if source.kind() == std::io::ErrorKind::AlreadyExists {
+            SceneInitError::Exists(path.to_owned())
+        } else {
+            SceneInitError::Write {
+                path: path.to_owned(),
+                source,
+            }
+        }
+    })
+}
+
+/// Writes `bytes` to a temporary sibling, then hard-links it to `path`. Unlike the rename of
+/// [`crate::material::write_atomically`], a link never replaces an existing file, so a file that
+/// appears between the check and the write (another `scene init`) is not overwritten either.
+fn write_new_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)?;
+    let name = path
+        .file_name()
+        .map_or("scene.toml".into(), |n| n.to_string_lossy().into_owned());
+    let temp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let written = (|| {
+        let mut file = std::fs::File::create(&temp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        std::fs::hard_link(&temp, path)
+    })();
+    let _ = std::fs::remove_file(&temp);
+    written
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_starter_is_written_once_and_loads() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("new/scene.toml");
+        write_starter_scene(&path).unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), starter_scene());
+        let scene = crate::scene::load_scene(&path).unwrap();
+        assert_eq!(scene.object_names, ["sphere", "ground"]);
+        let again = write_starter_scene(&path).unwrap_err().to_string();
+        assert!(again.contains("already exists"), "{again}");
+        assert!(!again.contains('\n'));
+        // Only the scene: no temporary file left beside it.
+        assert_eq!(
+            std::fs::read_dir(path.parent().unwrap()).unwrap().count(),
+            1
+        );
+    }
+}
