@@ -1,12 +1,14 @@
-//! The scene documentation works as written (issue 16): every shipped example in docs/examples/
-//! renders, every block of docs/scenes.md marked as a complete scene loads, and the shipped
-//! example files are exactly the ones the page shows, so the page and the files cannot drift.
+//! The documentation works as written (issue 16): every shipped example in docs/examples/
+//! renders, every block of docs/scenes.md marked as a complete scene loads, the shipped example
+//! files are exactly the ones the page shows (so the page and the files cannot drift), and the
+//! hand-written material of docs/materials.md is a valid library entry.
 //!
-//! Markers in docs/scenes.md, each on the line just before a fenced block:
-//! `<!-- check: scene -->` (a complete scene) and `<!-- check: file NAME -->` (a file the scenes
-//! on the page may use, written next to them as NAME).
+//! Markers, each on the line just before a fenced block: `<!-- check: scene -->` (a complete
+//! scene), `<!-- check: file NAME -->` (a file the scenes on the page may use, written next to
+//! them as NAME) and `<!-- check: material -->` (a material TOML).
 
 use irpol::commands::render::render_scene;
+use irpol::material::Material;
 use irpol::progress::Silent;
 use irpol::scene::load_scene;
 use std::path::{Path, PathBuf};
@@ -15,10 +17,17 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// What a marked block is.
+#[derive(PartialEq)]
+enum Kind {
+    Scene,
+    File(String),
+    Material,
+}
+
 /// A fenced block of the page that carries a marker.
 struct Block {
-    /// `None` for a scene, the file name for a file block.
-    file: Option<String>,
+    kind: Kind,
     /// Line of the marker, for messages.
     line: usize,
     text: String,
@@ -37,9 +46,10 @@ fn marked_blocks(page: &str) -> Vec<Block> {
         else {
             continue;
         };
-        let file = match marker.trim() {
-            "scene" => None,
-            other => Some(
+        let kind = match marker.trim() {
+            "scene" => Kind::Scene,
+            "material" => Kind::Material,
+            other => Kind::File(
                 other
                     .strip_prefix("file ")
                     .unwrap_or_else(|| panic!("line {}: unknown marker '{other}'", i + 1))
@@ -63,7 +73,7 @@ fn marked_blocks(page: &str) -> Vec<Block> {
             i + 1
         );
         blocks.push(Block {
-            file,
+            kind,
             line: i + 1,
             text: body.join("\n") + "\n",
         });
@@ -71,8 +81,8 @@ fn marked_blocks(page: &str) -> Vec<Block> {
     blocks
 }
 
-fn scenes_page() -> String {
-    std::fs::read_to_string(root().join("docs/scenes.md")).expect("read docs/scenes.md")
+fn page(name: &str) -> String {
+    std::fs::read_to_string(root().join("docs").join(name)).expect("read the page")
 }
 
 /// The shipped example files, sorted.
@@ -122,14 +132,14 @@ fn every_shipped_example_renders() {
 
 #[test]
 fn complete_scenes_on_the_page_load() {
-    let blocks = marked_blocks(&scenes_page());
-    let scenes: Vec<&Block> = blocks.iter().filter(|b| b.file.is_none()).collect();
+    let blocks = marked_blocks(&page("scenes.md"));
+    let scenes: Vec<&Block> = blocks.iter().filter(|b| b.kind == Kind::Scene).collect();
     // The minimal, the worked and the full example at least: fewer means lost markers.
     assert!(scenes.len() >= 3, "only {} marked scenes", scenes.len());
     for scene in scenes {
         let dir = tempfile::tempdir().unwrap();
         for block in &blocks {
-            if let Some(name) = &block.file {
+            if let Kind::File(name) = &block.kind {
                 std::fs::write(dir.path().join(name), &block.text).unwrap();
             }
         }
@@ -153,14 +163,15 @@ fn complete_scenes_on_the_page_load() {
 
 #[test]
 fn shipped_examples_are_the_files_the_page_shows() {
-    let blocks = marked_blocks(&scenes_page());
+    let blocks = marked_blocks(&page("scenes.md"));
     for file in example_files() {
         let name = file.file_name().unwrap().to_string_lossy().into_owned();
         let text = std::fs::read_to_string(&file).unwrap();
         let shown = blocks.iter().any(|b| {
-            let same_kind = match &b.file {
-                Some(block_name) => *block_name == name,
-                None => name.ends_with(".toml"),
+            let same_kind = match &b.kind {
+                Kind::File(block_name) => *block_name == name,
+                Kind::Scene => name.ends_with(".toml"),
+                Kind::Material => false,
             };
             same_kind && b.text == text
         });
@@ -168,5 +179,24 @@ fn shipped_examples_are_the_files_the_page_shows() {
             shown,
             "docs/examples/{name} differs from every marked block of docs/scenes.md"
         );
+    }
+}
+
+#[test]
+fn the_hand_written_material_is_a_library_entry() {
+    let blocks = marked_blocks(&page("materials.md"));
+    let materials: Vec<&Block> = blocks.iter().filter(|b| b.kind == Kind::Material).collect();
+    assert!(
+        !materials.is_empty(),
+        "no marked material in docs/materials.md"
+    );
+    for block in materials {
+        let path = Path::new("docs/materials.md");
+        if let Err(e) = Material::from_toml(&block.text, path) {
+            panic!(
+                "the material at docs/materials.md line {} is invalid: {e}",
+                block.line
+            );
+        }
     }
 }
