@@ -158,9 +158,17 @@ pub struct TransportSummary {
     pub bounces: Option<u32>,
     pub samples: Option<u32>,
     pub seed: Option<u64>,
-    /// Sun elevation, azimuth (degrees) and band irradiance (W m⁻²), if the scene has a sun above
-    /// the horizon.
-    pub sun: Option<[f64; 3]>,
+    /// The sun, if the scene has one above the horizon.
+    pub sun: Option<SunSummary>,
+}
+
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct SunSummary {
+    pub elevation_deg: f64,
+    /// Clockwise from north (+y) toward east (+x).
+    pub azimuth_deg: f64,
+    /// Band irradiance on a surface facing the sun.
+    pub irradiance_w_m2: f64,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -386,9 +394,11 @@ fn stokes_index(channel: Channel) -> Option<usize> {
 fn transport_summary(scene: &Scene) -> TransportSummary {
     let sun = scene.sun.map(|sun| {
         let d = sun.direction;
-        let elevation = d.z.clamp(-1.0, 1.0).asin().to_degrees();
-        let azimuth = d.x.atan2(d.y).to_degrees().rem_euclid(360.0);
-        [elevation, azimuth, sun.irradiance]
+        SunSummary {
+            elevation_deg: d.z.clamp(-1.0, 1.0).asin().to_degrees(),
+            azimuth_deg: d.x.atan2(d.y).to_degrees().rem_euclid(360.0),
+            irradiance_w_m2: sun.irradiance,
+        }
     });
     match scene.transport {
         Transport::OpenWorld => TransportSummary {
