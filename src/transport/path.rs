@@ -129,21 +129,19 @@ impl PathTracer<'_> {
         // Visibility of the disc by a few stratified shadow rays, reused cyclically: a lit or
         // shadowed point needs one answer, only penumbrae need more, and each sample still
         // carries one of them so that the standard error sees the penumbra's spread.
-        let shadow_rays = n.min(SHADOW_RAYS_PER_PIXEL);
-        let visibility: Vec<f64> = match sun {
-            Some(_) => (0..shadow_rays)
-                .map(|s| {
-                    let stratum = (s as f64 + rng.random::<f64>()) / shadow_rays as f64;
-                    self.sun_visibility(vertex, stratum, rng)
-                })
-                .collect(),
-            None => Vec::new(),
-        };
+        let shadow_rays = n.min(SHADOW_RAYS_PER_PIXEL) as usize;
+        let mut visibility = [0.0; SHADOW_RAYS_PER_PIXEL as usize];
+        if sun.is_some() {
+            for (s, v) in visibility.iter_mut().take(shadow_rays).enumerate() {
+                let stratum = (s as f64 + rng.random::<f64>()) / shadow_rays as f64;
+                *v = self.sun_visibility(vertex, stratum, rng);
+            }
+        }
         for s in 0..n {
             let stratum = (s as f64 + rng.random::<f64>()) / n as f64;
             let mut x = self.correction(vertex, &frame, material, 0, stratum, rng);
             if let Some(integral) = sun {
-                x += integral * visibility[s as usize % visibility.len()];
+                x += integral * visibility[s as usize % shadow_rays];
             }
             let x = to_pixel(&x);
             let d = x - *first.get_or_insert(x);
