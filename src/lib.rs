@@ -8,6 +8,7 @@
 pub mod commands;
 pub mod emitter;
 pub mod fit;
+pub mod interrupt;
 pub mod material;
 pub mod measure;
 pub mod optics;

@@ -408,6 +408,7 @@ fn fit_and_summarize(
     fits_dir: &Path,
     reports_dir: &Path,
 ) -> anyhow::Result<()> {
+    cli::signals::remove_on_interrupt(vec![], vec![fits_dir.to_owned(), reports_dir.to_owned()]);
     let written = fit_and_write(inputs, options, fits_dir, reports_dir, true)?;
     for (outcome, entry) in written.outcomes.iter().zip(&written.entries) {
         let chosen = &outcome.chosen;
@@ -451,7 +452,7 @@ fn significant(value: f64, digits: i32) -> String {
 
 fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| default_output_dir(scene));
-    cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())]);
+    cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
     let summary = render_scene(scene, &out, &TerminalProgress::new())?;
     let temperature = summary
         .apparent_temperature_k

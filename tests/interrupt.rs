@@ -101,3 +101,96 @@ fn an_interrupted_render_leaves_the_old_or_the_new_set() {
         .count();
     assert_eq!(leftovers, 0);
 }
+
+/// Every library entry in `fits` is from the same fit: all equal to `a` or all equal to `b`.
+fn one_library(fits: &Path, a: &[(String, Vec<u8>)], b: &[(String, Vec<u8>)]) -> bool {
+    let same_as = |set: &[(String, Vec<u8>)]| {
+        set.iter()
+            .all(|(name, bytes)| std::fs::read(fits.join(name)).ok().as_deref() == Some(bytes))
+    };
+    same_as(a) || same_as(b)
+}
+
+fn library(fits: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(fits)
+        .unwrap()
+        .flatten()
+        .map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            (name, std::fs::read(e.path()).unwrap())
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+fn temporaries(dirs: &[&Path]) -> Vec<String> {
+    dirs.iter()
+        .flat_map(|d| std::fs::read_dir(d).unwrap().flatten())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect()
+}
+
+/// SIGTERM at any moment of `irpol fit` leaves the library as it was or wholly replaced, and no
+/// temporary file (issue 15).
+#[test]
+fn an_interrupted_fit_leaves_the_old_or_the_new_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (fits, reports) = (dir.path().join("fits"), dir.path().join("reports"));
+    let inputs: Vec<String> = [
+        "paper_paint",
+        "rough_paint",
+        "smooth_glass",
+        "anodized_panel",
+    ]
+    .iter()
+    .map(|m| {
+        root.join(format!("measurements/{m}.csv"))
+            .display()
+            .to_string()
+    })
+    .collect();
+    let fit = |seed: &str| {
+        let mut args = vec!["fit".to_owned()];
+        args.extend(inputs.iter().cloned());
+        args.extend(["--seed", seed, "--out"].map(str::to_owned));
+        args.push(fits.display().to_string());
+        args.push("--reports".into());
+        args.push(reports.display().to_string());
+        args
+    };
+    let run = |seed: &str| {
+        let args = fit(seed);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (ok, _, err) = irpol(&args);
+        assert!(ok, "{err}");
+        library(&fits)
+    };
+    let new = run("2");
+    let old = run("1");
+    assert_ne!(old, new, "the two seeds must give different entries");
+    for k in 0..8u64 {
+        let args = fit("2");
+        let mut child = Command::new(env!("CARGO_BIN_EXE_irpol"))
+            .args(&args)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(30 + 110 * k));
+        Command::new("kill")
+            .args(["-TERM", &child.id().to_string()])
+            .status()
+            .unwrap();
+        child.wait().unwrap();
+        assert!(
+            one_library(&fits, &old, &new),
+            "a mixed library after SIGTERM #{k}"
+        );
+        let left = temporaries(&[&fits, &reports]);
+        assert!(left.is_empty(), "temporaries {left:?} after SIGTERM #{k}");
+        run("1");
+    }
+}

@@ -4,6 +4,7 @@
 //! renames leaves every target as it was, and the temporaries and any folders made for them are
 //! removed.
 
+use crate::interrupt::WriteGuard;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -23,6 +24,7 @@ impl OutputSet {
 
     /// Writes `bytes` to a temporary file beside `target` (creating its folder), synced to disk.
     pub fn stage(&mut self, target: &Path, bytes: &[u8]) -> std::io::Result<()> {
+        let _guard = WriteGuard::start()?;
         let dir = target
             .parent()
             .filter(|d| !d.as_os_str().is_empty())
@@ -54,6 +56,7 @@ impl OutputSet {
 
     /// Renames every staged file over its target, in staging order.
     pub fn commit(mut self) -> std::io::Result<()> {
+        let _guard = WriteGuard::start()?;
         let staged = std::mem::take(&mut self.staged);
         let mut renames = staged.iter();
         for (temp, target) in renames.by_ref() {

@@ -9,6 +9,7 @@
 //! SIGINT/SIGTERM handler ([`staging_folder`] names it), and, after a SIGKILL, by the next run
 //! into the same target.
 
+use crate::interrupt::WriteGuard;
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -42,6 +43,7 @@ pub struct StagedFolder {
 impl StagedFolder {
     /// Starts a fresh staging folder for `target` (removing those left by killed runs).
     pub fn begin(target: &Path) -> io::Result<StagedFolder> {
+        let _guard = WriteGuard::start()?;
         fs::create_dir_all(parent_of(target))?;
         remove_stale_staging(target);
         let staging = staging_folder(target, std::process::id());
@@ -58,12 +60,14 @@ impl StagedFolder {
 
     /// Writes one file of the set.
     pub fn write(&self, name: &str, bytes: &[u8]) -> io::Result<()> {
+        let _guard = WriteGuard::start()?;
         fs::write(self.staging.join(name), bytes)
     }
 
     /// Puts the set in place of the target in one step and removes the old set. `earlier_output`
     /// tells which names in the target an earlier run wrote (they go with the old set).
     pub fn commit(mut self, earlier_output: &dyn Fn(&str) -> bool) -> io::Result<()> {
+        let _guard = WriteGuard::start()?;
         if !self.target.exists() {
             fs::rename(&self.staging, &self.target)?;
             self.committed = true;
