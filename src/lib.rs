@@ -18,4 +18,5 @@ pub mod render;
 pub mod report;
 pub mod scene;
 pub mod text;
+pub mod thermal;
 pub mod transport;
