@@ -646,3 +646,89 @@ fn solve_surface(b: f64, k4: f64, d: f64, start: f64, tol: f64) -> Result<f64, T
         "surface Newton did not converge to {tol} K in 100 iterations (last T = {t} K)"
     )))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The front-ward Thomas elimination plus substitution solves a tridiagonal system exactly
+    /// (checked against the residual of a random diagonally dominant system).
+    #[test]
+    fn thomas_solves_tridiagonal_systems() {
+        let n = 9;
+        let mut seed = 12345_u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let z = vec![0.0; n];
+        let mut r = Rows {
+            a: z.clone(),
+            b: z.clone(),
+            c: z.clone(),
+            d: z.clone(),
+            bp: z.clone(),
+            dp: z.clone(),
+        };
+        for i in 0..n {
+            r.a[i] = if i > 0 { -rnd() } else { 0.0 };
+            r.c[i] = if i + 1 < n { -rnd() } else { 0.0 };
+            r.b[i] = 2.5 + rnd();
+            r.d[i] = rnd() * 10.0 - 5.0;
+        }
+        eliminate_towards_front(&mut r);
+        let mut x = vec![0.0; n];
+        substitute_from_front(&r, r.dp[0] / r.bp[0], &mut x);
+        for i in 0..n {
+            let left = if i > 0 { r.a[i] * x[i - 1] } else { 0.0 };
+            let right = if i + 1 < n { r.c[i] * x[i + 1] } else { 0.0 };
+            let res = left + r.b[i] * x[i] + right - r.d[i];
+            assert!(res.abs() < 1e-12, "row {i}: residual {res}");
+        }
+    }
+
+    #[test]
+    fn surface_newton_finds_the_root_from_either_side() {
+        let (b, k) = (50.0, 3e-8);
+        for start in [1.0, 250.0, 5000.0] {
+            let t = solve_surface(b, k, 20_000.0, start, 1e-12).unwrap();
+            assert!(
+                (b * t + k * t.powi(4) - 20_000.0).abs() < 1e-8,
+                "{start}: {t}"
+            );
+        }
+        assert!(solve_surface(b, k, -1.0, 300.0, 1e-9).is_err());
+    }
+
+    #[test]
+    fn bad_forcing_is_refused_with_its_name() {
+        let f = FrontForcing {
+            absorbed_w_m2: 0.0,
+            longwave_in_w_m2: 0.0,
+            emissivity: 1.5,
+            h_w_m2k: 1.0,
+            air_k: 280.0,
+        };
+        assert!(f.validate().unwrap_err().to_string().contains("emissivity"));
+        let b = Back::Convective {
+            h_w_m2k: f64::INFINITY,
+            air_k: None,
+        };
+        assert!(b
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("back h_w_m2k"));
+        let c = SolverControl {
+            tolerance_k: 0.0,
+            ..SolverControl::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("tolerance_k"));
+    }
+}
