@@ -248,6 +248,12 @@ impl SolverControl {
         }
     }
 
+    /// The sub-step rule: error estimate and surface change within bounds, or the step already
+    /// at its shortest.
+    fn accepts(&self, err: f64, change: f64, h: f64) -> bool {
+        (err <= self.tolerance_k && change <= self.max_surface_change_k) || h <= self.min_substep_s
+    }
+
     fn validate(&self) -> Result<(), ThermalError> {
         let fields = [
             ("tolerance_k", self.tolerance_k),
@@ -423,9 +429,7 @@ impl Solver {
             let remaining = dt_s - t;
             let take = if h >= 0.99 * remaining { remaining } else { h };
             let (err, change) = self.try_substep(state, t, take, dt_s, start, end, &mut report)?;
-            let accepted = (err <= self.control.tolerance_k
-                && change <= self.control.max_surface_change_k)
-                || take <= self.control.min_substep_s;
+            let accepted = self.control.accepts(err, change, take);
             let factor = self.step_factor(err, change);
             if accepted {
                 t += take;
@@ -504,8 +508,7 @@ impl Solver {
         )?;
         let err = (self.half[0] - self.full[0]).abs();
         let change = (self.half[0] - old[0]).abs();
-        let c = &self.control;
-        if (err <= c.tolerance_k && change <= c.max_surface_change_k) || h <= c.min_substep_s {
+        if self.control.accepts(err, change, h) {
             // Richardson: 2·(two half steps) − (one full step), for the state and the energies.
             for ((t_new, th), tf) in state
                 .temperatures_k
