@@ -237,6 +237,22 @@ fn energy_closes_over_48_hours() {
     let rel = (r.stored_j_m2 - r.net_in_j_m2).abs() / r.absorbed_j_m2;
     println!("closure 48 h, convective back + 150 W/m² internal: relative {rel:.2e}");
     assert!(rel < 1e-6, "closure with back flux {rel}");
+    // A fixed back temperature: the reservoir's flux is reconstructed from the back node's balance.
+    let fixed_back = |t: f64| Forcing {
+        back: Back::Fixed(290.0),
+        internal_w_m2: 50.0,
+        ..diurnal(t)
+    };
+    let r = run(
+        &panel(),
+        &Resolution::default(),
+        &SolverControl::default(),
+        48.0,
+        fixed_back,
+    );
+    let rel = (r.stored_j_m2 - r.net_in_j_m2).abs() / r.absorbed_j_m2;
+    println!("closure 48 h, fixed back 290 K + 50 W/m² internal: relative {rel:.2e}");
+    assert!(rel < 1e-6, "closure with a fixed back {rel}");
 }
 
 /// (d) Halving the time-step control and doubling the spatial resolution changes surface
