@@ -19,4 +19,5 @@ pub mod render;
 pub mod report;
 pub mod scene;
 pub mod text;
+pub mod thermal;
 pub mod transport;

@@ -1,0 +1,15 @@
+//! Temperatures from a thermal model (DESIGN §1.8, issue 12): per-vertex 1-D conduction through a
+//! layer stack with the front surface energy balance. This is the numerical core; weather, the sun
+//! and scenes feed it numbers per step.
+//!
+//! - [`layers`]: layer materials and stacks, validated, discretised into finite volumes.
+//! - [`solver`]: implicit stepping with adaptive sub-steps, the non-linear surface balance and
+//!   energy bookkeeping.
+
+pub mod layers;
+pub mod solver;
+
+pub use layers::{Grid, Layer, LayerMaterial, LayerStack, Resolution, ThermalError};
+pub use solver::{
+    Back, Forcing, FrontForcing, Solver, SolverControl, StepReport, ThermalState, STEFAN_BOLTZMANN,
+};
