@@ -400,16 +400,14 @@ fn draw_rings_m00<DB: DrawingBackend>(
         entries.push(LegendEntry::line("only in (g)", WHITE, LineKind::Solid));
     }
     if data.unshown_ring_points > 0 {
-        entries.push(LegendEntry::line(
+        // Rings beyond the drawn ones (other incidence angles, or more than MAX_RINGS).
+        for line in [
             format!("{} pts on", data.unshown_ring_points),
-            WHITE,
-            LineKind::Solid,
-        ));
-        entries.push(LegendEntry::line(
-            "other rings: (g)",
-            WHITE,
-            LineKind::Solid,
-        ));
+            "other rings".to_owned(),
+            "only in (g)".to_owned(),
+        ] {
+            entries.push(LegendEntry::line(line, WHITE, LineKind::Solid));
+        }
     }
     let heading = (FONT, style::LEGEND_SIZE)
         .into_font()
