@@ -642,6 +642,27 @@ mod tests {
     }
 
     #[test]
+    fn curves_go_to_a_few_angles_spread_over_the_range() {
+        let few = [20.0, 40.0, 60.0];
+        assert_eq!(representatives(&few, 8), [0, 1, 2]);
+        let many: Vec<f64> = (0..1000).map(|i| 5.0 + 0.07 * i as f64).collect();
+        let chosen = representatives(&many, 8);
+        assert_eq!(chosen.len(), 8);
+        assert_eq!((chosen[0], chosen[7]), (0, 999), "both ends of the range");
+        for (i, &c) in chosen.iter().enumerate() {
+            let target = 5.0 + 69.93 * i as f64 / 7.0;
+            assert!((many[c] - target).abs() <= 0.035 + 1e-9, "{i}: {}", many[c]);
+        }
+        // Clustered angles: the nearest measured one to each target, never twice.
+        let clustered = [10.0, 10.5, 11.0, 50.0, 80.0, 80.5, 81.0, 81.5, 82.0, 82.5];
+        assert_eq!(representatives(&clustered, 8), [0, 2, 3, 4, 9]);
+        assert_eq!(evenly(200, 18).len(), 18);
+        assert_eq!(evenly(200, 18)[17], 199);
+        assert_eq!(evenly(5, 18), [0, 1, 2, 3, 4]);
+        assert_eq!(position_of(&many, 5.0 + 0.07 * 500.0), 500);
+    }
+
+    #[test]
     fn residuals_are_data_minus_model_over_sigma() {
         let geometry = [(40.0, 0.0, 40.0, 180.0), (40.0, 0.0, 20.0, 0.0)];
         let exact_set = set_of(&geometry, exact, [None, None]);
