@@ -141,8 +141,8 @@ const DENSITY_X_DEG: f64 = 2.0;
 const DENSITY_Y_SIGMA: f64 = 0.25;
 
 /// Counts of `residuals` within ±`bound` in cells of [`DENSITY_X_DEG`] × [`DENSITY_Y_SIGMA`]
-/// over −90…90° × ±`bound`, row-major by x bin; and the number of x and y bins.
-pub fn residual_density(residuals: &[Residual], bound: f64) -> (Vec<usize>, usize, usize) {
+/// over −90…90° × ±`bound`, one run of y bins per x bin; and the number of y bins.
+pub fn residual_density(residuals: &[Residual], bound: f64) -> (Vec<usize>, usize) {
     let columns = (180.0 / DENSITY_X_DEG).round() as usize;
     let rows = ((2.0 * bound / DENSITY_Y_SIGMA).ceil() as usize).max(1);
     let mut counts = vec![0; columns * rows];
@@ -155,7 +155,7 @@ pub fn residual_density(residuals: &[Residual], bound: f64) -> (Vec<usize>, usiz
         let row = (((r.value + bound) / DENSITY_Y_SIGMA).floor().max(0.0) as usize).min(rows - 1);
         counts[column * rows + row] += 1;
     }
-    (counts, columns, rows)
+    (counts, rows)
 }
 
 /// Cell colour for `count` of at most `most`: light to dark blue on a log scale.
@@ -177,7 +177,7 @@ fn draw_residual_density<DB: DrawingBackend>(
     bound: f64,
     hidden: usize,
 ) -> DrawResult<DB> {
-    let (counts, columns, rows) = residual_density(&data.residuals, bound);
+    let (counts, rows) = residual_density(&data.residuals, bound);
     let most = counts.iter().copied().max().unwrap_or(0);
     chart.draw_series(counts.iter().enumerate().filter(|(_, &c)| c > 0).map(
         |(cell, &count)| {
@@ -191,7 +191,6 @@ fn draw_residual_density<DB: DrawingBackend>(
             )
         },
     ))?;
-    debug_assert_eq!(counts.len(), columns * rows);
     chart.draw_series(LineSeries::new(
         [(-90.0, 0.0), (90.0, 0.0)],
         GREY.stroke_width(1),
@@ -584,6 +583,37 @@ mod tests {
         );
         assert_eq!(outside, 3, "5.0, −7 and NaN");
         assert_eq!(counts.iter().sum::<usize>() + outside, 9);
+    }
+
+    #[test]
+    fn residual_density_counts_cells_of_two_degrees_and_a_quarter_sigma() {
+        let at = |forward_zenith, value| Residual {
+            forward_zenith,
+            element: 0,
+            value,
+        };
+        let residuals = [
+            at(-90.0, -4.0),
+            at(-89.0, -3.9),
+            at(0.5, 0.1),
+            at(90.0, 3.99),
+            at(10.0, 4.5),
+            at(10.0, f64::NAN),
+        ];
+        let (counts, rows) = residual_density(&residuals, 4.0);
+        assert_eq!((counts.len(), rows), (90 * 32, 32));
+        assert_eq!(counts[0], 2, "the first cell holds both corner points");
+        assert_eq!(counts[45 * rows + 16], 1, "0.5°, +0.1σ");
+        assert_eq!(
+            counts[89 * rows + 31],
+            1,
+            "the top edge closes the last cell"
+        );
+        assert_eq!(
+            counts.iter().sum::<usize>(),
+            4,
+            "beyond the bound or NaN: not counted"
+        );
     }
 
     #[test]
