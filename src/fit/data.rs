@@ -72,15 +72,18 @@ impl MeasurementData {
         let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
         let floor = DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE);
 
+        // Distinct zenith cosines, found by hash: a goniometer export can have as many distinct
+        // angles as rows, and a linear search per row made 2e5 such rows take 20 s.
         let mut zenith_cosines: Vec<f64> = Vec::new();
+        let mut zenith_positions: std::collections::HashMap<u64, usize> =
+            std::collections::HashMap::new();
         let mut zenith_index = |cos: f64| -> usize {
-            match zenith_cosines.iter().position(|&c| c == cos) {
-                Some(i) => i,
-                None => {
-                    zenith_cosines.push(cos);
-                    zenith_cosines.len() - 1
-                }
-            }
+            // == on floats: +0 and −0 are one key (the cosines are finite).
+            let key = if cos == 0.0 { 0 } else { cos.to_bits() };
+            *zenith_positions.entry(key).or_insert_with(|| {
+                zenith_cosines.push(cos);
+                zenith_cosines.len() - 1
+            })
         };
         let mut geometry = Vec::with_capacity(set.points.len());
         let mut values = Vec::with_capacity(set.points.len() * width);

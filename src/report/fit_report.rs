@@ -30,7 +30,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::FontStyle;
-use profiles::{draw_profile, linear_axis, log_axis, profile_series, Domain, Profile, Quantity};
+use profiles::{
+    draw_profile, linear_axis, log_axis, profile_series, Domain, Profile, Quantity, BIN_DEGREES,
+};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use style::{
@@ -253,17 +255,29 @@ fn draw_header<DB: DrawingBackend>(
     root.draw_text(&title, &title_style.into_text_style(root), (24, 14))?;
 
     let mut entries: Vec<LegendEntry> = data
-        .incidences
+        .shown
         .iter()
         .enumerate()
-        .map(|(i, theta)| {
+        .map(|(slot, &incidence)| {
             LegendEntry::marker(
-                format!("θi = {}°", format_angle(*theta)),
-                incidence_color(i),
+                format!("θi = {}°", format_angle(data.incidences[incidence])),
+                incidence_color(slot),
                 Marker::FilledCircle,
             )
         })
         .collect();
+    if data.shown.len() < data.incidences.len() {
+        // Curves at a few angles spread over the range; every point is in (g) and (h).
+        entries.push(LegendEntry::line(
+            format!(
+                "(curves at {} of {} incidence angles)",
+                data.shown.len(),
+                data.incidences.len()
+            ),
+            WHITE,
+            LineKind::Solid,
+        ));
+    }
     entries.push(LegendEntry {
         label: "measured ± 1σ".into(),
         color: RGBColor(60, 60, 60),
@@ -290,23 +304,32 @@ fn draw_in_plane_m00<DB: DrawingBackend>(
     data: &ReportData,
 ) -> DrawResult<DB> {
     let caption = "(a) m00 in the plane of incidence";
-    let series = profile_series(data, Quantity::M00, Domain::InPlane);
+    let (series, binned) = profile_series(data, Quantity::M00, Domain::InPlane);
     let Some(y) = log_axis(&series) else {
         return draw_note(area, caption, "no measurements in the plane of incidence");
     };
     draw_profile(
         area,
         &Profile {
-            caption: caption.into(),
+            caption: with_binning(caption, binned),
             x_desc: Domain::InPlane.x_desc(false).into(),
             y_desc: "m00 = f00, BRDF (sr⁻¹)".into(),
             x_axis: Domain::InPlane.axis(area.dim_in_pixel().0),
             y,
             series,
-            error_bars: true,
+            error_bars: !binned,
             compact: false,
         },
     )
+}
+
+/// A profile panel's caption, saying when its points are medians per bin.
+fn with_binning(caption: &str, binned: bool) -> String {
+    if binned {
+        format!("{caption} (median per {BIN_DEGREES}° bin)")
+    } else {
+        caption.to_owned()
+    }
 }
 
 /// Width of the ring legend strip at the right of panel (b).
@@ -319,7 +342,7 @@ fn draw_rings_m00<DB: DrawingBackend>(
     data: &ReportData,
 ) -> DrawResult<DB> {
     let caption = "(b) m00 on out-of-plane rings";
-    let series = profile_series(data, Quantity::M00, Domain::Rings);
+    let (series, binned) = profile_series(data, Quantity::M00, Domain::Rings);
     let Some(y) = log_axis(&series) else {
         let note = match data.off_ring_points() {
             0 => "no out-of-plane measurements".to_owned(),
@@ -333,13 +356,13 @@ fn draw_rings_m00<DB: DrawingBackend>(
     draw_profile(
         &chart_area,
         &Profile {
-            caption: caption.into(),
+            caption: with_binning(caption, binned),
             x_desc: Domain::Rings.x_desc(false).into(),
             y_desc: "m00 (sr⁻¹)".into(),
             x_axis: Domain::Rings.axis(chart_area.dim_in_pixel().0),
             y,
             series,
-            error_bars: true,
+            error_bars: !binned,
             compact: false,
         },
     )?;
@@ -354,7 +377,7 @@ fn draw_rings_m00<DB: DrawingBackend>(
                     format_angle(data.incidences[ring.incidence]),
                     format_angle(ring.theta_r_deg)
                 ),
-                incidence_color(ring.incidence),
+                incidence_color(data.slot[ring.incidence].unwrap_or(0)),
                 Marker::for_rank(ring.rank),
             )
         })
@@ -375,6 +398,16 @@ fn draw_rings_m00<DB: DrawingBackend>(
             LineKind::Solid,
         ));
         entries.push(LegendEntry::line("only in (g)", WHITE, LineKind::Solid));
+    }
+    if data.unshown_ring_points > 0 {
+        // Rings beyond the drawn ones (other incidence angles, or more than MAX_RINGS).
+        for line in [
+            format!("{} pts on", data.unshown_ring_points),
+            "other rings".to_owned(),
+            "only in (g)".to_owned(),
+        ] {
+            entries.push(LegendEntry::line(line, WHITE, LineKind::Solid));
+        }
     }
     let heading = (FONT, style::LEGEND_SIZE)
         .into_font()
@@ -432,14 +465,15 @@ fn draw_linear_block<DB: DrawingBackend>(
             Domain::InPlane
         };
         let quantity = Quantity::Ratio(element);
-        let series = profile_series(data, quantity, domain);
+        let (series, binned) = profile_series(data, quantity, domain);
         draw_profile(
             cell,
             &Profile {
                 caption: format!(
-                    "{}{}",
+                    "{}{}{}",
                     quantity.label(),
-                    if on_rings { " (rings)" } else { "" }
+                    if on_rings { " (rings)" } else { "" },
+                    if binned { ", medians" } else { "" }
                 ),
                 x_desc: domain.x_desc(true).into(),
                 y_desc: String::new(),
@@ -472,7 +506,8 @@ fn draw_dolp<DB: DrawingBackend>(
     } else {
         return draw_note(area, &caption, NO_PROFILE_NOTE);
     };
-    let series = profile_series(data, Quantity::Dolp, domain);
+    let (series, binned) = profile_series(data, Quantity::Dolp, domain);
+    let caption = with_binning(&caption, binned);
     let y = match linear_axis(&series, 1.0) {
         YAxis::Linear { high, .. } => YAxis::Linear { low: 0.0, high },
         other => other,

@@ -84,12 +84,23 @@ pub struct EmissivityCurves {
 }
 
 pub struct ReportData {
-    /// Distinct incidence angles (°), ascending: the colour key of every panel.
+    /// Distinct incidence angles (°), ascending.
     pub incidences: Vec<f64>,
+    /// The incidence angles (indices into `incidences`) drawn with model curves, ascending: all of
+    /// them up to [`MAX_CURVE_INCIDENCES`], else that many chosen evenly over the measured range.
+    /// Their position in this list is their colour.
+    pub shown: Vec<usize>,
+    /// Per incidence angle, its position in `shown` (`None` when it has no curves).
+    pub slot: Vec<Option<usize>>,
+    /// Off-plane points on no ring of at least [`RING_MIN_SPAN_DEG`] (a raster around specular).
+    pub raster_points: usize,
+    /// Off-plane points on rings left out of the profile panels (more rings than
+    /// [`MAX_RINGS`], or at incidence angles without curves).
+    pub unshown_ring_points: usize,
     /// Mueller indices present in the measurement, ascending.
     pub elements: Vec<usize>,
     pub points: Vec<PointView>,
-    /// In-plane model sweeps, one per incidence angle (`None` when no point of that angle lies in
+    /// In-plane model sweeps, one per entry of `shown` (`None` when no point of that angle lies in
     /// the plane).
     pub in_plane: Vec<Option<ModelSweep>>,
     pub rings: Vec<Ring>,
@@ -149,15 +160,28 @@ impl ReportData {
             });
         }
 
-        let rings = find_rings(&mut points, set, &incidences, &chosen, alternative.as_ref());
-        let in_plane = incidences
+        let shown = representatives(&incidences, MAX_CURVE_INCIDENCES);
+        let mut slot = vec![None; incidences.len()];
+        for (position, &incidence) in shown.iter().enumerate() {
+            slot[incidence] = Some(position);
+        }
+        let found = find_rings(
+            &mut points,
+            set,
+            &incidences,
+            &slot,
+            &chosen,
+            alternative.as_ref(),
+        );
+        let mut has_in_plane = vec![false; incidences.len()];
+        for p in points.iter().filter(|p| p.signed_zenith.is_some()) {
+            has_in_plane[p.incidence] = true;
+        }
+        let in_plane = shown
             .iter()
-            .enumerate()
-            .map(|(group, &theta_i)| {
-                points
-                    .iter()
-                    .any(|p| p.incidence == group && p.signed_zenith.is_some())
-                    .then(|| in_plane_sweep(theta_i, &chosen, alternative.as_ref()))
+            .map(|&incidence| {
+                has_in_plane[incidence]
+                    .then(|| in_plane_sweep(incidences[incidence], &chosen, alternative.as_ref()))
             })
             .collect();
         let residuals = points
@@ -176,10 +200,14 @@ impl ReportData {
 
         Ok(ReportData {
             incidences,
+            shown,
+            slot,
+            raster_points: found.raster_points,
+            unshown_ring_points: found.unshown_points,
             elements: set.elements.clone(),
             points,
             in_plane,
-            rings,
+            rings: found.rings,
             residuals,
             emissivity,
             chosen_label: chosen.label,
@@ -194,11 +222,52 @@ impl ReportData {
     /// Off-plane points that lie on no ring (a raster around specular): they appear only among
     /// the residuals.
     pub fn off_ring_points(&self) -> usize {
-        self.points
-            .iter()
-            .filter(|p| p.signed_zenith.is_none() && p.ring.is_none())
-            .count()
+        self.raster_points
     }
+}
+
+/// Most incidence angles drawn with model curves: beyond it, curves and their points are shown
+/// for this many angles spread evenly over the measured range (a report draws each curve in
+/// several panels, so their number must not grow with the file). Every point stays in the
+/// residual panels.
+pub const MAX_CURVE_INCIDENCES: usize = 8;
+/// Most out-of-plane rings drawn (chosen evenly, by incidence angle then detector zenith).
+pub const MAX_RINGS: usize = 18;
+
+/// Indices of at most `limit` of the ascending `values`: all when they are few, else the one
+/// nearest to each of `limit` targets evenly spaced from the first to the last.
+pub fn representatives(values: &[f64], limit: usize) -> Vec<usize> {
+    if values.len() <= limit {
+        return (0..values.len()).collect();
+    }
+    let (low, high) = (values[0], values[values.len() - 1]);
+    let mut chosen: Vec<usize> = (0..limit)
+        .map(|i| {
+            let target = low + (high - low) * i as f64 / (limit - 1).max(1) as f64;
+            let at = values
+                .partition_point(|&v| v < target)
+                .min(values.len() - 1);
+            if at > 0 && (target - values[at - 1]) <= (values[at] - target) {
+                at - 1
+            } else {
+                at
+            }
+        })
+        .collect();
+    chosen.dedup();
+    chosen
+}
+
+/// `limit` indices of `0..count` spread evenly, first and last included (all when fewer).
+fn evenly(count: usize, limit: usize) -> Vec<usize> {
+    if count <= limit {
+        return (0..count).collect();
+    }
+    let mut picked: Vec<usize> = (0..limit)
+        .map(|i| (i * (count - 1) + (limit - 1) / 2) / (limit - 1).max(1))
+        .collect();
+    picked.dedup();
+    picked
 }
 
 fn checked_direction(name: &'static str, theta: f64, phi: f64) -> Result<Direction, ReportError> {
@@ -225,66 +294,127 @@ fn distinct_sorted(values: impl Iterator<Item = f64>) -> Vec<f64> {
     all
 }
 
+/// Index of `value` in the ascending, deduplicated `sorted` (a binary search: a file can hold
+/// as many distinct angles as rows).
 fn position_of(sorted: &[f64], value: f64) -> usize {
-    sorted
-        .iter()
-        .position(|&v| (v - value).abs() < SAME_ANGLE_DEG)
-        .unwrap_or(0)
+    let at = sorted.partition_point(|&v| v < value - SAME_ANGLE_DEG);
+    if sorted
+        .get(at)
+        .is_some_and(|&v| (v - value).abs() < SAME_ANGLE_DEG)
+    {
+        at
+    } else {
+        0
+    }
 }
 
 /// A group of off-plane points at one (θ_i, θ_r) is drawn as a ring when it spans at least this
 /// much azimuth; a small raster around specular (a few degrees of φ_r) would only pile up at 180°.
 const RING_MIN_SPAN_DEG: f64 = 60.0;
 
+/// Rings found in a measurement, and the off-plane points the profile panels do not show.
+struct FoundRings {
+    rings: Vec<Ring>,
+    raster_points: usize,
+    unshown_points: usize,
+}
+
 /// Groups the out-of-plane points by (θ_i, θ_r) into rings. A ring also claims the in-plane
-/// points of the same (θ_i, θ_r), which are its φ_r − φ_i = 0° and 180° members.
+/// points of the same (θ_i, θ_r), which are its φ_r − φ_i = 0° and 180° members. Rings are drawn
+/// only at incidence angles with curves (`slot`), at most [`MAX_RINGS`] of them, spread evenly;
+/// grouping sorts once, so it costs N log N however many rings the file has.
 fn find_rings(
     points: &mut [PointView],
     set: &MeasurementSet,
     incidences: &[f64],
+    slot: &[Option<usize>],
     chosen: &ModelCurveSource,
     alternative: Option<&ModelCurveSource>,
-) -> Vec<Ring> {
-    let same_group = |view: &PointView, theta_r: f64, key: (usize, f64)| {
-        view.incidence == key.0 && (theta_r - key.1).abs() < SAME_ANGLE_DEG
-    };
-    let mut keys: Vec<(usize, f64)> = Vec::new();
-    for (view, p) in points.iter().zip(&set.points) {
-        if view.signed_zenith.is_none()
-            && !keys.iter().any(|&key| same_group(view, p.theta_r_deg, key))
-        {
-            keys.push((view.incidence, p.theta_r_deg));
+) -> FoundRings {
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    let theta_r = |i: usize| set.points[i].theta_r_deg;
+    order.sort_by(|&a, &b| {
+        points[a]
+            .incidence
+            .cmp(&points[b].incidence)
+            .then(theta_r(a).total_cmp(&theta_r(b)))
+    });
+    // Runs of one incidence angle whose θ_r agree with the run's first to a microdegree.
+    let mut groups: Vec<&[usize]> = Vec::new();
+    let mut start = 0;
+    for end in 1..=order.len() {
+        let split = end == order.len() || {
+            let (first, next) = (order[start], order[end]);
+            points[first].incidence != points[next].incidence
+                || (theta_r(next) - theta_r(first)).abs() >= SAME_ANGLE_DEG
+        };
+        if split {
+            groups.push(&order[start..end]);
+            start = end;
         }
     }
-    keys.retain(|&key| {
-        let azimuths = points
+    let mut raster_points = 0;
+    let mut candidates: Vec<&[usize]> = Vec::new();
+    for group in groups {
+        let off_plane = group
             .iter()
-            .zip(&set.points)
-            .filter(|(view, p)| same_group(view, p.theta_r_deg, key))
-            .map(|(view, _)| view.relative_azimuth);
-        let (low, high) = azimuths.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-            (a.min(x), b.max(x))
-        });
-        high - low >= RING_MIN_SPAN_DEG
-    });
-    keys.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    for (view, p) in points.iter_mut().zip(&set.points) {
-        view.ring = keys
+            .filter(|&&i| points[i].signed_zenith.is_none())
+            .count();
+        if off_plane == 0 {
+            continue;
+        }
+        let (low, high) = group
             .iter()
-            .position(|&key| same_group(view, p.theta_r_deg, key));
+            .map(|&i| points[i].relative_azimuth)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            });
+        if high - low >= RING_MIN_SPAN_DEG {
+            candidates.push(group);
+        } else {
+            raster_points += off_plane;
+        }
     }
-    keys.iter()
-        .enumerate()
-        .map(|(index, &(incidence, theta_r_deg))| Ring {
+    let drawable: Vec<&[usize]> = candidates
+        .iter()
+        .copied()
+        .filter(|group| slot[points[group[0]].incidence].is_some())
+        .collect();
+    let kept: Vec<&[usize]> = evenly(drawable.len(), MAX_RINGS)
+        .into_iter()
+        .map(|i| drawable[i])
+        .collect();
+    let off_plane_on_rings = |groups: &[&[usize]]| -> usize {
+        groups
+            .iter()
+            .flat_map(|g| g.iter())
+            .filter(|&&i| points[i].signed_zenith.is_none())
+            .count()
+    };
+    let unshown_points = off_plane_on_rings(&candidates) - off_plane_on_rings(&kept);
+    let mut rings = Vec::with_capacity(kept.len());
+    for (index, group) in kept.iter().enumerate() {
+        let incidence = points[group[0]].incidence;
+        let theta_r_deg = theta_r(group[0]);
+        for &i in group.iter() {
+            points[i].ring = Some(index);
+        }
+        let rank = rings
+            .iter()
+            .filter(|r: &&Ring| r.incidence == incidence)
+            .count();
+        rings.push(Ring {
             incidence,
             theta_r_deg,
-            rank: keys[..index]
-                .iter()
-                .filter(|&&(i, _)| i == incidence)
-                .count(),
+            rank,
             sweep: ring_sweep(incidences[incidence], theta_r_deg, chosen, alternative),
-        })
-        .collect()
+        });
+    }
+    FoundRings {
+        rings,
+        raster_points,
+        unshown_points,
+    }
 }
 
 /// Detector zeniths for an in-plane curve: every 0.5° to ±89.5°, and every 0.05° within 3° of
@@ -509,6 +639,27 @@ mod tests {
         assert_eq!(data.off_ring_points(), 3);
         // Only θi = 60° has in-plane points, so only it gets an in-plane model sweep.
         assert!(data.in_plane[0].is_none() && data.in_plane[1].is_some());
+    }
+
+    #[test]
+    fn curves_go_to_a_few_angles_spread_over_the_range() {
+        let few = [20.0, 40.0, 60.0];
+        assert_eq!(representatives(&few, 8), [0, 1, 2]);
+        let many: Vec<f64> = (0..1000).map(|i| 5.0 + 0.07 * i as f64).collect();
+        let chosen = representatives(&many, 8);
+        assert_eq!(chosen.len(), 8);
+        assert_eq!((chosen[0], chosen[7]), (0, 999), "both ends of the range");
+        for (i, &c) in chosen.iter().enumerate() {
+            let target = 5.0 + 69.93 * i as f64 / 7.0;
+            assert!((many[c] - target).abs() <= 0.035 + 1e-9, "{i}: {}", many[c]);
+        }
+        // Clustered angles: the nearest measured one to each target, never twice.
+        let clustered = [10.0, 10.5, 11.0, 50.0, 80.0, 80.5, 81.0, 81.5, 82.0, 82.5];
+        assert_eq!(representatives(&clustered, 8), [0, 2, 3, 4, 9]);
+        assert_eq!(evenly(200, 18).len(), 18);
+        assert_eq!(evenly(200, 18)[17], 199);
+        assert_eq!(evenly(5, 18), [0, 1, 2, 3, 4]);
+        assert_eq!(position_of(&many, 5.0 + 0.07 * 500.0), 500);
     }
 
     #[test]

@@ -8,6 +8,7 @@ use super::style::{
 };
 use crate::material::FitRecord;
 use crate::report::FONT;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -90,6 +91,9 @@ pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
             GREY.stroke_width(1),
         ))?;
     }
+    if data.residuals.len() > MAX_RESIDUAL_POINTS {
+        return draw_residual_density(area, &mut chart, data, bound, hidden);
+    }
     // Draw the many polarization residuals first so that m00 stays visible on top.
     for class in [2, 1, 0] {
         let points: Vec<&Residual> = data
@@ -119,6 +123,102 @@ pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
         })
         .collect();
     entries.push(LegendEntry::line("±3σ", GREY, LineKind::Dashed));
+    if hidden > 0 {
+        entries.push(LegendEntry::line(
+            format!("{hidden} beyond ±{bound:.0}σ not shown"),
+            WHITE,
+            LineKind::Solid,
+        ));
+    }
+    draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 8)
+}
+
+/// Most residuals panel (g) draws one by one; beyond it, it draws their density as a 2-D
+/// histogram ([`DENSITY_X_DEG`] × [`DENSITY_Y_SIGMA`] cells), whose size does not grow with the
+/// file.
+pub const MAX_RESIDUAL_POINTS: usize = 20_000;
+const DENSITY_X_DEG: f64 = 2.0;
+const DENSITY_Y_SIGMA: f64 = 0.25;
+
+/// Counts of `residuals` within ±`bound` in cells of [`DENSITY_X_DEG`] × [`DENSITY_Y_SIGMA`]
+/// over −90…90° × ±`bound`, one run of y bins per x bin; and the number of y bins.
+pub fn residual_density(residuals: &[Residual], bound: f64) -> (Vec<usize>, usize) {
+    let columns = (180.0 / DENSITY_X_DEG).round() as usize;
+    let rows = ((2.0 * bound / DENSITY_Y_SIGMA).ceil() as usize).max(1);
+    let mut counts = vec![0; columns * rows];
+    for r in residuals {
+        if !(r.value.abs() <= bound && r.forward_zenith.is_finite()) {
+            continue;
+        }
+        let column = (((r.forward_zenith + 90.0) / DENSITY_X_DEG).floor().max(0.0) as usize)
+            .min(columns - 1);
+        let row = (((r.value + bound) / DENSITY_Y_SIGMA).floor().max(0.0) as usize).min(rows - 1);
+        counts[column * rows + row] += 1;
+    }
+    (counts, rows)
+}
+
+/// Cell colour for `count` of at most `most`: light to dark blue on a log scale.
+fn density_color(count: usize, most: usize) -> RGBColor {
+    let t = if most > 1 {
+        (count as f64).ln() / (most as f64).ln()
+    } else {
+        1.0
+    };
+    let mix = |a: u8, b: u8| (a as f64 + t * (b as f64 - a as f64)).round() as u8;
+    RGBColor(mix(198, 8), mix(219, 48), mix(239, 107))
+}
+
+/// Panel (g) for many residuals: their density over (detector zenith, residual).
+fn draw_residual_density<DB: DrawingBackend>(
+    area: &Area<DB>,
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    data: &ReportData,
+    bound: f64,
+    hidden: usize,
+) -> DrawResult<DB> {
+    let (counts, rows) = residual_density(&data.residuals, bound);
+    let most = counts.iter().copied().max().unwrap_or(0);
+    chart.draw_series(counts.iter().enumerate().filter(|(_, &c)| c > 0).map(
+        |(cell, &count)| {
+            let (column, row) = (cell / rows, cell % rows);
+            let x0 = -90.0 + column as f64 * DENSITY_X_DEG;
+            let y0 = -bound + row as f64 * DENSITY_Y_SIGMA;
+            let top = (y0 + DENSITY_Y_SIGMA).min(bound);
+            Rectangle::new(
+                [(x0, y0), (x0 + DENSITY_X_DEG, top)],
+                density_color(count, most).filled(),
+            )
+        },
+    ))?;
+    chart.draw_series(LineSeries::new(
+        [(-90.0, 0.0), (90.0, 0.0)],
+        GREY.stroke_width(1),
+    ))?;
+    for level in [-3.0, 3.0] {
+        chart.draw_series(DashedLineSeries::new(
+            [(-90.0, level), (90.0, level)],
+            6,
+            5,
+            GREY.stroke_width(1),
+        ))?;
+    }
+    let mut entries = vec![
+        LegendEntry::line(
+            format!(
+                "{} residuals, all elements: count per {DENSITY_X_DEG}° × {DENSITY_Y_SIGMA}σ cell",
+                data.residuals.len()
+            ),
+            density_color(1, most.max(2)),
+            LineKind::Patch,
+        ),
+        LegendEntry::line(
+            format!("darkest: {most} (log scale)"),
+            density_color(most, most),
+            LineKind::Patch,
+        ),
+        LegendEntry::line("±3σ", GREY, LineKind::Dashed),
+    ];
     if hidden > 0 {
         entries.push(LegendEntry::line(
             format!("{hidden} beyond ±{bound:.0}σ not shown"),
@@ -483,6 +583,37 @@ mod tests {
         );
         assert_eq!(outside, 3, "5.0, −7 and NaN");
         assert_eq!(counts.iter().sum::<usize>() + outside, 9);
+    }
+
+    #[test]
+    fn residual_density_counts_cells_of_two_degrees_and_a_quarter_sigma() {
+        let at = |forward_zenith, value| Residual {
+            forward_zenith,
+            element: 0,
+            value,
+        };
+        let residuals = [
+            at(-90.0, -4.0),
+            at(-89.0, -3.9),
+            at(0.5, 0.1),
+            at(90.0, 3.99),
+            at(10.0, 4.5),
+            at(10.0, f64::NAN),
+        ];
+        let (counts, rows) = residual_density(&residuals, 4.0);
+        assert_eq!((counts.len(), rows), (90 * 32, 32));
+        assert_eq!(counts[0], 2, "the first cell holds both corner points");
+        assert_eq!(counts[45 * rows + 16], 1, "0.5°, +0.1σ");
+        assert_eq!(
+            counts[89 * rows + 31],
+            1,
+            "the top edge closes the last cell"
+        );
+        assert_eq!(
+            counts.iter().sum::<usize>(),
+            4,
+            "beyond the bound or NaN: not counted"
+        );
     }
 
     #[test]

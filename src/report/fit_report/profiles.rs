@@ -198,8 +198,20 @@ fn series_of(
     }
 }
 
-/// The series of `quantity` along `domain`: one per incidence angle in the plane, one per ring.
-pub fn profile_series(data: &ReportData, quantity: Quantity, domain: Domain) -> Vec<ProfileSeries> {
+/// Most measured points a profile panel draws one by one (with error bars). Beyond it, each
+/// series is binned along x ([`BIN_DEGREES`]) and drawn as the median per bin, so that a panel
+/// costs the same for 10⁴ points as for 10⁶.
+pub const MAX_PROFILE_POINTS: usize = 4000;
+/// Width of a bin of a binned profile series, in degrees of the panel's x axis.
+pub const BIN_DEGREES: f64 = 1.0;
+
+/// The series of `quantity` along `domain`: one per incidence angle with curves in the plane, one
+/// per drawn ring. The second value is true when the points were binned.
+pub fn profile_series(
+    data: &ReportData,
+    quantity: Quantity,
+    domain: Domain,
+) -> (Vec<ProfileSeries>, bool) {
     let measured = |p: &PointView, x: f64| {
         quantity.of_point(p).map(|(value, sigma)| ProfilePoint {
             x,
@@ -208,21 +220,37 @@ pub fn profile_series(data: &ReportData, quantity: Quantity, domain: Domain) -> 
             model: quantity.of_model(&p.model),
         })
     };
-    match domain {
+    // One pass over the points into their series: a file may hold as many groups as points.
+    let groups = match domain {
+        Domain::InPlane => data.in_plane.len(),
+        Domain::Rings => data.rings.len(),
+    };
+    let mut buckets: Vec<Vec<ProfilePoint>> = vec![Vec::new(); groups];
+    for p in &data.points {
+        let placed = match domain {
+            Domain::InPlane => data.slot[p.incidence].zip(p.signed_zenith),
+            Domain::Rings => p.ring.map(|ring| (ring, p.relative_azimuth)),
+        };
+        if let Some(point) = placed.and_then(|(group, x)| Some((group, measured(p, x)?))) {
+            buckets[point.0].push(point.1);
+        }
+    }
+    let binned = buckets.iter().map(Vec::len).sum::<usize>() > MAX_PROFILE_POINTS;
+    if binned {
+        for bucket in &mut buckets {
+            *bucket = bin_points(std::mem::take(bucket));
+        }
+    }
+    let series = match domain {
         Domain::InPlane => data
             .in_plane
             .iter()
+            .zip(buckets)
             .enumerate()
-            .filter_map(|(group, sweep)| {
-                let points = data
-                    .points
-                    .iter()
-                    .filter(|p| p.incidence == group)
-                    .filter_map(|p| p.signed_zenith.and_then(|x| measured(p, x)))
-                    .collect();
+            .filter_map(|(slot, (sweep, points))| {
                 sweep.as_ref().map(|sweep| {
                     series_of(
-                        incidence_color(group),
+                        incidence_color(slot),
                         Marker::FilledCircle,
                         points,
                         sweep,
@@ -234,16 +262,10 @@ pub fn profile_series(data: &ReportData, quantity: Quantity, domain: Domain) -> 
         Domain::Rings => data
             .rings
             .iter()
-            .enumerate()
-            .map(|(index, ring)| {
-                let points = data
-                    .points
-                    .iter()
-                    .filter(|p| p.ring == Some(index))
-                    .filter_map(|p| measured(p, p.relative_azimuth))
-                    .collect();
+            .zip(buckets)
+            .map(|(ring, points)| {
                 series_of(
-                    incidence_color(ring.incidence),
+                    incidence_color(data.slot[ring.incidence].unwrap_or(0)),
                     Marker::for_rank(ring.rank),
                     points,
                     &ring.sweep,
@@ -251,7 +273,40 @@ pub fn profile_series(data: &ReportData, quantity: Quantity, domain: Domain) -> 
                 )
             })
             .collect(),
-    }
+    };
+    (series, binned)
+}
+
+/// The median value (and median model) of the points in each [`BIN_DEGREES`]-wide bin of x,
+/// at the bin's mean x, without error bars.
+fn bin_points(mut points: Vec<ProfilePoint>) -> Vec<ProfilePoint> {
+    let bin = |p: &ProfilePoint| (p.x / BIN_DEGREES).floor() as i64;
+    points.sort_by(|a, b| bin(a).cmp(&bin(b)).then(a.value.total_cmp(&b.value)));
+    let median = |values: &mut Vec<f64>| -> Option<f64> {
+        values.sort_by(f64::total_cmp);
+        let n = values.len();
+        (n > 0).then(|| {
+            if n % 2 == 1 {
+                values[n / 2]
+            } else {
+                0.5 * (values[n / 2 - 1] + values[n / 2])
+            }
+        })
+    };
+    points
+        .chunk_by(|a, b| bin(a) == bin(b))
+        .map(|chunk| {
+            let x = chunk.iter().map(|p| p.x).sum::<f64>() / chunk.len() as f64;
+            let value = median(&mut chunk.iter().map(|p| p.value).collect()).unwrap_or(f64::NAN);
+            let model = median(&mut chunk.iter().filter_map(|p| p.model).collect());
+            ProfilePoint {
+                x,
+                value,
+                sigma: None,
+                model,
+            }
+        })
+        .collect()
 }
 
 /// Decades a log axis spans at least, so that it carries two labelled powers of ten.
