@@ -132,8 +132,9 @@ fn temporaries(dirs: &[&Path]) -> Vec<String> {
         .collect()
 }
 
-/// SIGTERM at any moment of `irpol fit` leaves the library as it was or wholly replaced, and no
-/// temporary file (issue 15).
+/// SIGTERM or SIGKILL at any moment of `irpol fit` leaves the library as it was or wholly
+/// replaced; SIGTERM leaves no temporary file, and the next fit removes a SIGKILLed one's
+/// (issue 15).
 #[test]
 fn an_interrupted_fit_leaves_the_old_or_the_new_library() {
     let dir = tempfile::tempdir().unwrap();
@@ -172,6 +173,7 @@ fn an_interrupted_fit_leaves_the_old_or_the_new_library() {
     let old = run("1");
     assert_ne!(old, new, "the two seeds must give different entries");
     for k in 0..8u64 {
+        let signal = if k % 3 == 2 { "KILL" } else { "TERM" };
         let args = fit("2");
         let mut child = Command::new(env!("CARGO_BIN_EXE_irpol"))
             .args(&args)
@@ -181,16 +183,20 @@ fn an_interrupted_fit_leaves_the_old_or_the_new_library() {
             .unwrap();
         std::thread::sleep(Duration::from_millis(30 + 110 * k));
         Command::new("kill")
-            .args(["-TERM", &child.id().to_string()])
+            .args([&format!("-{signal}"), &child.id().to_string()])
             .status()
             .unwrap();
         child.wait().unwrap();
         assert!(
             one_library(&fits, &old, &new),
-            "a mixed library after SIGTERM #{k}"
+            "a mixed library after SIG{signal} #{k}"
         );
         let left = temporaries(&[&fits, &reports]);
-        assert!(left.is_empty(), "temporaries {left:?} after SIGTERM #{k}");
+        if signal == "TERM" {
+            assert!(left.is_empty(), "temporaries {left:?} after SIGTERM #{k}");
+        }
+        // The next fit also removes what a SIGKILLed one left.
         run("1");
+        assert!(temporaries(&[&fits, &reports]).is_empty());
     }
 }

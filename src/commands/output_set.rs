@@ -34,6 +34,7 @@ impl OutputSet {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
+        remove_stale_temporary(dir, &file_name);
         let temp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
         self.staged.push((temp.clone(), target.to_owned()));
         let mut file = std::fs::File::create(&temp)?;
@@ -70,6 +71,27 @@ impl OutputSet {
         }
         self.created_dirs.clear();
         Ok(())
+    }
+}
+
+/// Removes `.<file_name>.<pid>.tmp` files beside the target left by processes that no longer run
+/// (a SIGKILL during staging; SIGINT/SIGTERM clean up themselves).
+fn remove_stale_temporary(dir: &Path, file_name: &str) {
+    let prefix = format!(".{file_name}.");
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let pid = name
+            .strip_prefix(&prefix)
+            .and_then(|rest| rest.strip_suffix(".tmp"))
+            .and_then(|pid| pid.parse::<u32>().ok());
+        if let Some(pid) = pid {
+            if !Path::new("/proc").join(pid.to_string()).exists() {
+                let _ = std::fs::remove_file(entry.path());
+            }
+        }
     }
 }
 
