@@ -244,10 +244,14 @@ impl Previews {
     }
 
     /// The five panels in a 3 × 2 grid (the sixth cell holds the caption), each image at most
-    /// 480 pixels wide.
+    /// 480 pixels wide and tall.
     pub fn composite_png(&self) -> io::Result<Vec<u8>> {
         register_fonts();
-        let scale = (480.0 / self.width as f64).min(1.0);
+        // At most 480 pixels wide and tall per panel, so an extreme aspect ratio (20 × 200000)
+        // does not make a sheet of hundreds of megabytes.
+        let scale = (480.0 / self.width as f64)
+            .min(480.0 / self.height as f64)
+            .min(1.0);
         let (img_w, img_h) = (
             ((self.width as f64 * scale).round() as usize).max(1),
             ((self.height as f64 * scale).round() as usize).max(1),

@@ -236,7 +236,14 @@ pub fn write_outputs(
     jobs.push(Job::Exr);
     jobs.extend((0..previews.len()).map(Job::Panel));
     jobs.push(Job::Composite);
-    let encoded: Vec<(String, Vec<u8>)> = jobs
+    let write_error = |source| RenderError::Write {
+        path: out_dir.to_owned(),
+        source,
+    };
+    // Each file goes into the staging folder as soon as it is encoded (the folder is swapped in
+    // as a whole at the end), so no more than a file per thread is held in memory.
+    let staged = StagedFolder::begin(out_dir).map_err(write_error)?;
+    let mut files: Vec<String> = jobs
         .par_iter()
         .map(|job| {
             let (name, bytes) = match job {
@@ -253,28 +260,14 @@ pub fn write_outputs(
                 Job::Composite => ("composite.png".to_owned(), previews.composite_png()),
             };
             bytes
-                .map(|b| (name.clone(), b))
+                .and_then(|b| staged.write(&name, &b))
+                .map(|()| name.clone())
                 .map_err(|source| RenderError::Write {
                     path: out_dir.join(&name),
                     source,
                 })
         })
         .collect::<Result<_, _>>()?;
-    let write_error = |source| RenderError::Write {
-        path: out_dir.to_owned(),
-        source,
-    };
-    let staged = StagedFolder::begin(out_dir).map_err(write_error)?;
-    let mut files = Vec::with_capacity(encoded.len() + 1);
-    for (name, bytes) in encoded {
-        staged
-            .write(&name, &bytes)
-            .map_err(|source| RenderError::Write {
-                path: out_dir.join(&name),
-                source,
-            })?;
-        files.push(name);
-    }
 
     let summary_stats: Vec<ChannelSummary> = channels
         .iter()
