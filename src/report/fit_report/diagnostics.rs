@@ -79,18 +79,7 @@ pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
         .light_line_style(RGBColor(235, 235, 235))
         .bold_line_style(RGBColor(215, 215, 215))
         .draw()?;
-    chart.draw_series(LineSeries::new(
-        [(-90.0, 0.0), (90.0, 0.0)],
-        GREY.stroke_width(1),
-    ))?;
-    for level in [-3.0, 3.0] {
-        chart.draw_series(DashedLineSeries::new(
-            [(-90.0, level), (90.0, level)],
-            6,
-            5,
-            GREY.stroke_width(1),
-        ))?;
-    }
+    draw_residual_guides(&mut chart)?;
     if data.residuals.len() > MAX_RESIDUAL_POINTS {
         return draw_residual_density(area, &mut chart, data, bound, hidden);
     }
@@ -170,6 +159,25 @@ fn density_color(count: usize, most: usize) -> RGBColor {
 }
 
 /// Panel (g) for many residuals: their density over (detector zenith, residual).
+/// The zero line and the ±3σ guides of a residual panel (θ_r from −90° to 90°).
+fn draw_residual_guides<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+) -> DrawResult<DB> {
+    chart.draw_series(LineSeries::new(
+        [(-90.0, 0.0), (90.0, 0.0)],
+        GREY.stroke_width(1),
+    ))?;
+    for level in [-3.0, 3.0] {
+        chart.draw_series(DashedLineSeries::new(
+            [(-90.0, level), (90.0, level)],
+            6,
+            5,
+            GREY.stroke_width(1),
+        ))?;
+    }
+    Ok(())
+}
+
 fn draw_residual_density<DB: DrawingBackend>(
     area: &Area<DB>,
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
@@ -191,18 +199,7 @@ fn draw_residual_density<DB: DrawingBackend>(
             )
         },
     ))?;
-    chart.draw_series(LineSeries::new(
-        [(-90.0, 0.0), (90.0, 0.0)],
-        GREY.stroke_width(1),
-    ))?;
-    for level in [-3.0, 3.0] {
-        chart.draw_series(DashedLineSeries::new(
-            [(-90.0, level), (90.0, level)],
-            6,
-            5,
-            GREY.stroke_width(1),
-        ))?;
-    }
+    draw_residual_guides(chart)?;
     let mut entries = vec![
         LegendEntry::line(
             format!(
