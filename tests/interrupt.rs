@@ -37,6 +37,22 @@ fn complete_set(out: &Path, old_s0: &[u8], new_s0: &[u8]) -> bool {
     all_there && (s0 == old_s0 || s0 == new_s0)
 }
 
+/// Starts `irpol args`, sends it `signal` ("TERM" or "KILL") after `delay_ms` and waits for it.
+fn interrupt_after(args: &[&str], delay_ms: u64, signal: &str) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(delay_ms));
+    Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .unwrap();
+    child.wait().unwrap();
+}
+
 #[test]
 fn an_interrupted_render_leaves_the_old_or_the_new_set() {
     let dir = tempfile::tempdir().unwrap();
@@ -60,24 +76,14 @@ fn an_interrupted_render_leaves_the_old_or_the_new_set() {
         .iter()
         .enumerate()
     {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_irpol"))
-            .args([
-                "render",
-                new_scene.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-            ])
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::null())
-            .spawn()
-            .unwrap();
         // Spread the interrupts over loading, rendering and writing.
-        std::thread::sleep(Duration::from_millis(40 + 90 * k as u64));
-        Command::new("kill")
-            .args([&format!("-{signal}"), &child.id().to_string()])
-            .status()
-            .unwrap();
-        child.wait().unwrap();
+        let args = [
+            "render",
+            new_scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        interrupt_after(&args, 40 + 90 * k as u64, signal);
         assert!(
             complete_set(&out, &old_s0, &new_s0),
             "after SIG{signal} #{k}"
@@ -175,18 +181,8 @@ fn an_interrupted_fit_leaves_the_old_or_the_new_library() {
     for k in 0..8u64 {
         let signal = if k % 3 == 2 { "KILL" } else { "TERM" };
         let args = fit("2");
-        let mut child = Command::new(env!("CARGO_BIN_EXE_irpol"))
-            .args(&args)
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::null())
-            .spawn()
-            .unwrap();
-        std::thread::sleep(Duration::from_millis(30 + 110 * k));
-        Command::new("kill")
-            .args([&format!("-{signal}"), &child.id().to_string()])
-            .status()
-            .unwrap();
-        child.wait().unwrap();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        interrupt_after(&args, 30 + 110 * k, signal);
         assert!(
             one_library(&fits, &old, &new),
             "a mixed library after SIG{signal} #{k}"

@@ -354,6 +354,21 @@ struct Rows {
     dp: Vec<f64>,
 }
 
+impl Rows {
+    /// Rows of a system of `n` unknowns, all zero.
+    fn zeros(n: usize) -> Rows {
+        let z = vec![0.0; n];
+        Rows {
+            a: z.clone(),
+            b: z.clone(),
+            c: z.clone(),
+            d: z.clone(),
+            bp: z.clone(),
+            dp: z,
+        }
+    }
+}
+
 /// Integrates one vertex's stack; holds the grid and scratch space, not the temperatures, so one
 /// solver serves every vertex that shares a stack.
 #[derive(Debug, Clone)]
@@ -373,14 +388,7 @@ impl Solver {
         let n = grid.len();
         let z = vec![0.0; n];
         Ok(Self {
-            rows: Rows {
-                a: z.clone(),
-                b: z.clone(),
-                c: z.clone(),
-                d: z.clone(),
-                bp: z.clone(),
-                dp: z.clone(),
-            },
+            rows: Rows::zeros(n),
             full: z.clone(),
             mid: z.clone(),
             half: z,
@@ -666,15 +674,7 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let z = vec![0.0; n];
-        let mut r = Rows {
-            a: z.clone(),
-            b: z.clone(),
-            c: z.clone(),
-            d: z.clone(),
-            bp: z.clone(),
-            dp: z.clone(),
-        };
+        let mut r = Rows::zeros(n);
         for i in 0..n {
             r.a[i] = if i > 0 { -rnd() } else { 0.0 };
             r.c[i] = if i + 1 < n { -rnd() } else { 0.0 };

@@ -112,14 +112,13 @@ pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
         })
         .collect();
     entries.push(LegendEntry::line("±3σ", GREY, LineKind::Dashed));
-    if hidden > 0 {
-        entries.push(LegendEntry::line(
-            format!("{hidden} beyond ±{bound:.0}σ not shown"),
-            WHITE,
-            LineKind::Solid,
-        ));
-    }
-    draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 8)
+    residual_legend(
+        area,
+        chart.plotting_area().get_pixel_range(),
+        entries,
+        hidden,
+        bound,
+    )
 }
 
 /// Most residuals panel (g) draws one by one; beyond it, it draws their density as a 2-D
@@ -159,6 +158,24 @@ fn density_color(count: usize, most: usize) -> RGBColor {
 }
 
 /// Panel (g) for many residuals: their density over (detector zenith, residual).
+/// A residual panel's legend: `entries`, then a note of the points beyond ±`bound` σ, if any.
+fn residual_legend<DB: DrawingBackend>(
+    area: &Area<DB>,
+    plot: (std::ops::Range<i32>, std::ops::Range<i32>),
+    mut entries: Vec<LegendEntry>,
+    hidden: usize,
+    bound: f64,
+) -> DrawResult<DB> {
+    if hidden > 0 {
+        entries.push(LegendEntry::line(
+            format!("{hidden} beyond ±{bound:.0}σ not shown"),
+            WHITE,
+            LineKind::Solid,
+        ));
+    }
+    draw_legend_top_right(area, plot, &entries, 8)
+}
+
 /// The zero line and the ±3σ guides of a residual panel (θ_r from −90° to 90°).
 fn draw_residual_guides<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
@@ -200,7 +217,7 @@ fn draw_residual_density<DB: DrawingBackend>(
         },
     ))?;
     draw_residual_guides(chart)?;
-    let mut entries = vec![
+    let entries = vec![
         LegendEntry::line(
             format!(
                 "{} residuals, all elements: count per {DENSITY_X_DEG}° × {DENSITY_Y_SIGMA}σ cell",
@@ -216,14 +233,13 @@ fn draw_residual_density<DB: DrawingBackend>(
         ),
         LegendEntry::line("±3σ", GREY, LineKind::Dashed),
     ];
-    if hidden > 0 {
-        entries.push(LegendEntry::line(
-            format!("{hidden} beyond ±{bound:.0}σ not shown"),
-            WHITE,
-            LineKind::Solid,
-        ));
-    }
-    draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 8)
+    residual_legend(
+        area,
+        chart.plotting_area().get_pixel_range(),
+        entries,
+        hidden,
+        bound,
+    )
 }
 
 /// Bins of the residual histogram: 0.25σ wide over ±5σ.
