@@ -5,6 +5,12 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
+/// Whether process `pid` still runs (Linux /proc): temporaries of one that does not were left by a
+/// SIGKILL and may be removed.
+pub fn process_is_alive(pid: u32) -> bool {
+    std::path::Path::new("/proc").join(pid.to_string()).exists()
+}
+
 /// Writes of output sets in progress (staging a file or renaming a set into place), and whether
 /// the process was told to stop. An interrupt handler sets [`INTERRUPTED`] and waits for
 /// [`WRITES_IN_PROGRESS`] to reach 0 before it removes the temporaries and exits: no new write

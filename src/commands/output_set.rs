@@ -4,7 +4,7 @@
 //! renames leaves every target as it was, and the temporaries and any folders made for them are
 //! removed.
 
-use crate::interrupt::WriteGuard;
+use crate::interrupt::{process_is_alive, WriteGuard};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -88,7 +88,7 @@ fn remove_stale_temporary(dir: &Path, file_name: &str) {
             .and_then(|rest| rest.strip_suffix(".tmp"))
             .and_then(|pid| pid.parse::<u32>().ok());
         if let Some(pid) = pid {
-            if !Path::new("/proc").join(pid.to_string()).exists() {
+            if !process_is_alive(pid) {
                 let _ = std::fs::remove_file(entry.path());
             }
         }

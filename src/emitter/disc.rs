@@ -10,7 +10,7 @@
 //! exact where the disc is wholly visible or hidden, so a lit or shadowed point has no noise and
 //! only penumbrae are estimated.
 
-use super::sun::SUN_HALF_ANGLE_DEG;
+use super::sun::{SunPosition, SUN_HALF_ANGLE_DEG};
 use crate::optics::frame::any_perpendicular;
 use crate::pbrdf::Pbrdf;
 use gauss_quad::legendre::GaussLegendre;
@@ -37,6 +37,16 @@ pub struct DiscQuadrature {
 }
 
 impl Sun {
+    /// Elevation and azimuth (clockwise from north) of the disc centre: the inverse of
+    /// [`super::sun_direction`].
+    pub fn position(&self) -> SunPosition {
+        let d = self.direction;
+        SunPosition {
+            elevation_deg: d.z.clamp(-1.0, 1.0).asin().to_degrees(),
+            azimuth_deg: d.x.atan2(d.y).to_degrees().rem_euclid(360.0),
+        }
+    }
+
     /// The disc point of area fraction (u, v) ∈ [0, 1)²: radius r√u, angle 2πv.
     pub fn disc_point(&self, u: f64, v: f64) -> Vector3<f64> {
         let (e1, e2) = self.tangents();

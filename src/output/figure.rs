@@ -144,11 +144,10 @@ impl Previews {
                 settings.bounces, settings.samples
             );
             if let Some(sun) = scene.sun {
-                let d = sun.direction;
+                let p = sun.position();
                 caption += &format!(
                     ", sun at {:.0}° elevation, {:.0}° azimuth",
-                    d.z.asin().to_degrees(),
-                    d.x.atan2(d.y).to_degrees().rem_euclid(360.0)
+                    p.elevation_deg, p.azimuth_deg
                 );
             }
         }

@@ -386,10 +386,10 @@ fn stokes_index(channel: Channel) -> Option<usize> {
 
 fn transport_summary(scene: &Scene) -> TransportSummary {
     let sun = scene.sun.map(|sun| {
-        let d = sun.direction;
+        let p = sun.position();
         SunSummary {
-            elevation_deg: d.z.clamp(-1.0, 1.0).asin().to_degrees(),
-            azimuth_deg: d.x.atan2(d.y).to_degrees().rem_euclid(360.0),
+            elevation_deg: p.elevation_deg,
+            azimuth_deg: p.azimuth_deg,
             irradiance_w_m2: sun.irradiance,
         }
     });

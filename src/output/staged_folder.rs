@@ -9,7 +9,7 @@
 //! SIGINT/SIGTERM handler ([`staging_folder`] names it), and, after a SIGKILL, by the next run
 //! into the same target.
 
-use crate::interrupt::WriteGuard;
+use crate::interrupt::{process_is_alive, WriteGuard};
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -134,8 +134,7 @@ fn remove_stale_staging(target: &Path) {
         else {
             continue;
         };
-        let alive = Path::new("/proc").join(pid.to_string()).exists();
-        if !alive || pid == std::process::id() {
+        if !process_is_alive(pid) || pid == std::process::id() {
             let _ = fs::remove_dir_all(entry.path());
         }
     }

@@ -178,7 +178,6 @@ fn vertex_stokes(scene: &Scene, open_world: &OpenWorld) -> Vec<[f64; 4]> {
                 vertex_material[v],
                 &mesh.positions[v],
                 &mesh.normals[v],
-                false,
                 mesh.temperatures[v],
             )
         })
@@ -237,17 +236,12 @@ impl PixelShader<'_> {
                 [0, 1, 2, 3].map(|j| a[j] * b0 + b[j] * b1 + c[j] * b2)
             }
             Shading::Pixel => {
-                // The back of a face is seen when its winding and its interpolated normal both
-                // face away (a silhouette of a closed mesh has only the latter; a mesh whose
-                // winding disagrees with its normals only the former).
-                let back =
-                    hit.geometric_normal.dot(to_camera) < 0.0 && hit.normal.dot(to_camera) < 0.0;
+                let vertex = Vertex::seen_from(*hit, to_camera);
                 self.open_world.toward_camera(
                     &scene.camera,
                     scene.triangle_material(t),
                     &hit.point,
-                    &hit.normal,
-                    back,
+                    &vertex.normal,
                     hit.temperature,
                 )
             }

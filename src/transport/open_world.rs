@@ -35,19 +35,17 @@ impl OpenWorld<'_> {
     }
 
     /// The open-world Stokes vector seen by `camera` at `point` (pixel frame, DESIGN §1.6), with
-    /// unit shading normal `normal`; `back` shades the other side (the face is seen from behind).
+    /// unit shading normal `normal` on the side seen (`path::Vertex::seen_from` turns it).
     pub fn toward_camera(
         &self,
         camera: &Camera,
         material: usize,
         point: &Vector3<f64>,
         normal: &Vector3<f64>,
-        back: bool,
         temperature: f64,
     ) -> [f64; 4] {
         let w_r = (camera.position - point).normalize();
-        let n = if back { -normal } else { *normal };
-        let frame = OutgoingFrame::new(&n, &w_r);
+        let frame = OutgoingFrame::new(normal, &w_r);
         let local = self.leaving(material, &frame, temperature);
         let pixel = stokes_to_camera_frame(&local, &frame.s_axis, &w_r, &camera.right);
         [pixel[0], pixel[1], pixel[2], pixel[3]]

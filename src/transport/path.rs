@@ -48,9 +48,10 @@ pub struct Vertex {
 }
 
 impl Vertex {
-    /// The side of `hit` seen from direction `toward_viewer` (unit, from the point to the
-    /// viewer). The back is shaded when the winding and the interpolated normal both face away
-    /// (the camera's rule; a silhouette of a closed mesh has only the latter).
+    /// The side of `hit` seen from direction `toward_viewer` (from the point to the viewer, any
+    /// length). The back is shaded when the winding and the interpolated normal both face away:
+    /// a silhouette of a closed mesh has only the latter (its normal is read at grazing), a mesh
+    /// whose winding disagrees with its normals only the former.
     pub fn seen_from(hit: SurfaceHit, toward_viewer: &Vector3<f64>) -> Vertex {
         let geometric_front = hit.geometric_normal.dot(toward_viewer) >= 0.0;
         let back = !geometric_front && hit.normal.dot(toward_viewer) < 0.0;
