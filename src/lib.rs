@@ -20,4 +20,5 @@ pub mod report;
 pub mod scene;
 pub mod text;
 pub mod thermal;
+pub mod thermal_scene;
 pub mod transport;

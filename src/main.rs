@@ -9,9 +9,10 @@ use irpol::commands::evaluate::{
     read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
 };
 use irpol::commands::fit::fit_and_write;
-use irpol::commands::render::{default_output_dir, render_scene};
+use irpol::commands::render::{default_output_dir, render_scene, render_scene_at, Instants};
 use irpol::commands::scene_init::write_starter_scene;
 use irpol::commands::sun::{read_times_file, write_sun_csv};
+use irpol::commands::thermal::run_thermal;
 use irpol::commands::{parse_sweep, ModelArgs};
 use irpol::emitter::parse_time_utc;
 use irpol::fit::{
@@ -120,6 +121,26 @@ enum Command {
         /// The scene TOML.
         scene: PathBuf,
         /// Output folder (default out/<scene stem>/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// A scene with [thermal]: render its thermal solution at this many seconds from
+        /// thermal.start_utc.
+        #[arg(long, conflicts_with_all = ["time_utc", "times"])]
+        time: Option<f64>,
+        /// A scene with [thermal]: render it at this RFC 3339 instant.
+        #[arg(long, conflicts_with = "times")]
+        time_utc: Option<String>,
+        /// A scene with [thermal]: render START:STOP:STEP (seconds) into numbered folders, plus
+        /// preview.gif animating S0 and DoLP.
+        #[arg(long)]
+        times: Option<String>,
+    },
+    /// Temperatures from a scene's [thermal] model: temperatures.csv (min/mean/max per part),
+    /// a PLY per recorded step, temperatures.png and summary.json (docs/scenes.md, "Thermal").
+    Thermal {
+        /// The scene TOML (with a [thermal] section).
+        scene: PathBuf,
+        /// Output folder (default out/<scene stem>_thermal/).
         #[arg(long)]
         out: Option<PathBuf>,
     },
@@ -335,7 +356,25 @@ fn run(command: Command) -> anyhow::Result<()> {
                 write_library_index(library, &reports)?.display()
             );
         }
-        Command::Render { scene, out } => render_and_summarize(&scene, out)?,
+        Command::Render {
+            scene,
+            out,
+            time,
+            time_utc,
+            times,
+        } => {
+            let instants = match (time, time_utc, times) {
+                (Some(t), _, _) => Some(Instants::Seconds(vec![t])),
+                (_, Some(text), _) => Some(Instants::Utc(text)),
+                (_, _, Some(sweep)) => Some(Instants::Seconds(parse_sweep(&sweep, "times")?)),
+                _ => None,
+            };
+            match instants {
+                Some(instants) => render_instants(&scene, out, &instants)?,
+                None => render_and_summarize(&scene, out)?,
+            }
+        }
+        Command::Thermal { scene, out } => thermal_and_summarize(&scene, out)?,
         Command::Scene {
             command: SceneCommand::Init { out },
         } => {
@@ -472,6 +511,50 @@ fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()
     for file in &summary.files {
         say!("  {file}");
     }
+    Ok(())
+}
+
+fn render_instants(scene: &Path, out: Option<PathBuf>, instants: &Instants) -> anyhow::Result<()> {
+    let out = out.unwrap_or_else(|| default_output_dir(scene));
+    let renders = render_scene_at(scene, &out, instants, &TerminalProgress::new())?;
+    for r in &renders {
+        say!(
+            "rendered {} at t = {} s ({}×{}) → {}",
+            scene.display(),
+            r.time_s,
+            r.summary.width,
+            r.summary.height,
+            r.folder.display()
+        );
+    }
+    if renders.len() > 1 {
+        say!("  {}", out.join("preview.gif").display());
+    }
+    Ok(())
+}
+
+fn thermal_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {
+    let out = out.unwrap_or_else(|| {
+        let mut dir = default_output_dir(scene).into_os_string();
+        dir.push("_thermal");
+        PathBuf::from(dir)
+    });
+    cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
+    let summary = run_thermal(scene, &out, &TerminalProgress::new())?;
+    say!(
+        "thermal run of {} ({} h from {}, {} vertices, {} distinct solves) in {:.2} s → {}",
+        scene.display(),
+        summary.duration_s / 3600.0,
+        summary.start_utc,
+        summary.stats.thermal_vertices,
+        summary.stats.distinct_solves,
+        summary.seconds,
+        out.display()
+    );
+    say!(
+        "  temperatures.csv, temperatures.png, summary.json and {} surface PLYs",
+        summary.recorded_instants
+    );
     Ok(())
 }
 

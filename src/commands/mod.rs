@@ -7,6 +7,7 @@ pub mod output_set;
 pub mod render;
 pub mod scene_init;
 pub mod sun;
+pub mod thermal;
 
 use crate::material::Material;
 use crate::optics::RefractiveIndex;

@@ -1,9 +1,15 @@
-//! `irpol render`: scene file in, output files out.
+//! `irpol render`: scene file in, output files out; for a scene with `[thermal]`, at instants of
+//! its thermal run (DESIGN §2.6).
 
+use crate::material::write_atomically;
 use crate::output::{write_outputs, RenderSummary};
 use crate::progress::Progress;
 use crate::render::{render, RenderError};
-use crate::scene::load_scene;
+use crate::scene::{load_scene, Scene, SceneError};
+use crate::thermal_scene::{scene_at, solve_scene};
+use anyhow::Context;
+use image::codecs::gif::{GifEncoder, Repeat};
+use image::{Delay, Frame, RgbaImage};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -16,7 +22,8 @@ pub fn default_output_dir(scene_path: &Path) -> PathBuf {
 }
 
 /// Loads the scene, renders it and writes every output into `out_dir`. A bad scene (or a
-/// failed render) writes nothing.
+/// failed render) writes nothing. A scene with `[thermal]` needs an instant
+/// ([`render_scene_at`]).
 pub fn render_scene(
     scene_path: &Path,
     out_dir: &Path,
@@ -24,8 +31,132 @@ pub fn render_scene(
 ) -> Result<RenderSummary, RenderError> {
     let start = Instant::now();
     let scene = load_scene(scene_path)?;
+    if scene.thermal.is_some() {
+        return Err(SceneError::new(
+            scene_path,
+            "has a [thermal] section: say when to render it with --time SECONDS, \
+             --time-utc INSTANT or --times START:STOP:STEP (seconds from thermal.start_utc)",
+        )
+        .into());
+    }
+    render_loaded(&scene, out_dir, progress, start)
+}
+
+fn render_loaded(
+    scene: &Scene,
+    out_dir: &Path,
+    progress: &dyn Progress,
+    start: Instant,
+) -> Result<RenderSummary, RenderError> {
     let load = start.elapsed().as_secs_f64();
-    let mut rendered = render(&scene, progress)?;
+    let mut rendered = render(scene, progress)?;
     rendered.timings.load = load;
-    write_outputs(&scene, &rendered, out_dir, start)
+    write_outputs(scene, &rendered, out_dir, start)
+}
+
+/// When to render a thermal scene.
+#[derive(Clone, Debug)]
+pub enum Instants {
+    /// Seconds from `thermal.start_utc`; one instant renders into the output folder itself,
+    /// several into numbered folders inside it plus an animated preview.
+    Seconds(Vec<f64>),
+    /// One RFC 3339 instant.
+    Utc(String),
+}
+
+/// One rendered instant.
+pub struct TimedRender {
+    pub time_s: f64,
+    pub folder: PathBuf,
+    pub summary: RenderSummary,
+}
+
+/// Runs the scene's thermal model through the last instant asked for, then renders the scene at
+/// each instant. With several instants, `preview.gif` in `out_dir` animates S0 beside DoLP.
+pub fn render_scene_at(
+    scene_path: &Path,
+    out_dir: &Path,
+    instants: &Instants,
+    progress: &dyn Progress,
+) -> anyhow::Result<Vec<TimedRender>> {
+    let start = Instant::now();
+    let scene = load_scene(scene_path)?;
+    let setup = scene.thermal.as_deref().ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: --time/--times need temperatures from the thermal model, but the scene has no \
+             [thermal] section",
+            scene_path.display()
+        )
+    })?;
+    let times = match instants {
+        Instants::Seconds(times) => times.clone(),
+        Instants::Utc(text) => {
+            let at = crate::emitter::parse_time_utc(text).context("--time-utc")?;
+            let seconds = (at - setup.site.start_utc).num_milliseconds() as f64 / 1000.0;
+            vec![seconds]
+        }
+    };
+    let solution = solve_scene(&scene, &times, progress)
+        .with_context(|| format!("{}: thermal run", scene_path.display()))?;
+    let series = times.len() > 1;
+    let mut renders = Vec::with_capacity(times.len());
+    for (i, &time_s) in times.iter().enumerate() {
+        let index = solution
+            .times_s
+            .iter()
+            .position(|&t| (t - time_s).abs() < 1e-6)
+            .expect("every asked instant is recorded");
+        let at = scene_at(&scene, &solution, index).map_err(|e| SceneError::new(scene_path, e))?;
+        let folder = if series {
+            out_dir.join(format!("{i:03}_{}s", time_s.round()))
+        } else {
+            out_dir.to_owned()
+        };
+        let summary = render_loaded(&at, &folder, progress, start)?;
+        renders.push(TimedRender {
+            time_s,
+            folder,
+            summary,
+        });
+    }
+    if series {
+        let gif = animated_preview(&renders)?;
+        write_atomically(&out_dir.join("preview.gif"), &gif)
+            .with_context(|| format!("{}: cannot write", out_dir.display()))?;
+    }
+    Ok(renders)
+}
+
+/// One second per frame: S0.png beside DoLP.png of each rendered instant.
+fn animated_preview(renders: &[TimedRender]) -> anyhow::Result<Vec<u8>> {
+    let mut frames = Vec::with_capacity(renders.len());
+    for r in renders {
+        let panel = |name: &str| -> anyhow::Result<RgbaImage> {
+            let path = r.folder.join(name);
+            Ok(image::open(&path)
+                .with_context(|| format!("{}: cannot read", path.display()))?
+                .to_rgba8())
+        };
+        let (s0, dolp) = (panel("S0.png")?, panel("DoLP.png")?);
+        let mut frame = RgbaImage::from_pixel(
+            s0.width() + dolp.width(),
+            s0.height().max(dolp.height()),
+            image::Rgba([255, 255, 255, 255]),
+        );
+        image::imageops::overlay(&mut frame, &s0, 0, 0);
+        image::imageops::overlay(&mut frame, &dolp, i64::from(s0.width()), 0);
+        frames.push(Frame::from_parts(
+            frame,
+            0,
+            0,
+            Delay::from_numer_denom_ms(1000, 1),
+        ));
+    }
+    let mut bytes = Vec::new();
+    {
+        let mut encoder = GifEncoder::new_with_speed(&mut bytes, 10);
+        encoder.set_repeat(Repeat::Infinite)?;
+        encoder.encode_frames(frames)?;
+    }
+    Ok(bytes)
 }

@@ -125,10 +125,13 @@ impl Previews {
             })
             .collect();
 
-        let stem = scene
+        let mut stem = scene
             .path
             .file_stem()
             .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+        if let Some(instant) = &scene.thermal_instant {
+            stem += &format!(" at {}", instant.time_utc);
+        }
         let (lo_um, hi_um) = band.limits_um();
         let shading = match scene.shading {
             Shading::Pixel => "per-pixel",

@@ -7,6 +7,8 @@
 pub mod colormap;
 pub mod figure;
 pub mod staged_folder;
+pub mod thermal;
+pub mod thermal_plot;
 
 use crate::render::film::{dolp_aop, polarizer, StokesImage, BACKGROUND};
 use crate::render::{RenderError, Rendered, Timings};
@@ -202,6 +204,9 @@ pub struct RenderSummary {
     /// Brightness temperature of S0 over object pixels (K).
     pub apparent_temperature_k: Option<Stats>,
     pub transport: TransportSummary,
+    /// The instant of the thermal run shown (`render --time`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thermal_instant: Option<crate::scene::ThermalInstant>,
     pub materials: Vec<MaterialSummary>,
     pub timings_s: Timings,
     pub files: Vec<String>,
@@ -325,6 +330,7 @@ pub fn write_outputs(
         channels: summary_stats,
         apparent_temperature_k: apparent,
         transport: transport_summary(scene),
+        thermal_instant: scene.thermal_instant.clone(),
         materials: scene
             .materials
             .iter()

@@ -16,6 +16,6 @@ mod shadowing;
 pub use crate::optics::Direction;
 pub use distribution::SlopeDistribution;
 pub use error::ModelError;
-pub use hemisphere::HemisphereQuadrature;
+pub use hemisphere::{cosine_hemisphere_rule, HemisphereQuadrature};
 pub use model::{Pbrdf, ScatteringGeometry};
 pub use shadowing::Shadowing;

@@ -11,6 +11,7 @@ pub mod sensor;
 use crate::pbrdf::ModelError;
 use crate::progress::Progress;
 use crate::scene::config::Shading;
+use crate::scene::mesh::bounding_diagonal;
 use crate::scene::mesh::SurfaceHit;
 use crate::scene::{Scene, SceneError, Transport};
 use crate::transport::accel::Accelerator;
@@ -87,7 +88,7 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
     let tick = || progress.advance(1);
     let raster_start = Instant::now();
     // Near plane: far below any scene detail, far above f64 depth resolution.
-    let near = (1e-5 * mesh_extent(&mesh.positions)).max(1e-9);
+    let near = (1e-5 * bounding_diagonal(&mesh.positions)).max(1e-9);
     let fragments = rasterize(&scene.camera, &mesh.positions, &mesh.triangles, near, &tick);
     timings.raster = raster_start.elapsed().as_secs_f64();
 
@@ -100,7 +101,7 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
     let tracer = match scene.transport {
         Transport::OpenWorld => None,
         Transport::Path(settings) => {
-            accel = Accelerator::new(mesh, mesh_extent(&mesh.positions))
+            accel = Accelerator::new(mesh, bounding_diagonal(&mesh.positions))
                 .map_err(|e| RenderError::Scene(SceneError::new(&scene.path, e)))?;
             Some(PathTracer::new(scene, &open_world, &accel, settings))
         }
@@ -142,22 +143,6 @@ fn material_tables(
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok((tables, resolutions))
-}
-
-/// Diagonal of the bounding box of the vertices.
-fn mesh_extent(positions: &[nalgebra::Vector3<f64>]) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (0..3)
-        .map(|k| (hi[k] - lo[k]).max(0.0).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 /// Gouraud shading: Stokes vectors at the vertices, in the pixel frame of each vertex's own ray.

@@ -248,7 +248,8 @@ fn checked_face_normals(
         .collect()
 }
 
-fn bounding_diagonal(positions: &[Vector3<f64>]) -> f64 {
+/// Diagonal of the bounding box of `positions` (m); 0 for none.
+pub fn bounding_diagonal(positions: &[Vector3<f64>]) -> f64 {
     let mut lo = Vector3::repeat(f64::INFINITY);
     let mut hi = Vector3::repeat(f64::NEG_INFINITY);
     for p in positions {

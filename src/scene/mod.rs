@@ -13,6 +13,7 @@ pub mod mesh;
 pub mod obj;
 pub mod ply;
 pub mod procedural;
+pub mod thermal;
 
 use crate::emitter::{
     default_band_irradiance, parse_time_utc, sun_direction, sun_position, validate_irradiance,
@@ -140,6 +141,19 @@ pub struct Scene {
     pub object_names: Vec<String>,
     pub surfaces: Vec<Surface>,
     pub mesh: ShadedMesh,
+    /// `[thermal]`: temperatures from the model of §1.8 (solved by `thermal_scene`).
+    pub thermal: Option<std::sync::Arc<thermal::ThermalSetup>>,
+    /// Set when the scene is a thermal scene at an instant of its run (`thermal_scene::scene_at`).
+    pub thermal_instant: Option<ThermalInstant>,
+}
+
+/// The instant of a thermal run a scene shows.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ThermalInstant {
+    /// Seconds from `thermal.start_utc`.
+    pub time_s: f64,
+    /// The same instant as RFC 3339.
+    pub time_utc: String,
 }
 
 impl Scene {
@@ -241,8 +255,20 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         return Err(fail("the scene has no [[objects]]".into()));
     }
     let transport = transport_settings(&config.render).map_err(&fail)?;
-    let sun = match &config.sun {
-        Some(sun) => resolve_sun(sun, &band).map_err(&fail)?,
+    let thermal_run = match &config.thermal {
+        Some(t) => {
+            let instants = thermal_instants(&config, &band).map_err(&fail)?;
+            let ground_k = config.environment.ground.temperature_k;
+            Some(thermal::resolve_run(t, dir, ground_k, instants).map_err(&fail)?)
+        }
+        None => None,
+    };
+    let sun = match (&config.sun, &thermal_run) {
+        (Some(sun), None) => resolve_sun(sun, &band).map_err(&fail)?,
+        _ => None,
+    };
+    let start_air_k = match &thermal_run {
+        Some(run) => Some(run.weather.at(0.0).map_err(|e| fail(e.to_string()))?.air_k),
         None => None,
     };
 
@@ -275,10 +301,26 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
             object_names.len(),
             &mut materials,
             &mut surfaces,
+            start_air_k,
         )?;
         object_names.push(name);
         mesh.append(object_mesh);
     }
+    let thermal = match (thermal_run, &config.thermal) {
+        (Some(mut run), Some(thermal_config)) => {
+            let pbrdfs: Vec<&Pbrdf> = materials.resolved.iter().map(|m| &m.pbrdf).collect();
+            run.surfaces = thermal::resolve_surfaces(
+                &config,
+                thermal_config,
+                &surfaces,
+                &object_names,
+                &pbrdfs,
+            )
+            .map_err(&fail)?;
+            Some(std::sync::Arc::new(run))
+        }
+        _ => None,
+    };
 
     Ok(Scene {
         path: path.to_owned(),
@@ -300,6 +342,43 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         object_names,
         surfaces,
         mesh,
+        thermal,
+        thermal_instant: None,
+    })
+}
+
+/// What a thermal scene needs to be rendered at an instant of its run: the sky at that instant's
+/// air temperature, and the sun's band irradiance (its direction comes from the weather). With
+/// `[thermal]`, `[sun]` may only give the irradiance or transmittance.
+fn thermal_instants(config: &SceneConfig, band: &Band) -> Result<thermal::InstantSettings, String> {
+    let sun = config.sun.as_ref();
+    if let Some(s) = sun {
+        if s.elevation_deg.is_some()
+            || s.azimuth_deg.is_some()
+            || s.latitude_deg.is_some()
+            || s.longitude_deg.is_some()
+            || s.time_utc.is_some()
+        {
+            return Err(
+                "with [thermal] the sun moves with the run (thermal.start_utc, \
+                        latitude_deg, longitude_deg): remove the position keys from [sun] \
+                        (irradiance_w_m2 and transmittance may stay)"
+                    .into(),
+            );
+        }
+    }
+    let irradiance = match sun {
+        Some(s) => sun_band_irradiance(s, band)?,
+        None => default_band_irradiance(band, DEFAULT_SUN_TRANSMITTANCE),
+    };
+    Ok(thermal::InstantSettings {
+        environment: config.environment.clone(),
+        atmosphere_temperature_given: config
+            .atmosphere
+            .as_ref()
+            .is_some_and(|a| a.temperature_k.is_some()),
+        netd_reference_given: config.sensor.netd_reference_k.is_some(),
+        sun_irradiance_w_m2: irradiance,
     })
 }
 
@@ -352,15 +431,7 @@ fn resolve_sun(config: &config::SunConfig, band: &Band) -> Result<Option<Sun>, S
         }
     };
     validate_sun_angles(elevation, azimuth).map_err(|e| key("elevation_deg/azimuth_deg", e))?;
-    let transmittance = config.transmittance.unwrap_or(DEFAULT_SUN_TRANSMITTANCE);
-    validate_transmittance(transmittance).map_err(|e| key("transmittance", e))?;
-    let irradiance = match config.irradiance_w_m2 {
-        Some(e) => {
-            validate_irradiance(e).map_err(|err| key("irradiance_w_m2", err))?;
-            e
-        }
-        None => default_band_irradiance(band, transmittance),
-    };
+    let irradiance = sun_band_irradiance(config, band)?;
     if elevation <= 0.0 {
         return Ok(None);
     }
@@ -368,6 +439,20 @@ fn resolve_sun(config: &config::SunConfig, band: &Band) -> Result<Option<Sun>, S
         direction: sun_direction(elevation, azimuth),
         irradiance,
     }))
+}
+
+/// The sun's band irradiance on a surface facing it: given, or τ Ω L_bb(5772 K) over the band.
+fn sun_band_irradiance(config: &config::SunConfig, band: &Band) -> Result<f64, String> {
+    let key = |key: &str, e: crate::emitter::SunError| format!("sun.{key}: {e}");
+    let transmittance = config.transmittance.unwrap_or(DEFAULT_SUN_TRANSMITTANCE);
+    validate_transmittance(transmittance).map_err(|e| key("transmittance", e))?;
+    match config.irradiance_w_m2 {
+        Some(e) => {
+            validate_irradiance(e).map_err(|err| key("irradiance_w_m2", err))?;
+            Ok(e)
+        }
+        None => Ok(default_band_irradiance(band, transmittance)),
+    }
 }
 
 /// Atmospheric transmittance of the default solar irradiance (a clear LWIR window).
@@ -381,6 +466,7 @@ fn build_object(
     object_index: usize,
     materials: &mut MaterialResolver,
     surfaces: &mut Vec<Surface>,
+    thermal_start_air_k: Option<f64>,
 ) -> Result<ShadedMesh, SceneError> {
     let scene = materials.scene;
     let fail = |message: String| SceneError::new(scene, format!("{label}: {message}"));
@@ -427,9 +513,12 @@ fn build_object(
             continue;
         }
         let settings = object.parts.get(part);
+        // A part whose temperatures come from the thermal model starts at the first air
+        // temperature unless one is given (§1.8 initial state).
         let temperature = settings
             .and_then(|p| p.temperature_k)
-            .or(object.temperature_k);
+            .or(object.temperature_k)
+            .or(thermal_start_air_k.filter(|_| thermal::part_thermal(object, part).is_some()));
         if let Some(t) = temperature {
             check_temperature(t, &format!("part '{part}': "))?;
             if has_vertex_temperatures {

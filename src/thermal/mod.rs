@@ -13,3 +13,5 @@ pub use layers::{Grid, Layer, LayerMaterial, LayerStack, Resolution, ThermalErro
 pub use solver::{
     Back, Forcing, FrontForcing, Solver, SolverControl, StepReport, ThermalState, STEFAN_BOLTZMANN,
 };
+pub mod weather;
+pub use weather::{ClearDay, Site, Weather, WeatherError, WeatherSample};

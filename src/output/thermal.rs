@@ -1,0 +1,197 @@
+//! Outputs of `irpol thermal` (DESIGN §2.6): the per-part temperature table, per-vertex PLY meshes
+//! at each recorded instant, the temperature plot and a JSON summary, swapped into the output
+//! folder as one set (see `staged_folder`).
+
+use super::staged_folder::StagedFolder;
+use super::thermal_plot::temperature_plot_png;
+use crate::scene::Scene;
+use crate::thermal_scene::{vertex_surfaces, SolveStats, ThermalSolution};
+use ply_rs_bw::ply::{
+    Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType,
+    ScalarType,
+};
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::io;
+use std::path::Path;
+
+/// Min, mean and max over one part's vertices at every recorded instant.
+pub struct PartSeries {
+    /// `object/part`.
+    pub name: String,
+    /// (min, mean, max) per recorded instant (K).
+    pub surface_k: Vec<[f64; 3]>,
+}
+
+/// Every part's series, in scene order.
+pub fn part_series(scene: &Scene, solution: &ThermalSolution) -> Vec<PartSeries> {
+    let vertex_surface = vertex_surfaces(scene);
+    scene
+        .surfaces
+        .iter()
+        .enumerate()
+        .map(|(s, surface)| {
+            let vertices: Vec<usize> = (0..vertex_surface.len())
+                .filter(|&v| vertex_surface[v] as usize == s)
+                .collect();
+            let surface_k = solution
+                .surface_k
+                .iter()
+                .map(|row| {
+                    let values = vertices.iter().map(|&v| row[v]);
+                    let min = values.clone().fold(f64::INFINITY, f64::min);
+                    let max = values.clone().fold(f64::NEG_INFINITY, f64::max);
+                    let mean = values.sum::<f64>() / vertices.len().max(1) as f64;
+                    [min, mean, max]
+                })
+                .collect();
+            PartSeries {
+                name: format!("{}/{}", scene.object_names[surface.object], surface.part),
+                surface_k,
+            }
+        })
+        .collect()
+}
+
+/// `temperatures.csv`: `time_s,part,t_surface_min_k,t_surface_mean_k,t_surface_max_k`.
+pub fn temperatures_csv(times_s: &[f64], parts: &[PartSeries]) -> String {
+    let mut csv = String::from("time_s,part,t_surface_min_k,t_surface_mean_k,t_surface_max_k\n");
+    for (i, t) in times_s.iter().enumerate() {
+        for part in parts {
+            let [lo, mean, hi] = part.surface_k[i];
+            let _ = writeln!(csv, "{t},{},{lo:.4},{mean:.4},{hi:.4}", part.name);
+        }
+    }
+    csv
+}
+
+/// The name of the PLY of recorded instant `index` at `time_s`.
+pub fn surface_ply_name(index: usize, time_s: f64) -> String {
+    format!("surface_{index:04}_{}s.ply", time_s.round())
+}
+
+/// The scene's shading mesh with `temperature` per vertex (binary little-endian PLY; the same
+/// `temperature` property irpol reads, so a step can be rendered or viewed directly).
+pub fn surface_ply(scene: &Scene, temperatures_k: &[f64], time_s: f64) -> io::Result<Vec<u8>> {
+    let mut ply = Ply::<DefaultElement>::new();
+    ply.header.encoding = Encoding::BinaryLittleEndian;
+    ply.header.comments.push(format!(
+        "irpol thermal: surface temperatures (K) of {} at time_s = {time_s}",
+        scene.path.display()
+    ));
+    let scalar = |name: &str, t: ScalarType| PropertyDef::new(name.into(), PropertyType::Scalar(t));
+    let mut vertex = ElementDef::new("vertex".into());
+    for name in ["x", "y", "z", "temperature"] {
+        vertex.properties.add(scalar(name, ScalarType::Float));
+    }
+    ply.header.elements.add(vertex);
+    let mut face = ElementDef::new("face".into());
+    face.properties.add(PropertyDef::new(
+        "vertex_indices".into(),
+        PropertyType::List(ScalarType::UChar, ScalarType::Int),
+    ));
+    ply.header.elements.add(face);
+    let vertices = scene
+        .mesh
+        .positions
+        .iter()
+        .zip(temperatures_k)
+        .map(|(p, &t)| {
+            let mut e = DefaultElement::new();
+            for (name, v) in [("x", p.x), ("y", p.y), ("z", p.z), ("temperature", t)] {
+                e.insert(name.into(), Property::Float(v as f32));
+            }
+            e
+        })
+        .collect();
+    let faces = scene
+        .mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let mut e = DefaultElement::new();
+            let list = t.iter().map(|&v| v as i32).collect();
+            e.insert("vertex_indices".into(), Property::ListInt(list));
+            e
+        })
+        .collect();
+    ply.payload.insert("vertex".into(), vertices);
+    ply.payload.insert("face".into(), faces);
+    let mut bytes = Vec::new();
+    ply_rs_bw::writer::Writer::new()
+        .write_ply(&mut bytes, &mut ply)
+        .map_err(io::Error::other)?;
+    Ok(bytes)
+}
+
+/// `summary.json` of a thermal run.
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct ThermalSummary {
+    pub scene: String,
+    pub start_utc: String,
+    pub duration_s: f64,
+    pub recorded_instants: usize,
+    #[serde(skip_deserializing)]
+    pub stats: SolveStats,
+    pub seconds: f64,
+    pub files: Vec<String>,
+}
+
+/// Writes every output of a thermal run into `out_dir` as one set.
+pub fn write_thermal_outputs(
+    scene: &Scene,
+    solution: &ThermalSolution,
+    out_dir: &Path,
+    seconds: f64,
+) -> io::Result<ThermalSummary> {
+    let setup = scene.thermal.as_deref().ok_or_else(|| {
+        io::Error::other(format!("{} has no [thermal] section", scene.path.display()))
+    })?;
+    let parts = part_series(scene, solution);
+    let staged = StagedFolder::begin(out_dir)?;
+    let mut files = Vec::new();
+    let mut put = |name: String, bytes: &[u8]| -> io::Result<()> {
+        staged.write(&name, bytes)?;
+        files.push(name);
+        Ok(())
+    };
+    put(
+        "temperatures.csv".into(),
+        temperatures_csv(&solution.times_s, &parts).as_bytes(),
+    )?;
+    put(
+        "temperatures.png".into(),
+        &temperature_plot_png(scene, solution, &parts)?,
+    )?;
+    for (i, (t, row)) in solution.times_s.iter().zip(&solution.surface_k).enumerate() {
+        put(surface_ply_name(i, *t), &surface_ply(scene, row, *t)?)?;
+    }
+    files.push("summary.json".into());
+    let summary = ThermalSummary {
+        scene: scene.path.display().to_string(),
+        start_utc: crate::emitter::format_time_utc(&setup.site.start_utc),
+        duration_s: setup.duration_s,
+        recorded_instants: solution.times_s.len(),
+        stats: solution.stats,
+        seconds,
+        files,
+    };
+    let json = serde_json::to_string_pretty(&summary).map_err(io::Error::other)?;
+    staged.write("summary.json", json.as_bytes())?;
+    let earlier = earlier_outputs(out_dir);
+    staged.commit(&|name| earlier.contains(name) || is_surface_ply(name))?;
+    Ok(summary)
+}
+
+/// Names listed by the summary of an earlier run into `out_dir`.
+fn earlier_outputs(out_dir: &Path) -> BTreeSet<String> {
+    std::fs::read_to_string(out_dir.join("summary.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str::<ThermalSummary>(&text).ok())
+        .map(|s| s.files.into_iter().collect())
+        .unwrap_or_default()
+}
+
+fn is_surface_ply(name: &str) -> bool {
+    name.starts_with("surface_") && name.ends_with("s.ply")
+}

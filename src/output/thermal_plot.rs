@@ -1,0 +1,166 @@
+//! The temperature plot of a thermal run: every part's surface temperature over time (mean line,
+//! min–max band over its vertices), the air temperature dashed, sunrise and sunset marked.
+
+use super::thermal::PartSeries;
+use crate::report::paper_figures::encode_png;
+use crate::report::{register_fonts, FONT};
+use crate::scene::Scene;
+use crate::thermal_scene::ThermalSolution;
+use plotters::prelude::*;
+use std::io;
+
+const WIDTH: u32 = 1400;
+const HEIGHT: u32 = 800;
+
+/// Distinct line colours (Tableau 20, dark then light), cycled beyond 20 parts.
+const PALETTE: [RGBColor; 20] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+    RGBColor(174, 199, 232),
+    RGBColor(255, 187, 120),
+    RGBColor(152, 223, 138),
+    RGBColor(255, 152, 150),
+    RGBColor(197, 176, 213),
+    RGBColor(196, 156, 148),
+    RGBColor(247, 182, 210),
+    RGBColor(199, 199, 199),
+    RGBColor(219, 219, 141),
+    RGBColor(158, 218, 229),
+];
+
+/// Times (h) where the sun's centre crosses the horizon, linear between recorded instants, with
+/// whether it rises there.
+pub fn horizon_crossings(solution: &ThermalSolution) -> Vec<(f64, bool)> {
+    let z: Vec<f64> = solution.weather.iter().map(|w| w.sun_direction.z).collect();
+    let t = &solution.times_s;
+    (1..z.len())
+        .filter(|&i| (z[i - 1] > 0.0) != (z[i] > 0.0))
+        .map(|i| {
+            let s = z[i - 1] / (z[i - 1] - z[i]);
+            ((t[i - 1] + s * (t[i] - t[i - 1])) / 3600.0, z[i] > 0.0)
+        })
+        .collect()
+}
+
+/// The plot as PNG bytes.
+pub fn temperature_plot_png(
+    scene: &Scene,
+    solution: &ThermalSolution,
+    parts: &[PartSeries],
+) -> io::Result<Vec<u8>> {
+    let mut rgb = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (WIDTH, HEIGHT)).into_drawing_area();
+        draw(&root, scene, solution, parts).map_err(|e| io::Error::other(e.to_string()))?;
+    }
+    encode_png(&rgb, WIDTH, HEIGHT).map_err(io::Error::other)
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    scene: &Scene,
+    solution: &ThermalSolution,
+    parts: &[PartSeries],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    register_fonts();
+    root.fill(&WHITE)?;
+    let hours: Vec<f64> = solution.times_s.iter().map(|t| t / 3600.0).collect();
+    let air: Vec<f64> = solution.weather.iter().map(|w| w.air_k).collect();
+    let all = parts
+        .iter()
+        .flat_map(|p| p.surface_k.iter().flat_map(|v| [v[0], v[2]]))
+        .chain(air.iter().copied());
+    let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    let pad = ((hi - lo) * 0.05).max(0.5);
+    let end = hours.last().copied().unwrap_or(1.0).max(1e-3);
+    let (plot, legend) = root.split_horizontally(WIDTH - 260);
+    let title = format!("Surface temperatures: {}", scene.path.display());
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(title, (FONT, 22))
+        .margin(16)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..end, (lo - pad)..(hi + pad))?;
+    chart
+        .configure_mesh()
+        .x_desc("time from start_utc (h)")
+        .y_desc("surface temperature (K)")
+        .label_style((FONT, 16))
+        .axis_desc_style((FONT, 18))
+        .draw()?;
+    for (hour, rises) in horizon_crossings(solution) {
+        let color = if rises {
+            RGBColor(230, 160, 0)
+        } else {
+            RGBColor(90, 90, 160)
+        };
+        chart.draw_series(LineSeries::new(
+            [(hour, lo - pad), (hour, hi + pad)],
+            color.stroke_width(1),
+        ))?;
+        let label = if rises { "sunrise" } else { "sunset" };
+        chart.draw_series([Text::new(label, (hour, hi + pad * 0.5), (FONT, 14))])?;
+    }
+    for (i, part) in parts.iter().enumerate() {
+        let color = PALETTE[i % PALETTE.len()];
+        let band: Vec<(f64, f64)> = hours
+            .iter()
+            .zip(&part.surface_k)
+            .map(|(&h, v)| (h, v[2]))
+            .chain(
+                hours
+                    .iter()
+                    .zip(&part.surface_k)
+                    .rev()
+                    .map(|(&h, v)| (h, v[0])),
+            )
+            .collect();
+        chart.draw_series([Polygon::new(band, color.mix(0.15).filled())])?;
+        let mean = hours.iter().zip(&part.surface_k).map(|(&h, v)| (h, v[1]));
+        chart.draw_series(LineSeries::new(mean, color.stroke_width(2)))?;
+    }
+    let dashes = DashedLineSeries::new(hours.iter().copied().zip(air), 8, 5, BLACK.stroke_width(2));
+    chart.draw_series(dashes)?;
+    draw_legend(&legend, parts)?;
+    root.present()
+}
+
+/// Part names with their colours, and the air line, in a column beside the plot.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    parts: &[PartSeries],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let style = (FONT, 15).into_font().color(&BLACK);
+    let row = 22;
+    let mut y = 60;
+    area.draw(&Text::new(
+        "mean (line), min–max (band)",
+        (8, y - 30),
+        style.clone(),
+    ))?;
+    for (i, part) in parts.iter().enumerate() {
+        let color = PALETTE[i % PALETTE.len()];
+        area.draw(&PathElement::new(
+            vec![(8, y + 8), (36, y + 8)],
+            color.stroke_width(3),
+        ))?;
+        area.draw(&Text::new(part.name.clone(), (44, y), style.clone()))?;
+        y += row;
+    }
+    area.draw(&PathElement::new(
+        vec![(8, y + 8), (36, y + 8)],
+        BLACK.stroke_width(2),
+    ))?;
+    area.draw(&Text::new("air (dashed)", (44, y), style))?;
+    Ok(())
+}

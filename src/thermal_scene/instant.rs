@@ -1,0 +1,47 @@
+//! A thermal scene as it is at one recorded instant of its run: the solved surface temperatures,
+//! the sky at that instant's air temperature, and the sun where the weather puts it (DESIGN §2.6,
+//! `render --time`).
+
+use super::ThermalSolution;
+use crate::emitter::format_time_utc;
+use crate::emitter::Sun;
+use crate::scene::environment::Environment;
+use crate::scene::{Scene, ThermalInstant};
+
+/// `scene` at recorded instant `index` of `solution`. The sky is rebuilt at the instant's air
+/// temperature, and so are the atmosphere's path temperature and the NETD reference unless the
+/// scene fixes them; the sun is the weather's direction with the scene's band irradiance (none
+/// below the horizon).
+pub fn scene_at(scene: &Scene, solution: &ThermalSolution, index: usize) -> Result<Scene, String> {
+    let setup = scene
+        .thermal
+        .as_deref()
+        .ok_or_else(|| format!("{} has no [thermal] section", scene.path.display()))?;
+    let w = &solution.weather[index];
+    let mut at = scene.clone();
+    at.mesh.temperatures = solution.surface_k[index].clone();
+    at.air_temperature_k = w.air_k;
+    let mut environment = setup.instants.environment.clone();
+    environment.air_temperature_k = w.air_k;
+    at.environment = Environment::new(&environment, &scene.sensor.band)?;
+    if !setup.instants.atmosphere_temperature_given {
+        if let Some(a) = &mut at.atmosphere {
+            a.temperature_k = w.air_k;
+        }
+    }
+    if !setup.instants.netd_reference_given {
+        at.sensor.netd_reference_k = w.air_k;
+    }
+    let time_s = solution.times_s[index];
+    let instant =
+        setup.site.start_utc + chrono::Duration::milliseconds((time_s * 1e3).round() as i64);
+    at.thermal_instant = Some(ThermalInstant {
+        time_s,
+        time_utc: format_time_utc(&instant),
+    });
+    at.sun = (w.sun_direction.z > 0.0).then_some(Sun {
+        direction: w.sun_direction,
+        irradiance: setup.instants.sun_irradiance_w_m2,
+    });
+    Ok(at)
+}

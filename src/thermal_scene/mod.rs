@@ -1,0 +1,14 @@
+//! Temperatures of a scene over time (DESIGN §1.8, issue 12): the thermal model of `thermal`
+//! applied to every shading vertex of the parts that have a layer stack, with the sky and sun each
+//! vertex sees from the ray tracer, and the scene rebuilt at an instant of the run for rendering.
+//!
+//! - [`exposure`]: sky view factors and sun visibility per vertex.
+//! - [`solve`]: the per-vertex runs and the recorded surface temperatures.
+//! - [`instant`]: the scene rebuilt at a recorded instant, for rendering.
+
+pub mod exposure;
+pub mod instant;
+pub mod solve;
+
+pub use instant::scene_at;
+pub use solve::{solve_scene, vertex_surfaces, SolveStats, ThermalRunError, ThermalSolution};

@@ -1,0 +1,470 @@
+//! Runs the thermal model over a scene (DESIGN §1.8): every shading vertex of a part with a thermal
+//! stack gets its own 1-D solve, forced by the weather, the sun it sees and the sky it sees.
+//!
+//! **Front forcing per vertex** (§1.8), n its normal, s the sun direction, at each sample time:
+//!   absorbed = α_s [E_dn max(0, n·s) V_sun + E_dh F_sky],
+//!   long-wave in = ε [E_lw F_sky + σ T_g⁴ (1 − F_sky)],
+//!   h = given or 5.7 + 3.8 v (McAdams), T_air from the weather; the solver adds −εσT⁴ + h(T_air − T).
+//! V_sun is linear in time between shadow instants (a shadow edge crossing a vertex takes one
+//! shadow step); the weather is sampled every `time_step_s` and at every recorded instant, and the
+//! solver interpolates linearly in between with its own adaptive sub-steps.
+//!
+//! **Identical vertices are solved once.** Two vertices of one part with bit-identical normal,
+//! F_sky, shadow history and initial temperature have bit-identical forcing, so one solve serves
+//! both (most of a ground plane, the flat panels of a box). This is exact, not an approximation.
+
+use super::exposure::{sky_view_factors, sun_visibility, VertexFrame};
+use crate::progress::Progress;
+use crate::scene::mesh::{bounding_diagonal, ShadedMesh};
+use crate::scene::thermal::{SurfaceThermal, ThermalSetup};
+use crate::scene::Scene;
+use crate::thermal::{
+    Forcing, FrontForcing, Resolution, Solver, SolverControl, ThermalError, ThermalState,
+    WeatherSample, STEFAN_BOLTZMANN,
+};
+use crate::transport::accel::Accelerator;
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// Surface temperatures of every shading vertex at the recorded instants.
+#[derive(Clone, Debug)]
+pub struct ThermalSolution {
+    /// Recorded instants (s from `start_utc`), ascending: 0, every output step, the end, and any
+    /// extra instants asked for.
+    pub times_s: Vec<f64>,
+    /// `surface_k[i][v]`: vertex v's surface temperature at `times_s[i]` (K). Vertices of parts
+    /// without a thermal stack keep their typed temperature.
+    pub surface_k: Vec<Vec<f64>>,
+    /// The weather at each recorded instant.
+    pub weather: Vec<WeatherSample>,
+    pub stats: SolveStats,
+}
+
+/// How much work the run took and how well it closed its energy budget.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct SolveStats {
+    /// Shading vertices whose temperatures the model computes.
+    pub thermal_vertices: usize,
+    /// Distinct forcing histories among them (each solved once).
+    pub distinct_solves: usize,
+    /// Accepted solver sub-steps summed over the distinct solves.
+    pub substeps: u64,
+    /// Worst |stored heat − ∫ net flux| over the run, relative to the ∫|flux| of that vertex.
+    pub worst_energy_closure: f64,
+}
+
+/// Why a thermal run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ThermalRunError {
+    #[error("{0} has no [thermal] section")]
+    NotThermal(String),
+    #[error("{0}")]
+    Scene(String),
+    #[error("thermal time {time_s} s is outside the run 0…{duration_s} s")]
+    OutsideRun { time_s: f64, duration_s: f64 },
+    #[error("part '{part}': {source}")]
+    Solver {
+        part: String,
+        #[source]
+        source: ThermalError,
+    },
+}
+
+const DAY_S: f64 = 86_400.0;
+
+/// The sample times of the run: every `time_step_s`, every `output_step_s`, the end and `extra`
+/// (through the first day too when it is spun up), and which of them are recorded.
+fn sample_times(setup: &ThermalSetup, extra: &[f64]) -> (Vec<f64>, Vec<bool>) {
+    let end = setup.duration_s;
+    let sampled_end = if setup.spinup_days > 0 { end.max(DAY_S) } else { end };
+    let mut times: Vec<(f64, bool)> = Vec::new();
+    let mut push_grid = |step: f64, last: f64, record: bool| {
+        let n = (last / step).floor() as usize;
+        times.extend((0..=n).map(|i| (i as f64 * step, record)));
+    };
+    push_grid(setup.time_step_s, sampled_end, false);
+    push_grid(setup.output_step_s, end, true);
+    times.push((end, true));
+    times.push((sampled_end, false));
+    times.extend(extra.iter().map(|&t| (t, true)));
+    times.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut merged: Vec<(f64, bool)> = Vec::with_capacity(times.len());
+    for (t, record) in times {
+        match merged.last_mut() {
+            Some(last) if (t - last.0).abs() < 1e-6 => last.1 |= record,
+            _ => merged.push((t, record)),
+        }
+    }
+    merged.into_iter().unzip()
+}
+
+/// One distinct forcing history: the first vertex that has it stands for all.
+#[derive(Hash, PartialEq, Eq)]
+struct HistoryKey {
+    surface: u32,
+    normal: [u64; 3],
+    sky_view: u64,
+    initial_k: u64,
+    lit: Vec<u8>,
+}
+
+/// The shading vertices the model computes, and what each sees.
+struct ThermalVertices {
+    /// Shading vertex index of each thermal vertex.
+    index: Vec<usize>,
+    /// Surface (part) of each thermal vertex.
+    surface: Vec<u32>,
+    sky_view: Vec<f64>,
+    /// V_sun per thermal vertex and shadow instant, row-major.
+    lit: Vec<u8>,
+    /// Shadow instants per vertex.
+    shadows: usize,
+}
+
+impl ThermalVertices {
+    /// The vertices of parts with a stack, with their sky view and sun visibility traced.
+    fn trace(
+        scene: &Scene,
+        setup: &ThermalSetup,
+        progress: &dyn Progress,
+    ) -> Result<ThermalVertices, ThermalRunError> {
+        let mesh = &scene.mesh;
+        let all_surfaces = vertex_surfaces(scene);
+        let index: Vec<usize> = (0..mesh.positions.len())
+            .filter(|&v| setup.surfaces[all_surfaces[v] as usize].is_some())
+            .collect();
+        let frames: Vec<VertexFrame> = index
+            .iter()
+            .map(|&v| VertexFrame {
+                position: mesh.positions[v],
+                normal: mesh.normals[v],
+            })
+            .collect();
+        progress.begin("sky view and shadows", 2);
+        let accel = Accelerator::new(mesh, bounding_diagonal(&mesh.positions))
+            .map_err(ThermalRunError::Scene)?;
+        let sky_view = sky_view_factors(&accel, &frames);
+        progress.advance(1);
+        let sun = shadow_instants(setup)
+            .iter()
+            .map(|&t| weather_at(setup, t).map(|w| w.sun_direction))
+            .collect::<Result<Vec<_>, _>>()?;
+        let lit = sun_visibility(&accel, &frames, &sun);
+        progress.advance(1);
+        progress.end();
+        Ok(ThermalVertices {
+            surface: index.iter().map(|&v| all_surfaces[v]).collect(),
+            index,
+            sky_view,
+            lit,
+            shadows: sun.len(),
+        })
+    }
+
+    fn lit(&self, i: usize) -> &[u8] {
+        &self.lit[i * self.shadows..(i + 1) * self.shadows]
+    }
+
+    /// Each thermal vertex's history class, and one representative vertex per class.
+    fn group(&self, mesh: &ShadedMesh) -> (Vec<usize>, Vec<usize>) {
+        let mut class_of: HashMap<HistoryKey, usize> = HashMap::new();
+        let mut representatives = Vec::new();
+        let class = (0..self.index.len())
+            .map(|i| {
+                let v = self.index[i];
+                let n = mesh.normals[v];
+                let key = HistoryKey {
+                    surface: self.surface[i],
+                    normal: [n.x.to_bits(), n.y.to_bits(), n.z.to_bits()],
+                    sky_view: self.sky_view[i].to_bits(),
+                    initial_k: mesh.temperatures[v].to_bits(),
+                    lit: self.lit(i).to_vec(),
+                };
+                *class_of.entry(key).or_insert_with(|| {
+                    representatives.push(i);
+                    representatives.len() - 1
+                })
+            })
+            .collect();
+        (class, representatives)
+    }
+}
+
+fn weather_at(setup: &ThermalSetup, time_s: f64) -> Result<WeatherSample, ThermalRunError> {
+    setup
+        .weather
+        .at(time_s)
+        .map_err(|e| ThermalRunError::Scene(e.to_string()))
+}
+
+/// Solves the scene's thermal model, recording every output step plus `extra_times_s`.
+pub fn solve_scene(
+    scene: &Scene,
+    extra_times_s: &[f64],
+    progress: &dyn Progress,
+) -> Result<ThermalSolution, ThermalRunError> {
+    let setup = scene
+        .thermal
+        .as_deref()
+        .ok_or_else(|| ThermalRunError::NotThermal(scene.path.display().to_string()))?;
+    if let Some(&t) = extra_times_s
+        .iter()
+        .find(|&&t| !(t.is_finite() && (0.0..=setup.duration_s).contains(&t)))
+    {
+        return Err(ThermalRunError::OutsideRun {
+            time_s: t,
+            duration_s: setup.duration_s,
+        });
+    }
+    let (times, recorded) = sample_times(setup, extra_times_s);
+    let samples = times
+        .iter()
+        .map(|&t| weather_at(setup, t))
+        .collect::<Result<Vec<_>, _>>()?;
+    let vertices = ThermalVertices::trace(scene, setup, progress)?;
+    let (class, representatives) = vertices.group(&scene.mesh);
+    let run = Run {
+        setup,
+        times: &times,
+        recorded: &recorded,
+        samples: &samples,
+        run_samples: times.partition_point(|&t| t <= setup.duration_s + 1e-6),
+    };
+    progress.begin("thermal solve", representatives.len() as u64);
+    let histories = representatives
+        .par_iter()
+        .map(|&i| {
+            let v = vertices.index[i];
+            let surface = vertices.surface[i] as usize;
+            let model = setup.surfaces[surface].as_ref().expect("thermal vertex");
+            let exposure = Exposure {
+                normal: scene.mesh.normals[v],
+                sky_view: vertices.sky_view[i],
+                lit: vertices.lit(i),
+            };
+            let result = run
+                .vertex(model, &exposure, scene.mesh.temperatures[v])
+                .map_err(|source| ThermalRunError::Solver {
+                    part: scene.surfaces[surface].part.clone(),
+                    source,
+                });
+            progress.advance(1);
+            result
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    progress.end();
+    Ok(run.solution(&scene.mesh, &vertices, &class, &histories))
+}
+
+/// The surface (object part) of every shading vertex (a shading vertex belongs to one part).
+pub fn vertex_surfaces(scene: &Scene) -> Vec<u32> {
+    let mut surface = vec![0u32; scene.mesh.positions.len()];
+    for (triangle, &s) in scene
+        .mesh
+        .triangles
+        .iter()
+        .zip(&scene.mesh.triangle_surface)
+    {
+        for &v in triangle {
+            surface[v as usize] = s;
+        }
+    }
+    surface
+}
+
+/// Shadow instants 0, step, 2·step, … through the end of the run (and of the spin-up day).
+fn shadow_instants(setup: &ThermalSetup) -> Vec<f64> {
+    let end = if setup.spinup_days > 0 {
+        setup.duration_s.max(DAY_S)
+    } else {
+        setup.duration_s
+    };
+    let n = (end / setup.shadow_step_s).ceil() as usize;
+    (0..=n)
+        .map(|i| (i as f64 * setup.shadow_step_s).min(end))
+        .collect()
+}
+
+/// What one vertex sees.
+struct Exposure<'a> {
+    normal: nalgebra::Vector3<f64>,
+    sky_view: f64,
+    /// V_sun at each shadow instant.
+    lit: &'a [u8],
+}
+
+impl Exposure<'_> {
+    /// V_sun at `time_s`, linear between shadow instants.
+    fn sun_visible(&self, time_s: f64, step_s: f64) -> f64 {
+        let x = time_s / step_s;
+        let i = (x.floor() as usize).min(self.lit.len() - 1);
+        let j = (i + 1).min(self.lit.len() - 1);
+        let s = (x - i as f64).clamp(0.0, 1.0);
+        f64::from(self.lit[i]) * (1.0 - s) + f64::from(self.lit[j]) * s
+    }
+}
+
+/// The shared inputs of every vertex's solve.
+struct Run<'a> {
+    setup: &'a ThermalSetup,
+    times: &'a [f64],
+    recorded: &'a [bool],
+    samples: &'a [WeatherSample],
+    /// Samples 0..run_samples are the run (the rest only spin up the first day).
+    run_samples: usize,
+}
+
+/// One vertex's recorded surface temperatures and bookkeeping.
+struct History {
+    surface_k: Vec<f64>,
+    substeps: u64,
+    closure: f64,
+}
+
+impl Run<'_> {
+    /// The recorded temperatures of every shading vertex, each thermal vertex's from its class.
+    fn solution(
+        &self,
+        mesh: &ShadedMesh,
+        vertices: &ThermalVertices,
+        class: &[usize],
+        histories: &[History],
+    ) -> ThermalSolution {
+        let recorded: Vec<usize> = (0..self.run_samples).filter(|&j| self.recorded[j]).collect();
+        let mut surface_k = vec![mesh.temperatures.clone(); recorded.len()];
+        for (i, &v) in vertices.index.iter().enumerate() {
+            let history = &histories[class[i]];
+            for (r, row) in surface_k.iter_mut().enumerate() {
+                row[v] = history.surface_k[r];
+            }
+        }
+        ThermalSolution {
+            times_s: recorded.iter().map(|&j| self.times[j]).collect(),
+            surface_k,
+            weather: recorded.iter().map(|&j| self.samples[j]).collect(),
+            stats: SolveStats {
+                thermal_vertices: vertices.index.len(),
+                distinct_solves: histories.len(),
+                substeps: histories.iter().map(|h| h.substeps).sum(),
+                worst_energy_closure: histories.iter().map(|h| h.closure).fold(0.0, f64::max),
+            },
+        }
+    }
+
+    /// The forcing of §1.8 at sample `j` (see the module docs).
+    fn forcing(&self, model: &SurfaceThermal, exposure: &Exposure, j: usize) -> Forcing {
+        let (t, w) = (self.times[j], &self.samples[j]);
+        let s = w.sun_direction;
+        let cos_sun = exposure.normal.dot(&s).max(0.0);
+        let direct = if s.z > 0.0 {
+            w.direct_normal_w_m2 * cos_sun * exposure.sun_visible(t, self.setup.shadow_step_s)
+        } else {
+            0.0
+        };
+        let f_sky = exposure.sky_view;
+        let ground = STEFAN_BOLTZMANN * self.setup.ground_temperature_k.powi(4);
+        Forcing {
+            front: FrontForcing {
+                absorbed_w_m2: model.solar_absorptance
+                    * (direct + w.diffuse_horizontal_w_m2 * f_sky),
+                longwave_in_w_m2: model.emissivity
+                    * (w.longwave_down_w_m2 * f_sky + ground * (1.0 - f_sky)),
+                emissivity: model.emissivity,
+                h_w_m2k: model.convection_w_m2k.unwrap_or(5.7 + 3.8 * w.wind_m_s),
+                air_k: w.air_k,
+            },
+            back: model.back,
+            internal_w_m2: model.internal_heat.at(t),
+        }
+    }
+
+    /// Spin-up (the first day repeated) and the run, recording the surface temperature.
+    fn vertex(
+        &self,
+        model: &SurfaceThermal,
+        exposure: &Exposure,
+        initial_k: f64,
+    ) -> Result<History, ThermalError> {
+        let grid = model.stack.discretise(&Resolution::default())?;
+        let mut state = ThermalState::uniform(&grid, initial_k)?;
+        let mut solver = Solver::new(grid, SolverControl::default())?;
+        let mut history = History {
+            surface_k: Vec::new(),
+            substeps: 0,
+            closure: 0.0,
+        };
+        let first_day = self.times.partition_point(|&t| t <= DAY_S + 1e-6);
+        for _ in 0..self.setup.spinup_days {
+            self.march(&mut solver, &mut state, model, exposure, 0..first_day, None)?;
+        }
+        if self.recorded[0] {
+            history.surface_k.push(state.surface_k());
+        }
+        let all = 0..self.run_samples;
+        self.march(
+            &mut solver,
+            &mut state,
+            model,
+            exposure,
+            all,
+            Some(&mut history),
+        )?;
+        Ok(history)
+    }
+
+    /// Steps through samples `range` (from its first to its last time).
+    fn march(
+        &self,
+        solver: &mut Solver,
+        state: &mut ThermalState,
+        model: &SurfaceThermal,
+        exposure: &Exposure,
+        range: std::ops::Range<usize>,
+        mut history: Option<&mut History>,
+    ) -> Result<(), ThermalError> {
+        let mut stored = 0.0;
+        let mut net_in = 0.0;
+        let mut gross = 0.0;
+        let mut start = self.forcing(model, exposure, range.start);
+        for j in range.start + 1..range.end {
+            let end = self.forcing(model, exposure, j);
+            let report = solver.step(state, self.times[j] - self.times[j - 1], &start, &end)?;
+            stored += report.stored_j_m2;
+            net_in += report.net_in_j_m2();
+            gross +=
+                report.front_in_j_m2.abs() + report.back_in_j_m2.abs() + report.internal_j_m2.abs();
+            if let Some(h) = history.as_deref_mut() {
+                h.substeps += report.substeps as u64;
+                if self.recorded[j] {
+                    h.surface_k.push(state.surface_k());
+                }
+            }
+            start = end;
+        }
+        if let Some(h) = history {
+            h.closure = (stored - net_in).abs() / gross.max(f64::MIN_POSITIVE);
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn visibility_is_linear_between_shadow_instants() {
+        let lit = [1u8, 0, 0, 1];
+        let e = Exposure {
+            normal: nalgebra::Vector3::z(),
+            sky_view: 1.0,
+            lit: &lit,
+        };
+        assert_eq!(e.sun_visible(0.0, 600.0), 1.0);
+        assert!((e.sun_visible(150.0, 600.0) - 0.75).abs() < 1e-12);
+        assert_eq!(e.sun_visible(900.0, 600.0), 0.0);
+        assert!((e.sun_visible(1500.0, 600.0) - 0.5).abs() < 1e-12);
+        assert_eq!(e.sun_visible(1800.0, 600.0), 1.0);
+        assert_eq!(e.sun_visible(5000.0, 600.0), 1.0);
+    }
+}

@@ -1,0 +1,411 @@
+//! The thermal model over a scene (DESIGN §1.8, issue 12 acceptance 3–5 and 7, bad input): a
+//! ball over a ground plane and a thin plate high above it, on a clear midsummer day in Munich.
+
+mod common;
+
+use common::{irpol, write_scene};
+use irpol::progress::Silent;
+use irpol::scene::{load_scene, Scene};
+use irpol::thermal_scene::{scene_at, solve_scene, vertex_surfaces, ThermalSolution};
+use nalgebra::Vector3;
+
+/// Ball centre (m): radius 0.5, 0.8 m above the ground.
+const BALL: [f64; 3] = [0.0, 0.0, 0.8];
+
+/// The scene, with `thermal_extra` appended to `[thermal]`.
+fn scene_text(thermal_extra: &str) -> String {
+    format!(
+        r#"[camera]
+position = [6.0, -6.0, 3.0]
+look_at = [0.0, 0.0, 0.5]
+fov_deg = 40.0
+resolution = [64, 48]
+
+[environment]
+air_temperature_k = 290.0
+sky = {{ model = "window", zenith_emissivity = 0.75 }}
+ground = {{ temperature_k = 290.0, emissivity = 0.95 }}
+
+[render]
+samples = 2
+
+[materials.paint]
+distribution = "cauchy"
+sigma = 0.2
+q = 2.0
+n = 1.5
+k = 0.2
+rho_d = 0.02
+shadowing = "smith"
+
+[thermal]
+weather = {{ clear_day = {{ air_min_k = 287.0, air_max_k = 301.0, wind_m_s = 2.0 }} }}
+start_utc = "2026-06-21T00:00:00Z"
+latitude_deg = 48.14
+longitude_deg = 11.58
+output_step_s = 3600
+{thermal_extra}
+
+[thermal.layers.paint]
+conductivity_w_mk = 0.2
+density_kg_m3 = 1200.0
+heat_capacity_j_kgk = 1500.0
+
+[thermal.layers.steel]
+conductivity_w_mk = 45.0
+density_kg_m3 = 7850.0
+heat_capacity_j_kgk = 470.0
+
+[thermal.layers.asphalt]
+conductivity_w_mk = 0.75
+density_kg_m3 = 2300.0
+heat_capacity_j_kgk = 920.0
+
+[[objects]]
+name = "ball"
+shape = {{ kind = "sphere", radius = 0.5, subdivisions = 2 }}
+translate = {BALL:?}
+material = "paint"
+[objects.thermal]
+stack = [["paint", 0.0001], ["steel", 0.001]]
+back = {{ convection_w_m2k = 3.0 }}
+solar_absorptance = 0.6
+
+[[objects]]
+name = "ground"
+shape = {{ kind = "plane", size = [8.0, 8.0], divisions = [16, 16] }}
+material = "paint"
+[objects.thermal]
+stack = [["asphalt", 0.2]]
+back = {{ temperature_k = 290.0 }}
+solar_absorptance = 0.9
+
+[[objects]]
+name = "plate"
+shape = {{ kind = "plane", size = [0.5, 0.5], divisions = [1, 1] }}
+translate = [20.0, 20.0, 5.0]
+material = "paint"
+[objects.thermal]
+stack = [["steel", 0.001]]
+solar_absorptance = 0.6
+"#
+    )
+}
+
+fn solved(dir: &std::path::Path, extra: &str, times: &[f64]) -> (Scene, ThermalSolution) {
+    let path = write_scene(dir, &scene_text(extra));
+    let scene = load_scene(&path).unwrap();
+    let solution = solve_scene(&scene, times, &Silent).unwrap();
+    (scene, solution)
+}
+
+/// Vertices of object `name`.
+fn vertices_of(scene: &Scene, name: &str) -> Vec<usize> {
+    let object = scene.object_names.iter().position(|n| n == name).unwrap();
+    vertex_surfaces(scene)
+        .iter()
+        .enumerate()
+        .filter(|(_, &s)| scene.surfaces[s as usize].object == object)
+        .map(|(v, _)| v)
+        .collect()
+}
+
+fn record(solution: &ThermalSolution, time_s: f64) -> usize {
+    solution.times_s.iter().position(|&t| t == time_s).unwrap()
+}
+
+/// Acceptance 4: the ground in the ball's afternoon shadow is cooler than the ground in sun, and
+/// a thin plate under the clear night sky is colder than the air.
+#[test]
+fn shadowed_ground_is_cooler_and_a_plate_cools_below_the_air_at_night() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, solution) = solved(dir.path(), "", &[]);
+    // 13:00 UTC is 15:00 local summer time.
+    let afternoon = record(&solution, 13.0 * 3600.0);
+    let sun = solution.weather[afternoon].sun_direction;
+    assert!(sun.z > 0.3, "the sun is up: {sun:?}");
+    let centre = Vector3::from(BALL);
+    let shadow = centre - sun * (centre.z / sun.z);
+    let ground = vertices_of(&scene, "ground");
+    let nearest = |p: Vector3<f64>| {
+        *ground
+            .iter()
+            .min_by(|&&a, &&b| {
+                let d = |v: usize| (scene.mesh.positions[v] - p).norm();
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+    };
+    let in_shadow = nearest(shadow);
+    let in_sun = nearest(shadow + Vector3::new(-sun.y, sun.x, 0.0).normalize() * 3.0);
+    let t = &solution.surface_k[afternoon];
+    println!(
+        "ground at 15:00 local: {:.2} K in the ball's shadow, {:.2} K in sun",
+        t[in_shadow], t[in_sun]
+    );
+    assert!(t[in_shadow] < t[in_sun] - 3.0);
+
+    let night = record(&solution, 3600.0);
+    let plate = vertices_of(&scene, "plate");
+    let air = solution.weather[night].air_k;
+    for &v in &plate {
+        let plate_k = solution.surface_k[night][v];
+        assert!(plate_k < air - 1.0, "plate {plate_k} K, air {air} K");
+    }
+}
+
+/// Acceptance 5 at scene level: halving the forcing step changes no surface temperature of the
+/// day by 0.01 K or more.
+#[test]
+fn halving_the_time_step_changes_surface_temperatures_by_less_than_10_mk() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, coarse) = solved(dir.path(), "time_step_s = 60", &[]);
+    let (_, fine) = solved(dir.path(), "time_step_s = 30", &[]);
+    assert_eq!(coarse.times_s, fine.times_s);
+    let worst = coarse
+        .surface_k
+        .iter()
+        .zip(&fine.surface_k)
+        .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+        .fold(0.0, f64::max);
+    println!("time step 60 s vs 30 s: worst surface difference {worst:.2e} K");
+    assert!(worst < 0.01, "{worst} K");
+}
+
+/// Acceptance 3 at scene level: over 48 h of clear-day forcing (after a spin-up day) every
+/// vertex's stored heat equals its integrated net flux to 1e-6 of the flux through it.
+#[test]
+fn energy_closes_over_48_hours_of_weather() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, solution) = solved(dir.path(), "duration_h = 48\nspinup_days = 1", &[]);
+    println!(
+        "energy closure: {:.2e}",
+        solution.stats.worst_energy_closure
+    );
+    assert!(solution.stats.worst_energy_closure < 1e-6);
+    assert!(solution.stats.distinct_solves < solution.stats.thermal_vertices);
+}
+
+/// Identical vertices share one solve: the four corners of the plate high above everything have
+/// one normal, the whole sky and the same sun, so one history; the ground does not collapse into
+/// one (its vertices see the ball and its shadow differently).
+#[test]
+fn identical_vertices_are_solved_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, solution) = solved(dir.path(), "", &[]);
+    let plate = vertices_of(&scene, "plate");
+    assert_eq!(plate.len(), 4);
+    for row in &solution.surface_k {
+        assert!(plate.iter().all(|&v| row[v] == row[plate[0]]));
+    }
+    let ground = vertices_of(&scene, "ground");
+    let noon = &solution.surface_k[record(&solution, 11.0 * 3600.0)];
+    let lo = ground
+        .iter()
+        .map(|&v| noon[v])
+        .fold(f64::INFINITY, f64::min);
+    let hi = ground.iter().map(|&v| noon[v]).fold(0.0, f64::max);
+    assert!(hi - lo > 3.0, "ground at noon {lo}…{hi} K");
+    let stats = solution.stats;
+    assert!(stats.distinct_solves < stats.thermal_vertices, "{stats:?}");
+}
+
+/// An instant renders with the solved temperatures, the weather's air and the sun where it is.
+#[test]
+fn a_scene_at_an_instant_carries_the_solution() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, solution) = solved(dir.path(), "", &[5000.0]);
+    let i = record(&solution, 5000.0);
+    let at = scene_at(&scene, &solution, i).unwrap();
+    assert_eq!(at.mesh.temperatures, solution.surface_k[i]);
+    assert_eq!(at.air_temperature_k, solution.weather[i].air_k);
+    let instant = at.thermal_instant.as_ref().unwrap();
+    assert_eq!(instant.time_utc, "2026-06-21T01:23:20Z");
+    assert!(
+        at.sun.is_none(),
+        "the sun is below the horizon at 03:23 local time"
+    );
+    let noon = scene_at(&scene, &solution, record(&solution, 43200.0)).unwrap();
+    let sun = noon.sun.unwrap();
+    assert_eq!(
+        sun.direction,
+        solution.weather[record(&solution, 43200.0)].sun_direction
+    );
+}
+
+#[test]
+fn thermal_command_writes_the_table_meshes_and_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path(), &scene_text("duration_h = 6"));
+    let out = dir.path().join("thermal");
+    let (ok, stdout, stderr) = irpol(&[
+        "thermal",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("thermal run of"), "{stdout}");
+    let csv = std::fs::read_to_string(out.join("temperatures.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("time_s,part,t_surface_min_k,t_surface_mean_k,t_surface_max_k")
+    );
+    // 7 instants (0…6 h) × 3 parts.
+    assert_eq!(lines.clone().count(), 21);
+    assert!(lines
+        .clone()
+        .any(|l| l.starts_with("21600,ground/surface,")));
+    for line in lines {
+        let v: Vec<f64> = line
+            .split(',')
+            .skip(2)
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert!(
+            v[0] <= v[1] && v[1] <= v[2] && v[0] > 250.0 && v[2] < 350.0,
+            "{line}"
+        );
+    }
+    assert!(out.join("temperatures.png").is_file());
+    assert!(out.join("surface_0006_21600s.ply").is_file());
+    // The PLY is a mesh irpol reads back, with the temperature property.
+    let ply = std::fs::read(out.join("surface_0003_10800s.ply")).unwrap();
+    let header = String::from_utf8_lossy(&ply[..300]);
+    assert!(header.contains("property float temperature"), "{header}");
+}
+
+#[test]
+fn render_at_times_writes_numbered_folders_and_an_animation() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path(), &scene_text("duration_h = 12"));
+    let out = dir.path().join("series");
+    let (ok, _, stderr) = irpol(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--times",
+        "0:43200:21600",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    for folder in ["000_0s", "001_21600s", "002_43200s"] {
+        assert!(out.join(folder).join("S0.tif").is_file(), "{folder}");
+    }
+    let summary = std::fs::read_to_string(out.join("001_21600s/summary.json")).unwrap();
+    assert!(
+        summary.contains("\"time_utc\": \"2026-06-21T06:00:00Z\""),
+        "{summary}"
+    );
+    let gif = std::fs::read(out.join("preview.gif")).unwrap();
+    assert_eq!(&gif[..6], b"GIF89a");
+}
+
+/// Bad thermal input: one-line errors naming the key, and nothing written.
+#[test]
+fn bad_thermal_input_is_refused_by_name_and_writes_nothing() {
+    let cases: [(&str, &str, &str); 6] = [
+        (
+            "[[\"paint\", 0.0001], [\"stel\", 0.001]]",
+            "",
+            "layer 'stel' is not defined in [thermal.layers] (defined: asphalt, paint, steel)",
+        ),
+        ("[[\"paint\", -0.0001]]", "", "thickness must be positive"),
+        (
+            "[[\"paint\"]]",
+            "",
+            "a stack entry is [layer name, thickness_m]",
+        ),
+        ("[]", "", "stack is empty"),
+        (
+            "[[\"paint\", 0.001]]",
+            "shadow_step_s = 0",
+            "thermal.shadow_step_s = 0 must be positive",
+        ),
+        (
+            "[[\"paint\", 0.001]]",
+            "latitude = 3",
+            "unknown field `latitude`",
+        ),
+    ];
+    for (stack, extra, expected) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let text = scene_text(extra).replace(
+            "stack = [[\"paint\", 0.0001], [\"steel\", 0.001]]",
+            &format!("stack = {stack}"),
+        );
+        let scene = write_scene(dir.path(), &text);
+        let out = dir.path().join("out");
+        let (ok, _, stderr) = irpol(&[
+            "thermal",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!ok);
+        assert!(stderr.contains(expected), "{expected}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn render_needs_an_instant_for_thermal_scenes_and_a_thermal_scene_for_instants() {
+    let dir = tempfile::tempdir().unwrap();
+    let thermal = write_scene(dir.path(), &scene_text(""));
+    let out = dir.path().join("out");
+    let (ok, _, stderr) = irpol(&[
+        "render",
+        thermal.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("has a [thermal] section: say when"),
+        "{stderr}"
+    );
+    let (ok, _, stderr) = irpol(&[
+        "render",
+        thermal.to_str().unwrap(),
+        "--time",
+        "90000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("outside the run 0…86400 s"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+
+    let plain = dir.path().join("plain.toml");
+    let text = scene_text("");
+    let cut = text.find("[thermal]").unwrap();
+    let objects = text.find("[[objects]]").unwrap();
+    let no_thermal = format!("{}{}", &text[..cut], &text[objects..])
+        .lines()
+        .filter(|l| {
+            !l.starts_with("[objects.thermal]")
+                && !l.starts_with("stack")
+                && !l.starts_with("back")
+                && !l.starts_with("solar_absorptance")
+        })
+        .map(|l| format!("{l}\n"))
+        .collect::<String>()
+        .replace(
+            "material = \"paint\"\n",
+            "material = \"paint\"\ntemperature_k = 290.0\n",
+        );
+    std::fs::write(&plain, no_thermal).unwrap();
+    let (ok, _, stderr) = irpol(&[
+        "render",
+        plain.to_str().unwrap(),
+        "--time",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("no [thermal] section"), "{stderr}");
+    assert!(!out.exists());
+}
