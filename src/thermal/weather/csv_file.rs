@@ -12,7 +12,7 @@
 use super::{nlerp_defined, swinbank_longwave_w_m2, Site, Weather, WeatherError, WeatherSample};
 use crate::emitter::{format_time_utc, sun_direction, sun_position};
 use crate::scene::MAX_TEMPERATURE_K;
-use crate::text::shown;
+use crate::text::{number, shown};
 use nalgebra::Vector3;
 use std::path::Path;
 
@@ -114,16 +114,15 @@ fn parse_rows(bytes: &[u8], site: &Site) -> Result<Weather, Refusal> {
                 "no header row: the file is empty or only comments".into(),
             ))
         }
-        Some(record) => record.map_err(csv_refusal)?,
+        Some(record) => record.map_err(|e| csv_refusal(bytes, e))?,
     };
-    let header_line = line_of(&header);
-    let layout = header_layout(&header, raw_line(bytes, &header))?;
+    let (header_line, header_raw) = locate(bytes, header.position());
+    let layout = header_layout(&header, header_line, header_raw)?;
     let (mut times, mut samples, mut lines) = (Vec::new(), Vec::<WeatherSample>::new(), vec![]);
     for record in records {
-        let record = record.map_err(csv_refusal)?;
-        let line = line_of(&record);
-        let raw = raw_line(bytes, &record);
-        let (time, sample) = parse_row(&record, raw, &layout, site)?;
+        let record = record.map_err(|e| csv_refusal(bytes, e))?;
+        let (line, raw) = locate(bytes, record.position());
+        let (time, sample) = parse_row(&record, line, raw, &layout, site)?;
         if let (Some(&last), Some(&last_line)) = (times.last(), lines.last()) {
             if time <= last {
                 return Err(at(
@@ -132,8 +131,10 @@ fn parse_rows(bytes: &[u8], site: &Site) -> Result<Weather, Refusal> {
                     line,
                     Column::Time,
                     format!(
-                    "column 'time_s': {time} s is not after {last} s on line {last_line}; times \
-                     must be strictly ascending"
+                    "column 'time_s': {} s is not after {} s on line {last_line}; times must be \
+                     strictly ascending",
+                    number(time),
+                    number(last)
                 ),
                 ));
             }
@@ -188,28 +189,32 @@ fn at(layout: &Layout, raw: &str, line: u64, column: Column, message: String) ->
     (line, field_column(raw, index), message)
 }
 
-fn line_of(record: &csv::StringRecord) -> u64 {
-    record.position().map_or(1, |p| p.line())
-}
-
-/// The text of the line a record starts on (lossy: the csv reader has already refused bad UTF-8).
-fn raw_line<'a>(bytes: &'a [u8], record: &csv::StringRecord) -> &'a str {
-    let start = record
-        .position()
-        .map_or(0, |p| p.byte() as usize)
-        .min(bytes.len());
-    let rest = &bytes[start..];
-    let end = rest
-        .iter()
-        .position(|&b| b == b'\n' || b == b'\r')
-        .unwrap_or(rest.len());
-    std::str::from_utf8(&rest[..end]).unwrap_or("")
+/// Where a record is: its line (1-based) and the text of that line. The csv crate's position of a
+/// record is where its reader started looking for it, before the comment and empty lines it
+/// skipped, so those are skipped here too.
+fn locate<'a>(bytes: &'a [u8], position: Option<&csv::Position>) -> (u64, &'a str) {
+    let (mut line, mut start) = position.map_or((1, 0), |p| (p.line(), p.byte() as usize));
+    loop {
+        let rest = &bytes[start.min(bytes.len())..];
+        let end = rest
+            .iter()
+            .position(|&b| b == b'\n' || b == b'\r')
+            .unwrap_or(rest.len());
+        let text = &rest[..end];
+        let skipped = text.is_empty() || text[0] == b'#';
+        if !skipped || end == rest.len() {
+            return (line, std::str::from_utf8(text).unwrap_or(""));
+        }
+        let crlf = rest[end] == b'\r' && rest.get(end + 1) == Some(&b'\n');
+        start += end + if crlf { 2 } else { 1 };
+        line += 1;
+    }
 }
 
 /// The csv crate's own refusals: invalid UTF-8 (the only one possible with flexible records read
 /// from memory), placed on the record's line.
-fn csv_refusal(error: csv::Error) -> Refusal {
-    let line = error.position().map_or(1, |p| p.line());
+fn csv_refusal(bytes: &[u8], error: csv::Error) -> Refusal {
+    let (line, _) = locate(bytes, error.position());
     let message = match error.kind() {
         csv::ErrorKind::Utf8 { .. } => "invalid UTF-8: a weather CSV must be UTF-8 text".into(),
         _ => shown(&error.to_string()),
@@ -244,8 +249,7 @@ fn field_column(line: &str, index: usize) -> u64 {
 
 /// The columns of the header row: known names, no duplicates, the required ones, both sun
 /// angles or neither.
-fn header_layout(header: &csv::StringRecord, raw: &str) -> Result<Layout, Refusal> {
-    let line = line_of(header);
+fn header_layout(header: &csv::StringRecord, line: u64, raw: &str) -> Result<Layout, Refusal> {
     let mut index = [None; 8];
     for (i, name) in header.iter().enumerate() {
         let refuse = |message: String| Err((line, field_column(raw, i), message));
@@ -306,11 +310,11 @@ fn unknown_column(name: &str) -> String {
 /// One data row: its time and the weather then.
 fn parse_row(
     record: &csv::StringRecord,
+    line: u64,
     raw: &str,
     layout: &Layout,
     site: &Site,
 ) -> Result<(f64, WeatherSample), Refusal> {
-    let line = line_of(record);
     if record.len() != layout.width {
         let column = field_column(raw, record.len().min(layout.width));
         let message = format!(
@@ -325,7 +329,7 @@ fn parse_row(
             return Ok(None);
         };
         let refuse = |message: String| (line, field_column(raw, i), message);
-        let v = number(column.name(), &record[i]).map_err(refuse)?;
+        let v = parse_number(column.name(), &record[i]).map_err(refuse)?;
         column.check(v, &record[i]).map_err(refuse)?;
         Ok(Some(v))
     };
@@ -351,7 +355,8 @@ fn parse_row(
 fn spa_direction(site: &Site, time_s: f64) -> Result<Vector3<f64>, String> {
     let instant = site.instant(time_s).ok_or_else(|| {
         format!(
-            "time_s {time_s} s after start_utc {} is not an instant irpol can represent",
+            "time_s {} s after start_utc {} is not an instant irpol can represent",
+            number(time_s),
             format_time_utc(&site.start_utc)
         )
     })?;
@@ -361,7 +366,7 @@ fn spa_direction(site: &Site, time_s: f64) -> Result<Vector3<f64>, String> {
 }
 
 /// A field as a finite number.
-fn number(column: &str, text: &str) -> Result<f64, String> {
+fn parse_number(column: &str, text: &str) -> Result<f64, String> {
     if text.is_empty() {
         return Err(format!("column '{column}' is empty, expected a number"));
     }
