@@ -181,9 +181,15 @@ fn bad_files_are_refused_with_file_line_and_column() {
             "FILE:1:26: duplicate column 'time_s' (already column 1)",
         ),
         (
-            format!("{header}0,290,1\n1e30,291,1\n"),
-            "FILE:3:1: time_s 1e30 s after start_utc \
-             2026-06-21T00:00:00Z is not an instant irpol can represent",
+            format!("{header}0,290,1\n1e14,291,1\n"),
+            "FILE:3:1: time_s 1e14 s after start_utc 2026-06-21T00:00:00Z is not an instant irpol \
+             can represent",
+        ),
+        (
+            "time_s,air_temperature_k,sun_elevation_deg,sun_azimuth_deg\n0,290,1,2\n1e16,291,1,2\n"
+                .to_string(),
+            "FILE:3:1: column 'time_s': 1e16 s is beyond ±1e15 s (31.7 million years) from \
+             start_utc",
         ),
     ] {
         assert_eq!(refusal(&text), expected, "{text}");
@@ -248,6 +254,13 @@ fn a_missing_file_and_a_bad_site_are_one_line() {
             "{text}"
         );
     }
+    // Beyond the SPA's ΔT estimate: the sun's failure, as one line.
+    let error = Weather::clear_day(&day, &munich("9999-06-21T00:00:00Z"), 3600.0).unwrap_err();
+    let text = error.to_string();
+    assert!(
+        text.starts_with("clear day: no sun position at latitude 48.14°") && !text.contains('\n'),
+        "{text}"
+    );
     let error = Weather::clear_day(&day, &munich("2026-06-21T00:00:00Z"), -1.0).unwrap_err();
     assert!(error.to_string().contains("duration -1 s"), "{error}");
 }
@@ -370,4 +383,21 @@ fn polar_day_and_night_have_a_cycle_without_sunrise() {
             assert!(noon.sun_direction.z < 0.0 && noon.direct_normal_w_m2 == 0.0);
         }
     }
+}
+
+#[test]
+fn the_example_of_the_scenes_page_reads() {
+    // docs/scenes.md, "The weather CSV": the fenced block that starts with the Munich comment.
+    let page =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scenes.md"))
+            .unwrap();
+    let start = page
+        .find("```\n# Munich, 21 June 2026")
+        .expect("the example block")
+        + 4;
+    let block = &page[start..start + page[start..].find("```").unwrap()];
+    let (weather, _path, _dir) = read("weather.csv", block);
+    let weather = weather.unwrap();
+    assert_eq!(weather.span_s(), (0.0, 86_400.0));
+    assert!((weather.at(43_200.0).unwrap().air_k - 292.1).abs() < 1e-12);
 }

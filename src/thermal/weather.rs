@@ -78,7 +78,7 @@ impl Site {
     /// The instant `time_s` seconds after `start_utc` (to the nanosecond), if chrono can hold it.
     pub fn instant(&self, time_s: f64) -> Option<DateTime<Utc>> {
         let whole = time_s.floor();
-        if !(whole.abs() < 1e15) {
+        if !whole.is_finite() || whole.abs() >= 1e15 {
             return None;
         }
         let nanos = ((time_s - whole) * 1e9).round() as i64;
@@ -169,7 +169,13 @@ impl Weather {
             file: path.to_path_buf(),
             reason: e.to_string(),
         })?;
-        csv_file::parse(path, &bytes, site)
+        Weather::parse_csv(path, &bytes, site)
+    }
+
+    /// [`Weather::read_csv`] of a file's bytes; `source` names it in messages.
+    pub fn parse_csv(source: &Path, bytes: &[u8], site: &Site) -> Result<Weather, WeatherError> {
+        site.validate()?;
+        csv_file::parse(source, bytes, site)
     }
 
     /// Built-in clear day, covering [0, duration_s] from site.start_utc (any duration, several
@@ -215,8 +221,8 @@ impl Weather {
         ))
     }
 
-    /// Rows as they are stored, for the checks of the readers (times ascending, ≥ 2 rows, sun
-    /// directions with an nlerp between neighbours).
+    /// Weather from rows the caller has checked: at least two, times strictly ascending, sun
+    /// directions of neighbours not opposite.
     fn from_rows(
         start_utc: DateTime<Utc>,
         times_s: Vec<f64>,
@@ -323,6 +329,21 @@ mod tests {
                 "{text}"
             );
         }
+    }
+
+    #[test]
+    fn clear_days_deserialize_from_the_scene_toml() {
+        // DESIGN §2.4 writes integers; unknown keys are refused by name.
+        let day: ClearDay =
+            toml::from_str("air_min_k = 281\nair_max_k = 293.5\nwind_m_s = 2").unwrap();
+        assert_eq!(
+            (day.air_min_k, day.air_max_k, day.wind_m_s),
+            (281.0, 293.5, 2.0)
+        );
+        let error = toml::from_str::<ClearDay>("air_min_k = 281\nair_max_k = 293\nwind = 2")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("unknown field `wind`"), "{error}");
     }
 
     #[test]

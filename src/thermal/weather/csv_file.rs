@@ -6,7 +6,7 @@
 //! required; `wind_speed_m_s`, `direct_normal_w_m2`, `diffuse_horizontal_w_m2` (0 when absent),
 //! `longwave_down_w_m2` (Swinbank when absent) and `sun_elevation_deg` + `sun_azimuth_deg` (both
 //! or neither; the SPA when absent) optional. Every value is a finite number; times strictly
-//! ascending (any sign: seconds from `start_utc`), air temperatures within (0, 10⁴] K, wind and
+//! ascending (any sign, |time_s| ≤ 1e15: seconds from `start_utc`), air temperatures within (0, 10⁴] K, wind and
 //! irradiances ≥ 0, elevations within [−90°, 90°]; at least two rows.
 
 use super::{nlerp_defined, swinbank_longwave_w_m2, Site, Weather, WeatherError, WeatherSample};
@@ -15,6 +15,10 @@ use crate::scene::MAX_TEMPERATURE_K;
 use crate::text::{number, shown};
 use nalgebra::Vector3;
 use std::path::Path;
+
+/// Largest |time_s| (s): ~31.7 million years, far beyond the SPA's years, and small enough that
+/// differences of times never overflow.
+const MAX_TIME_S: f64 = 1e15;
 
 /// What a column of the file holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -50,6 +54,9 @@ impl Column {
     fn check(self, value: f64, text: &str) -> Result<(), String> {
         let text = shown(text);
         let problem = match self {
+            Column::Time if value.abs() > MAX_TIME_S => {
+                format!("{text} s is beyond ±1e15 s (31.7 million years) from start_utc")
+            }
             Column::Air if !(value > 0.0 && value <= MAX_TEMPERATURE_K) => {
                 format!("{text} K is outside (0, {MAX_TEMPERATURE_K}] K")
             }
@@ -118,59 +125,62 @@ fn parse_rows(bytes: &[u8], site: &Site) -> Result<Weather, Refusal> {
     };
     let (header_line, header_raw) = locate(bytes, header.position());
     let layout = header_layout(&header, header_line, header_raw)?;
-    let (mut times, mut samples, mut lines) = (Vec::new(), Vec::<WeatherSample>::new(), vec![]);
+    let mut rows: Vec<Row> = Vec::new();
     for record in records {
         let record = record.map_err(|e| csv_refusal(bytes, e))?;
         let (line, raw) = locate(bytes, record.position());
-        let (time, sample) = parse_row(&record, line, raw, &layout, site)?;
-        if let (Some(&last), Some(&last_line)) = (times.last(), lines.last()) {
-            if time <= last {
-                return Err(at(
-                    &layout,
-                    raw,
-                    line,
-                    Column::Time,
-                    format!(
-                    "column 'time_s': {} s is not after {} s on line {last_line}; times must be \
-                     strictly ascending",
-                    number(time),
-                    number(last)
-                ),
-                ));
-            }
-        }
-        if let Some(previous) = samples.last() {
-            if !nlerp_defined(&previous.sun_direction, &sample.sun_direction) {
-                let column = sun_column(&layout);
-                return Err(at(
-                    &layout,
-                    raw,
-                    line,
-                    column,
-                    format!(
-                        "the sun is opposite to where it is on line {}: no interpolation between \
-                     them, add rows in between",
-                        lines[lines.len() - 1]
-                    ),
-                ));
-            }
-        }
-        times.push(time);
-        samples.push(sample);
-        lines.push(line);
-    }
-    if times.len() < 2 {
-        let line = lines.last().copied().unwrap_or(header_line);
-        return Err((
+        let (time_s, sample) = parse_row(&record, line, raw, &layout, site)?;
+        let row = Row {
+            time_s,
+            sample,
             line,
-            1,
-            format!(
-                "{} data row(s): the weather needs at least two rows to interpolate between",
-                times.len()
-            ),
-        ));
+        };
+        if let Some(previous) = rows.last() {
+            follows(previous, &row, &layout, raw)?;
+        }
+        rows.push(row);
     }
+    if rows.len() < 2 {
+        let line = rows.last().map_or(header_line, |row| row.line);
+        let message = format!(
+            "{} data row(s): the weather needs at least two rows to interpolate between",
+            rows.len()
+        );
+        return Err((line, 1, message));
+    }
+    let times = rows.iter().map(|row| row.time_s).collect();
+    let samples = rows.iter().map(|row| row.sample).collect();
     Ok(Weather::from_rows(site.start_utc, times, samples))
+}
+
+/// A data row read, with its line for messages.
+struct Row {
+    time_s: f64,
+    sample: WeatherSample,
+    line: u64,
+}
+
+/// Whether `row` may follow `previous`: a later time, and a sun direction with an nlerp between
+/// the two. `raw` is the text of `row`'s line.
+fn follows(previous: &Row, row: &Row, layout: &Layout, raw: &str) -> Result<(), Refusal> {
+    if row.time_s <= previous.time_s {
+        let message = format!(
+            "column 'time_s': {} s is not after {} s on line {}; times must be strictly ascending",
+            number(row.time_s),
+            number(previous.time_s),
+            previous.line
+        );
+        return Err(at(layout, raw, row.line, Column::Time, message));
+    }
+    if !nlerp_defined(&previous.sample.sun_direction, &row.sample.sun_direction) {
+        let message = format!(
+            "the sun is opposite to where it is on line {}: no interpolation between them, add \
+             rows in between",
+            previous.line
+        );
+        return Err(at(layout, raw, row.line, sun_column(layout), message));
+    }
+    Ok(())
 }
 
 /// The column that places a refusal about the sun: the given elevation, else the time the SPA

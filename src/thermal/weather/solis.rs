@@ -72,7 +72,7 @@ pub fn simplified_solis(
     atmosphere: &SolisAtmosphere,
 ) -> ClearSkyIrradiance {
     let sin_h = apparent_elevation_deg.to_radians().sin();
-    if !(sin_h > 0.0) {
+    if sin_h.is_nan() || sin_h <= 0.0 {
         return ClearSkyIrradiance {
             direct_normal_w_m2: 0.0,
             diffuse_horizontal_w_m2: 0.0,
