@@ -73,7 +73,7 @@ impl Column {
     }
 }
 
-/// Where each column is in the records, and the header's line for messages.
+/// Where each column is in the records.
 struct Layout {
     /// Record index of each [`Column`] (by `Column as usize`), if present.
     index: [Option<usize>; 8],
