@@ -150,7 +150,8 @@ enum Command {
         command: SceneCommand,
     },
     /// Apparent sun position (NREL SPA, standard atmosphere, sea level) at a site, as CSV on stdout:
-    /// time_utc,elevation_deg,azimuth_deg (azimuth clockwise from north).
+    /// time_utc,elevation_deg,azimuth_deg (azimuth clockwise from north); with --clear-sky also
+    /// dni_w_m2,dhi_w_m2,ghi_w_m2.
     Sun {
         /// Latitude (°, north positive).
         #[arg(long, allow_negative_numbers = true)]
@@ -168,6 +169,12 @@ enum Command {
         /// A file of RFC 3339 instants, one per line (blank lines and # comments skipped).
         #[arg(long)]
         times_file: Option<PathBuf>,
+        /// Also the clear-sky irradiance at that elevation (W/m²): direct normal, diffuse and global
+        /// horizontal from the simplified Solis model (Ineichen 2008, as pvlib defines it) with
+        /// aod700 = 0.1, 1 cm precipitable water, 101325 Pa, 1364 W/m² extraterrestrial; 0 with
+        /// the sun below the horizon. The same model as the thermal clear day.
+        #[arg(long)]
+        clear_sky: bool,
     },
     /// A table of the materials in a library folder.
     Library {
@@ -389,6 +396,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             longitude,
             time_utc,
             times_file,
+            clear_sky,
         } => {
             let times = match (time_utc, times_file) {
                 (Some(text), None) => vec![parse_time_utc(&text)?],
@@ -396,7 +404,7 @@ fn run(command: Command) -> anyhow::Result<()> {
                 _ => anyhow::bail!("give either --time-utc RFC3339 or --times-file FILE"),
             };
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-            write_sun_csv(latitude, longitude, &times, &mut out)?;
+            write_sun_csv(latitude, longitude, &times, clear_sky, &mut out)?;
             out.flush()?;
         }
         Command::Library { dir } => print_library(&dir)?,

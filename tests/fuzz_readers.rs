@@ -1,7 +1,8 @@
 //! Bounded fuzzing of every reader of user files (issue 15): the measurement CSV reader, the OBJ
-//! and PLY mesh readers, the material TOML loader and the eval geometry reader get random bytes
+//! and PLY mesh readers, the material TOML loader, the eval geometry reader and the thermal
+//! weather CSV reader get random bytes
 //! and mutations of real inputs (the shipped measurements and materials, excerpts of the car
-//! mesh, small PLY files). Whatever they are fed, they must return — a value or an error whose
+//! mesh, small PLY files, weather CSVs). Whatever they are fed, they must return — a value or an error whose
 //! message is one line without control characters — and never panic.
 //!
 //! Each property runs a fixed number of cases with proptest's default deterministic-per-run RNG;
@@ -15,6 +16,7 @@ use irpol::optics::RefractiveIndex;
 use irpol::pbrdf::{Pbrdf, Shadowing, SlopeDistribution};
 use irpol::scene::obj::parse_obj;
 use irpol::scene::ply::parse_ply;
+use irpol::thermal::{Site, Weather};
 use proptest::prelude::*;
 use std::path::Path;
 
@@ -272,6 +274,17 @@ fn mesh_seeds() -> Vec<Vec<u8>> {
     ]
 }
 
+fn weather_seeds() -> Vec<Vec<u8>> {
+    vec![
+        b"# Munich\ntime_s,air_temperature_k,wind_speed_m_s,direct_normal_w_m2\n0,283.4,1.5,0\n\
+          21600,285,2,640\n\n# noon\n43200,292.1,3,870\n"
+            .to_vec(),
+        b"\"sun_azimuth_deg\",time_s,air_temperature_k,sun_elevation_deg,longwave_down_w_m2,\
+          diffuse_horizontal_w_m2\r\n180,0,290,60,330,100\r\n240,3600,296,40,340,120\r\n"
+            .to_vec(),
+    ]
+}
+
 fn material_seeds() -> Vec<Vec<u8>> {
     ["paper_paint", "anodized_panel"]
         .iter()
@@ -327,6 +340,23 @@ proptest! {
                 prop_assert!(widths.windows(2).all(|w| w[0] == w[1]), "ragged output");
             }
             Err(e) => check_message(&format!("{e:#}"))?,
+        }
+    }
+
+    #[test]
+    fn weather_reader_never_panics(bytes in prop_oneof![mutated(weather_seeds()), noise()]) {
+        let site = Site {
+            latitude_deg: 48.14,
+            longitude_deg: 11.58,
+            start_utc: irpol::emitter::parse_time_utc("2026-06-21T00:00:00Z").unwrap(),
+        };
+        match Weather::parse_csv(Path::new("fuzz.csv"), &bytes, &site) {
+            Ok(weather) => {
+                let (first, last) = weather.span_s();
+                let middle = weather.at(0.5 * first + 0.5 * last).unwrap();
+                prop_assert!((middle.sun_direction.norm() - 1.0).abs() < 1e-9);
+            }
+            Err(e) => check_message(&e.to_string())?,
         }
     }
 }

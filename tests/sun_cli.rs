@@ -110,3 +110,65 @@ fn bad_input_is_one_clear_line() {
     // One of --time-utc and --times-file, not both, not neither (clap's usage error).
     assert!(!irpol(&base).0);
 }
+
+#[test]
+fn clear_sky_adds_the_solis_irradiance() {
+    // Munich at midsummer: near noon, at sunset and at night. The numbers are the library's
+    // simplified Solis model at the elevation irpol prints (pvlib agreement:
+    // scripts/crosscheck_clearsky.py).
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("times.txt");
+    std::fs::write(
+        &file,
+        "2026-06-21T11:15:00Z\n2026-06-21T19:00:00Z\n2026-06-21T23:00:00Z\n",
+    )
+    .unwrap();
+    let (ok, stdout, stderr) = irpol(&[
+        "sun",
+        "--latitude",
+        "48.14",
+        "--longitude",
+        "11.58",
+        "--times-file",
+        file.to_str().unwrap(),
+        "--clear-sky",
+    ]);
+    assert!(ok, "{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(
+        lines[0],
+        "time_utc,elevation_deg,azimuth_deg,dni_w_m2,dhi_w_m2,ghi_w_m2"
+    );
+    let rows: Vec<Vec<f64>> = lines[1..]
+        .iter()
+        .map(|l| l.split(',').skip(1).map(|f| f.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 3);
+    for row in &rows {
+        let solis =
+            irpol::thermal::simplified_solis(row[0], &irpol::thermal::SolisAtmosphere::DEFAULT);
+        assert_eq!(
+            row[2..],
+            [
+                solis.direct_normal_w_m2,
+                solis.diffuse_horizontal_w_m2,
+                solis.global_horizontal_w_m2
+            ]
+        );
+    }
+    // High sun: strong beam; low evening sun: weak; night: nothing.
+    assert!(rows[0][2] > 850.0 && rows[0][4] > 850.0, "{:?}", rows[0]);
+    assert!(rows[1][0] > 0.0 && rows[1][4] < 100.0, "{:?}", rows[1]);
+    assert_eq!(rows[2][2..], [0.0, 0.0, 0.0]);
+    // Without the flag the columns are not there.
+    let (ok, stdout, _) = irpol(&[
+        "sun",
+        "--latitude",
+        "48.14",
+        "--longitude",
+        "11.58",
+        "--time-utc",
+        "2026-06-21T11:15:00Z",
+    ]);
+    assert!(ok && stdout.starts_with("time_utc,elevation_deg,azimuth_deg\n"));
+}

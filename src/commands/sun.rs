@@ -1,14 +1,18 @@
 //! `irpol sun`: the apparent sun position (SPA, standard atmosphere; see `emitter::sun`) at one site
-//! for one instant or a file of them, as CSV. The batch form exists so that a cross-check over a
-//! year of hours runs one process, not thousands.
+//! for one instant or a file of them, as CSV, and with `--clear-sky` the simplified Solis clear-sky
+//! irradiance at that elevation (`thermal::weather::solis`, its default atmosphere). The batch form
+//! exists so that a cross-check over a year of hours runs one process, not thousands.
 
 use crate::emitter::{format_time_utc, parse_time_utc, sun_position, SunPosition};
+use crate::thermal::{simplified_solis, SolisAtmosphere};
 use anyhow::Context;
 use chrono::{DateTime, Utc};
 use std::io::Write;
 use std::path::Path;
 
 pub const SUN_HEADER: &str = "time_utc,elevation_deg,azimuth_deg";
+/// The columns `--clear-sky` appends: DNI, DHI and GHI of the simplified Solis model (W m⁻²).
+pub const CLEAR_SKY_COLUMNS: &str = "dni_w_m2,dhi_w_m2,ghi_w_m2";
 
 /// One RFC 3339 instant per line; blank lines and lines starting with `#` are skipped. A bad line is
 /// refused as `FILE:LINE: …`.
@@ -47,23 +51,39 @@ pub fn sun_table(
 }
 
 /// Writes `time_utc,elevation_deg,azimuth_deg` and one line per instant, the angles in degrees to
-/// full (round-trip) precision. Every position is computed before anything is written.
+/// full (round-trip) precision; with `clear_sky` also `dni_w_m2,dhi_w_m2,ghi_w_m2`, the simplified
+/// Solis irradiance ([`SolisAtmosphere::DEFAULT`]) at the apparent elevation, to full precision.
+/// Every position is computed before anything is written.
 pub fn write_sun_csv(
     latitude_deg: f64,
     longitude_deg: f64,
     times: &[DateTime<Utc>],
+    clear_sky: bool,
     out: &mut impl Write,
 ) -> anyhow::Result<()> {
     let table = sun_table(latitude_deg, longitude_deg, times)?;
-    writeln!(out, "{SUN_HEADER}")?;
+    if clear_sky {
+        writeln!(out, "{SUN_HEADER},{CLEAR_SKY_COLUMNS}")?;
+    } else {
+        writeln!(out, "{SUN_HEADER}")?;
+    }
     for (time, position) in table {
-        writeln!(
+        write!(
             out,
             "{},{},{}",
             format_time_utc(&time),
             position.elevation_deg,
             position.azimuth_deg
         )?;
+        if clear_sky {
+            let sky = simplified_solis(position.elevation_deg, &SolisAtmosphere::DEFAULT);
+            write!(
+                out,
+                ",{},{},{}",
+                sky.direct_normal_w_m2, sky.diffuse_horizontal_w_m2, sky.global_horizontal_w_m2
+            )?;
+        }
+        writeln!(out)?;
     }
     Ok(())
 }
@@ -79,7 +99,7 @@ mod tests {
             parse_time_utc("2026-12-21T10:00:00+01:00").unwrap(),
         ];
         let mut out = Vec::new();
-        write_sun_csv(48.14, 11.58, &times, &mut out).unwrap();
+        write_sun_csv(48.14, 11.58, &times, false, &mut out).unwrap();
         let text = String::from_utf8(out).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 3);
@@ -101,6 +121,42 @@ mod tests {
             .collect();
         let expected = sun_position(48.14, 11.58, &times[0]).unwrap();
         assert_eq!(fields, vec![expected.elevation_deg, expected.azimuth_deg]);
+    }
+
+    #[test]
+    fn clear_sky_appends_the_solis_irradiance_at_the_apparent_elevation() {
+        let times = [
+            parse_time_utc("2026-06-21T11:00:00Z").unwrap(),
+            parse_time_utc("2026-06-21T23:00:00Z").unwrap(),
+        ];
+        let mut out = Vec::new();
+        write_sun_csv(48.14, 11.58, &times, true, &mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(
+            lines[0],
+            "time_utc,elevation_deg,azimuth_deg,dni_w_m2,dhi_w_m2,ghi_w_m2"
+        );
+        let row = |i: usize| -> Vec<f64> {
+            lines[i]
+                .split(',')
+                .skip(1)
+                .map(|f| f.parse().unwrap())
+                .collect()
+        };
+        let noon = row(1);
+        let expected = simplified_solis(noon[0], &SolisAtmosphere::DEFAULT);
+        assert_eq!(
+            noon[2..],
+            [
+                expected.direct_normal_w_m2,
+                expected.diffuse_horizontal_w_m2,
+                expected.global_horizontal_w_m2
+            ]
+        );
+        assert!(noon[2] > 800.0 && noon[4] > 800.0, "{noon:?}");
+        // Midnight: the sun below the horizon, no irradiance.
+        assert_eq!(row(2)[2..], [0.0, 0.0, 0.0]);
     }
 
     #[test]
@@ -130,7 +186,7 @@ mod tests {
     fn a_bad_site_writes_nothing() {
         let times = [parse_time_utc("2026-06-21T10:00:00Z").unwrap()];
         let mut out = Vec::new();
-        let error = write_sun_csv(95.0, 0.0, &times, &mut out).unwrap_err();
+        let error = write_sun_csv(95.0, 0.0, &times, true, &mut out).unwrap_err();
         assert!(error.to_string().contains("latitude"), "{error}");
         assert!(out.is_empty());
     }

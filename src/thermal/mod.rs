@@ -5,13 +5,18 @@
 //! - [`layers`]: layer materials and stacks, validated, discretised into finite volumes.
 //! - [`solver`]: implicit stepping with adaptive sub-steps, the non-linear surface balance and
 //!   energy bookkeeping.
+//! - [`weather`]: the weather the surface balance needs, from a CSV or a built-in clear day,
+//!   interpolated in time.
 
 pub mod layers;
 pub mod solver;
+pub mod weather;
 
 pub use layers::{Grid, Layer, LayerMaterial, LayerStack, Resolution, ThermalError};
 pub use solver::{
     Back, Forcing, FrontForcing, Solver, SolverControl, StepReport, ThermalState, STEFAN_BOLTZMANN,
 };
-pub mod weather;
-pub use weather::{ClearDay, Site, Weather, WeatherError, WeatherSample};
+pub use weather::{
+    simplified_solis, swinbank_longwave_w_m2, ClearDay, ClearSkyIrradiance, Site, SolisAtmosphere,
+    Weather, WeatherError, WeatherSample,
+};

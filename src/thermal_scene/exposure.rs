@@ -15,11 +15,13 @@ use crate::transport::accel::Accelerator;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-/// Radial × azimuthal nodes of the sky-view rule: 64 rays, F_sky within ~0.02 of the converged
-/// value at the car's wheel arches and ground under the sills (a 0.02 error in F_sky moves the
-/// long-wave balance by ~2 W m⁻², a few tenths of a kelvin on a thin panel).
-const SKY_RULE_RADIAL: usize = 4;
-const SKY_RULE_AZIMUTHAL: usize = 16;
+/// Radial × azimuthal nodes of the sky-view rule: 288 rays. A fixed rule converges slowly on a
+/// sharp-edged occluder; for a square roof over a point (the test below) 64 rays were 0.054 off
+/// the exact view factor, 288 are within 0.013, and 512 within 0.007 at twice the cost. 0.013 of
+/// F_sky moves the long-wave balance by ~1.3 W m⁻² (~0.1 K on a thin panel); the rays take ~0.3 s
+/// of the car's run.
+const SKY_RULE_RADIAL: usize = 12;
+const SKY_RULE_AZIMUTHAL: usize = 24;
 
 /// A vertex's position and unit normal.
 #[derive(Clone, Copy, Debug)]
