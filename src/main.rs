@@ -9,10 +9,12 @@ use irpol::commands::evaluate::{
     read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
 };
 use irpol::commands::fit::fit_and_write;
-use irpol::commands::render::{default_output_dir, render_scene, render_scene_at, Instants};
+use irpol::commands::render::{
+    default_output_dir, instant_folder, render_scene, render_scene_at, Instants, TimedRender,
+};
 use irpol::commands::scene_init::write_starter_scene;
 use irpol::commands::sun::{read_times_file, write_sun_csv};
-use irpol::commands::thermal::run_thermal;
+use irpol::commands::thermal::{run_thermal, run_thermal_and_render};
 use irpol::commands::{parse_sweep, ModelArgs};
 use irpol::emitter::parse_time_utc;
 use irpol::fit::{
@@ -20,6 +22,7 @@ use irpol::fit::{
     RobustLoss,
 };
 use irpol::output::staged_folder::staging_folder;
+use irpol::output::thermal::ThermalSummary;
 use irpol::pbrdf::Shadowing;
 use irpol::report::fit_report::rebuild_report;
 use irpol::report::index::write_library_index;
@@ -524,8 +527,23 @@ fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()
 
 fn render_instants(scene: &Path, out: Option<PathBuf>, instants: &Instants) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| default_output_dir(scene));
+    if let Instants::Seconds(times) = instants {
+        let staging = (0..times.len())
+            .map(|i| instant_folder(&out, i, times[i], times.len() > 1))
+            .map(|folder| staging_folder(&folder, std::process::id()))
+            .collect();
+        cli::signals::remove_on_interrupt(staging, vec![out.clone()]);
+    } else {
+        let staging = vec![staging_folder(&out, std::process::id())];
+        cli::signals::remove_on_interrupt(staging, vec![]);
+    }
     let renders = render_scene_at(scene, &out, instants, &TerminalProgress::new())?;
-    for r in &renders {
+    report_instants(scene, &out, &renders);
+    Ok(())
+}
+
+fn report_instants(scene: &Path, out: &Path, renders: &[TimedRender]) {
+    for r in renders {
         say!(
             "rendered {} at t = {} s ({}×{}) → {}",
             scene.display(),
@@ -538,17 +556,24 @@ fn render_instants(scene: &Path, out: Option<PathBuf>, instants: &Instants) -> a
     if renders.len() > 1 {
         say!("  {}", out.join("preview.gif").display());
     }
-    Ok(())
+}
+
+/// `out/<stem>_thermal/`, the default output folder of `irpol thermal`.
+fn thermal_output_dir(scene: &Path) -> PathBuf {
+    let mut dir = default_output_dir(scene).into_os_string();
+    dir.push("_thermal");
+    PathBuf::from(dir)
 }
 
 fn thermal_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {
-    let out = out.unwrap_or_else(|| {
-        let mut dir = default_output_dir(scene).into_os_string();
-        dir.push("_thermal");
-        PathBuf::from(dir)
-    });
+    let out = out.unwrap_or_else(|| thermal_output_dir(scene));
     cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
     let summary = run_thermal(scene, &out, &TerminalProgress::new())?;
+    report_thermal(scene, &out, &summary);
+    Ok(())
+}
+
+fn report_thermal(scene: &Path, out: &Path, summary: &ThermalSummary) {
     say!(
         "thermal run of {} ({} h from {}, {} vertices, {} distinct solves) in {:.2} s → {}",
         scene.display(),
@@ -563,7 +588,6 @@ fn thermal_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<(
         "  temperatures.csv, temperatures.png, summary.json and {} surface PLYs",
         summary.recorded_instants
     );
-    Ok(())
 }
 
 fn print_library(dir: &Path) -> anyhow::Result<()> {
@@ -631,6 +655,21 @@ fn demo() -> anyhow::Result<()> {
     }
     say!("the car scene, with the library just fitted:");
     render_and_summarize(Path::new("scenes/car.toml"), None)?;
-    say!("open reports/index.html for the fits and out/car/composite.png for the imagery");
+    let day = Path::new("scenes/car_day.toml");
+    say!("the car through a clear summer day, temperatures from the thermal model:");
+    let (thermal_out, render_out) = (thermal_output_dir(day), default_output_dir(day));
+    let (summary, renders) = run_thermal_and_render(
+        day,
+        &thermal_out,
+        &render_out,
+        &parse_sweep("0:86400:10800", "times")?,
+        &TerminalProgress::new(),
+    )?;
+    report_thermal(day, &thermal_out, &summary);
+    report_instants(day, &render_out, &renders);
+    say!(
+        "open reports/index.html for the fits, out/car/composite.png for the imagery, \
+         out/car_day_thermal/temperatures.png and out/car_day/preview.gif for the day"
+    );
     Ok(())
 }

@@ -6,7 +6,7 @@ use crate::output::{write_outputs, RenderSummary};
 use crate::progress::Progress;
 use crate::render::{render, RenderError};
 use crate::scene::{load_scene, Scene, SceneError};
-use crate::thermal_scene::{scene_at, solve_scene};
+use crate::thermal_scene::{scene_at, solve_scene, ThermalSolution};
 use anyhow::Context;
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbaImage};
@@ -72,14 +72,13 @@ pub struct TimedRender {
 }
 
 /// Runs the scene's thermal model through the last instant asked for, then renders the scene at
-/// each instant. With several instants, `preview.gif` in `out_dir` animates S0 beside DoLP.
+/// each instant ([`render_solution_at`]).
 pub fn render_scene_at(
     scene_path: &Path,
     out_dir: &Path,
     instants: &Instants,
     progress: &dyn Progress,
 ) -> anyhow::Result<Vec<TimedRender>> {
-    let start = Instant::now();
     let scene = load_scene(scene_path)?;
     let setup = scene.thermal.as_deref().ok_or_else(|| {
         anyhow::anyhow!(
@@ -92,26 +91,37 @@ pub fn render_scene_at(
         Instants::Seconds(times) => times.clone(),
         Instants::Utc(text) => {
             let at = crate::emitter::parse_time_utc(text).context("--time-utc")?;
-            let seconds = (at - setup.site.start_utc).num_milliseconds() as f64 / 1000.0;
-            vec![seconds]
+            vec![(at - setup.site.start_utc).num_milliseconds() as f64 / 1000.0]
         }
     };
     let solution = solve_scene(&scene, &times, progress)
         .with_context(|| format!("{}: thermal run", scene_path.display()))?;
+    render_solution_at(&scene, &solution, &times, out_dir, progress)
+}
+
+/// Renders a thermal scene at each of `times` (recorded in `solution`). One instant renders into
+/// `out_dir` itself; several into numbered folders inside it, plus `preview.gif` animating S0
+/// beside DoLP.
+pub fn render_solution_at(
+    scene: &Scene,
+    solution: &ThermalSolution,
+    times: &[f64],
+    out_dir: &Path,
+    progress: &dyn Progress,
+) -> anyhow::Result<Vec<TimedRender>> {
     let series = times.len() > 1;
     let mut renders = Vec::with_capacity(times.len());
     for (i, &time_s) in times.iter().enumerate() {
+        let start = Instant::now();
         let index = solution
             .times_s
             .iter()
             .position(|&t| (t - time_s).abs() < 1e-6)
-            .expect("every asked instant is recorded");
-        let at = scene_at(&scene, &solution, index).map_err(|e| SceneError::new(scene_path, e))?;
-        let folder = if series {
-            out_dir.join(format!("{i:03}_{}s", time_s.round()))
-        } else {
-            out_dir.to_owned()
-        };
+            .ok_or_else(|| {
+                anyhow::anyhow!("t = {time_s} s is not an instant of the thermal run")
+            })?;
+        let at = scene_at(scene, solution, index).map_err(|e| SceneError::new(&scene.path, e))?;
+        let folder = instant_folder(out_dir, i, time_s, series);
         let summary = render_loaded(&at, &folder, progress, start)?;
         renders.push(TimedRender {
             time_s,
@@ -125,6 +135,15 @@ pub fn render_scene_at(
             .with_context(|| format!("{}: cannot write", out_dir.display()))?;
     }
     Ok(renders)
+}
+
+/// Where instant `i` at `time_s` is written: `out_dir` itself, or `out_dir/NNN_<t>s/` in a series.
+pub fn instant_folder(out_dir: &Path, i: usize, time_s: f64, series: bool) -> PathBuf {
+    if series {
+        out_dir.join(format!("{i:03}_{}s", time_s.round()))
+    } else {
+        out_dir.to_owned()
+    }
 }
 
 /// One second per frame: S0.png beside DoLP.png of each rendered instant.

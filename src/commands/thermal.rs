@@ -1,5 +1,6 @@
 //! `irpol thermal`: a scene's temperatures over its `[thermal]` run (DESIGN §1.8, §2.6).
 
+use super::render::{render_solution_at, TimedRender};
 use crate::output::thermal::{write_thermal_outputs, ThermalSummary};
 use crate::progress::Progress;
 use crate::scene::load_scene;
@@ -22,4 +23,24 @@ pub fn run_thermal(
     let seconds = start.elapsed().as_secs_f64();
     write_thermal_outputs(&scene, &solution, out_dir, seconds)
         .with_context(|| format!("{}: cannot write", out_dir.display()))
+}
+
+/// The thermal run written to `thermal_out` and rendered at `times` into `render_out`, from one
+/// solve (the demo's day of the car).
+pub fn run_thermal_and_render(
+    scene_path: &Path,
+    thermal_out: &Path,
+    render_out: &Path,
+    times: &[f64],
+    progress: &dyn Progress,
+) -> anyhow::Result<(ThermalSummary, Vec<TimedRender>)> {
+    let start = Instant::now();
+    let scene = load_scene(scene_path)?;
+    let solution = solve_scene(&scene, times, progress)
+        .with_context(|| format!("{}: thermal run", scene_path.display()))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let summary = write_thermal_outputs(&scene, &solution, thermal_out, seconds)
+        .with_context(|| format!("{}: cannot write", thermal_out.display()))?;
+    let renders = render_solution_at(&scene, &solution, times, render_out, progress)?;
+    Ok((summary, renders))
 }

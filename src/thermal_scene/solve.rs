@@ -76,7 +76,11 @@ const DAY_S: f64 = 86_400.0;
 /// (through the first day too when it is spun up), and which of them are recorded.
 fn sample_times(setup: &ThermalSetup, extra: &[f64]) -> (Vec<f64>, Vec<bool>) {
     let end = setup.duration_s;
-    let sampled_end = if setup.spinup_days > 0 { end.max(DAY_S) } else { end };
+    let sampled_end = if setup.spinup_days > 0 {
+        end.max(DAY_S)
+    } else {
+        end
+    };
     let mut times: Vec<(f64, bool)> = Vec::new();
     let mut push_grid = |step: f64, last: f64, record: bool| {
         let n = (last / step).floor() as usize;
@@ -330,7 +334,9 @@ impl Run<'_> {
         class: &[usize],
         histories: &[History],
     ) -> ThermalSolution {
-        let recorded: Vec<usize> = (0..self.run_samples).filter(|&j| self.recorded[j]).collect();
+        let recorded: Vec<usize> = (0..self.run_samples)
+            .filter(|&j| self.recorded[j])
+            .collect();
         let mut surface_k = vec![mesh.temperatures.clone(); recorded.len()];
         for (i, &v) in vertices.index.iter().enumerate() {
             let history = &histories[class[i]];
