@@ -433,3 +433,52 @@ fn bad_parameters_are_refused_with_a_clear_error() {
         assert!(message.contains(needle), "{message:?} lacks {needle:?}");
     }
 }
+
+/// Hemispherical emissivity (the thermal model's default ε, DESIGN §1.8): in the smooth limit it
+/// is 1 − 2∫ R(θ) cosθ sinθ dθ with R the unpolarized Fresnel reflectance, integrated here by a
+/// 20 000-point midpoint rule in θ; ρ_d lowers it by exactly ρ_d; a rough surface agrees with a
+/// brute-force midpoint integral of its own ε0(θ).
+#[test]
+fn hemispherical_emissivity_is_the_flux_weighted_mean() {
+    let eps = RefractiveIndex::new(1.5, 0.1).permittivity();
+    let n = 20_000;
+    let smooth_reference: f64 = 1.0
+        - (0..n)
+            .map(|i| {
+                let theta = (i as f64 + 0.5) / n as f64 * std::f64::consts::FRAC_PI_2;
+                let (rs, rp) = fresnel_amplitudes(theta.cos(), eps);
+                let r = 0.5 * (rs.norm_sqr() + rp.norm_sqr());
+                2.0 * r * theta.cos() * theta.sin() * std::f64::consts::FRAC_PI_2 / n as f64
+            })
+            .sum::<f64>();
+    let cauchy = |sigma| SlopeDistribution::Cauchy { sigma, q: 4.0 };
+    let smooth = model(cauchy(0.0002), Shadowing::Smith, 1.5, 0.1, 0.0);
+    let e = smooth.hemispherical_emissivity();
+    assert!(
+        (e - smooth_reference).abs() < 2e-4,
+        "{e} vs {smooth_reference}"
+    );
+
+    let rough = model(cauchy(0.2), Shadowing::Smith, 1.5, 0.1, 0.0);
+    let with_rho = model(cauchy(0.2), Shadowing::Smith, 1.5, 0.1, 0.05);
+    let (a, b) = (
+        rough.hemispherical_emissivity(),
+        with_rho.hemispherical_emissivity(),
+    );
+    assert!((a - b - 0.05).abs() < 1e-9, "{a} − {b}");
+
+    let quad = HemisphereQuadrature::default();
+    let m = 400;
+    let brute: f64 = (0..m)
+        .map(|i| {
+            let theta = (i as f64 + 0.5) / m as f64 * std::f64::consts::FRAC_PI_2;
+            let e0 = rough.emissivity(theta, &quad)[0];
+            2.0 * e0 * theta.cos() * theta.sin() * std::f64::consts::FRAC_PI_2 / m as f64
+        })
+        .sum();
+    assert!((a - brute).abs() < 1e-4, "{a} vs brute force {brute}");
+    assert!(
+        a > smooth_reference,
+        "roughness raises ε: {a} vs {smooth_reference}"
+    );
+}

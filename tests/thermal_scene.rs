@@ -409,3 +409,40 @@ fn render_needs_an_instant_for_thermal_scenes_and_a_thermal_scene_for_instants()
     assert!(!ok && stderr.contains("no [thermal] section"), "{stderr}");
     assert!(!out.exists());
 }
+
+/// A weather file that is too short, or broken, is refused naming the file (and its line).
+#[test]
+fn bad_weather_files_are_refused_by_file_and_line() {
+    let cases = [
+        (
+            "time_s,air_temperature_k\n0,290\n43200,295\n",
+            "duration_h = 24",
+            "the weather covers 0…43200 s but the run needs 0…86400 s",
+        ),
+        (
+            "time_s,air_temperature_k\n0,290\n600,291\n300,292\n",
+            "",
+            "weather.csv:4:1: column 'time_s': 300 s is not after 600 s",
+        ),
+        ("air_temperature_k\n290\n291\n", "", "weather.csv"),
+    ];
+    for (csv, extra, expected) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("weather.csv"), csv).unwrap();
+        let text = scene_text(extra).replace(
+            "weather = { clear_day = { air_min_k = 287.0, air_max_k = 301.0, wind_m_s = 2.0 } }",
+            "weather = \"weather.csv\"",
+        );
+        let scene = write_scene(dir.path(), &text);
+        let out = dir.path().join("out");
+        let (ok, _, stderr) = irpol(&[
+            "thermal",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!ok && stderr.contains(expected), "{expected}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+        assert!(!out.exists());
+    }
+}

@@ -146,7 +146,7 @@ pub fn instant_folder(out_dir: &Path, i: usize, time_s: f64, series: bool) -> Pa
     }
 }
 
-/// One second per frame: S0.png beside DoLP.png of each rendered instant.
+/// One second per frame: the instant above S0.png beside DoLP.png of each rendered instant.
 fn animated_preview(renders: &[TimedRender]) -> anyhow::Result<Vec<u8>> {
     let mut frames = Vec::with_capacity(renders.len());
     for r in renders {
@@ -157,13 +157,21 @@ fn animated_preview(renders: &[TimedRender]) -> anyhow::Result<Vec<u8>> {
                 .to_rgba8())
         };
         let (s0, dolp) = (panel("S0.png")?, panel("DoLP.png")?);
+        let label = match &r.summary.thermal_instant {
+            Some(i) => format!("{}   (t = {} s)", i.time_utc, i.time_s),
+            None => format!("t = {} s", r.time_s),
+        };
+        let width = s0.width() + dolp.width();
+        let header = caption_strip(&label, width)?;
+        let top = i64::from(header.height());
         let mut frame = RgbaImage::from_pixel(
-            s0.width() + dolp.width(),
-            s0.height().max(dolp.height()),
+            width,
+            header.height() + s0.height().max(dolp.height()),
             image::Rgba([255, 255, 255, 255]),
         );
-        image::imageops::overlay(&mut frame, &s0, 0, 0);
-        image::imageops::overlay(&mut frame, &dolp, i64::from(s0.width()), 0);
+        image::imageops::overlay(&mut frame, &header, 0, 0);
+        image::imageops::overlay(&mut frame, &s0, 0, top);
+        image::imageops::overlay(&mut frame, &dolp, i64::from(s0.width()), top);
         frames.push(Frame::from_parts(
             frame,
             0,
@@ -178,4 +186,23 @@ fn animated_preview(renders: &[TimedRender]) -> anyhow::Result<Vec<u8>> {
         encoder.encode_frames(frames)?;
     }
     Ok(bytes)
+}
+
+/// A white strip `width` pixels wide with `text` on it.
+fn caption_strip(text: &str, width: u32) -> anyhow::Result<RgbaImage> {
+    use plotters::prelude::*;
+    const HEIGHT: u32 = 26;
+    crate::report::register_fonts();
+    let mut rgb = vec![255u8; (width * HEIGHT * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (width, HEIGHT)).into_drawing_area();
+        let style = (crate::report::FONT, 17).into_font().color(&BLACK);
+        root.draw(&Text::new(text.to_owned(), (8, 4), style))
+            .map_err(|e| anyhow::anyhow!("cannot draw the preview caption: {e}"))?;
+        root.present()
+            .map_err(|e| anyhow::anyhow!("cannot draw the preview caption: {e}"))?;
+    }
+    let strip = image::RgbImage::from_raw(width, HEIGHT, rgb)
+        .ok_or_else(|| anyhow::anyhow!("caption buffer has the wrong size"))?;
+    Ok(image::DynamicImage::ImageRgb8(strip).to_rgba8())
 }
