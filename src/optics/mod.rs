@@ -8,7 +8,9 @@ mod polarization;
 
 pub use frame::{rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame};
 pub use fresnel::{fresnel_amplitudes, FresnelFractions, RefractiveIndex};
-pub use planck::{Band, OpticsError, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
+pub use planck::{
+    valid_temperature, Band, OpticsError, MAX_TEMPERATURE_K, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM,
+};
 pub use polarization::{
     fresnel_mueller, jones_to_mueller, rotate_stokes, stokes_rotator, Mueller, Stokes,
 };

@@ -26,6 +26,16 @@ pub const MIN_WAVELENGTH_UM: f64 = 0.1;
 /// 2000 panels (an 8 µm–1 km band asked for 2·10⁹).
 pub const MAX_WAVELENGTH_UM: f64 = 1000.0;
 
+/// The hottest temperature a scene or a weather file may give (K): far above any thermal scene,
+/// and low enough that band radiances and their statistics stay finite (1e308 K overflowed them
+/// to NaN).
+pub const MAX_TEMPERATURE_K: f64 = 1e4;
+
+/// Whether `t` is a temperature a scene may hold: finite, in [0, [`MAX_TEMPERATURE_K`]].
+pub fn valid_temperature(t: f64) -> bool {
+    t.is_finite() && (0.0..=MAX_TEMPERATURE_K).contains(&t)
+}
+
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum OpticsError {
     #[error("sensor band {}–{} µm is invalid: need 0.1 ≤ lower < upper ≤ 1000 µm", number(*.lo_um), number(*.hi_um))]

@@ -5,7 +5,7 @@
 use super::staged_folder::StagedFolder;
 use super::thermal_plot::temperature_plot_png;
 use crate::scene::Scene;
-use crate::thermal_scene::{vertex_surfaces, SolveStats, ThermalSolution};
+use crate::thermal_scene::{part_series, PartSeries, SolveStats, ThermalSolution};
 use ply_rs_bw::ply::{
     Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType,
     ScalarType,
@@ -14,44 +14,6 @@ use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::io;
 use std::path::Path;
-
-/// Min, mean and max over one part's vertices at every recorded instant.
-pub struct PartSeries {
-    /// `object/part`.
-    pub name: String,
-    /// (min, mean, max) per recorded instant (K).
-    pub surface_k: Vec<[f64; 3]>,
-}
-
-/// Every part's series, in scene order.
-pub fn part_series(scene: &Scene, solution: &ThermalSolution) -> Vec<PartSeries> {
-    let vertex_surface = vertex_surfaces(scene);
-    scene
-        .surfaces
-        .iter()
-        .enumerate()
-        .map(|(s, surface)| {
-            let vertices: Vec<usize> = (0..vertex_surface.len())
-                .filter(|&v| vertex_surface[v] as usize == s)
-                .collect();
-            let surface_k = solution
-                .surface_k
-                .iter()
-                .map(|row| {
-                    let values = vertices.iter().map(|&v| row[v]);
-                    let min = values.clone().fold(f64::INFINITY, f64::min);
-                    let max = values.clone().fold(f64::NEG_INFINITY, f64::max);
-                    let mean = values.sum::<f64>() / vertices.len().max(1) as f64;
-                    [min, mean, max]
-                })
-                .collect();
-            PartSeries {
-                name: format!("{}/{}", scene.object_names[surface.object], surface.part),
-                surface_k,
-            }
-        })
-        .collect()
-}
 
 /// `temperatures.csv`: `time_s,part,t_surface_min_k,t_surface_mean_k,t_surface_max_k`.
 pub fn temperatures_csv(times_s: &[f64], parts: &[PartSeries]) -> String {

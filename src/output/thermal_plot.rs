@@ -1,11 +1,10 @@
 //! The temperature plot of a thermal run: every part's surface temperature over time (mean line,
 //! min–max band over its vertices), the air temperature dashed, sunrise and sunset marked.
 
-use super::thermal::PartSeries;
 use crate::report::paper_figures::encode_png;
 use crate::report::{register_fonts, FONT};
 use crate::scene::Scene;
-use crate::thermal_scene::ThermalSolution;
+use crate::thermal_scene::{PartSeries, ThermalSolution};
 use plotters::prelude::*;
 use std::io;
 

@@ -31,14 +31,7 @@ use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-/// The hottest temperature a scene may give (K): far above any thermal scene, and low enough that
-/// band radiances and their statistics stay finite (1e308 K overflowed them to NaN).
-pub const MAX_TEMPERATURE_K: f64 = 1e4;
-
-/// Whether `t` is a temperature a scene may hold: finite, in [0, [`MAX_TEMPERATURE_K`]].
-pub fn valid_temperature(t: f64) -> bool {
-    t.is_finite() && (0.0..=MAX_TEMPERATURE_K).contains(&t)
-}
+pub use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
 
 /// A scene or one of its files is unusable; `file` is the file at fault.
 #[derive(Debug, thiserror::Error)]

@@ -4,11 +4,14 @@
 //!
 //! - [`exposure`]: sky view factors and sun visibility per vertex.
 //! - [`solve`]: the per-vertex runs and the recorded surface temperatures.
+//! - [`parts`]: min/mean/max per part over time.
 //! - [`instant`]: the scene rebuilt at a recorded instant, for rendering.
 
 pub mod exposure;
 pub mod instant;
+pub mod parts;
 pub mod solve;
 
 pub use instant::scene_at;
+pub use parts::{part_series, PartSeries};
 pub use solve::{solve_scene, vertex_surfaces, SolveStats, ThermalRunError, ThermalSolution};

@@ -21,7 +21,7 @@ use super::{
     WeatherError, WeatherSample, CLEAR_DAY_STEP_S, MAX_CLEAR_DAY_DURATION_S,
 };
 use crate::emitter::{format_time_utc, sun_position, SunError};
-use crate::scene::MAX_TEMPERATURE_K;
+use crate::optics::MAX_TEMPERATURE_K;
 use chrono::{DateTime, TimeDelta, Utc};
 use solar_positioning::{delta_t, Horizon, Location, SolarEvents};
 

@@ -11,7 +11,7 @@
 
 use super::{nlerp_defined, swinbank_longwave_w_m2, Site, Weather, WeatherError, WeatherSample};
 use crate::emitter::{format_time_utc, sun_direction, sun_position};
-use crate::scene::MAX_TEMPERATURE_K;
+use crate::optics::MAX_TEMPERATURE_K;
 use crate::text::{number, shown};
 use nalgebra::Vector3;
 use std::path::Path;

@@ -1,0 +1,43 @@
+//! Per-part summaries of a thermal solution: min, mean and max surface temperature over each
+//! part's vertices at every recorded instant (`temperatures.csv` and the plot).
+
+use super::{vertex_surfaces, ThermalSolution};
+use crate::scene::Scene;
+
+/// Min, mean and max over one part's vertices at every recorded instant.
+pub struct PartSeries {
+    /// `object/part`.
+    pub name: String,
+    /// (min, mean, max) per recorded instant (K).
+    pub surface_k: Vec<[f64; 3]>,
+}
+
+/// Every part's series, in scene order.
+pub fn part_series(scene: &Scene, solution: &ThermalSolution) -> Vec<PartSeries> {
+    let vertex_surface = vertex_surfaces(scene);
+    scene
+        .surfaces
+        .iter()
+        .enumerate()
+        .map(|(s, surface)| {
+            let vertices: Vec<usize> = (0..vertex_surface.len())
+                .filter(|&v| vertex_surface[v] as usize == s)
+                .collect();
+            let surface_k = solution
+                .surface_k
+                .iter()
+                .map(|row| {
+                    let values = vertices.iter().map(|&v| row[v]);
+                    let min = values.clone().fold(f64::INFINITY, f64::min);
+                    let max = values.clone().fold(f64::NEG_INFINITY, f64::max);
+                    let mean = values.sum::<f64>() / vertices.len().max(1) as f64;
+                    [min, mean, max]
+                })
+                .collect();
+            PartSeries {
+                name: format!("{}/{}", scene.object_names[surface.object], surface.part),
+                surface_k,
+            }
+        })
+        .collect()
+}
