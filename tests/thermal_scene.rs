@@ -305,13 +305,14 @@ fn render_at_times_writes_numbered_folders_and_an_animation() {
 /// Bad thermal input: one-line errors naming the key, and nothing written.
 #[test]
 fn bad_thermal_input_is_refused_by_name_and_writes_nothing() {
-    let cases: [(&str, &str, &str); 6] = [
+    let cases: [(&str, &str, &str); 7] = [
         (
             "[[\"paint\", 0.0001], [\"stel\", 0.001]]",
             "",
             "layer 'stel' is not defined in [thermal.layers] (defined: asphalt, paint, steel)",
         ),
         ("[[\"paint\", -0.0001]]", "", "thickness must be positive"),
+        ("[[\"asphalt\", 0.1]]", "", "conductivity must be positive"),
         (
             "[[\"paint\"]]",
             "",
@@ -331,10 +332,13 @@ fn bad_thermal_input_is_refused_by_name_and_writes_nothing() {
     ];
     for (stack, extra, expected) in cases {
         let dir = tempfile::tempdir().unwrap();
-        let text = scene_text(extra).replace(
-            "stack = [[\"paint\", 0.0001], [\"steel\", 0.001]]",
-            &format!("stack = {stack}"),
-        );
+        let text = scene_text(extra)
+            .replace(
+                "stack = [[\"paint\", 0.0001], [\"steel\", 0.001]]",
+                &format!("stack = {stack}"),
+            )
+            // The asphalt case: a negative conductivity (its stack names the asphalt).
+            .replace("conductivity_w_mk = 0.75", "conductivity_w_mk = -0.75");
         let scene = write_scene(dir.path(), &text);
         let out = dir.path().join("out");
         let (ok, _, stderr) = irpol(&[
@@ -445,4 +449,55 @@ fn bad_weather_files_are_refused_by_file_and_line() {
         assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
         assert!(!out.exists());
     }
+}
+
+/// Acceptance 4 on the shipped car (`scenes/car_day.toml`, 14 h without spin-up): at 15:00 local
+/// time the ground in the car's shadow is cooler than the same ground (one part, one stack) in sun.
+#[test]
+fn the_ground_in_the_cars_shadow_is_cooler_in_the_afternoon() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(root.join("scenes/car.obj"), dir.path().join("car.obj")).unwrap();
+    let text = std::fs::read_to_string(root.join("scenes/car_day.toml"))
+        .unwrap()
+        .replace(
+            "material_library = \"../fits\"",
+            &format!(
+                "material_library = {:?}",
+                root.join("fits").display().to_string()
+            ),
+        )
+        .replace("spinup_days = 1", "spinup_days = 0")
+        .replace("duration_h = 24", "duration_h = 14");
+    let path = dir.path().join("car_day.toml");
+    std::fs::write(&path, text).unwrap();
+    let scene = load_scene(&path).unwrap();
+    let solution = solve_scene(&scene, &[], &Silent).unwrap();
+    let afternoon = record(&solution, 13.0 * 3600.0);
+    let sun = solution.weather[afternoon].sun_direction;
+    let roof = Vector3::new(0.0, 0.0, 1.0);
+    let shadow = roof - sun * (roof.z / sun.z);
+    let ground: Vec<usize> = vertex_surfaces(&scene)
+        .iter()
+        .enumerate()
+        .filter(|(_, &s)| scene.surfaces[s as usize].part == "ground")
+        .map(|(v, _)| v)
+        .collect();
+    let nearest = |p: Vector3<f64>| {
+        *ground
+            .iter()
+            .min_by(|&&a, &&b| {
+                let d = |v: usize| (scene.mesh.positions[v] - p).norm();
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+    };
+    let side = Vector3::new(-sun.y, sun.x, 0.0).normalize();
+    let (in_shadow, in_sun) = (nearest(shadow), nearest(shadow + side * 6.0));
+    let t = &solution.surface_k[afternoon];
+    println!(
+        "car_day ground at 15:00 local: {:.2} K in the car's shadow, {:.2} K in sun",
+        t[in_shadow], t[in_sun]
+    );
+    assert!(t[in_shadow] < t[in_sun] - 5.0);
 }
