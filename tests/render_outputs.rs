@@ -129,9 +129,9 @@ fn files_hold_the_rendered_channels() {
     let t = &json["apparent_temperature_k"];
     assert!(t["min"].as_f64().unwrap() < t["mean"].as_f64().unwrap());
     assert!(t["max"].as_f64().unwrap() < 300.0 && t["min"].as_f64().unwrap() > 270.0);
-    // 10 channel TIFFs, stderr_S0.tif, the EXR, 6 previews (S3 with transport), the composite
-    // and the summary.
-    assert_eq!(summary.files.len(), 20);
+    // 10 channel TIFFs, stderr_S0.tif, 6 ground-truth TIFFs, the EXR, 6 previews (S3 with
+    // transport), the composite and the summary.
+    assert_eq!(summary.files.len(), 26);
     assert!(json["timings_s"]["total"].as_f64().unwrap() > 0.0);
 }
 
@@ -269,4 +269,80 @@ fn netd_noise_has_its_stated_size_and_is_seeded() {
     assert!((mean - l).abs() < 4.0 * sigma / n.sqrt());
     assert!((std / sigma - 1.0).abs() < 0.05, "{std} vs {sigma}");
     assert!((std1 / (sigma * 2f64.sqrt()) - 1.0).abs() < 0.05);
+}
+
+fn read_tiff_with_description(path: &std::path::Path) -> (tiff::decoder::DecodingResult, String) {
+    let mut decoder =
+        tiff::decoder::Decoder::new(Cursor::new(std::fs::read(path).unwrap())).unwrap();
+    let description = decoder
+        .get_tag_ascii_string(tiff::tags::Tag::ImageDescription)
+        .unwrap();
+    (decoder.read_image().unwrap(), description)
+}
+
+/// Ground truth (issue 16 item 12): a unit sphere 4 m in front of the camera. The centre pixel
+/// sees the sphere's nearest point: depth 3 m, normal toward the camera, the typed temperature,
+/// IDs 1; the apparent temperature is the exact brightness temperature of S0; the background has
+/// zeros and IDs 0; every TIFF names the camera's intrinsics in its ImageDescription.
+#[test]
+fn ground_truth_channels_describe_the_visible_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "{}{}{}{}",
+        camera_toml(49),
+        AUTUMN_ENVIRONMENT,
+        material_toml(0.1, 1.8, 1.2, 0.2, 0.0),
+        sphere_toml(4, 305.0),
+    );
+    let path = write_scene(dir.path(), &text);
+    let out = dir.path().join("out");
+    render_scene(&path, &out, &Silent).unwrap();
+    let centre = 24 * 49 + 24;
+    let float = |name: &str| match read_tiff_with_description(&out.join(name)) {
+        (tiff::decoder::DecodingResult::F32(data), description) => (data, description),
+        _ => panic!("{name} is not float"),
+    };
+    let id = |name: &str| match read_tiff_with_description(&out.join(name)).0 {
+        tiff::decoder::DecodingResult::U32(data) => data,
+        _ => panic!("{name} is not u32"),
+    };
+    let (depth, description) = float("depth.tif");
+    // The tessellated sphere's nearest point is within its chord sag of 3 m.
+    assert!((depth[centre] - 3.0).abs() < 2e-3, "{}", depth[centre]);
+    assert_eq!(depth[0], 0.0);
+    let (normal, _) = float("normal.tif");
+    let n = &normal[3 * centre..3 * centre + 3];
+    assert!(
+        n[1] < -0.999 && n[0].abs() < 0.03 && n[2].abs() < 0.03,
+        "{n:?}"
+    );
+    let (temperature, _) = float("surface_temperature.tif");
+    assert!((temperature[centre] - 305.0).abs() < 1e-4 && temperature[0] == 0.0);
+    assert_eq!(
+        (id("object_id.tif")[centre], id("part_id.tif")[centre]),
+        (1, 1)
+    );
+    assert_eq!((id("object_id.tif")[0], id("part_id.tif")[0]), (0, 0));
+    let (apparent, _) = float("apparent_temperature.tif");
+    let (_, _, s0) = read_tiff(&out.join("S0.tif"));
+    let band = Band::lwir();
+    for i in [centre, 0, 10 * 49 + 30] {
+        let exact = band.brightness_temperature(s0[i] as f64).unwrap();
+        assert!(
+            (apparent[i] as f64 - exact).abs() < 1e-3,
+            "{} vs {exact}",
+            apparent[i]
+        );
+    }
+    let metadata: serde_json::Value = serde_json::from_str(&description).unwrap();
+    let fy = metadata["camera"]["fy_px"].as_f64().unwrap();
+    assert!((fy - 24.5 / 18f64.to_radians().tan()).abs() < 1e-9, "{fy}");
+    assert_eq!(
+        metadata["unit"],
+        "m along the optical axis (0 = background)"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["ids"]["parts"]["1"], "ball/surface");
+    assert_eq!(summary["camera"]["forward"][1], 1.0);
 }

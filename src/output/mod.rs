@@ -6,6 +6,7 @@
 
 pub mod colormap;
 pub mod figure;
+pub mod ground_truth;
 pub mod staged_folder;
 pub mod thermal;
 pub mod thermal_plot;
@@ -15,6 +16,9 @@ use crate::render::{RenderError, Rendered, Timings};
 use crate::scene::config::Shading;
 use crate::scene::{Scene, Transport};
 use crate::transport::tables::{TableResolution, TemperatureLookup};
+use ground_truth::{
+    camera_summary, id_maps, truth_images, CameraSummary, FileMetadata, IdMaps, TruthData,
+};
 use rayon::prelude::*;
 use serde::Serialize;
 use staged_folder::StagedFolder;
@@ -207,6 +211,10 @@ pub struct RenderSummary {
     /// The instant of the thermal run shown (`render --time`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub thermal_instant: Option<crate::scene::ThermalInstant>,
+    /// Intrinsics and pose (ground truth, issue 16 item 12).
+    pub camera: CameraSummary,
+    /// What the IDs of `object_id.tif` and `part_id.tif` are.
+    pub ids: IdMaps,
     pub materials: Vec<MaterialSummary>,
     pub timings_s: Timings,
     pub files: Vec<String>,
@@ -227,17 +235,22 @@ pub fn write_outputs(
         .map(|&c| (c, image.channel(c)))
         .collect();
     let previews = figure::Previews::new(scene, image);
+    let camera = camera_summary(scene);
+    let truth = truth_images(scene, image);
+    let metadata = |file: &str, unit: &str| FileMetadata::new(scene, &camera, file, unit).json();
 
     // Encode everything in memory, in parallel; write only when every encoding succeeded.
     enum Job {
         Tiff(usize),
         StandardError,
+        Truth(usize),
         Exr,
         Panel(usize),
         Composite,
     }
     let mut jobs: Vec<Job> = (0..channels.len()).map(Job::Tiff).collect();
     jobs.push(Job::StandardError);
+    jobs.extend((0..truth.len()).map(Job::Truth));
     jobs.push(Job::Exr);
     jobs.extend((0..previews.len()).map(Job::Panel));
     jobs.push(Job::Composite);
@@ -254,13 +267,27 @@ pub fn write_outputs(
             let (name, bytes) = match job {
                 Job::Tiff(i) => {
                     let (channel, data) = &channels[*i];
-                    (format!("{}.tif", channel.name()), encode_tiff(w, h, data))
+                    let name = format!("{}.tif", channel.name());
+                    let description = metadata(&name, channel.unit());
+                    let bytes = encode_tiff(w, h, &TruthData::Float(data.clone()), &description);
+                    (name, bytes)
                 }
                 Job::StandardError => {
                     let data: Vec<f32> = image.standard_error.iter().map(|e| e[0] as f32).collect();
-                    ("stderr_S0.tif".to_owned(), encode_tiff(w, h, &data))
+                    let description = metadata("stderr_S0.tif", Channel::S0.unit());
+                    let bytes = encode_tiff(w, h, &TruthData::Float(data), &description);
+                    ("stderr_S0.tif".to_owned(), bytes)
                 }
-                Job::Exr => ("stokes.exr".to_owned(), encode_exr(w, h, &channels)),
+                Job::Truth(i) => {
+                    let t = &truth[*i];
+                    let bytes = encode_tiff(w, h, &t.data, &metadata(t.file, t.unit));
+                    (t.file.to_owned(), bytes)
+                }
+                Job::Exr => {
+                    let description = metadata("stokes.exr", "per channel as in the TIFFs");
+                    let bytes = encode_exr(w, h, &channels, &description);
+                    ("stokes.exr".to_owned(), bytes)
+                }
                 Job::Panel(i) => (previews.file_name(*i).to_owned(), previews.panel_png(*i)),
                 Job::Composite => ("composite.png".to_owned(), previews.composite_png()),
             };
@@ -331,6 +358,8 @@ pub fn write_outputs(
         apparent_temperature_k: apparent,
         transport: transport_summary(scene),
         thermal_instant: scene.thermal_instant.clone(),
+        camera,
+        ids: id_maps(scene),
         materials: scene
             .materials
             .iter()
@@ -445,12 +474,41 @@ impl StokesImage {
 }
 
 /// Single-channel 32-bit IEEE float TIFF (SampleFormat = 3), uncompressed.
-fn encode_tiff(width: usize, height: usize, data: &[f32]) -> std::io::Result<Vec<u8>> {
+/// An uncompressed TIFF of `data` (32-bit float gray, float RGB for vectors, 32-bit unsigned for
+/// IDs) with `description` (JSON metadata) in its ImageDescription tag.
+fn encode_tiff(
+    width: usize,
+    height: usize,
+    data: &TruthData,
+    description: &str,
+) -> std::io::Result<Vec<u8>> {
+    use tiff::encoder::colortype::{ColorType, Gray32, Gray32Float, RGB32Float};
+    use tiff::encoder::{TiffEncoder, TiffValue};
+    use tiff::tags::Tag;
+    fn write<C: ColorType>(
+        encoder: &mut TiffEncoder<&mut Cursor<Vec<u8>>>,
+        (width, height): (u32, u32),
+        data: &[C::Inner],
+        description: &str,
+    ) -> tiff::TiffResult<()>
+    where
+        [C::Inner]: TiffValue,
+    {
+        let mut image = encoder.new_image::<C>(width, height)?;
+        image
+            .encoder()
+            .write_tag(Tag::ImageDescription, description)?;
+        image.write_data(data)
+    }
     let mut bytes = Cursor::new(Vec::new());
-    let mut encoder = tiff::encoder::TiffEncoder::new(&mut bytes).map_err(std::io::Error::other)?;
-    encoder
-        .write_image::<tiff::encoder::colortype::Gray32Float>(width as u32, height as u32, data)
-        .map_err(std::io::Error::other)?;
+    let mut encoder = TiffEncoder::new(&mut bytes).map_err(std::io::Error::other)?;
+    let size = (width as u32, height as u32);
+    match data {
+        TruthData::Float(v) => write::<Gray32Float>(&mut encoder, size, v, description),
+        TruthData::Vector(v) => write::<RGB32Float>(&mut encoder, size, v, description),
+        TruthData::Id(v) => write::<Gray32>(&mut encoder, size, v, description),
+    }
+    .map_err(std::io::Error::other)?;
     Ok(bytes.into_inner())
 }
 
@@ -459,6 +517,7 @@ fn encode_exr(
     width: usize,
     height: usize,
     channels: &[(Channel, Vec<f32>)],
+    description: &str,
 ) -> std::io::Result<Vec<u8>> {
     use exr::prelude::*;
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
@@ -473,7 +532,12 @@ fn encode_exr(
         AnyChannels::sort(list),
     );
     let mut bytes = Cursor::new(Vec::new());
-    Image::from_layer(layer)
+    let mut image = Image::from_layer(layer);
+    image.attributes.other.insert(
+        Text::from("irpol"),
+        AttributeValue::Text(Text::from(description)),
+    );
+    image
         .write()
         .to_buffered(&mut bytes)
         .map_err(std::io::Error::other)?;
@@ -488,15 +552,28 @@ mod tests {
     fn tiff_and_exr_round_trip() {
         let (w, h) = (5, 3);
         let data: Vec<f32> = (0..15).map(|i| i as f32 * 0.25 - 1.0).collect();
-        let tiff = encode_tiff(w, h, &data).unwrap();
+        let tiff = encode_tiff(w, h, &TruthData::Float(data.clone()), "{\"a\": 1}").unwrap();
         let mut decoder = tiff::decoder::Decoder::new(Cursor::new(tiff)).unwrap();
         assert_eq!(decoder.dimensions().unwrap(), (5, 3));
+        let description = decoder
+            .get_tag_ascii_string(tiff::tags::Tag::ImageDescription)
+            .unwrap();
+        assert_eq!(description, "{\"a\": 1}");
         match decoder.read_image().unwrap() {
             tiff::decoder::DecodingResult::F32(back) => assert_eq!(back, data),
             _ => panic!("not a float TIFF"),
         }
+        let ids = TruthData::Id((0..15).collect());
+        let mut decoder =
+            tiff::decoder::Decoder::new(Cursor::new(encode_tiff(w, h, &ids, "").unwrap())).unwrap();
+        match decoder.read_image().unwrap() {
+            tiff::decoder::DecodingResult::U32(back) => {
+                assert_eq!(back, (0..15).collect::<Vec<_>>())
+            }
+            _ => panic!("not a 32-bit unsigned TIFF"),
+        }
         let channels = vec![(Channel::S0, data.clone()), (Channel::Dolp, vec![0.5; 15])];
-        let exr_bytes = encode_exr(w, h, &channels).unwrap();
+        let exr_bytes = encode_exr(w, h, &channels, "{}").unwrap();
         use exr::prelude::{ReadChannels, ReadLayers};
         let image = exr::prelude::read()
             .no_deep_data()
@@ -515,6 +592,16 @@ mod tests {
             .map(|c| c.name.to_string())
             .collect();
         assert_eq!(names, vec!["DoLP", "S0"]);
+        let key = exr::prelude::Text::from("irpol");
+        let irpol = image
+            .attributes
+            .other
+            .get(&key)
+            .or(layer.attributes.other.get(&key));
+        assert!(
+            matches!(irpol, Some(exr::meta::attribute::AttributeValue::Text(t)) if t.as_slice() == b"{}"),
+            "{irpol:?}"
+        );
         let s0: Vec<f32> = layer.channel_data.list[1]
             .sample_data
             .values_as_f32()

@@ -14,6 +14,20 @@ pub struct StokesImage {
     pub standard_error: Vec<[f64; 4]>,
     /// Scene surface (object part, `Scene::surfaces`) seen at each pixel, or [`BACKGROUND`].
     pub surface: Vec<u32>,
+    /// Ground truth of the visible point at each pixel (zeros for the background).
+    pub truth: Vec<SurfaceTruth>,
+}
+
+/// The visible point at a pixel, for users who train or validate algorithms (issue 16 item 12).
+/// Single precision: these become 32-bit float images.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SurfaceTruth {
+    /// Depth along the optical axis, camera-space z (m); 0 for the background.
+    pub depth_m: f32,
+    /// Unit world-frame normal of the side the camera sees; 0 for the background.
+    pub normal: [f32; 3],
+    /// Surface temperature of the visible point (K); 0 for the background.
+    pub temperature_k: f32,
 }
 
 /// DoLP = √(S1² + S2²)/S0 (0 where S0 ≤ 0) and AoP = ½ atan2(S2, S1) in (−π/2, π/2], radians

@@ -28,7 +28,7 @@ use sensor::{through_atmosphere, Noise};
 use std::path::PathBuf;
 use std::time::Instant;
 
-pub use film::{StokesImage, BACKGROUND};
+pub use film::{StokesImage, SurfaceTruth, BACKGROUND};
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
@@ -180,12 +180,18 @@ struct PixelShader<'a> {
 }
 
 impl PixelShader<'_> {
-    /// (Stokes, standard error) of the visible point at barycentric (b1, b2) of triangle `t`,
-    /// through the atmosphere; `pixel` indexes the pixel's random stream.
-    fn shade(&self, t: usize, b1: f64, b2: f64, pixel: u64) -> ([f64; 4], [f64; 4]) {
+    /// (Stokes, standard error, ground truth) of the visible point at barycentric (b1, b2) of
+    /// triangle `t`, through the atmosphere; `pixel` indexes the pixel's random stream.
+    fn shade(&self, t: usize, b1: f64, b2: f64, pixel: u64) -> ([f64; 4], [f64; 4], SurfaceTruth) {
         let scene = self.scene;
         let hit = scene.mesh.interpolate(t, b1, b2);
         let to_camera = scene.camera.position - hit.point;
+        let seen = Vertex::seen_from(hit, &to_camera.normalize()).normal;
+        let truth = SurfaceTruth {
+            depth_m: scene.camera.to_view(&hit.point).z as f32,
+            normal: [seen.x as f32, seen.y as f32, seen.z as f32],
+            temperature_k: hit.temperature as f32,
+        };
         let (mut s, mut error) = match self.tracer {
             None => (self.open_world_value(t, &hit, &to_camera), [0.0; 4]),
             Some(tracer) => {
@@ -208,7 +214,7 @@ impl PixelShader<'_> {
             let tau = atmosphere.transmittance(range);
             error = error.map(|e| e * tau);
         }
-        (s, error)
+        (s, error, truth)
     }
 
     /// The open-world value: Gouraud-interpolated from the vertices, or shaded at the point.
@@ -259,12 +265,14 @@ fn shade_image(
     let mut stokes = vec![[0.0f64; 4]; width * height];
     let mut standard_error = vec![[0.0f64; 4]; width * height];
     let mut surface = vec![BACKGROUND; width * height];
+    let mut truth = vec![SurfaceTruth::default(); width * height];
     stokes
         .par_chunks_mut(width)
         .zip(standard_error.par_chunks_mut(width))
         .zip(surface.par_chunks_mut(width))
+        .zip(truth.par_chunks_mut(width))
         .enumerate()
-        .for_each(|(y, ((row, row_error), row_surface))| {
+        .for_each(|(y, (((row, row_error), row_surface), row_truth))| {
             for x in 0..width {
                 let fragment = fragments.fragments[y * width + x];
                 if fragment.triangle == NO_TRIANGLE {
@@ -275,7 +283,7 @@ fn shade_image(
                 }
                 let t = fragment.triangle as usize;
                 let pixel = (y * width + x) as u64;
-                (row[x], row_error[x]) =
+                (row[x], row_error[x], row_truth[x]) =
                     shader.shade(t, fragment.b1 as f64, fragment.b2 as f64, pixel);
                 row_surface[x] = scene.mesh.triangle_surface[t];
             }
@@ -288,5 +296,6 @@ fn shade_image(
         stokes,
         standard_error,
         surface,
+        truth,
     }
 }

@@ -309,7 +309,12 @@ pub struct TemperatureLookup {
 
 impl TemperatureLookup {
     pub fn new(band: &Band, lo: f64, hi: f64) -> TemperatureLookup {
-        let n = 257;
+        TemperatureLookup::with_nodes(band, lo, hi, 257)
+    }
+
+    /// The lookup with `n` ≥ 2 exact inversions (more nodes, smaller interpolation error).
+    pub fn with_nodes(band: &Band, lo: f64, hi: f64, n: usize) -> TemperatureLookup {
+        let n = n.max(2);
         let step = ((hi - lo) / (n - 1) as f64).max(1e-12);
         let values = (0..n)
             .map(|i| {
