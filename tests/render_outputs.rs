@@ -346,3 +346,55 @@ fn ground_truth_channels_describe_the_visible_point() {
     assert_eq!(summary["ids"]["parts"]["1"], "ball/surface");
     assert_eq!(summary["camera"]["forward"][1], 1.0);
 }
+
+/// Issue 16 item 9: with noise, I0…I135 are the recorded polarizer images (S0…S2 are re-estimated
+/// from them, so the identities hold to f32 rounding), and with `dofp = true` the raw mosaic holds
+/// each pixel's own orientation (pattern 90/45 over 135/0) and the demosaicked S0 follows the
+/// full-resolution S0 inside smooth regions.
+#[test]
+fn polarizer_images_are_the_recorded_ones_and_the_dofp_mosaic_samples_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "{}{}{}{}",
+        camera_toml(40),
+        AUTUMN_ENVIRONMENT,
+        material_toml(0.1, 1.8, 1.2, 0.2, 0.0),
+        sphere_toml(4, 305.0),
+    )
+    .replace(
+        "[environment]",
+        "[sensor]\nnetd_mk = 50.0\nseed = 3\ndofp = true\n\n[environment]",
+    );
+    let path = write_scene(dir.path(), &text);
+    let out = dir.path().join("out");
+    render_scene(&path, &out, &Silent).unwrap();
+    let read = |name: &str| read_tiff(&out.join(name)).2;
+    let (s0, s1, s2) = (read("S0.tif"), read("S1.tif"), read("S2.tif"));
+    let i: Vec<Vec<f32>> = ["I0.tif", "I45.tif", "I90.tif", "I135.tif"]
+        .iter()
+        .map(|n| read(n))
+        .collect();
+    let mut redundancy = 0.0f64;
+    for p in 0..40 * 40 {
+        let sum = 0.5 * (i[0][p] + i[1][p] + i[2][p] + i[3][p]);
+        assert!((s0[p] - sum).abs() < 1e-4 * s0[p].abs().max(1.0));
+        assert!((s1[p] - (i[0][p] - i[2][p])).abs() < 1e-4);
+        assert!((s2[p] - (i[1][p] - i[3][p])).abs() < 1e-4);
+        // I0 + I90 − I45 − I135 is pure noise in recorded images (zero if re-derived from S).
+        redundancy += f64::from(i[0][p] + i[2][p] - i[1][p] - i[3][p]).powi(2);
+    }
+    assert!(
+        redundancy > 0.0,
+        "the polarizer images were re-derived from the Stokes images"
+    );
+    let raw = read("dofp_mosaic.tif");
+    let expected = [[2, 1], [3, 0]];
+    for (x, y) in [(0, 0), (1, 0), (0, 1), (1, 1), (17, 22), (20, 20)] {
+        let k = expected[y % 2][x % 2];
+        assert_eq!(raw[y * 40 + x], i[k][y * 40 + x], "({x},{y})");
+    }
+    let dofp_s0 = read("dofp_S0.tif");
+    let centre = 20 * 40 + 20;
+    assert!((dofp_s0[centre] / s0[centre] - 1.0).abs() < 0.01);
+    assert_eq!(read("dofp_DoLP.tif").len(), 1600);
+}

@@ -18,6 +18,7 @@ use crate::scene::{Scene, Transport};
 use crate::transport::tables::{TableResolution, TemperatureLookup};
 use ground_truth::{
     camera_summary, id_maps, truth_images, CameraSummary, FileMetadata, IdMaps, TruthData,
+    TruthImage,
 };
 use rayon::prelude::*;
 use serde::Serialize;
@@ -79,6 +80,17 @@ impl Channel {
         }
     }
 
+    /// Which of I0, I45, I90, I135 the channel is, if a polarizer image.
+    pub fn polarizer_index(self) -> Option<usize> {
+        match self {
+            Channel::I0 => Some(0),
+            Channel::I45 => Some(1),
+            Channel::I90 => Some(2),
+            Channel::I135 => Some(3),
+            _ => None,
+        }
+    }
+
     /// The channel's value for a pixel-frame Stokes vector.
     #[inline]
     pub fn value(self, s: [f64; 4]) -> f64 {
@@ -99,8 +111,15 @@ impl Channel {
 }
 
 impl StokesImage {
-    /// One channel as 32-bit floats, row-major from the top.
+    /// One channel as 32-bit floats, row-major from the top. The polarizer images are the
+    /// recorded (noisy) ones when the sensor has noise, not re-derived from the Stokes estimate.
     pub fn channel(&self, channel: Channel) -> Vec<f32> {
+        if let (Some(k), false) = (
+            channel.polarizer_index(),
+            self.recorded_polarizers.is_empty(),
+        ) {
+            return self.recorded_polarizers.iter().map(|i| i[k]).collect();
+        }
         self.stokes
             .iter()
             .map(|&s| channel.value(s) as f32)
@@ -236,7 +255,10 @@ pub fn write_outputs(
         .collect();
     let previews = figure::Previews::new(scene, image);
     let camera = camera_summary(scene);
-    let truth = truth_images(scene, image);
+    let mut truth = truth_images(scene, image);
+    if scene.sensor.dofp {
+        truth.extend(dofp_images(image));
+    }
     let metadata = |file: &str, unit: &str| FileMetadata::new(scene, &camera, file, unit).json();
 
     // Encode everything in memory, in parallel; write only when every encoding succeeded.
@@ -406,6 +428,59 @@ fn earlier_outputs(out_dir: &Path) -> Vec<String> {
                 .collect()
         })
         .unwrap_or_default()
+}
+
+/// `[sensor] dofp = true`: the raw division-of-focal-plane mosaic and the Stokes, DoLP and AoP
+/// images demosaicked from it (`render::dofp`).
+fn dofp_images(image: &StokesImage) -> Vec<TruthImage> {
+    use crate::render::dofp::{demosaic, mosaic, stokes_from_polarizers};
+    let polarizers: Vec<[f32; 4]> = if image.recorded_polarizers.is_empty() {
+        let exact = [Channel::I0, Channel::I45, Channel::I90, Channel::I135];
+        image
+            .stokes
+            .iter()
+            .map(|&s| exact.map(|c| c.value(s) as f32))
+            .collect()
+    } else {
+        image.recorded_polarizers.clone()
+    };
+    let raw = mosaic(image.width, &polarizers);
+    let stokes: Vec<[f32; 3]> = demosaic(image.width, image.height, &raw)
+        .into_iter()
+        .map(stokes_from_polarizers)
+        .collect();
+    let derived = |f: fn([f64; 4]) -> f64| {
+        stokes
+            .iter()
+            .map(|s| f([s[0] as f64, s[1] as f64, s[2] as f64, 0.0]) as f32)
+            .collect()
+    };
+    let radiance = "W m-2 sr-1";
+    let image_of = |file, unit, data| TruthImage {
+        file,
+        unit,
+        data: TruthData::Float(data),
+    };
+    vec![
+        image_of("dofp_mosaic.tif", radiance, raw),
+        image_of(
+            "dofp_S0.tif",
+            radiance,
+            stokes.iter().map(|s| s[0]).collect(),
+        ),
+        image_of(
+            "dofp_S1.tif",
+            radiance,
+            stokes.iter().map(|s| s[1]).collect(),
+        ),
+        image_of(
+            "dofp_S2.tif",
+            radiance,
+            stokes.iter().map(|s| s[2]).collect(),
+        ),
+        image_of("dofp_DoLP.tif", "1", derived(|s| dolp_aop(s).0)),
+        image_of("dofp_AoP.tif", "rad", derived(|s| dolp_aop(s).1)),
+    ]
 }
 
 /// The Stokes component a channel is, if it is one.

@@ -16,6 +16,10 @@ pub struct StokesImage {
     pub surface: Vec<u32>,
     /// Ground truth of the visible point at each pixel (zeros for the background).
     pub truth: Vec<SurfaceTruth>,
+    /// With detector noise: the noisy polarizer images I0, I45, I90, I135 per pixel as the camera
+    /// records them (each with its own noise; the Stokes vectors are re-estimated from them).
+    /// Empty without noise, where I(α) follows from the Stokes vector exactly.
+    pub recorded_polarizers: Vec<[f32; 4]>,
 }
 
 /// The visible point at a pixel, for users who train or validate algorithms (issue 16 item 12).

@@ -4,6 +4,7 @@
 //! the atmosphere and detector noise ([`sensor`]) onto the [`film`]. Nothing here writes files
 //! (that is [`crate::output`]) or prints (progress goes to a [`Progress`] callback).
 
+pub mod dofp;
 pub mod film;
 pub mod raster;
 pub mod sensor;
@@ -266,30 +267,41 @@ fn shade_image(
     let mut standard_error = vec![[0.0f64; 4]; width * height];
     let mut surface = vec![BACKGROUND; width * height];
     let mut truth = vec![SurfaceTruth::default(); width * height];
+    let recorded_len = if noise.is_noisy() { width * height } else { 0 };
+    let mut recorded = vec![[0.0f32; 4]; recorded_len];
+    // Without noise `recorded` is empty: each row gets an empty slice.
+    let mut recorded_rows: Vec<&mut [[f32; 4]]> = if recorded_len > 0 {
+        recorded.chunks_mut(width).collect()
+    } else {
+        (0..height).map(|_| &mut [][..]).collect()
+    };
     stokes
         .par_chunks_mut(width)
         .zip(standard_error.par_chunks_mut(width))
         .zip(surface.par_chunks_mut(width))
         .zip(truth.par_chunks_mut(width))
+        .zip(recorded_rows.par_iter_mut())
         .enumerate()
-        .for_each(|(y, (((row, row_error), row_surface), row_truth))| {
-            for x in 0..width {
-                let fragment = fragments.fragments[y * width + x];
-                if fragment.triangle == NO_TRIANGLE {
-                    // The sky or ground of the environment model, seen directly.
-                    let ray = scene.camera.ray_direction(x as f64 + 0.5, y as f64 + 0.5);
-                    row[x] = [scene.environment.radiance(&ray), 0.0, 0.0, 0.0];
-                    continue;
+        .for_each(
+            |(y, ((((row, row_error), row_surface), row_truth), row_recorded))| {
+                for x in 0..width {
+                    let fragment = fragments.fragments[y * width + x];
+                    if fragment.triangle == NO_TRIANGLE {
+                        // The sky or ground of the environment model, seen directly.
+                        let ray = scene.camera.ray_direction(x as f64 + 0.5, y as f64 + 0.5);
+                        row[x] = [scene.environment.radiance(&ray), 0.0, 0.0, 0.0];
+                        continue;
+                    }
+                    let t = fragment.triangle as usize;
+                    let pixel = (y * width + x) as u64;
+                    (row[x], row_error[x], row_truth[x]) =
+                        shader.shade(t, fragment.b1 as f64, fragment.b2 as f64, pixel);
+                    row_surface[x] = scene.mesh.triangle_surface[t];
                 }
-                let t = fragment.triangle as usize;
-                let pixel = (y * width + x) as u64;
-                (row[x], row_error[x], row_truth[x]) =
-                    shader.shade(t, fragment.b1 as f64, fragment.b2 as f64, pixel);
-                row_surface[x] = scene.mesh.triangle_surface[t];
-            }
-            noise.apply_to_row(y, row);
-            tick();
-        });
+                noise.apply_to_row(y, row, row_recorded);
+                tick();
+            },
+        );
     StokesImage {
         width,
         height,
@@ -297,5 +309,6 @@ fn shade_image(
         standard_error,
         surface,
         truth,
+        recorded_polarizers: recorded,
     }
 }

@@ -52,18 +52,28 @@ impl Noise {
         }
     }
 
-    /// Adds polarizer-image noise to a row of Stokes vectors and re-estimates them.
-    /// S3 is not measured by linear polarizers and is left as it is.
-    pub fn apply_to_row(&self, row: usize, stokes: &mut [[f64; 4]]) {
-        if self.sigma_polarizer <= 0.0 {
+    /// Whether the sensor adds noise at all.
+    pub fn is_noisy(&self) -> bool {
+        self.sigma_polarizer > 0.0
+    }
+
+    /// Adds polarizer-image noise to a row of Stokes vectors and re-estimates them; the noisy
+    /// polarizer images themselves (what the camera records) go into `recorded` (I0, I45, I90,
+    /// I135 per pixel) when it is not empty. S3 is not measured by linear polarizers and is left
+    /// as it is.
+    pub fn apply_to_row(&self, row: usize, stokes: &mut [[f64; 4]], recorded: &mut [[f32; 4]]) {
+        if !self.is_noisy() {
             return;
         }
         let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
         rng.set_stream(row as u64);
-        for s in stokes.iter_mut() {
+        for (x, s) in stokes.iter_mut().enumerate() {
             let i = [0.0, FRAC_PI_4, FRAC_PI_2, 3.0 * FRAC_PI_4].map(|alpha| {
                 polarizer(*s, alpha) + self.sigma_polarizer * standard_normal(&mut rng)
             });
+            if let Some(r) = recorded.get_mut(x) {
+                *r = i.map(|v| v as f32);
+            }
             *s = [
                 0.5 * (i[0] + i[1] + i[2] + i[3]),
                 i[0] - i[2],
@@ -105,10 +115,29 @@ mod tests {
             seed: 7,
         };
         let mut row = vec![[5.0, 0.2, -0.1, 0.0]; 20_000];
-        noise.apply_to_row(3, &mut row);
+        let mut recorded = vec![[0.0f32; 4]; 20_000];
+        noise.apply_to_row(3, &mut row, &mut recorded);
         let mut again = vec![[5.0, 0.2, -0.1, 0.0]; 20_000];
-        noise.apply_to_row(3, &mut again);
+        noise.apply_to_row(3, &mut again, &mut []);
         assert_eq!(row, again);
+        // The Stokes vectors are the re-estimate from the recorded polarizer images.
+        for (s, i) in row.iter().zip(&recorded).take(100) {
+            let i = i.map(f64::from);
+            assert!((s[0] - 0.5 * (i[0] + i[1] + i[2] + i[3])).abs() < 1e-5);
+            assert!((s[1] - (i[0] - i[2])).abs() < 1e-5 && (s[2] - (i[1] - i[3])).abs() < 1e-5);
+        }
+        // Each recorded image has its own noise: I0's spread is σ_I, not that of ½(S0 + S1).
+        let mean_i0 = recorded.iter().map(|i| i[0] as f64).sum::<f64>() / 20_000.0;
+        let var_i0 = recorded
+            .iter()
+            .map(|i| (i[0] as f64 - mean_i0).powi(2))
+            .sum::<f64>()
+            / 20_000.0;
+        assert!(
+            (var_i0.sqrt() / 0.01 - 1.0).abs() < 0.03,
+            "{}",
+            var_i0.sqrt()
+        );
         let n = row.len() as f64;
         let mean0 = row.iter().map(|s| s[0]).sum::<f64>() / n;
         let var0 = row.iter().map(|s| (s[0] - mean0).powi(2)).sum::<f64>() / n;
@@ -118,7 +147,7 @@ mod tests {
         assert!((var0.sqrt() / 0.01 - 1.0).abs() < 0.03, "{}", var0.sqrt());
         assert!((var1.sqrt() / (0.01 * 2f64.sqrt()) - 1.0).abs() < 0.03);
         let mut other = vec![[5.0, 0.2, -0.1, 0.0]; 10];
-        noise.apply_to_row(4, &mut other);
+        noise.apply_to_row(4, &mut other, &mut []);
         assert_ne!(other[0], row[0]);
     }
 }

@@ -153,6 +153,9 @@ pub struct SensorConfig {
     pub seed: u64,
     /// Temperature at which NETD is converted to radiance (dL/dT); default the air temperature.
     pub netd_reference_k: Option<f64>,
+    /// Also write the raw division-of-focal-plane mosaic and the Stokes images demosaicked from it.
+    #[serde(default)]
+    pub dofp: bool,
 }
 
 fn lwir_band() -> [f64; 2] {
@@ -167,6 +170,7 @@ impl Default for SensorConfig {
             netd_mk: 0.0,
             seed: 0,
             netd_reference_k: None,
+            dofp: false,
         }
     }
 }

@@ -79,6 +79,8 @@ pub struct Sensor {
     pub netd_mk: f64,
     pub seed: u64,
     pub netd_reference_k: f64,
+    /// Write the division-of-focal-plane mosaic and its demosaicked Stokes images too.
+    pub dofp: bool,
 }
 
 /// Optional atmospheric path: S_sensor = τ S + (1 − τ) L_bb(T_path) δ_j0, τ = exp(−β·range).
@@ -323,6 +325,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
             netd_mk: s.netd_mk,
             seed: s.seed,
             netd_reference_k,
+            dofp: s.dofp,
         },
         air_temperature_k: air,
         environment,
