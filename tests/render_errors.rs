@@ -289,3 +289,32 @@ fn wrong_lengths_and_absurd_temperatures() {
         expect(&text, pieces);
     }
 }
+
+/// `[render.preview]` ranges are checked when the scene loads (issue 16 item 4).
+#[test]
+fn preview_ranges_are_checked_by_key() {
+    for (table, expected) in [
+        (
+            "percentiles = [50.0, 10.0]",
+            "render.preview.percentiles = [50, 10] must be two finite numbers, low < high",
+        ),
+        (
+            "percentiles = [-1.0, 99.0]",
+            "render.preview.percentiles = [-1, 99] must lie within [0, 100]",
+        ),
+        ("dolp_percent = [5.0, 5.0]", "render.preview.dolp_percent"),
+        ("s0_colormap = \"rainbow\"", "unknown variant `rainbow`"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let text = format!(
+            "{}{}{}{}[render.preview]\n{table}\n",
+            common::camera_toml(8),
+            common::AUTUMN_ENVIRONMENT,
+            common::material_toml(0.1, 1.8, 1.2, 0.2, 0.0),
+            common::sphere_toml(1, 300.0),
+        );
+        let path = common::write_scene(dir.path(), &text);
+        let err = irpol::scene::load_scene(&path).unwrap_err().to_string();
+        assert!(err.contains(expected), "{expected}: {err}");
+    }
+}

@@ -2,9 +2,12 @@
 //! S1/S2 (white at zero), a viridis-like sequential map for DoLP, and a cyclic hue wheel for AoP
 //! (AoP = −90° and +90° are the same orientation and get the same colour).
 
-/// Piecewise-linear map through (position, RGB) anchors on [0, 1].
+/// Piecewise-linear map through (position, RGB) anchors on [0, 1], with the colours of values
+/// below and above the displayed range (chosen to stand out from the map itself).
 pub struct ColorMap {
     anchors: &'static [(f64, [u8; 3])],
+    pub under: [u8; 3],
+    pub over: [u8; 3],
 }
 
 pub const THERMAL: ColorMap = ColorMap {
@@ -17,6 +20,15 @@ pub const THERMAL: ColorMap = ColorMap {
         (0.9, [255, 220, 80]),
         (1.0, [255, 255, 230]),
     ],
+    under: [0, 150, 255],
+    over: [0, 220, 0],
+};
+
+/// White-hot grey scale, as thermal cameras show it.
+pub const GRAY: ColorMap = ColorMap {
+    anchors: &[(0.0, [0, 0, 0]), (1.0, [255, 255, 255])],
+    under: [0, 90, 255],
+    over: [255, 40, 0],
 };
 
 pub const DIVERGING: ColorMap = ColorMap {
@@ -27,6 +39,8 @@ pub const DIVERGING: ColorMap = ColorMap {
         (0.75, [225, 130, 110]),
         (1.0, [180, 30, 40]),
     ],
+    under: [0, 150, 0],
+    over: [150, 255, 120],
 };
 
 pub const SEQUENTIAL: ColorMap = ColorMap {
@@ -37,6 +51,8 @@ pub const SEQUENTIAL: ColorMap = ColorMap {
         (0.75, [94, 201, 98]),
         (1.0, [253, 231, 37]),
     ],
+    under: [255, 0, 255],
+    over: [255, 0, 255],
 };
 
 /// Masked pixels (AoP where the polarization is too weak to have an angle).

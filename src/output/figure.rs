@@ -1,13 +1,16 @@
 //! PNG previews with colour bars (S0 as apparent temperature, S1/S2 diverging about zero, DoLP
 //! sequential, AoP cyclic and masked where DoLP is below the scene's threshold) and a composite
-//! figure in the layout of the paper's Fig. 5. Colour ranges are robust: 1st–99th percentiles over
-//! the object pixels (symmetric for S1/S2), so a few glints do not wash out the image.
+//! figure in the layout of the paper's Fig. 5. Colour ranges follow `[render.preview]`: by default
+//! the 0.1th–99.9th percentiles over the object pixels (symmetric for S1/S2/S3), so a few glints do
+//! not wash out the image; values outside are drawn in the map's under/over colours, capped on the
+//! colour bar and counted in the title, never silently clipped.
 //! Text is drawn with plotters using the embedded DejaVu Sans font.
 
-use super::colormap::{cyclic, ColorMap, Lut, DIVERGING, MASKED, SEQUENTIAL, THERMAL};
+use super::colormap::{cyclic, ColorMap, Lut, DIVERGING, GRAY, MASKED, SEQUENTIAL, THERMAL};
 use crate::render::film::{dolp_aop, StokesImage, BACKGROUND};
 use crate::report::{register_fonts, FONT};
 use crate::scene::config::Shading;
+use crate::scene::config::{PreviewConfig, PreviewRange, S0Colormap};
 use crate::scene::{Scene, Transport};
 use crate::transport::tables::TemperatureLookup;
 use image::ImageEncoder;
@@ -17,6 +20,12 @@ use plotters::style::FontStyle;
 use rayon::prelude::*;
 use std::io;
 
+/// Default percentile range of the previews: wide enough that a hot hood or a strongly
+/// polarizing windshield (a few % of the pixels) stays inside the colour bar, narrow enough that
+/// a handful of glint or noise pixels does not wash the image out; what falls outside is drawn in
+/// the map's under/over colours and counted in the title.
+const DEFAULT_PERCENTILES: [f64; 2] = [0.1, 99.9];
+
 /// How a panel's colour bar is drawn: its colours bottom to top and labelled ticks.
 enum Bar {
     Linear {
@@ -24,8 +33,17 @@ enum Bar {
         lo: f64,
         hi: f64,
         format: fn(f64) -> String,
+        clipped: Clipped,
     },
     Cyclic,
+}
+
+/// Fractions of the panel's pixels below and above its colour range, drawn in the map's
+/// under/over colours (issue 16 item 4: a clip is shown, never silent).
+#[derive(Clone, Copy, Default)]
+struct Clipped {
+    below: f64,
+    above: f64,
 }
 
 struct Panel {
@@ -43,179 +61,33 @@ pub struct Previews {
     caption: String,
 }
 
+/// How a linear panel is coloured: the value of each pixel, how its range is chosen, the map.
+struct LinearPanel {
+    file: &'static str,
+    title: String,
+    /// Each pixel's value (NaN for none).
+    values: Vec<f64>,
+    fixed: Option<[f64; 2]>,
+    /// Symmetric about zero (S1, S2, S3).
+    symmetric: bool,
+    map: &'static ColorMap,
+    format: fn(f64) -> String,
+}
+
 impl Previews {
     pub fn new(scene: &Scene, image: &StokesImage) -> Previews {
-        let any_object = image.surface.iter().any(|&o| o != BACKGROUND);
-        let pick = |f: &(dyn Fn([f64; 4]) -> f64 + Sync)| -> Vec<f64> {
-            image
-                .stokes
-                .par_iter()
-                .zip(&image.surface)
-                .filter(|&(_, &surface)| surface != BACKGROUND || !any_object)
-                .map(|(&s, _)| f(s))
-                .filter(|v| v.is_finite())
-                .collect()
-        };
-        let band = &scene.sensor.band;
-
-        // S0 as apparent temperature: percentiles in radiance map to percentiles in temperature.
-        let s0 = pick(&|s| s[0]);
-        let (r_lo, r_hi) = robust_range(s0, 0.01, 0.99);
-        let t_of = |r: f64| band.brightness_temperature(r.max(0.0)).unwrap_or(0.0);
-        let (t_lo, t_hi) = widen(t_of(r_lo), t_of(r_hi));
-        let temperature = TemperatureLookup::new(band, r_lo.min(r_hi), r_hi.max(r_lo));
-        let thermal = Lut::new(&THERMAL);
-        let s0_colors = image
-            .stokes
-            .par_iter()
-            .map(|s| thermal.at((temperature.at(s[0]) - t_lo) / (t_hi - t_lo)))
+        let ranged = ranged_pixels(image);
+        let mut panels: Vec<Panel> = linear_panels(scene, image)
+            .into_iter()
+            .map(|spec| spec.panel(&ranged, &scene.preview))
             .collect();
-
-        let diverging = Lut::new(&DIVERGING);
-        let symmetric = |j: usize| {
-            let magnitudes = pick(&|s| s[j].abs());
-            let (_, hi) = robust_range(magnitudes, 0.0, 0.99);
-            let m = if hi > 0.0 { hi } else { 1.0 };
-            let colors = image
-                .stokes
-                .par_iter()
-                .map(|s| diverging.at(0.5 + 0.5 * s[j] / m))
-                .collect();
-            (colors, m)
-        };
-        let (s1_colors, s1_max) = symmetric(1);
-        let (s2_colors, s2_max) = symmetric(2);
-        // S3 only where light was transported between surfaces (the open world has none).
-        let s3_panel = matches!(scene.transport, Transport::Path(_)).then(|| {
-            let (colors, m) = symmetric(3);
-            Panel {
-                file: "S3.png",
-                title: "S3 (W·m⁻²·sr⁻¹)".into(),
-                colors,
-                bar: Bar::Linear {
-                    map: &DIVERGING,
-                    lo: -m,
-                    hi: m,
-                    format: format_signed,
-                },
-            }
-        });
-
-        let dolp = pick(&|s| dolp_aop(s).0);
-        let (_, d_hi) = robust_range(dolp, 0.0, 0.99);
-        let d_hi = if d_hi > 0.0 { d_hi } else { 1e-3 };
-        let sequential = Lut::new(&SEQUENTIAL);
-        let dolp_colors = image
-            .stokes
-            .par_iter()
-            .map(|&s| sequential.at(dolp_aop(s).0 / d_hi))
-            .collect();
-
-        let mask = scene.aop_mask_dolp;
-        let aop_colors = image
-            .stokes
-            .par_iter()
-            .map(|&s| {
-                let (d, a) = dolp_aop(s);
-                if d < mask || d == 0.0 {
-                    MASKED
-                } else {
-                    cyclic(a / std::f64::consts::PI + 0.5)
-                }
-            })
-            .collect();
-
-        let mut stem = scene
-            .path
-            .file_stem()
-            .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-        if let Some(instant) = &scene.thermal_instant {
-            stem += &format!(" at {}", instant.time_utc);
-        }
-        let (lo_um, hi_um) = band.limits_um();
-        let shading = match scene.shading {
-            Shading::Pixel => "per-pixel",
-            Shading::Gouraud => "Gouraud",
-        };
-        let mut caption = format!(
-            "{stem}: {}×{}, {shading} shading, {lo_um}–{hi_um} µm, air {:.2} K",
-            image.width, image.height, scene.air_temperature_k
-        );
-        if let Transport::Path(settings) = scene.transport {
-            caption += &format!(
-                ", occlusion: {} bounces, {} paths/pixel",
-                settings.bounces, settings.samples
-            );
-            if let Some(sun) = scene.sun {
-                let p = sun.position();
-                caption += &format!(
-                    ", sun at {:.0}° elevation, {:.0}° azimuth",
-                    p.elevation_deg, p.azimuth_deg
-                );
-            }
-        }
+        // The composite shows the first five: S0, S1, S2, DoLP, AoP (the paper's Fig. 5).
+        panels.insert(4, aop_panel(image, scene.aop_mask_dolp));
         Previews {
             width: image.width,
             height: image.height,
-            panels: [
-                Panel {
-                    file: "S0.png",
-                    title: "S0 — apparent temperature (K)".into(),
-                    colors: s0_colors,
-                    bar: Bar::Linear {
-                        map: &THERMAL,
-                        lo: t_lo,
-                        hi: t_hi,
-                        format: |v| format!("{v:.1}"),
-                    },
-                },
-                Panel {
-                    file: "S1.png",
-                    title: "S1 (W·m⁻²·sr⁻¹)".into(),
-                    colors: s1_colors,
-                    bar: Bar::Linear {
-                        map: &DIVERGING,
-                        lo: -s1_max,
-                        hi: s1_max,
-                        format: format_signed,
-                    },
-                },
-                Panel {
-                    file: "S2.png",
-                    title: "S2 (W·m⁻²·sr⁻¹)".into(),
-                    colors: s2_colors,
-                    bar: Bar::Linear {
-                        map: &DIVERGING,
-                        lo: -s2_max,
-                        hi: s2_max,
-                        format: format_signed,
-                    },
-                },
-                Panel {
-                    file: "DoLP.png",
-                    title: "DoLP (%)".into(),
-                    colors: dolp_colors,
-                    bar: Bar::Linear {
-                        map: &SEQUENTIAL,
-                        lo: 0.0,
-                        hi: d_hi * 100.0,
-                        format: |v| format!("{v:.2}"),
-                    },
-                },
-                Panel {
-                    file: "AoP.png",
-                    title: format!(
-                        "AoP (° from image right; grey: DoLP < {:.2} %)",
-                        mask * 100.0
-                    ),
-                    colors: aop_colors,
-                    bar: Bar::Cyclic,
-                },
-            ]
-            .into_iter()
-            .chain(s3_panel)
-            .collect(),
-            caption,
+            panels,
+            caption: caption(scene, image),
         }
     }
 
@@ -296,6 +168,207 @@ impl Previews {
     }
 }
 
+impl LinearPanel {
+    /// The panel: its range (fixed, else by `settings.range` over the `ranged` pixels), each
+    /// pixel's colour, out-of-range pixels in the map's under/over colours, the clip stated in
+    /// the title.
+    fn panel(self, ranged: &[bool], settings: &PreviewConfig) -> Panel {
+        let auto = || {
+            let chosen: Vec<f64> = self
+                .values
+                .iter()
+                .zip(ranged)
+                .filter(|&(v, &r)| r && v.is_finite())
+                .map(|(&v, _)| if self.symmetric { v.abs() } else { v })
+                .collect();
+            let [p_lo, p_hi] = match settings.range {
+                PreviewRange::Minmax => [0.0, 100.0],
+                PreviewRange::Percentile => settings.percentiles.unwrap_or(DEFAULT_PERCENTILES),
+            };
+            let p_lo = if self.symmetric { 0.0 } else { p_lo };
+            robust_range(chosen, p_lo / 100.0, p_hi / 100.0)
+        };
+        let (lo, hi) = match self.fixed {
+            // DoLP's default: from 0 to the automatic high end.
+            Some([lo, hi]) if hi.is_nan() => (lo, auto().1),
+            Some([lo, hi]) => (lo, hi),
+            None if self.symmetric => {
+                let m = auto().1;
+                let m = if m > 0.0 { m } else { 1.0 };
+                (-m, m)
+            }
+            None => auto(),
+        };
+        let (lo, hi) = widen(lo, hi);
+        let lut = Lut::new(self.map);
+        let colors: Vec<[u8; 3]> = self
+            .values
+            .par_iter()
+            .map(|&v| match v {
+                v if v < lo => self.map.under,
+                v if v > hi => self.map.over,
+                v => lut.at((v - lo) / (hi - lo)),
+            })
+            .collect();
+        let count = |f: &dyn Fn(f64) -> bool| {
+            self.values.iter().filter(|&&v| f(v)).count() as f64 / self.values.len().max(1) as f64
+        };
+        let clipped = Clipped {
+            below: count(&|v| v < lo),
+            above: count(&|v| v > hi),
+        };
+        let mut title = self.title;
+        if clipped.below + clipped.above > 0.0 {
+            title += &format!(
+                " — clipped {:.1} % below, {:.1} % above",
+                100.0 * clipped.below,
+                100.0 * clipped.above
+            );
+        }
+        Panel {
+            file: self.file,
+            title,
+            colors,
+            bar: Bar::Linear {
+                map: self.map,
+                lo,
+                hi,
+                format: self.format,
+                clipped,
+            },
+        }
+    }
+}
+
+/// S0 (as apparent temperature), S1, S2, DoLP and, with transport between surfaces, S3.
+fn linear_panels(scene: &Scene, image: &StokesImage) -> Vec<LinearPanel> {
+    let settings = &scene.preview;
+    let temperature = apparent_temperature(scene, image);
+    let per_pixel = |f: &(dyn Fn([f64; 4]) -> f64 + Sync)| -> Vec<f64> {
+        image.stokes.par_iter().map(|&s| f(s)).collect()
+    };
+    let stokes = |j: usize, fixed| LinearPanel {
+        file: ["S0.png", "S1.png", "S2.png", "S3.png"][j],
+        title: format!("S{j} (W·m⁻²·sr⁻¹)"),
+        values: per_pixel(&|s| s[j]),
+        fixed,
+        symmetric: true,
+        map: &DIVERGING,
+        format: format_signed,
+    };
+    let mut panels = vec![
+        LinearPanel {
+            file: "S0.png",
+            title: "S0 — apparent temperature (K)".into(),
+            values: per_pixel(&|s| temperature.at(s[0])),
+            fixed: settings.s0_k,
+            symmetric: false,
+            map: match settings.s0_colormap {
+                S0Colormap::Thermal => &THERMAL,
+                S0Colormap::Gray => &GRAY,
+            },
+            format: |v| format!("{v:.1}"),
+        },
+        stokes(1, settings.s1),
+        stokes(2, settings.s2),
+        LinearPanel {
+            file: "DoLP.png",
+            title: "DoLP (%)".into(),
+            values: per_pixel(&|s| 100.0 * dolp_aop(s).0),
+            // From 0 unless fixed (NaN: the automatic high end).
+            fixed: settings.dolp_percent.or(Some([0.0, f64::NAN])),
+            symmetric: false,
+            map: &SEQUENTIAL,
+            format: |v| format!("{v:.2}"),
+        },
+    ];
+    // S3 only where light was transported between surfaces (the open world has none).
+    if matches!(scene.transport, Transport::Path(_)) {
+        panels.push(stokes(3, settings.s3));
+    }
+    panels
+}
+
+/// Which pixels set the automatic colour ranges: the object pixels, or all when none is seen.
+fn ranged_pixels(image: &StokesImage) -> Vec<bool> {
+    let any_object = image.surface.iter().any(|&o| o != BACKGROUND);
+    image
+        .surface
+        .iter()
+        .map(|&s| s != BACKGROUND || !any_object)
+        .collect()
+}
+
+/// S0 → apparent temperature, through a lookup over the radiance range of the image.
+fn apparent_temperature(scene: &Scene, image: &StokesImage) -> TemperatureLookup {
+    let (lo, hi) = image
+        .stokes
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), s| {
+            (lo.min(s[0]), hi.max(s[0]))
+        });
+    TemperatureLookup::new(&scene.sensor.band, lo.max(0.0).min(hi), hi)
+}
+
+/// AoP on the cyclic map, grey where DoLP is below the scene's threshold.
+fn aop_panel(image: &StokesImage, mask: f64) -> Panel {
+    let colors = image
+        .stokes
+        .par_iter()
+        .map(|&s| {
+            let (d, a) = dolp_aop(s);
+            if d < mask || d == 0.0 {
+                MASKED
+            } else {
+                cyclic(a / std::f64::consts::PI + 0.5)
+            }
+        })
+        .collect();
+    Panel {
+        file: "AoP.png",
+        title: format!(
+            "AoP (° from image right; grey: DoLP < {:.2} %)",
+            mask * 100.0
+        ),
+        colors,
+        bar: Bar::Cyclic,
+    }
+}
+
+/// The composite's caption: scene, size, shading, band, air, transport and sun.
+fn caption(scene: &Scene, image: &StokesImage) -> String {
+    let mut stem = scene
+        .path
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    if let Some(instant) = &scene.thermal_instant {
+        stem += &format!(" at {}", instant.time_utc);
+    }
+    let (lo_um, hi_um) = scene.sensor.band.limits_um();
+    let shading = match scene.shading {
+        Shading::Pixel => "per-pixel",
+        Shading::Gouraud => "Gouraud",
+    };
+    let mut caption = format!(
+        "{stem}: {}×{}, {shading} shading, {lo_um}–{hi_um} µm, air {:.2} K",
+        image.width, image.height, scene.air_temperature_k
+    );
+    if let Transport::Path(settings) = scene.transport {
+        caption += &format!(
+            ", occlusion: {} bounces, {} paths/pixel",
+            settings.bounces, settings.samples
+        );
+        if let Some(sun) = scene.sun {
+            let p = sun.position();
+            caption += &format!(
+                ", sun at {:.0}° elevation, {:.0}° azimuth",
+                p.elevation_deg, p.azimuth_deg
+            );
+        }
+    }
+    caption
+}
+
 /// RGB image buffer.
 struct Canvas {
     width: usize,
@@ -372,12 +445,28 @@ fn draw_panel(
         }
     }
     let bar_x = margin + img_w + margin;
+    // Clipped values get a cap of the map's under/over colour at that end of the bar.
+    let cap = (img_h / 14).max(6).min(img_h / 4);
+    let (cap_top, cap_bottom) = match &panel.bar {
+        Bar::Linear { clipped, .. } => (
+            if clipped.above > 0.0 { cap } else { 0 },
+            if clipped.below > 0.0 { cap } else { 0 },
+        ),
+        Bar::Cyclic => (0, 0),
+    };
+    let gradient_h = img_h - cap_top - cap_bottom;
     for y in 0..img_h {
-        // Top of the bar is the high end.
-        let t = 1.0 - (y as f64 + 0.5) / img_h as f64;
         let color = match &panel.bar {
-            Bar::Linear { map, .. } => map.at(t),
-            Bar::Cyclic => cyclic(t),
+            Bar::Linear { map, .. } if y < cap_top => map.over,
+            Bar::Linear { map, .. } if y >= img_h - cap_bottom => map.under,
+            bar => {
+                // Top of the gradient is the high end.
+                let t = 1.0 - ((y - cap_top) as f64 + 0.5) / gradient_h as f64;
+                match bar {
+                    Bar::Linear { map, .. } => map.at(t),
+                    Bar::Cyclic => cyclic(t),
+                }
+            }
         };
         for x in 0..bar_w {
             canvas.set(bar_x + x, title_h + y, color);
@@ -415,8 +504,9 @@ fn draw_panel(
             .color(&BLACK)
             .pos(Pos::new(HPos::Left, VPos::Center));
         let x = (bar_x + bar_w) as i32;
+        let top = (title_h + cap_top) as i32;
         for (t, text) in ticks {
-            let y = title_h as i32 + ((1.0 - t) * (img_h as f64 - 1.0)).round() as i32;
+            let y = top + ((1.0 - t) * (gradient_h as f64 - 1.0)).round() as i32;
             root.draw(&PathElement::new(vec![(x, y), (x + 4, y)], BLACK))
                 .map_err(draw_error)?;
             root.draw_text(&text, &label, (x + 6, y))
@@ -467,5 +557,62 @@ fn widen(lo: f64, hi: f64) -> (f64, f64) {
         (lo, hi)
     } else {
         (lo - 0.5, hi + 0.5)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp_panel(fixed: Option<[f64; 2]>, range: PreviewRange) -> Panel {
+        // 0, 1, …, 999 with every pixel ranged.
+        let ranged = vec![true; 1000];
+        let settings = PreviewConfig {
+            range,
+            ..PreviewConfig::default()
+        };
+        LinearPanel {
+            file: "x.png",
+            title: "x".into(),
+            values: (0..1000).map(f64::from).collect(),
+            fixed,
+            symmetric: false,
+            map: &THERMAL,
+            format: |v| format!("{v}"),
+        }
+        .panel(&ranged, &settings)
+    }
+
+    fn clipped(panel: &Panel) -> (f64, f64, f64, f64) {
+        match &panel.bar {
+            Bar::Linear {
+                lo, hi, clipped, ..
+            } => (*lo, *hi, clipped.below, clipped.above),
+            Bar::Cyclic => unreachable!(),
+        }
+    }
+
+    #[test]
+    fn out_of_range_pixels_are_marked_and_counted() {
+        let panel = ramp_panel(Some([100.0, 899.0]), PreviewRange::Percentile);
+        assert_eq!(clipped(&panel), (100.0, 899.0, 0.1, 0.1));
+        assert_eq!(panel.colors[50], THERMAL.under);
+        assert_eq!(panel.colors[950], THERMAL.over);
+        assert_eq!(panel.colors[100], THERMAL.at(0.0));
+        assert!(
+            panel.title.contains("clipped 10.0 % below, 10.0 % above"),
+            "{}",
+            panel.title
+        );
+
+        let minmax = ramp_panel(None, PreviewRange::Minmax);
+        assert_eq!(clipped(&minmax), (0.0, 999.0, 0.0, 0.0));
+        assert_eq!(minmax.title, "x");
+
+        // The default percentiles clip one pixel in a thousand at each end.
+        let auto = ramp_panel(None, PreviewRange::Percentile);
+        let (lo, hi, below, above) = clipped(&auto);
+        assert_eq!((lo, hi), (1.0, 998.0));
+        assert_eq!((below, above), (0.001, 0.001));
     }
 }

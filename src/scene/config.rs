@@ -241,6 +241,62 @@ pub struct RenderConfig {
     /// The paper's model (no occlusion, no sun): today's images exactly.
     #[serde(default)]
     pub open_world: bool,
+    /// `[render.preview]`: colour ranges and maps of the PNG previews.
+    #[serde(default)]
+    pub preview: PreviewConfig,
+}
+
+/// `[render.preview]` (issue 16 item 4): how the PNG previews map values to colours. The data
+/// files (TIFF, EXR) are never affected.
+#[derive(Debug, Deserialize, Clone, Default, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PreviewConfig {
+    /// `"percentile"` (default: the 0.1th–99.9th percentiles over object pixels, or
+    /// `percentiles`) or `"minmax"` (the full range of the object pixels, nothing clipped).
+    #[serde(default)]
+    pub range: PreviewRange,
+    /// [low, high] percentiles of the `"percentile"` range; default [0.1, 99.9].
+    #[serde(default, deserialize_with = "optional_pair")]
+    pub percentiles: Option<[f64; 2]>,
+    /// Fixed ranges, overriding `range` for their panel: apparent temperature (K), S1, S2, S3
+    /// (W m⁻² sr⁻¹), DoLP (%).
+    #[serde(default, deserialize_with = "optional_pair")]
+    pub s0_k: Option<[f64; 2]>,
+    #[serde(default, deserialize_with = "optional_pair")]
+    pub s1: Option<[f64; 2]>,
+    #[serde(default, deserialize_with = "optional_pair")]
+    pub s2: Option<[f64; 2]>,
+    #[serde(default, deserialize_with = "optional_pair")]
+    pub s3: Option<[f64; 2]>,
+    #[serde(default, deserialize_with = "optional_pair")]
+    pub dolp_percent: Option<[f64; 2]>,
+    /// Colour map of the S0 panel: `"thermal"` (default) or `"gray"` (white hot).
+    #[serde(default)]
+    pub s0_colormap: S0Colormap,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, Default, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum PreviewRange {
+    #[default]
+    Percentile,
+    Minmax,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, Default, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum S0Colormap {
+    #[default]
+    Thermal,
+    Gray,
+}
+
+/// An optional `[low, high]` pair, exactly two numbers.
+fn optional_pair<'de, D>(deserializer: D) -> Result<Option<[f64; 2]>, D::Error>
+where
+    D: Deserializer<'de>,
+{
+    exactly(deserializer).map(Some)
 }
 
 fn default_bounces() -> u32 {
@@ -286,6 +342,7 @@ impl Default for RenderConfig {
             samples: default_samples(),
             seed: default_render_seed(),
             open_world: false,
+            preview: PreviewConfig::default(),
         }
     }
 }

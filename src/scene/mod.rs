@@ -129,6 +129,8 @@ pub struct Scene {
     pub atmosphere: Option<Atmosphere>,
     pub shading: Shading,
     pub aop_mask_dolp: f64,
+    /// `[render.preview]`, checked.
+    pub preview: config::PreviewConfig,
     pub transport: Transport,
     /// Above the horizon only (a sun below it lights nothing).
     pub sun: Option<Sun>,
@@ -332,6 +334,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         atmosphere,
         shading: config.render.shading,
         aop_mask_dolp: mask,
+        preview: checked_preview(&config.render.preview).map_err(&fail)?,
         transport,
         sun,
         materials: materials.resolved,
@@ -376,6 +379,36 @@ fn thermal_instants(config: &SceneConfig, band: &Band) -> Result<thermal::Instan
         netd_reference_given: config.sensor.netd_reference_k.is_some(),
         sun_irradiance_w_m2: irradiance,
     })
+}
+
+/// `[render.preview]`: percentiles within [0, 100] and increasing, fixed ranges finite and
+/// increasing.
+fn checked_preview(preview: &config::PreviewConfig) -> Result<config::PreviewConfig, String> {
+    let pairs = [
+        ("percentiles", preview.percentiles),
+        ("s0_k", preview.s0_k),
+        ("s1", preview.s1),
+        ("s2", preview.s2),
+        ("s3", preview.s3),
+        ("dolp_percent", preview.dolp_percent),
+    ];
+    for (key, pair) in pairs {
+        if let Some([lo, hi]) = pair {
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(format!(
+                    "render.preview.{key} = [{lo}, {hi}] must be two finite numbers, low < high"
+                ));
+            }
+        }
+    }
+    if let Some([lo, hi]) = preview.percentiles {
+        if lo < 0.0 || hi > 100.0 {
+            return Err(format!(
+                "render.preview.percentiles = [{lo}, {hi}] must lie within [0, 100]"
+            ));
+        }
+    }
+    Ok(preview.clone())
 }
 
 /// The `[render]` transport keys, checked.
