@@ -642,6 +642,19 @@ fn demo() -> anyhow::Result<()> {
         PathBuf::from("fits"),
         PathBuf::from("reports"),
     );
+    // The demo works on the repository's shipped files; anywhere else say what it needs.
+    let needed = ["measurements", "scenes/car.toml", "scenes/car.obj", "scenes/car_day.toml"];
+    let missing: Vec<&str> = needed
+        .into_iter()
+        .filter(|p| !Path::new(p).exists())
+        .collect();
+    if !missing.is_empty() {
+        anyhow::bail!(
+            "irpol demo runs on the files shipped in the irpol repository and must be started from \
+             its root folder (the one holding Cargo.toml); missing here: {}",
+            missing.join(", ")
+        );
+    }
     say!(
         "irpol demo: fit the shipped measurements in {}",
         measurements.display()

@@ -192,3 +192,23 @@ fn fit_with_one_bad_file_writes_nothing_and_render_refuses_a_missing_scene() {
     );
     assert!(!dir.path().join("out").exists());
 }
+
+/// Issue 16 item 11: `demo` outside the repository says what it needs instead of failing on the
+/// first missing file, and writes nothing.
+#[test]
+fn demo_outside_the_repository_says_what_it_needs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .arg("demo")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("must be started from its root folder")
+            && stderr.contains("missing here: measurements, scenes/car.toml"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
