@@ -643,7 +643,12 @@ fn demo() -> anyhow::Result<()> {
         PathBuf::from("reports"),
     );
     // The demo works on the repository's shipped files; anywhere else say what it needs.
-    let needed = ["measurements", "scenes/car.toml", "scenes/car.obj", "scenes/car_day.toml"];
+    let needed = [
+        "measurements",
+        "scenes/car.toml",
+        "scenes/car.obj",
+        "scenes/car_day.toml",
+    ];
     let missing: Vec<&str> = needed
         .into_iter()
         .filter(|p| !Path::new(p).exists())

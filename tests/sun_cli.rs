@@ -33,16 +33,12 @@ fn one_instant_is_one_csv_line_after_the_header() {
     assert!(off_north.abs() < 5.0, "{azimuth}");
 }
 
-#[test]
-fn a_times_file_gives_one_line_per_instant_in_order() {
+/// `irpol sun` at Munich for the instants in `times` (a times file), plus `extra` flags.
+fn munich_times(times: &str, extra: &[&str]) -> (bool, String, String) {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("times.txt");
-    std::fs::write(
-        &file,
-        "# Munich, 21 June\n2026-06-21T06:00:00Z\n2026-06-21T11:00:00Z\n2026-06-21T16:00:00Z\n",
-    )
-    .unwrap();
-    let (ok, stdout, stderr) = irpol(&[
+    std::fs::write(&file, times).unwrap();
+    let mut args = vec![
         "sun",
         "--latitude",
         "48.14",
@@ -50,7 +46,17 @@ fn a_times_file_gives_one_line_per_instant_in_order() {
         "11.58",
         "--times-file",
         file.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    irpol(&args)
+}
+
+#[test]
+fn a_times_file_gives_one_line_per_instant_in_order() {
+    let (ok, stdout, stderr) = munich_times(
+        "# Munich, 21 June\n2026-06-21T06:00:00Z\n2026-06-21T11:00:00Z\n2026-06-21T16:00:00Z\n",
+        &[],
+    );
     assert!(ok, "{stderr}");
     let rows: Vec<Vec<String>> = stdout
         .lines()
@@ -116,23 +122,10 @@ fn clear_sky_adds_the_solis_irradiance() {
     // Munich at midsummer: near noon, at sunset and at night. The numbers are the library's
     // simplified Solis model at the elevation irpol prints (pvlib agreement:
     // scripts/crosscheck_clearsky.py).
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("times.txt");
-    std::fs::write(
-        &file,
+    let (ok, stdout, stderr) = munich_times(
         "2026-06-21T11:15:00Z\n2026-06-21T19:00:00Z\n2026-06-21T23:00:00Z\n",
-    )
-    .unwrap();
-    let (ok, stdout, stderr) = irpol(&[
-        "sun",
-        "--latitude",
-        "48.14",
-        "--longitude",
-        "11.58",
-        "--times-file",
-        file.to_str().unwrap(),
-        "--clear-sky",
-    ]);
+        &["--clear-sky"],
+    );
     assert!(ok, "{stderr}");
     let lines: Vec<&str> = stdout.lines().collect();
     assert_eq!(

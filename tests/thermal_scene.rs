@@ -92,6 +92,16 @@ solar_absorptance = 0.6
     )
 }
 
+/// `irpol thermal SCENE --out OUT`: (success, stdout, stderr).
+fn thermal_cli(scene: &std::path::Path, out: &std::path::Path) -> (bool, String, String) {
+    irpol(&[
+        "thermal",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
 fn solved(dir: &std::path::Path, extra: &str, times: &[f64]) -> (Scene, ThermalSolution) {
     let path = write_scene(dir, &scene_text(extra));
     let scene = load_scene(&path).unwrap();
@@ -238,12 +248,7 @@ fn thermal_command_writes_the_table_meshes_and_plot() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path(), &scene_text("duration_h = 6"));
     let out = dir.path().join("thermal");
-    let (ok, stdout, stderr) = irpol(&[
-        "thermal",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, stdout, stderr) = thermal_cli(&scene, &out);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("thermal run of"), "{stdout}");
     let csv = std::fs::read_to_string(out.join("temperatures.csv")).unwrap();
@@ -341,12 +346,7 @@ fn bad_thermal_input_is_refused_by_name_and_writes_nothing() {
             .replace("conductivity_w_mk = 0.75", "conductivity_w_mk = -0.75");
         let scene = write_scene(dir.path(), &text);
         let out = dir.path().join("out");
-        let (ok, _, stderr) = irpol(&[
-            "thermal",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let (ok, _, stderr) = thermal_cli(&scene, &out);
         assert!(!ok);
         assert!(stderr.contains(expected), "{expected}: {stderr}");
         assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
@@ -439,12 +439,7 @@ fn bad_weather_files_are_refused_by_file_and_line() {
         );
         let scene = write_scene(dir.path(), &text);
         let out = dir.path().join("out");
-        let (ok, _, stderr) = irpol(&[
-            "thermal",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let (ok, _, stderr) = thermal_cli(&scene, &out);
         assert!(!ok && stderr.contains(expected), "{expected}: {stderr}");
         assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
         assert!(!out.exists());

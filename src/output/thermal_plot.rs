@@ -2,7 +2,7 @@
 //! min–max band over its vertices), the air temperature dashed, sunrise and sunset marked.
 
 use crate::report::paper_figures::encode_png;
-use crate::report::{register_fonts, FONT};
+use crate::report::{register_fonts, FONT, TABLEAU20};
 use crate::scene::Scene;
 use crate::thermal_scene::{PartSeries, ThermalSolution};
 use plotters::prelude::*;
@@ -10,30 +10,6 @@ use std::io;
 
 const WIDTH: u32 = 1400;
 const HEIGHT: u32 = 800;
-
-/// Distinct line colours (Tableau 20, dark then light), cycled beyond 20 parts.
-const PALETTE: [RGBColor; 20] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-    RGBColor(188, 189, 34),
-    RGBColor(23, 190, 207),
-    RGBColor(174, 199, 232),
-    RGBColor(255, 187, 120),
-    RGBColor(152, 223, 138),
-    RGBColor(255, 152, 150),
-    RGBColor(197, 176, 213),
-    RGBColor(196, 156, 148),
-    RGBColor(247, 182, 210),
-    RGBColor(199, 199, 199),
-    RGBColor(219, 219, 141),
-    RGBColor(158, 218, 229),
-];
 
 /// Times (h) where the sun's centre crosses the horizon, linear between recorded instants, with
 /// whether it rises there.
@@ -111,7 +87,7 @@ fn draw<DB: DrawingBackend>(
         chart.draw_series([Text::new(label, (hour, hi + pad * 0.5), (FONT, 14))])?;
     }
     for (i, part) in parts.iter().enumerate() {
-        let color = PALETTE[i % PALETTE.len()];
+        let color = TABLEAU20[i % TABLEAU20.len()];
         let band: Vec<(f64, f64)> = hours
             .iter()
             .zip(&part.surface_k)
@@ -148,7 +124,7 @@ fn draw_legend<DB: DrawingBackend>(
         style.clone(),
     ))?;
     for (i, part) in parts.iter().enumerate() {
-        let color = PALETTE[i % PALETTE.len()];
+        let color = TABLEAU20[i % TABLEAU20.len()];
         area.draw(&PathElement::new(
             vec![(8, y + 8), (36, y + 8)],
             color.stroke_width(3),

@@ -62,3 +62,31 @@ pub enum ReportError {
     #[error("material name '{name}' cannot name a report file: it must be a plain file name without folders")]
     MaterialName { name: String },
 }
+
+/// Tableau 20: the ten Tableau 10 colours (readable on white and in grey print), then their light
+/// companions. Series colours of every plot.
+pub const TABLEAU20: [plotters::style::RGBColor; 20] = {
+    use plotters::style::RGBColor as C;
+    [
+        C(31, 119, 180),
+        C(255, 127, 14),
+        C(44, 160, 44),
+        C(214, 39, 40),
+        C(148, 103, 189),
+        C(140, 86, 75),
+        C(227, 119, 194),
+        C(127, 127, 127),
+        C(188, 189, 34),
+        C(23, 190, 207),
+        C(174, 199, 232),
+        C(255, 187, 120),
+        C(152, 223, 138),
+        C(255, 152, 150),
+        C(197, 176, 213),
+        C(196, 156, 148),
+        C(247, 182, 210),
+        C(199, 199, 199),
+        C(219, 219, 141),
+        C(158, 218, 229),
+    ]
+};

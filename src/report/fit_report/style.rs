@@ -20,19 +20,7 @@ pub const SMALL_TICK_SIZE: i32 = 14;
 
 /// Colour of incidence angle number `index` (Tableau 10, readable on white and in grey print).
 pub fn incidence_color(index: usize) -> RGBColor {
-    const PALETTE: [RGBColor; 10] = [
-        RGBColor(31, 119, 180),
-        RGBColor(255, 127, 14),
-        RGBColor(44, 160, 44),
-        RGBColor(214, 39, 40),
-        RGBColor(148, 103, 189),
-        RGBColor(140, 86, 75),
-        RGBColor(227, 119, 194),
-        RGBColor(127, 127, 127),
-        RGBColor(188, 189, 34),
-        RGBColor(23, 190, 207),
-    ];
-    PALETTE[index % PALETTE.len()]
+    crate::report::TABLEAU20[index % 10]
 }
 
 pub const GREY: RGBColor = RGBColor(110, 110, 110);
