@@ -504,6 +504,7 @@ fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()
     let out = out.unwrap_or_else(|| default_output_dir(scene));
     cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
     let summary = render_scene(scene, &out, &TerminalProgress::new())?;
+    warn_once(&summary.warnings);
     let temperature = summary
         .apparent_temperature_k
         .as_ref()
@@ -543,6 +544,11 @@ fn render_instants(scene: &Path, out: Option<PathBuf>, instants: &Instants) -> a
 }
 
 fn report_instants(scene: &Path, out: &Path, renders: &[TimedRender]) {
+    let all: Vec<String> = renders
+        .iter()
+        .flat_map(|r| r.summary.warnings.iter().cloned())
+        .collect();
+    warn_once(&all);
     for r in renders {
         say!(
             "rendered {} at t = {} s ({}×{}) → {}",
@@ -555,6 +561,14 @@ fn report_instants(scene: &Path, out: &Path, renders: &[TimedRender]) {
     }
     if renders.len() > 1 {
         say!("  {}", out.join("preview.gif").display());
+    }
+}
+
+/// Each distinct warning once, in order, on stderr (issue 16 item 7).
+fn warn_once(warnings: &[String]) {
+    let mut seen = std::collections::BTreeSet::new();
+    for w in warnings.iter().filter(|w| seen.insert(w.as_str())) {
+        eprintln!("irpol: warning: {w}");
     }
 }
 
@@ -574,6 +588,7 @@ fn thermal_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<(
 }
 
 fn report_thermal(scene: &Path, out: &Path, summary: &ThermalSummary) {
+    warn_once(&summary.warnings);
     say!(
         "thermal run of {} ({} h from {}, {} vertices, {} distinct solves) in {:.2} s → {}",
         scene.display(),

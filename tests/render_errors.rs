@@ -104,16 +104,32 @@ fn malformed_toml() {
     expect(&text, &["scene.toml", "unknown field `fov`"]);
 }
 
+/// Issue 16 item 6: a degenerate face is skipped with a warning naming it; a mesh of nothing but
+/// degenerate faces is refused.
 #[test]
-fn degenerate_triangle() {
+fn degenerate_triangles_are_skipped_unless_nothing_remains() {
+    let dir = tempfile::tempdir().unwrap();
     let obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 0 1\ng panel\nf 1 2 4\nf 1 2 3\n";
-    let text = refuse(&scene_with_mesh("flat.obj", ""), &[("flat.obj", obj)]);
+    std::fs::write(dir.path().join("flat.obj"), obj).unwrap();
+    let path = write_scene(dir.path(), &scene_with_mesh("flat.obj", ""));
+    let scene = irpol::scene::load_scene(&path).unwrap();
+    assert_eq!(scene.mesh.triangles.len(), 1);
+    let warning = scene.warnings.join("\n");
+    assert!(
+        warning.contains(
+            "flat.obj (in objects[0] 'thing'): skipped 1 degenerate (zero-area) \
+                          triangle(s): line 7 (part 'panel')"
+        ),
+        "{warning}"
+    );
+    let only = "v 0 0 0\nv 1 0 0\nv 2 0 0\ng panel\nf 1 2 3\n";
+    let text = refuse(&scene_with_mesh("flat.obj", ""), &[("flat.obj", only)]);
     expect(
         &text,
         &[
             "flat.obj",
-            "line 7",
-            "degenerate triangle",
+            "every triangle is degenerate",
+            "line 5",
             "part 'panel'",
             "objects[0] 'thing'",
         ],
@@ -317,4 +333,54 @@ fn preview_ranges_are_checked_by_key() {
         let err = irpol::scene::load_scene(&path).unwrap_err().to_string();
         assert!(err.contains(expected), "{expected}: {err}");
     }
+}
+
+/// Issue 16 item 7: probable mistakes are warned about on stderr, once each, and listed in
+/// summary.json — a temperature that looks like °C, an inline material nothing uses, an object the
+/// camera cannot see, a PLY property that looks like a temperature but is ignored, a library
+/// material measured outside the sensor band — and the render still succeeds.
+#[test]
+fn likely_mistakes_are_warned_once_and_listed() {
+    let dir = tempfile::tempdir().unwrap();
+    write_truth_library(&dir.path().join("fits"));
+    std::fs::write(
+        dir.path().join("tri.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+         property float z\nproperty float temp\nelement face 1\nproperty list uchar int \
+         vertex_indices\nend_header\n0 0 0 300\n1 0 0 300\n0 0 1 300\n3 0 1 2\n",
+    )
+    .unwrap();
+    let text = format!(
+        "{}[sensor]\nband_um = [3.0, 5.0]\n\n{}{}{}\
+         [materials.spare]\ndistribution = \"cauchy\"\nsigma = 0.2\nq = 2.0\nn = 1.5\nk = 0.1\n\n\
+         [[objects]]\nname = \"behind\"\nmesh = \"tri.ply\"\nmaterial = \"paper_paint\"\n\
+         temperature_k = 300.0\ntranslate = [0.0, -20.0, 0.0]\n",
+        camera_toml(16),
+        AUTUMN_ENVIRONMENT,
+        material_toml(0.1, 1.8, 1.2, 0.2, 0.0),
+        sphere_toml(1, 45.0),
+    );
+    let path = write_scene(dir.path(), &text);
+    let out = dir.path().join("out");
+    let (ok, _, stderr) = irpol(&[
+        "render",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let expected = [
+        "objects[0] 'ball': temperature_k = 45 K looks like °C",
+        "[materials.spare] is never used by any object",
+        "material 'paper_paint'",
+        "outside the sensor band 3–5 µm",
+        "vertex property 'temp' looks like a temperature but is ignored",
+        "object 'behind' covers no pixel",
+    ];
+    for e in expected {
+        assert_eq!(stderr.matches(e).count(), 1, "{e}: {stderr}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["warnings"].as_array().unwrap().len(), 5);
 }

@@ -59,6 +59,8 @@ pub struct Previews {
     height: usize,
     panels: Vec<Panel>,
     caption: String,
+    /// "LWIR", "MWIR", "SWIR" or the band in µm: the composite's title follows the sensor.
+    band_name: String,
 }
 
 /// How a linear panel is coloured: the value of each pixel, how its range is chosen, the map.
@@ -88,6 +90,7 @@ impl Previews {
             height: image.height,
             panels,
             caption: caption(scene, image),
+            band_name: band_name(scene.sensor.band.limits_um()),
         }
     }
 
@@ -151,7 +154,7 @@ impl Previews {
                 .style(FontStyle::Bold)
                 .color(&BLACK);
             root.draw_text(
-                "LWIR polarimetric simulation (Stokes images)",
+                &format!("{} polarimetric simulation (Stokes images)", self.band_name),
                 &title.pos(Pos::new(HPos::Center, VPos::Top)),
                 (w as i32 / 2, 6),
             )
@@ -287,6 +290,19 @@ fn linear_panels(scene: &Scene, image: &StokesImage) -> Vec<LinearPanel> {
         panels.push(stokes(3, settings.s3));
     }
     panels
+}
+
+/// The usual name of an infrared band (ISO 20473 style ranges), else the band in µm.
+fn band_name((lo, hi): (f64, f64)) -> String {
+    if lo >= 7.0 && hi <= 15.0 {
+        "LWIR".into()
+    } else if lo >= 3.0 && hi <= 5.5 {
+        "MWIR".into()
+    } else if lo >= 0.9 && hi <= 2.5 {
+        "SWIR".into()
+    } else {
+        format!("{lo}–{hi} µm")
+    }
 }
 
 /// Which pixels set the automatic colour ranges: the object pixels, or all when none is seen.
@@ -590,6 +606,14 @@ mod tests {
             } => (*lo, *hi, clipped.below, clipped.above),
             Bar::Cyclic => unreachable!(),
         }
+    }
+
+    #[test]
+    fn titles_follow_the_band() {
+        assert_eq!(band_name((8.0, 14.0)), "LWIR");
+        assert_eq!(band_name((3.0, 5.0)), "MWIR");
+        assert_eq!(band_name((1.0, 1.7)), "SWIR");
+        assert_eq!(band_name((2.0, 12.0)), "2–12 µm");
     }
 
     #[test]

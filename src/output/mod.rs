@@ -230,6 +230,8 @@ pub struct RenderSummary {
     /// The instant of the thermal run shown (`render --time`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub thermal_instant: Option<crate::scene::ThermalInstant>,
+    /// Probable mistakes noticed while loading and rendering (issue 16 item 7).
+    pub warnings: Vec<String>,
     /// Intrinsics and pose (ground truth, issue 16 item 12).
     pub camera: CameraSummary,
     /// What the IDs of `object_id.tif` and `part_id.tif` are.
@@ -357,6 +359,7 @@ pub fn write_outputs(
         *per_object.entry(object).or_insert(0) += count;
     }
     let object_pixels: usize = per_surface.iter().sum();
+    let warnings = render_warnings(scene, &per_object);
     let mut timings = rendered.timings;
     timings.write = write_start.elapsed().as_secs_f64();
     timings.total = started.elapsed().as_secs_f64();
@@ -380,6 +383,7 @@ pub fn write_outputs(
         apparent_temperature_k: apparent,
         transport: transport_summary(scene),
         thermal_instant: scene.thermal_instant.clone(),
+        warnings,
         camera,
         ids: id_maps(scene),
         materials: scene
@@ -481,6 +485,21 @@ fn dofp_images(image: &StokesImage) -> Vec<TruthImage> {
         image_of("dofp_DoLP.tif", "1", derived(|s| dolp_aop(s).0)),
         image_of("dofp_AoP.tif", "rad", derived(|s| dolp_aop(s).1)),
     ]
+}
+
+/// The scene's warnings, plus every object that covers no pixel (behind the camera, outside the
+/// field of view or hidden behind other objects).
+fn render_warnings(scene: &Scene, per_object: &BTreeMap<String, usize>) -> Vec<String> {
+    let mut warnings = scene.warnings.clone();
+    for name in &scene.object_names {
+        if per_object.get(name).copied().unwrap_or(0) == 0 {
+            warnings.push(format!(
+                "object '{name}' covers no pixel: it is behind the camera, outside the field of \
+                 view or hidden behind other objects"
+            ));
+        }
+    }
+    warnings
 }
 
 /// The Stokes component a channel is, if it is one.

@@ -96,6 +96,9 @@ pub struct ThermalSummary {
     #[serde(skip_deserializing)]
     pub stats: SolveStats,
     pub seconds: f64,
+    /// Probable mistakes noticed while loading the scene (issue 16 item 7).
+    #[serde(default)]
+    pub warnings: Vec<String>,
     pub files: Vec<String>,
 }
 
@@ -136,6 +139,7 @@ pub fn write_thermal_outputs(
         recorded_instants: solution.times_s.len(),
         stats: solution.stats,
         seconds,
+        warnings: scene.warnings.clone(),
         files,
     };
     let json = serde_json::to_string_pretty(&summary).map_err(io::Error::other)?;

@@ -43,6 +43,9 @@ pub struct RawMesh {
     pub parts: Vec<String>,
     /// Per-vertex temperatures (PLY property `temperature`, K).
     pub vertex_temperatures: Option<Vec<f64>>,
+    /// What the reader noticed but did not refuse (a property that looks like a temperature
+    /// under another name), for the scene's warnings.
+    pub notes: Vec<String>,
 }
 
 impl RawMesh {
@@ -178,7 +181,11 @@ pub struct ObjectShading<'a> {
 }
 
 /// Transforms, checks and converts a raw mesh. Errors name the face or vertex ("line 12: …").
-pub fn shade_mesh(raw: &RawMesh, setup: &ObjectShading) -> Result<ShadedMesh, String> {
+/// Shades `raw` for rendering; the second value says which degenerate faces were skipped.
+pub fn shade_mesh(
+    raw: &RawMesh,
+    setup: &ObjectShading,
+) -> Result<(ShadedMesh, Option<String>), String> {
     let positions: Vec<Vector3<f64>> = raw
         .positions
         .iter()
@@ -190,7 +197,13 @@ pub fn shade_mesh(raw: &RawMesh, setup: &ObjectShading) -> Result<ShadedMesh, St
     {
         return Err(format!("vertex {} has a non-finite coordinate", i + 1));
     }
-    let face_normals = checked_face_normals(raw, &positions)?;
+    let (kept, skipped) = without_degenerate_faces(raw, &positions)?;
+    let raw = &kept;
+    let face_normals: Vec<Vector3<f64>> = raw
+        .faces
+        .iter()
+        .map(|f| area_normal(f, &positions))
+        .collect();
     let vertex_temperature = vertex_temperatures(raw, setup.part_temperature)?;
     let corner_normals = corner_normals(raw, setup, &face_normals)?;
 
@@ -215,37 +228,55 @@ pub fn shade_mesh(raw: &RawMesh, setup: &ObjectShading) -> Result<ShadedMesh, St
         mesh.triangle_surface
             .push(setup.part_surface[face.part as usize]);
     }
-    Ok(mesh)
+    Ok((mesh, skipped))
 }
 
-/// Area-weighted face normals (the cross product, length = 2·area), refusing degenerate faces.
-fn checked_face_normals(
+/// The cross product of a face's edges: its normal with length 2·area.
+fn area_normal(face: &RawFace, positions: &[Vector3<f64>]) -> Vector3<f64> {
+    let [a, b, c] = face.vertices.map(|i| positions[i as usize]);
+    (b - a).cross(&(c - a))
+}
+
+/// Faces kept to those with an area (issue 16 item 6: one degenerate face in a scanned mesh is
+/// common and should not reject the whole mesh), and a warning naming the skipped ones. Refused
+/// only when no face remains.
+fn without_degenerate_faces(
     raw: &RawMesh,
     positions: &[Vector3<f64>],
-) -> Result<Vec<Vector3<f64>>, String> {
+) -> Result<(RawMesh, Option<String>), String> {
     // Positions are finite here (checked by the caller), so the cross products are too.
     let extent = bounding_diagonal(positions);
     // Relative to the mesh size, so that millimetre and kilometre meshes are judged alike.
     let min_double_area = 1e-12 * extent * extent;
-    raw.faces
-        .iter()
-        .map(|face| {
-            let [a, b, c] = face.vertices.map(|i| positions[i as usize]);
-            let cross = (b - a).cross(&(c - a));
-            if face.vertices[0] == face.vertices[1]
-                || face.vertices[1] == face.vertices[2]
-                || face.vertices[0] == face.vertices[2]
-                || cross.norm() <= min_double_area
-            {
-                Err(format!(
-                    "{}: degenerate triangle (zero area) in part '{}'",
-                    face.origin, raw.parts[face.part as usize]
-                ))
-            } else {
-                Ok(cross)
-            }
-        })
-        .collect()
+    let degenerate = |face: &RawFace| {
+        let [a, b, c] = face.vertices;
+        a == b || b == c || a == c || area_normal(face, positions).norm() <= min_double_area
+    };
+    let (skipped, faces): (Vec<RawFace>, Vec<RawFace>) =
+        raw.faces.iter().cloned().partition(|f| degenerate(f));
+    let describe = |f: &RawFace| format!("{} (part '{}')", f.origin, raw.parts[f.part as usize]);
+    if faces.is_empty() && !skipped.is_empty() {
+        return Err(format!(
+            "every triangle is degenerate (zero area), e.g. {}",
+            describe(&skipped[0])
+        ));
+    }
+    let warning = (!skipped.is_empty()).then(|| {
+        let shown: Vec<String> = skipped.iter().take(5).map(describe).collect();
+        let more = if skipped.len() > 5 { ", …" } else { "" };
+        format!(
+            "skipped {} degenerate (zero-area) triangle(s): {}{more}",
+            skipped.len(),
+            shown.join(", ")
+        )
+    });
+    Ok((
+        RawMesh {
+            faces,
+            ..raw.clone()
+        },
+        warning,
+    ))
 }
 
 /// Diagonal of the bounding box of `positions` (m); 0 for none.
@@ -416,7 +447,7 @@ mod tests {
     fn shared_vertices_get_the_average_part_temperature() {
         let raw = square_with_two_parts();
         let temps = [Some(300.0), Some(320.0)];
-        let mesh = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap();
+        let (mesh, _) = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap();
         // Vertices 1 and 2 are split per part but both copies carry the average 310 K.
         assert_eq!(mesh.positions.len(), 6);
         let t_of = |p: Vector3<f64>| {
@@ -447,12 +478,23 @@ mod tests {
     }
 
     #[test]
-    fn degenerate_and_non_finite_geometry_is_refused() {
+    fn degenerate_faces_are_skipped_and_non_finite_geometry_is_refused() {
         let mut raw = square_with_two_parts();
         raw.positions[3] = Vector3::new(0.5, 0.5, 0.0); // on the shared edge: zero area
         let temps = [Some(300.0), Some(320.0)];
+        let (mesh, warning) = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap();
+        assert_eq!(mesh.triangles.len(), 1);
+        let warning = warning.unwrap();
+        assert!(
+            warning.contains("skipped 1 degenerate") && warning.contains("face 2 (part 'b')"),
+            "{warning}"
+        );
+        raw.faces.remove(0);
         let err = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap_err();
-        assert!(err.contains("face 2") && err.contains("degenerate") && err.contains("'b'"));
+        assert!(
+            err.contains("every triangle is degenerate") && err.contains("'b'"),
+            "{err}"
+        );
         raw.positions[3] = Vector3::new(f64::NAN, 0.5, 0.0);
         let err = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap_err();
         assert!(
@@ -497,7 +539,7 @@ mod tests {
                     origin: FaceOrigin::Index(2),
                 },
             ];
-            let mesh = shade_mesh(&raw, &shading(&[Some(1.0)], &[0])).unwrap();
+            let (mesh, _) = shade_mesh(&raw, &shading(&[Some(1.0)], &[0])).unwrap();
             let distinct = if smoothed { 4 } else { 6 };
             assert_eq!(mesh.positions.len(), distinct, "angle {angle_deg}");
             if smoothed {

@@ -63,6 +63,8 @@ pub struct SceneMaterial {
     /// Where it came from: the material file, or "inline".
     pub origin: String,
     pub pbrdf: Pbrdf,
+    /// The wavelength a library material was measured at (inline materials have none).
+    pub wavelength_um: Option<f64>,
 }
 
 /// One part of one object: what `ShadedMesh::triangle_surface` indexes.
@@ -142,6 +144,9 @@ pub struct Scene {
     pub thermal: Option<std::sync::Arc<thermal::ThermalSetup>>,
     /// Set when the scene is a thermal scene at an instant of its run (`thermal_scene::scene_at`).
     pub thermal_instant: Option<ThermalInstant>,
+    /// What is probably a mistake but not an error (issue 16 item 7): the binary prints each once
+    /// and `summary.json` lists them.
+    pub warnings: Vec<String>,
 }
 
 /// The instant of a thermal run a scene shows.
@@ -281,6 +286,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
     let mut surfaces = Vec::new();
     let mut object_names = Vec::new();
     let mut mesh = ShadedMesh::default();
+    let mut warnings = Vec::new();
     for (index, object) in config.objects.iter().enumerate() {
         let name = object.name.clone().unwrap_or_else(|| {
             object
@@ -299,10 +305,12 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
             &mut materials,
             &mut surfaces,
             start_air_k,
+            &mut warnings,
         )?;
         object_names.push(name);
         mesh.append(object_mesh);
     }
+    warnings.extend(likely_mistakes(&config, &materials.resolved, &band));
     let thermal = match (thermal_run, &config.thermal) {
         (Some(mut run), Some(thermal_config)) => {
             let pbrdfs: Vec<&Pbrdf> = materials.resolved.iter().map(|m| &m.pbrdf).collect();
@@ -343,7 +351,62 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         mesh,
         thermal,
         thermal_instant: None,
+        warnings,
     })
+}
+
+/// Below this a temperature is probably in °C (the coldest natural surface, Antarctic snow at
+/// night, is ~180 K; nothing a thermal camera images is colder in an irpol scene).
+const CELSIUS_SUSPECT_K: f64 = 200.0;
+
+/// Probable mistakes that are not errors (issue 16 item 7): temperatures that look like °C, inline
+/// materials nothing uses, library materials measured outside the sensor band.
+fn likely_mistakes(config: &SceneConfig, materials: &[SceneMaterial], band: &Band) -> Vec<String> {
+    let mut warnings = Vec::new();
+    for (i, object) in config.objects.iter().enumerate() {
+        let name = object
+            .name
+            .clone()
+            .unwrap_or_else(|| format!("object{}", i + 1));
+        let typed = std::iter::once((String::new(), object.temperature_k)).chain(
+            object
+                .parts
+                .iter()
+                .map(|(part, p)| (format!(" part '{part}'"), p.temperature_k)),
+        );
+        for (what, t) in typed {
+            if let Some(t) = t.filter(|&t| t < CELSIUS_SUSPECT_K) {
+                warnings.push(format!(
+                    "objects[{i}] '{name}'{what}: temperature_k = {} K looks like °C \
+                     (temperatures are kelvin: {} °C is {} K)",
+                    number(t),
+                    number(t),
+                    number(t + 273.15)
+                ));
+            }
+        }
+    }
+    for key in config.materials.keys() {
+        if !materials
+            .iter()
+            .any(|m| m.origin == "inline" && &m.name == key)
+        {
+            warnings.push(format!("[materials.{key}] is never used by any object"));
+        }
+    }
+    let (lo, hi) = band.limits_um();
+    for m in materials {
+        if let Some(w) = m.wavelength_um.filter(|&w| w < lo || w > hi) {
+            warnings.push(format!(
+                "material '{}' ({}) was measured at {} µm, outside the sensor band {lo}–{hi} µm: \
+                 its index is assumed to hold across the band",
+                m.name,
+                m.origin,
+                number(w)
+            ));
+        }
+    }
+    warnings
 }
 
 /// What a thermal scene needs to be rendered at an instant of its run: the sky at that instant's
@@ -496,6 +559,7 @@ fn build_object(
     materials: &mut MaterialResolver,
     surfaces: &mut Vec<Surface>,
     thermal_start_air_k: Option<f64>,
+    warnings: &mut Vec<String>,
 ) -> Result<ShadedMesh, SceneError> {
     let scene = materials.scene;
     let fail = |message: String| SceneError::new(scene, format!("{label}: {message}"));
@@ -508,6 +572,22 @@ fn build_object(
     let mesh_file_label = mesh_file
         .as_ref()
         .map_or("the shape".to_owned(), |f| f.display().to_string());
+    warnings.extend(
+        raw.notes
+            .iter()
+            .map(|note| format!("{mesh_file_label} (in {label}): {note}")),
+    );
+    let coldest = raw
+        .vertex_temperatures
+        .as_ref()
+        .and_then(|t| t.iter().copied().reduce(f64::min));
+    if let Some(t) = coldest.filter(|&t| t < CELSIUS_SUSPECT_K) {
+        warnings.push(format!(
+            "{mesh_file_label} (in {label}): per-vertex temperatures down to {} K look like °C \
+             (temperatures are kelvin)",
+            number(t)
+        ));
+    }
 
     let used = raw.used_parts();
     for part in object.parts.keys() {
@@ -603,10 +683,12 @@ fn build_object(
         part_temperature: &part_temperature,
         part_surface: &part_surface,
     };
-    mesh::shade_mesh(&raw, &setup).map_err(|message| match &mesh_file {
+    let (mesh, skipped) = mesh::shade_mesh(&raw, &setup).map_err(|message| match &mesh_file {
         Some(file) => SceneError::new(file, format!("{message} (in {label})")),
         None => fail(message),
-    })
+    })?;
+    warnings.extend(skipped.map(|w| format!("{mesh_file_label} (in {label}): {w}")));
+    Ok(mesh)
 }
 
 enum MeshLoadError {
@@ -709,6 +791,7 @@ impl MaterialResolver<'_> {
                     name: reference.to_owned(),
                     origin: "inline".into(),
                     pbrdf,
+                    wavelength_um: None,
                 },
             )
         } else {
@@ -737,6 +820,7 @@ impl MaterialResolver<'_> {
                     name: reference.to_owned(),
                     origin: path.display().to_string(),
                     pbrdf,
+                    wavelength_um: Some(loaded.model.wavelength_um),
                 },
             )
         };

@@ -46,6 +46,19 @@ pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
     let has_temperature = vertices
         .first()
         .is_some_and(|v| v.contains_key("temperature"));
+    if let Some(first) = vertices.first() {
+        mesh.notes.extend(
+            first
+                .keys()
+                .filter(|k| looks_like_temperature(k) && !has_temperature)
+                .map(|k| {
+                    format!(
+                        "vertex property '{k}' looks like a temperature but is ignored: irpol \
+                         reads per-vertex temperatures (K) only from a property named 'temperature'"
+                    )
+                }),
+        );
+    }
     let mut temperatures = Vec::new();
     for (i, vertex) in vertices.iter().enumerate() {
         let scalar = |key: &str| -> Result<f64, String> {
@@ -191,6 +204,14 @@ fn scalar_bytes(scalar: &ScalarType) -> usize {
     }
 }
 
+/// A vertex property name a user likely meant as the temperature (`temp`, `Temperature`,
+/// `temperature_k`, `T`, …), other than the exact `temperature` irpol reads.
+fn looks_like_temperature(name: &str) -> bool {
+    let lower = name.to_ascii_lowercase();
+    name != "temperature"
+        && (lower.starts_with("temp") || lower == "t" || lower == "t_k" || lower == "kelvin")
+}
+
 fn scalar_value(property: &Property) -> Option<f64> {
     Some(match *property {
         Property::Char(v) => v as f64,
@@ -220,6 +241,20 @@ fn list_value(property: &Property) -> Option<Vec<i64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn temperature_like_properties_are_noted() {
+        let text = TRIANGLE.replace("property float temperature", "property float Temperature");
+        let mesh = parse_ply(text.as_bytes()).unwrap();
+        assert!(mesh.vertex_temperatures.is_none());
+        assert_eq!(mesh.notes.len(), 1);
+        assert!(
+            mesh.notes[0].contains("'Temperature' looks like a temperature"),
+            "{:?}",
+            mesh.notes
+        );
+        assert!(parse_ply(TRIANGLE.as_bytes()).unwrap().notes.is_empty());
+    }
 
     const TRIANGLE: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n\
         property float y\nproperty float z\nproperty float temperature\nelement face 1\n\
