@@ -222,7 +222,8 @@ struct ModelFlags {
     /// Diffuse (unpolarized) reflectance ρ_d.
     #[arg(long, allow_negative_numbers = true)]
     rho: Option<f64>,
-    /// Shadowing: none, torrance-sparrow or smith.
+    /// Shadowing: none, torrance-sparrow or smith (default smith, as `fit`; with --material,
+    /// the material's own).
     #[arg(long)]
     shadowing: Option<String>,
 }
@@ -475,8 +476,17 @@ fn fit_and_summarize(
             .comparison
             .as_ref()
             .map_or(String::new(), |c| format!("; {}", c.summary()));
+        let fixed: Vec<String> = irpol::fit::fixed_values(chosen)
+            .iter()
+            .map(|(name, v)| format!("{name}={}", significant(*v, 6)))
+            .collect();
+        let fixed = if fixed.is_empty() {
+            String::new()
+        } else {
+            format!(" (fixed: {})", fixed.join(" "))
+        };
         say!(
-            "{}: {} {} χ²_red={:.3}{comparison} → {}",
+            "{}: {} {}{fixed} χ²_red={:.3}{comparison} → {}",
             outcome.material.name,
             chosen.distribution.name(),
             parameters.join(" "),

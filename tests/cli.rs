@@ -5,8 +5,9 @@ mod common;
 
 use common::irpol;
 
+/// A column of CSV output, after its `#` header lines.
 fn column(csv: &str, name: &str) -> Vec<f64> {
-    let mut lines = csv.lines();
+    let mut lines = csv.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let index = header.iter().position(|h| *h == name).unwrap();
     lines
@@ -34,12 +35,30 @@ fn eval_reproduces_the_scatmech_reference_through_a_geometry_file() {
         "1.5",
         "--k",
         "0.1",
+        "--shadowing",
+        "none",
         "--geometry",
         geometry.to_str().unwrap(),
     ]);
     assert!(ok, "{stderr}");
+    // `#` lines state the model, then the CSV (issue 16 item 5).
+    let mut lines = stdout.lines();
     assert!(
-        stdout.starts_with("label,theta_i_deg,phi_i_deg,theta_r_deg,phi_r_deg,m00,"),
+        lines
+            .next()
+            .unwrap()
+            .contains("gaussian slopes, sigma = 0.2121"),
+        "{stdout}"
+    );
+    assert_eq!(
+        lines.next().unwrap(),
+        "# N = n + ik: n = 1.5, k = 0.1; rho_d = 0; shadowing = none"
+    );
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .starts_with("label,theta_i_deg,phi_i_deg,theta_r_deg,phi_r_deg,m00,"),
         "{stdout}"
     );
     assert!(
@@ -88,6 +107,8 @@ fn emissivity_table_has_the_smooth_limit_and_reports_excess_reflectance() {
         "10",
         "--k",
         "60",
+        "--shadowing",
+        "none",
         "--theta",
         "85:89:2",
     ]);
@@ -211,4 +232,71 @@ fn demo_outside_the_repository_says_what_it_needs() {
         "{stderr}"
     );
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+/// Issue 16 item 5: one default shadowing everywhere. `eval` and `emissivity` without
+/// `--shadowing` use Smith, as `fit` does, and say so in their header.
+#[test]
+fn eval_and_emissivity_default_to_smith_shadowing() {
+    let model = ["--sigma", "0.3", "--q", "2", "--n", "1.5", "--k", "0.1"];
+    let eval = |extra: &[&str]| {
+        let mut args = vec!["eval", "--theta-i", "60", "--theta-r", "80"];
+        args.extend_from_slice(&model);
+        args.extend_from_slice(extra);
+        let (ok, stdout, stderr) = irpol(&args);
+        assert!(ok, "{stderr}");
+        (stdout.clone(), column(&stdout, "m00")[0])
+    };
+    let (default, m00) = eval(&[]);
+    assert!(default.contains("shadowing = smith"), "{default}");
+    assert_eq!(m00, eval(&["--shadowing", "smith"]).1);
+    assert!(
+        m00 < eval(&["--shadowing", "none"]).1,
+        "Smith shadows at 80°"
+    );
+    let mut args = vec!["emissivity", "--theta", "60"];
+    args.extend_from_slice(&model);
+    let (ok, stdout, _) = irpol(&args);
+    assert!(ok && stdout.contains("shadowing = smith"), "{stdout}");
+}
+
+/// Issue 16 item 8: `--free` fixes the other parameters; the summary line and the material TOML
+/// say at which values, and a parameter both free and fixed is refused.
+#[test]
+fn fixed_parameters_are_recorded_and_contradictions_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let csv = root.join("measurements/rough_paint.csv");
+    let (fits, reports) = (dir.path().join("fits"), dir.path().join("reports"));
+    let base = [
+        "fit",
+        csv.to_str().unwrap(),
+        "--distribution",
+        "cauchy",
+        "--out",
+        fits.to_str().unwrap(),
+        "--reports",
+        reports.to_str().unwrap(),
+    ];
+    let mut args = base.to_vec();
+    args.extend(["--free", "sigma,q,n", "--fix", "k=0.05"]);
+    let (ok, stdout, stderr) = irpol(&args);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("(fixed: k=0.05") && stdout.contains("rho_d=0)"),
+        "{stdout}"
+    );
+    let toml = std::fs::read_to_string(fits.join("rough_paint.toml")).unwrap();
+    assert!(
+        toml.contains("[fit.fixed_parameters]") && toml.contains("k = 0.05"),
+        "{toml}"
+    );
+
+    let mut args = base.to_vec();
+    args.extend(["--free", "sigma,q,n,k", "--fix", "k=0.05"]);
+    let (ok, _, stderr) = irpol(&args);
+    assert!(
+        !ok && stderr.contains("k is both free and fixed"),
+        "{stderr}"
+    );
 }

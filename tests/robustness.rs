@@ -465,7 +465,10 @@ fn eval_keeps_quoted_fields_quoted() {
     let command = format!("eval {MODEL} --geometry g.csv");
     let run = irpol(dir.path(), &command.split(' ').collect::<Vec<_>>());
     assert_eq!(run.code, Some(0), "{}", run.stderr);
-    let mut reader = csv::Reader::from_reader(run.stdout.as_bytes());
+    // The `#` lines before the table state the model (issue 16 item 5).
+    let mut reader = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .from_reader(run.stdout.as_bytes());
     assert_eq!(reader.headers().unwrap().len(), 19);
     let labels: Vec<String> = reader
         .records()

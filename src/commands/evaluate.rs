@@ -261,7 +261,11 @@ pub fn write_mueller_csv(
     table: &GeometryTable,
     out: &mut impl Write,
 ) -> anyhow::Result<()> {
-    let mut writer = csv::Writer::from_writer(out);
+    out.write_all(super::model_header(model).as_bytes())?;
+    // Readers skip the `#` model lines as comments, so a data field starting with '#' is quoted.
+    let mut writer = csv::WriterBuilder::new()
+        .comment(Some(b'#'))
+        .from_writer(out);
     writer
         .write_record(
             table
@@ -340,6 +344,7 @@ pub fn write_emissivity_csv(
     }
     let radians: Vec<f64> = thetas_deg.iter().map(|t| t.to_radians()).collect();
     let table = model.emissivity_table(&radians, &HemisphereQuadrature::default());
+    out.write_all(super::model_header(model).as_bytes())?;
     writeln!(out, "theta_deg,e0,e1,e2,e3")?;
     let mut excess = Vec::new();
     for (&theta, e) in thetas_deg.iter().zip(&table) {
@@ -379,12 +384,20 @@ mod tests {
 
     #[test]
     fn quoted_fields_stay_quoted_and_rows_rectangular() {
-        let out = eval_file("label,theta_i_deg,theta_r_deg\n\"a,b\",30,30\nplain,10,20\n").unwrap();
-        let lines: Vec<&str> = out.lines().collect();
+        let out =
+            eval_file("label,theta_i_deg,theta_r_deg\n\"a,b\",30,30\nplain,10,20\n\"#3\",5,5\n")
+                .unwrap();
+        // After the two `#` lines that state the model.
+        let lines: Vec<&str> = out.lines().skip(2).collect();
+        let out = lines.join("\n");
         assert!(lines[0].starts_with("label,theta_i_deg,theta_r_deg,m00,m01,"));
         assert!(lines[1].starts_with("\"a,b\",30,30,"), "{out}");
         assert!(lines[2].starts_with("plain,10,20,"), "{out}");
-        let mut reader = csv::Reader::from_reader(out.as_bytes());
+        // A label starting with '#' is quoted, so comment-aware readers keep the row.
+        assert!(lines[3].starts_with("\"#3\",5,5,"), "{out}");
+        let mut reader = csv::ReaderBuilder::new()
+            .comment(Some(b'#'))
+            .from_reader(out.as_bytes());
         for record in reader.records() {
             assert_eq!(record.unwrap().len(), 19);
         }
@@ -416,7 +429,7 @@ mod tests {
         let mut out = Vec::new();
         write_mueller_csv(&model(), &table, &mut out).unwrap();
         let text = String::from_utf8(out).unwrap();
-        assert_eq!(text.lines().count(), 3);
-        assert!(text.lines().nth(2).unwrap().starts_with("20,0,30,180,"));
+        assert_eq!(text.lines().count(), 5);
+        assert!(text.lines().nth(4).unwrap().starts_with("20,0,30,180,"));
     }
 }

@@ -84,11 +84,33 @@ impl ModelArgs {
         );
         Ok(Pbrdf::new(
             distribution,
-            shadowing.unwrap_or_default(),
+            // One default everywhere (fit, eval, emissivity, inline scene materials): Smith, the
+            // energy-conserving choice (issue 16 item 5).
+            shadowing.unwrap_or(Shadowing::Smith),
             index,
             self.rho.unwrap_or(0.0),
         )?)
     }
+}
+
+/// `#` lines stating the model a table was computed with (`eval`, `emissivity` output): the
+/// distribution and its parameters, the index, ρ_d and the shadowing.
+pub fn model_header(model: &Pbrdf) -> String {
+    let distribution = match model.distribution() {
+        SlopeDistribution::Cauchy { sigma, q } => {
+            format!("cauchy slopes, sigma = {sigma}, q = {q}")
+        }
+        SlopeDistribution::Gaussian { sigma } => format!("gaussian slopes, sigma = {sigma}"),
+    };
+    let index = model.index();
+    format!(
+        "# irpol {}: {distribution}\n# N = n + ik: n = {}, k = {}; rho_d = {}; shadowing = {}\n",
+        env!("CARGO_PKG_VERSION"),
+        index.n,
+        index.k,
+        model.rho_d(),
+        model.shadowing().name()
+    )
 }
 
 /// Most values one `START:STOP:STEP` sweep may hold.

@@ -10,6 +10,7 @@ use super::stages::Stage;
 use super::FitError;
 use crate::material::{AlternativeFit, FitRecord, Material};
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
+use crate::pbrdf::SlopeDistribution;
 use std::collections::BTreeMap;
 
 /// Everything a fit report needs about one measurement.
@@ -85,6 +86,27 @@ fn names(parameters: &[Parameter]) -> Vec<String> {
     parameters.iter().map(|p| p.name().to_owned()).collect()
 }
 
+/// The chosen family's parameters held fixed, with their values (issue 16 item 8: `--free` fixes
+/// the others, and the record and the summary line say at what).
+pub fn fixed_values(chosen: &ModelFit) -> BTreeMap<String, f64> {
+    let m = &chosen.model;
+    Parameter::ALL
+        .iter()
+        .filter(|p| chosen.distribution.has(**p) && !chosen.free.contains(p))
+        .map(|&p| {
+            let value = match (p, m.distribution) {
+                (Parameter::Sigma, d) => d.sigma(),
+                (Parameter::Q, SlopeDistribution::Cauchy { q, .. }) => q,
+                (Parameter::Q, SlopeDistribution::Gaussian { .. }) => f64::NAN,
+                (Parameter::N, _) => m.n,
+                (Parameter::K, _) => m.k,
+                (Parameter::RhoD, _) => m.rho_d,
+            };
+            (p.name().to_owned(), value)
+        })
+        .collect()
+}
+
 /// The provenance and quality record of DESIGN §2.2.
 fn fit_record(
     set: &MeasurementSet,
@@ -106,6 +128,7 @@ fn fit_record(
             .map(|&e| MUELLER_ELEMENT_NAMES[e].to_owned())
             .collect(),
         free_parameters: names(&chosen.free),
+        fixed_parameters: fixed_values(chosen),
         optimizer: options.optimizer.to_string(),
         seed: options.seed,
         settings: settings(data, options),

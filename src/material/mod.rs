@@ -126,6 +126,9 @@ pub struct FitRecord {
     /// Mueller elements used, e.g. ["m00", "m01", …].
     pub elements: Vec<String>,
     pub free_parameters: Vec<String>,
+    /// The model's parameters held fixed (`--fix`, or left out of `--free`), with their values.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub fixed_parameters: BTreeMap<String, f64>,
     pub optimizer: String,
     pub seed: u64,
     pub settings: BTreeMap<String, String>,

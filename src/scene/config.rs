@@ -358,7 +358,8 @@ pub struct InlineMaterialConfig {
     pub k: f64,
     #[serde(default)]
     pub rho_d: f64,
-    #[serde(default)]
+    /// Default Smith, as everywhere in irpol (issue 16 item 5).
+    #[serde(default = "smith")]
     pub shadowing: crate::pbrdf::Shadowing,
 }
 
@@ -493,6 +494,10 @@ pub struct PartThermalConfig {
     /// (hours from `start_utc`, non-decreasing; constant outside).
     #[serde(default)]
     pub internal_heat_w_m2: InternalHeatConfig,
+}
+
+fn smith() -> crate::pbrdf::Shadowing {
+    crate::pbrdf::Shadowing::Smith
 }
 
 /// `[[name, thickness_m], …]`, refusing other shapes with a message that says what an entry is
