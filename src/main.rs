@@ -27,6 +27,7 @@ use irpol::pbrdf::Shadowing;
 use irpol::report::fit_report::rebuild_report;
 use irpol::report::index::write_library_index;
 use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
+use irpol::text::significant;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -463,15 +464,30 @@ fn fit_and_summarize(
     let written = fit_and_write(inputs, options, fits_dir, reports_dir, true)?;
     for (outcome, entry) in written.outcomes.iter().zip(&written.entries) {
         let chosen = &outcome.chosen;
+        let bounds = outcome.material.fit.as_ref().map(|fit| &fit.profile_bounds);
+        let bound = |p: &irpol::fit::Parameter| bounds.and_then(|b| b.get(p.name()));
+        // Where the ± means nothing (undetermined, or bounded from one side only), the profile
+        // bound is listed instead.
         let parameters: Vec<String> = chosen
             .free
             .iter()
             .zip(&chosen.values)
+            .filter(|(p, _)| bound(p).is_none())
             .map(|(p, v)| match chosen.error(*p) {
                 Some(e) => format!("{}={}±{e:.1e}", p.name(), significant(*v, 6)),
                 None => format!("{}={}", p.name(), significant(*v, 6)),
             })
             .collect();
+        let undetermined: Vec<String> = chosen
+            .free
+            .iter()
+            .filter_map(|p| bound(p).map(|b| b.describe(p.name())))
+            .collect();
+        let undetermined = if undetermined.is_empty() {
+            String::new()
+        } else {
+            format!(" [bounded only: {}]", undetermined.join(", "))
+        };
         let comparison = outcome
             .comparison
             .as_ref()
@@ -486,7 +502,7 @@ fn fit_and_summarize(
             format!(" (fixed: {})", fixed.join(" "))
         };
         say!(
-            "{}: {} {}{fixed} χ²_red={:.3}{comparison} → {}",
+            "{}: {} {}{undetermined}{fixed} χ²_red={:.3}{comparison} → {}",
             outcome.material.name,
             chosen.distribution.name(),
             parameters.join(" "),
@@ -499,15 +515,6 @@ fn fit_and_summarize(
     }
     say!("  index  {}", written.index.display());
     Ok(())
-}
-
-/// `value` to `digits` significant digits in plain notation (0.0000061 stays readable as such).
-fn significant(value: f64, digits: i32) -> String {
-    if value == 0.0 || !value.is_finite() {
-        return format!("{value}");
-    }
-    let decimals = (digits - 1 - value.abs().log10().floor() as i32).clamp(0, 15) as usize;
-    format!("{value:.decimals$}")
 }
 
 fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {

@@ -41,6 +41,15 @@ pub fn number(x: f64) -> String {
     }
 }
 
+/// `value` to `digits` significant digits in plain notation (0.0000061 stays readable as such).
+pub fn significant(value: f64, digits: i32) -> String {
+    if value == 0.0 || !value.is_finite() {
+        return format!("{value}");
+    }
+    let decimals = (digits - 1 - value.abs().log10().floor() as i32).clamp(0, 15) as usize;
+    format!("{value:.decimals$}")
+}
+
 /// Characters that a terminal acts on or that reorder the text around them: C0/C1 controls and
 /// the Unicode bidirectional marks, embeddings, overrides and isolates.
 fn is_hidden(c: char) -> bool {

@@ -27,6 +27,7 @@ mod optimize;
 mod options;
 mod outcome;
 pub mod parameters;
+mod profile;
 mod robust;
 mod space;
 mod stages;
@@ -49,6 +50,7 @@ pub use outcome::{fit_measurement, fixed_values, FitOutcome};
 pub use parameters::{
     DistributionKind, Interval, Parameter, ParameterBounds, ParameterValues, SMITH_MIN_Q,
 };
+pub use profile::{CONFIDENCE, ONE_SIDED_95_DELTA_CHI2};
 pub use robust::RobustLoss;
 pub use space::ModelSpace;
 pub use stages::{ConvergenceHistory, Optimizer, Stage, StageHistory};

@@ -6,6 +6,7 @@ use super::objective::Objective;
 use super::optimize::minimize;
 use super::options::FitOptions;
 use super::parameters::{DistributionKind, Parameter, ParameterValues};
+use super::profile::{parameters_to_profile, profile_bounds};
 use super::space::ModelSpace;
 use super::stages::ConvergenceHistory;
 use super::uncertainty::{estimate, Uncertainty};
@@ -13,6 +14,7 @@ use super::FitError;
 use crate::material::ModelSpec;
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::optics::Mueller;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// The best fit of one slope distribution, with everything a report needs.
@@ -154,7 +156,18 @@ pub(crate) fn fit_model(
     let free_count = space.dimension();
     let degrees_of_freedom = observations - free_count;
     let reduced_chi2 = chi2 / degrees_of_freedom as f64;
-    let uncertainty = estimate(&objective, &best, reduced_chi2);
+    let mut uncertainty = estimate(&objective, &best, reduced_chi2);
+    // Where the linearized error means nothing, say what the data do allow.
+    uncertainty.profile_bounds = parameters_to_profile(&space, &values, &uncertainty)
+        .par_iter()
+        .map(|&p| {
+            let settings = &options.settings.levenberg_marquardt;
+            (
+                p,
+                profile_bounds(&objective, &best, reduced_chi2, p, settings),
+            )
+        })
+        .collect();
     Ok(ModelFit {
         distribution: kind,
         model: space.model_spec(&values, set.wavelength_um),

@@ -150,6 +150,11 @@ fn fit_record(
         correlation: uncertainty.correlation.clone(),
         undetermined: names(&uncertainty.undetermined),
         at_bound: names(&uncertainty.at_bound),
+        profile_bounds: uncertainty
+            .profile_bounds
+            .iter()
+            .map(|(p, bound)| (p.name().to_owned(), *bound))
+            .collect(),
         model_choice: comparison.map(ModelComparison::summary),
         alternative: alternative.map(|other| AlternativeFit {
             model: other.model.clone(),

@@ -12,6 +12,7 @@
 
 use super::objective::Objective;
 use super::parameters::{value_per_coordinate, Parameter, ParameterValues};
+use crate::material::ConfidenceBound;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
@@ -38,6 +39,8 @@ pub struct Uncertainty {
     pub undetermined: Vec<Parameter>,
     /// Parameters resting on a bound of their search interval.
     pub at_bound: Vec<Parameter>,
+    /// One-sided profile-likelihood bounds of each undetermined parameter ([`super::profile`]).
+    pub profile_bounds: Vec<(Parameter, ConfidenceBound)>,
 }
 
 /// Jacobian of the plain normalized residuals with respect to the physical free parameters, by
@@ -89,6 +92,7 @@ pub(crate) fn estimate(objective: &Objective, search: &[f64], reduced_chi2: f64)
         correlation: identity(dimension),
         undetermined: Vec::new(),
         at_bound,
+        profile_bounds: Vec::new(),
     };
     let Some(jacobian) = physical_jacobian(objective, search) else {
         uncertainty.undetermined = parameters;

@@ -3,7 +3,7 @@
 
 use crate::optics::{RefractiveIndex, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
 use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};
-use crate::text::{number, shown, shown_at_most};
+use crate::text::{number, shown, shown_at_most, significant};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -153,6 +153,11 @@ pub struct FitRecord {
     /// Free parameters resting on a bound of their search interval (e.g. ρ_d = 0).
     #[serde(default)]
     pub at_bound: Vec<String>,
+    /// One-sided profile-likelihood bounds of the parameters whose 1-σ `uncertainty` does not
+    /// describe what the data allow: the undetermined ones, and those the data bound from one
+    /// side only (a linear 95 % interval reaching an end of the search interval; issue 16 item 3).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub profile_bounds: BTreeMap<String, ConfidenceBound>,
     /// How the slope distribution was chosen when both were fitted (AIC/BIC comparison).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model_choice: Option<String>,
@@ -164,6 +169,39 @@ pub struct FitRecord {
     pub convergence: Vec<f64>,
     #[serde(default)]
     pub global_iterations: usize,
+}
+
+/// What the data say about a parameter they do not determine: a one-sided bound on each side of
+/// the fitted value from the profile likelihood (χ² minimized over the other parameters rises by
+/// z² s² there, z the one-sided quantile of `confidence`). A missing side means the data allow
+/// every value on that side within the fit's search interval.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConfidenceBound {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upper: Option<f64>,
+    /// The confidence of each side's bound (0.95).
+    pub confidence: f64,
+}
+
+impl ConfidenceBound {
+    /// "k < 0.0312 (95 %)", "n > 1.21 (95 %)", "0.8 < n < 2.1 (95 % each side)", or
+    /// "k not bounded in the search interval".
+    pub fn describe(&self, name: &str) -> String {
+        let percent = number(100.0 * self.confidence);
+        match (self.lower, self.upper) {
+            (None, Some(upper)) => format!("{name} < {} ({percent} %)", significant(upper, 3)),
+            (Some(lower), None) => format!("{name} > {} ({percent} %)", significant(lower, 3)),
+            (Some(lower), Some(upper)) => format!(
+                "{} < {name} < {} ({percent} % each side)",
+                significant(lower, 3),
+                significant(upper, 3)
+            ),
+            (None, None) => format!("{name} not bounded in the search interval"),
+        }
+    }
 }
 
 /// The other distribution's best fit on the same data (model comparison by AIC/BIC).
@@ -341,6 +379,28 @@ mod tests {
             },
             fit: None,
         }
+    }
+
+    #[test]
+    fn confidence_bounds_say_which_sides_the_data_bound() {
+        let bound = |lower, upper| ConfidenceBound {
+            lower,
+            upper,
+            confidence: 0.95,
+        };
+        assert_eq!(
+            bound(None, Some(0.031234)).describe("k"),
+            "k < 0.0312 (95 %)"
+        );
+        assert_eq!(bound(Some(1.2157), None).describe("n"), "n > 1.22 (95 %)");
+        assert_eq!(
+            bound(Some(0.8), Some(2.1)).describe("n"),
+            "0.800 < n < 2.10 (95 % each side)"
+        );
+        assert_eq!(
+            bound(None, None).describe("q"),
+            "q not bounded in the search interval"
+        );
     }
 
     #[test]

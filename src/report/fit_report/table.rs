@@ -3,7 +3,7 @@
 //! and optimizer, and the provenance of the measurement (DESIGN §2.2).
 
 use super::style::{DrawResult, CAPTION_SIZE, LEGEND_SIZE};
-use crate::material::{FitRecord, Material, ModelSpec};
+use crate::material::{ConfidenceBound, FitRecord, Material, ModelSpec};
 use crate::pbrdf::SlopeDistribution;
 use crate::report::FONT;
 use plotters::coord::Shift;
@@ -45,6 +45,19 @@ pub fn format_with_uncertainty(value: f64, sigma: Option<f64>) -> (String, Optio
             (value, Some(format!("{sigma:.decimals$}")))
         }
         None => (format_plain(value), None),
+    }
+}
+
+/// The ± cell of a parameter with a profile bound: "< 3.722e-6 ‡", "> 1.215 ‡", "0.8000 … 2.100 ‡",
+/// "unbounded ‡" (short enough for the column; the ‡ note below the table says what it is).
+fn bound_cell(bound: &ConfidenceBound) -> String {
+    match (bound.lower, bound.upper) {
+        (None, Some(upper)) => format!("< {} ‡", format_plain(upper)),
+        (Some(lower), None) => format!("> {} ‡", format_plain(lower)),
+        (Some(lower), Some(upper)) => {
+            format!("{} … {} ‡", format_plain(lower), format_plain(upper))
+        }
+        (None, None) => "unbounded ‡".into(),
     }
 }
 
@@ -180,10 +193,13 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
                 let sigma = lookup(|k| fit.uncertainty.get(k), name).copied();
                 let (text, sigma_text) = format_with_uncertainty(value, sigma);
                 let undetermined = fit.undetermined.iter().any(|u| u == name);
-                let sigma_text = match (sigma_text, undetermined) {
-                    (Some(s), false) => format!("± {s}"),
-                    (Some(s), true) => format!("± {s} undetermined"),
-                    (None, _) => "± ? undetermined".into(),
+                // An undetermined parameter's ± means nothing: its profile bound instead.
+                let bound = lookup(|k| fit.profile_bounds.get(k), name);
+                let sigma_text = match (bound, sigma_text, undetermined) {
+                    (Some(bound), _, _) => bound_cell(bound),
+                    (None, Some(s), false) => format!("± {s}"),
+                    (None, Some(s), true) => format!("± {s} undetermined"),
+                    (None, None, _) => "± ? undetermined".into(),
                 };
                 let tone = if undetermined {
                     Tone::Warning
@@ -260,6 +276,18 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
         rows.push(Row::Text(
             format!("† at a bound of its search interval: {}", names.join(", ")),
             Tone::Muted,
+        ));
+    }
+
+    if !fit.profile_bounds.is_empty() {
+        let names: Vec<&str> = fit.profile_bounds.keys().map(|n| symbol(n)).collect();
+        rows.push(Row::Text(
+            format!(
+                "‡ one-sided 95 % profile-likelihood bounds (the data bound {} from one side \
+                 at most; a ± would mislead)",
+                names.join(", ")
+            ),
+            Tone::Warning,
         ));
     }
 
@@ -475,7 +503,8 @@ mod tests {
                 "bic": aic + 3.0,
                 "uncertainty": { "sigma": 0.0012, "rho": 0.001 },
                 "correlation": [[1.0, -0.95, 0.1], [-0.95, 1.0, 0.2], [0.1, 0.2, 1.0]],
-                "undetermined": ["q"],
+                "undetermined": ["q", "rho_d"],
+                "profile_bounds": { "rho_d": { "upper": 0.00312, "confidence": 0.95 } },
                 "at_bound": ["rho_d"],
                 "alternative": AlternativeFit {
                     model: ModelSpec {
@@ -521,7 +550,11 @@ mod tests {
         assert_eq!(cells("q").1, Tone::Warning, "q is undetermined");
         assert_eq!(cells("q").0[2], "± ? undetermined");
         assert_eq!(cells("n").0[1..3], ["1.200", "fixed"]);
-        assert_eq!(cells("ρd").0[1..3], ["0 †", "± 0.0010"], "`rho` names ρ_d");
+        assert_eq!(
+            cells("ρd").0[1..3],
+            ["0 †", "< 0.003120 ‡"],
+            "an undetermined parameter shows its profile bound, not ±"
+        );
         assert!(rows.contains(&Row::Text(
             "† at a bound of its search interval: ρd".into(),
             Tone::Muted
