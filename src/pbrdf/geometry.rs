@@ -42,13 +42,12 @@ impl Direction {
                 value: theta_deg,
             });
         }
-        if !phi_deg.is_finite() {
-            return Err(ModelError::Azimuth {
-                name,
-                value: phi_deg,
-            });
-        }
-        let (theta, phi) = fold_signed_zenith(theta_deg, phi_deg);
+        // A non-finite azimuth is refused below as given (folded, it would read NaN).
+        let (theta, phi) = if phi_deg.is_finite() {
+            fold_signed_zenith(theta_deg, phi_deg)
+        } else {
+            (theta_deg.abs(), phi_deg)
+        };
         Direction::from_degrees_checked(name, theta, phi)
     }
 }
