@@ -55,15 +55,16 @@ enum Command {
         /// Incidence zenith (°), a value or START:STOP:STEP.
         #[arg(long)]
         theta_i: Option<String>,
-        /// Detector zenith (°), a value or START:STOP:STEP.
-        #[arg(long)]
+        /// Detector zenith (°), a value or START:STOP:STEP; θ_r < 0 is read as (|θ_r|, φ_r + 180°).
+        #[arg(long, allow_hyphen_values = true)]
         theta_r: Option<String>,
         /// Incidence azimuth (°).
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         phi_i: f64,
-        /// Detector azimuth (°); 180 is the specular plane.
-        #[arg(long, default_value_t = 180.0)]
-        phi_r: f64,
+        /// Detector azimuth (°), a value or START:STOP:STEP (inner to --theta-r: rows run over
+        /// φ_r for each θ_r); 180 is the specular side.
+        #[arg(long, default_value = "180", allow_hyphen_values = true)]
+        phi_r: String,
     },
     /// Polarized emissivity ε0…ε3 against emission angle, as CSV on stdout.
     Emissivity {
@@ -182,8 +183,12 @@ enum Command {
     },
     /// A table of the materials in a library folder.
     Library {
-        #[arg(long, default_value = "fits")]
+        /// The library folder (`irpol fit --out`'s folder).
+        #[arg(default_value = "fits")]
         dir: PathBuf,
+        /// The library folder, as a flag (the same as DIR; earlier versions took only this).
+        #[arg(long = "dir", conflicts_with = "dir", hide = true)]
+        dir_flag: Option<PathBuf>,
     },
     /// Runs the main job on shipped defaults and prints where everything went.
     Demo,
@@ -300,10 +305,11 @@ fn run(command: Command) -> anyhow::Result<()> {
                     &parse_sweep(&ti, "theta-i")?,
                     phi_i,
                     &parse_sweep(&tr, "theta-r")?,
-                    phi_r,
+                    &parse_sweep(&phi_r, "phi-r")?,
                 )?,
                 _ => anyhow::bail!("give --geometry FILE.csv, or --theta-i and --theta-r"),
             };
+            note_all(&table.notes);
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
             write_mueller_csv(&model, &table, &mut out)?;
             out.flush()?;
@@ -412,7 +418,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             write_sun_csv(latitude, longitude, &times, clear_sky, &mut out)?;
             out.flush()?;
         }
-        Command::Library { dir } => print_library(&dir)?,
+        Command::Library { dir, dir_flag } => print_library(&dir_flag.unwrap_or(dir))?,
         Command::Demo => demo()?,
     }
     Ok(())
@@ -462,6 +468,9 @@ fn fit_and_summarize(
 ) -> anyhow::Result<()> {
     cli::signals::remove_on_interrupt(vec![], vec![fits_dir.to_owned(), reports_dir.to_owned()]);
     let written = fit_and_write(inputs, options, fits_dir, reports_dir, true)?;
+    for outcome in &written.outcomes {
+        note_all(&outcome.measurement.notes);
+    }
     for (outcome, entry) in written.outcomes.iter().zip(&written.entries) {
         let chosen = &outcome.chosen;
         let bounds = outcome.material.fit.as_ref().map(|fit| &fit.profile_bounds);
@@ -578,6 +587,13 @@ fn report_instants(scene: &Path, out: &Path, renders: &[TimedRender]) {
     }
     if renders.len() > 1 {
         say!("  {}", out.join("preview.gif").display());
+    }
+}
+
+/// Each note on stderr: what irpol did that the user should know, not a problem.
+fn note_all(notes: &[String]) {
+    for note in notes {
+        eprintln!("irpol: note: {note}");
     }
 }
 

@@ -300,3 +300,287 @@ fn fixed_parameters_are_recorded_and_contradictions_refused() {
         "{stderr}"
     );
 }
+
+/// The model flags of the signed-angle tests.
+const EVAL_MODEL: [&str; 8] = ["--sigma", "0.2", "--q", "2", "--n", "1.5", "--k", "0.1"];
+
+/// `irpol eval` with the model above and `args`: (stdout, stderr), asserting success.
+fn eval(args: &[&str]) -> (String, String) {
+    let mut all = vec!["eval"];
+    all.extend_from_slice(&EVAL_MODEL);
+    all.extend_from_slice(args);
+    let (ok, stdout, stderr) = irpol(&all);
+    assert!(ok, "{all:?}: {stderr}");
+    (stdout, stderr)
+}
+
+/// The 16 Mueller values of each data row.
+fn mueller_rows(csv: &str) -> Vec<Vec<String>> {
+    csv.lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| l.split(',').rev().take(16).map(str::to_owned).collect())
+        .collect()
+}
+
+/// Issue 16 item 2: a signed detector zenith θ_r < 0 is the detector across the normal,
+/// (|θ_r|, φ_r + 180°), in sweeps and geometry files, with one note; rows are echoed as given.
+#[test]
+fn eval_reads_signed_theta_r_across_the_normal() {
+    let (signed, note) = eval(&["--theta-i", "40", "--theta-r", "-30", "--phi-r", "180"]);
+    let (unsigned, quiet) = eval(&["--theta-i", "40", "--theta-r", "30", "--phi-r", "0"]);
+    assert_eq!(mueller_rows(&signed), mueller_rows(&unsigned));
+    assert!(
+        signed.contains("\n40,0,-30,180,"),
+        "echoed as given: {signed}"
+    );
+    assert_eq!(
+        note,
+        "irpol: note: --theta-r: 1 row with θ_r < 0 read as (|θ_r|, φ_r + 180°)\n"
+    );
+    assert_eq!(quiet, "");
+
+    let (sweep, note) = eval(&["--theta-i", "40", "--theta-r", "-80:80:10"]);
+    assert_eq!(mueller_rows(&sweep).len(), 17);
+    assert_eq!(note.lines().count(), 1, "{note}");
+    assert!(note.contains(": 8 rows with θ_r < 0"), "{note}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let geometry = dir.path().join("g.csv");
+    std::fs::write(
+        &geometry,
+        "theta_i_deg,theta_r_deg,phi_r_deg\n40,-30,180\n40,30,0\n40,-20,90\n",
+    )
+    .unwrap();
+    let (table, note) = eval(&["--geometry", geometry.to_str().unwrap()]);
+    let rows = mueller_rows(&table);
+    assert_eq!(rows[0], rows[1]);
+    assert!(table.contains("\n40,-30,180,"), "{table}");
+    assert_eq!(
+        note,
+        format!(
+            "irpol: note: {}: 2 rows with θ_r < 0 read as (|θ_r|, φ_r + 180°)\n",
+            geometry.display()
+        )
+    );
+
+    std::fs::write(&geometry, "theta_i_deg,theta_r_deg\n40,-30\n40,-90\n").unwrap();
+    let mut args = vec!["eval"];
+    args.extend_from_slice(&EVAL_MODEL);
+    args.extend(["--geometry", geometry.to_str().unwrap()]);
+    let (ok, _, stderr) = irpol(&args);
+    assert!(
+        !ok && stderr.contains("g.csv:3: theta_r_deg = -90° is invalid")
+            && stderr.contains("(−90°, 90°)")
+            && stderr.lines().count() == 1,
+        "{stderr}"
+    );
+}
+
+/// Issue 16 item 2: `--phi-r` sweeps like `--theta-r`; rows run over φ_r within each θ_r, and
+/// the sweep bound holds for the product.
+#[test]
+fn eval_sweeps_phi_r_inside_theta_r() {
+    let (table, _) = eval(&[
+        "--theta-i",
+        "30",
+        "--theta-r",
+        "10:20:10",
+        "--phi-r",
+        "0:180:90",
+    ]);
+    let geometry: Vec<String> = table
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| l.split(',').take(4).collect::<Vec<_>>().join(","))
+        .collect();
+    assert_eq!(
+        geometry,
+        [
+            "30,0,10,0",
+            "30,0,10,90",
+            "30,0,10,180",
+            "30,0,20,0",
+            "30,0,20,90",
+            "30,0,20,180"
+        ]
+    );
+    let mut args = vec!["eval"];
+    args.extend_from_slice(&EVAL_MODEL);
+    args.extend([
+        "--theta-i",
+        "0:89:0.01",
+        "--theta-r",
+        "0:89:0.1",
+        "--phi-r",
+        "0:10:1",
+    ]);
+    let (ok, stdout, stderr) = irpol(&args);
+    assert!(
+        !ok && stdout.is_empty() && stderr.contains("at most 10000000"),
+        "{stderr}"
+    );
+}
+
+/// A measurement CSV of material `paint` at `wavelength` µm from SCATMECH-free synthetic rows:
+/// m00 and m10 of the model of [`EVAL_MODEL`] at the given (θ_i, θ_r, φ_r), as `irpol eval`
+/// computes them.
+fn measurement_file(path: &std::path::Path, wavelength: &str, geometry: &[(f64, f64, f64)]) {
+    let dir = path.parent().unwrap();
+    let g = dir.join(".geometry.csv");
+    let mut text = "theta_i_deg,theta_r_deg,phi_r_deg\n".to_owned();
+    for (ti, tr, pr) in geometry {
+        text.push_str(&format!("{ti},{tr},{pr}\n"));
+    }
+    std::fs::write(&g, text).unwrap();
+    let (table, _) = eval(&["--geometry", g.to_str().unwrap()]);
+    let (m00, m10) = (column(&table, "m00"), column(&table, "m10"));
+    let mut csv = format!(
+        "# material: paint\n# wavelength_um: {wavelength}\ntheta_i_deg,theta_r_deg,phi_r_deg,m00,m10\n"
+    );
+    for (((ti, tr, pr), a), b) in geometry.iter().zip(m00).zip(m10) {
+        csv.push_str(&format!("{ti},{tr},{pr},{a:e},{b:e}\n"));
+    }
+    std::fs::write(path, csv).unwrap();
+    std::fs::remove_file(g).unwrap();
+}
+
+/// In-plane scans at θ_i = 20°, 40°, 60°, detector −80…80° in `step`° steps.
+fn in_plane_scan(step: usize) -> Vec<(f64, f64, f64)> {
+    let mut geometry = Vec::new();
+    for ti in [20.0, 40.0, 60.0] {
+        for tr in (-80..=80).step_by(step) {
+            geometry.push((ti, tr as f64, 180.0));
+        }
+    }
+    geometry
+}
+
+/// Issue 16 items 2 and 11: a measurement file with signed θ_r fits (with one note), two files
+/// of one material at one wavelength are merged as repeat measurements with a note, recorded in
+/// the TOML, and `irpol report` rebuilds from both; another wavelength is refused naming both.
+#[test]
+fn fit_merges_repeat_files_of_one_material_and_reads_signed_angles() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b, far) = (
+        dir.path().join("a.csv"),
+        dir.path().join("b.csv"),
+        dir.path().join("far.csv"),
+    );
+    measurement_file(&a, "10", &in_plane_scan(10));
+    measurement_file(&b, "10.0000004", &in_plane_scan(20));
+    measurement_file(&far, "10.6", &in_plane_scan(20));
+    let (fits, reports) = (dir.path().join("fits"), dir.path().join("reports"));
+    let fit = |inputs: &[&std::path::Path]| {
+        let mut args = vec!["fit".to_owned()];
+        args.extend(inputs.iter().map(|p| p.display().to_string()));
+        args.extend(
+            [
+                "--distribution",
+                "cauchy",
+                "--optimizer",
+                "lm",
+                "--free",
+                "sigma,q,n",
+                "--fix",
+                "k=0.1",
+            ]
+            .map(str::to_owned),
+        );
+        args.extend(["--out".to_owned(), fits.display().to_string()]);
+        args.extend(["--reports".to_owned(), reports.display().to_string()]);
+        irpol(&args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+
+    let (ok, _, stderr) = fit(&[&a, &far]);
+    assert!(!ok && !fits.exists(), "{stderr}");
+    assert!(
+        stderr.contains("a.csv and ")
+            && stderr.contains("far.csv both hold material 'paint'")
+            && stderr.contains("10 µm and 10.6 µm")
+            && stderr.lines().count() == 1,
+        "{stderr}"
+    );
+
+    let (ok, stdout, stderr) = fit(&[&a, &b]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("paint: cauchy sigma=0.2") && stdout.contains("q=2.0000"),
+        "{stdout}"
+    );
+    let expected = [
+        format!(
+            "irpol: note: {}: 24 rows with θ_r < 0 read as (|θ_r|, φ_r + 180°)",
+            a.display()
+        ),
+        format!(
+            "irpol: note: {}: 12 rows with θ_r < 0 read as (|θ_r|, φ_r + 180°)",
+            b.display()
+        ),
+        format!(
+            "irpol: note: paint: merged {} (51 rows) and {} (27 rows) as repeat measurements",
+            a.display(),
+            b.display()
+        ),
+    ];
+    assert_eq!(stderr.lines().collect::<Vec<_>>(), expected);
+    let entry = fits.join("paint.toml");
+    let material = irpol::material::Material::load(&entry).unwrap();
+    let record = material.fit.unwrap();
+    assert_eq!((record.source.as_path(), record.points), (a.as_path(), 78));
+    assert_eq!(record.merged_sources.len(), 1);
+    assert_eq!(
+        (
+            record.merged_sources[0].source.as_path(),
+            record.merged_sources[0].points
+        ),
+        (b.as_path(), 27)
+    );
+
+    std::fs::remove_dir_all(&reports).unwrap();
+    let (ok, stdout, stderr) = irpol(&[
+        "report",
+        entry.to_str().unwrap(),
+        "--reports",
+        reports.to_str().unwrap(),
+    ]);
+    assert!(ok && stdout.contains("paint.png"), "{stderr}");
+    std::fs::write(
+        &b,
+        std::fs::read_to_string(&b).unwrap() + "40,10,180,0.1,0.0\n",
+    )
+    .unwrap();
+    let (ok, _, stderr) = irpol(&[
+        "report",
+        entry.to_str().unwrap(),
+        "--reports",
+        reports.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("b.csv: source CSV changed"),
+        "{stderr}"
+    );
+}
+
+/// Issue 16 item 11: `irpol library` takes the folder `irpol fit --out` wrote as an argument,
+/// and still as `--dir`.
+#[test]
+fn library_takes_its_folder_as_an_argument_or_dir() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let fits = root.join("fits");
+    for args in [
+        vec!["library", fits.to_str().unwrap()],
+        vec!["library", "--dir", fits.to_str().unwrap()],
+    ] {
+        let (ok, stdout, stderr) = irpol(&args);
+        assert!(ok, "{args:?}: {stderr}");
+        assert!(
+            stdout.starts_with("material") && stdout.contains("paper_paint"),
+            "{args:?}: {stdout}"
+        );
+    }
+    let empty = tempfile::tempdir().unwrap();
+    let (ok, stdout, _) = irpol(&["library", empty.path().to_str().unwrap()]);
+    assert!(ok && stdout.starts_with("no materials in"), "{stdout}");
+}

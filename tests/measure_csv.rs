@@ -36,7 +36,7 @@ const BAD_FILES: &[(&str, &str)] = &[
     ("overflow_value.csv", "3:7: column 'm00': '1e999' is not a finite number"),
     ("empty_field.csv", "3:7: column 'm00' is empty, expected a number"),
     ("theta_i_90.csv", "3:1: column 'theta_i_deg': 90 is outside [0°, 90°) (zenith angles of the hemisphere above the surface)"),
-    ("theta_r_negative.csv", "3:4: column 'theta_r_deg': -30 is outside [0°, 90°) (zenith angles of the hemisphere above the surface)"),
+    ("theta_r_minus_90.csv", "3:4: column 'theta_r_deg': -90 is outside (−90°, 90°) (detector zenith angles; a negative one is read as (|θ_r|, φ_r + 180°))"),
     ("negative_m00.csv", "3:7: column 'm00': -0.002 is negative, but m00 (the unpolarized BRDF, sr⁻¹) is ≥ 0"),
     ("zero_uncertainty.csv", "3:12: column 'u_m00': 0 is not a positive uncertainty"),
     ("negative_uncertainty.csv", "3:17: column 'u_m11': -1e-3 is not a positive uncertainty"),

@@ -1,6 +1,10 @@
 //! `irpol eval` and `irpol emissivity`: the model evaluated on a geometry CSV, an angle sweep or
 //! an emission-angle table, written as CSV.
 //!
+//! A detector zenith θ_r < 0 (in-plane scans are written −80…80°) is the detector across the
+//! normal, (|θ_r|, φ_r + 180°): the Mueller values are those of that geometry, the row is echoed
+//! as given, and the table carries one note saying how many rows were so read.
+//!
 //! Rows are produced one at a time, never held all at once: a geometry file is read into memory
 //! as bytes and parsed twice (once to validate every row, so that a bad row refuses the file
 //! before anything is printed, once to evaluate), and a sweep generates its rows from its angle
@@ -8,20 +12,20 @@
 //! stays quoted and the CSV stays rectangular.
 
 use crate::measure::MUELLER_ELEMENT_NAMES;
-use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
+use crate::pbrdf::{signed_zenith_note, Direction, HemisphereQuadrature, Pbrdf};
 use crate::text::{shown, shown_at_most};
 use anyhow::Context;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// Most rows an angle sweep may produce (θ_i values × θ_r values): about 3 GB of CSV, and minutes
+/// Most rows an angle sweep may produce (θ_i values × θ_r values × φ_r values): about 3 GB of CSV, and minutes
 /// of evaluation. A larger table is almost certainly a mistyped step.
 pub const MAX_SWEEP_ROWS: usize = 10_000_000;
 
 /// Characters of a header row quoted in a message.
 const HEADER_EXCERPT_CHARS: usize = 120;
 
-/// One evaluation geometry in degrees.
+/// One evaluation geometry in degrees, θ_r signed as given.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Geometry {
     pub theta_i_deg: f64,
@@ -34,7 +38,11 @@ impl Geometry {
     fn directions(&self) -> Result<(Direction, Direction), crate::pbrdf::ModelError> {
         Ok((
             Direction::from_degrees_checked("theta_i_deg", self.theta_i_deg, self.phi_i_deg)?,
-            Direction::from_degrees_checked("theta_r_deg", self.theta_r_deg, self.phi_r_deg)?,
+            Direction::from_signed_degrees_checked(
+                "theta_r_deg",
+                self.theta_r_deg,
+                self.phi_r_deg,
+            )?,
         ))
     }
 }
@@ -44,6 +52,9 @@ impl Geometry {
 pub struct GeometryTable {
     pub headers: Vec<String>,
     rows: Rows,
+    /// What the user should know about how the rows were read (θ_r < 0), for the caller to
+    /// print; the library never prints.
+    pub notes: Vec<String>,
 }
 
 enum Rows {
@@ -52,11 +63,12 @@ enum Rows {
         bytes: Vec<u8>,
         columns: GeometryColumns,
     },
+    /// Every θ_i, then every θ_r, then every φ_r (innermost: a ring of the detector per θ_r).
     Sweep {
         theta_i: Vec<f64>,
         phi_i: f64,
         theta_r: Vec<f64>,
-        phi_r: f64,
+        phi_r: Vec<f64>,
     },
 }
 
@@ -97,22 +109,27 @@ pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> anyhow::Result<Geometr
         .map(str::to_owned)
         .collect();
     let columns = geometry_columns(path, &headers)?;
-    let table = GeometryTable {
+    let mut table = GeometryTable {
         headers,
         rows: Rows::File {
             path: path.to_owned(),
             bytes,
             columns,
         },
+        notes: Vec::new(),
     };
-    let mut count = 0usize;
-    table.for_each_row(|_, _| {
+    let (mut count, mut signed) = (0usize, 0usize);
+    table.for_each_row(|_, geometry| {
         count += 1;
+        signed += usize::from(geometry.theta_r_deg < 0.0);
         Ok(())
     })?;
     if count == 0 {
         anyhow::bail!("{}: no geometry rows", path.display());
     }
+    table
+        .notes
+        .extend(signed_note(&path.display().to_string(), signed));
     Ok(table)
 }
 
@@ -226,18 +243,21 @@ impl GeometryTable {
                 theta_r,
                 phi_r,
             } => {
-                let (phi_i_text, phi_r_text) = (phi_i.to_string(), phi_r.to_string());
+                let phi_i_text = phi_i.to_string();
+                let phi_r_texts: Vec<String> = phi_r.iter().map(f64::to_string).collect();
                 for &ti in theta_i {
                     let ti_text = ti.to_string();
                     for &tr in theta_r {
-                        let geometry = Geometry {
-                            theta_i_deg: ti,
-                            phi_i_deg: *phi_i,
-                            theta_r_deg: tr,
-                            phi_r_deg: *phi_r,
-                        };
                         let tr_text = tr.to_string();
-                        visit(&[&ti_text, &phi_i_text, &tr_text, &phi_r_text], &geometry)?;
+                        for (&pr, pr_text) in phi_r.iter().zip(&phi_r_texts) {
+                            let geometry = Geometry {
+                                theta_i_deg: ti,
+                                phi_i_deg: *phi_i,
+                                theta_r_deg: tr,
+                                phi_r_deg: pr,
+                            };
+                            visit(&[&ti_text, &phi_i_text, &tr_text, pr_text], &geometry)?;
+                        }
                     }
                 }
                 Ok(())
@@ -292,44 +312,60 @@ pub fn write_mueller_csv(
     Ok(())
 }
 
-/// A sweep as a geometry table (every combination of the given angles), refused when it would
-/// exceed [`MAX_SWEEP_ROWS`] or holds an invalid angle.
+/// A sweep as a geometry table (every combination of the given angles, θ_r outer and φ_r
+/// inner), refused when it would exceed [`MAX_SWEEP_ROWS`] or holds an invalid angle.
 pub fn sweep_table(
     theta_i: &[f64],
     phi_i: f64,
     theta_r: &[f64],
-    phi_r: f64,
+    phi_r: &[f64],
 ) -> anyhow::Result<GeometryTable> {
-    let rows = theta_i.len().saturating_mul(theta_r.len());
+    let rows = theta_i
+        .len()
+        .saturating_mul(theta_r.len())
+        .saturating_mul(phi_r.len());
     if rows > MAX_SWEEP_ROWS {
         anyhow::bail!(
-            "the sweep asks for {} × {} = {rows} rows; at most {MAX_SWEEP_ROWS}",
+            "the sweep asks for {} × {} × {} = {rows} rows (θ_i × θ_r × φ_r); at most \
+             {MAX_SWEEP_ROWS}",
             theta_i.len(),
-            theta_r.len()
+            theta_r.len(),
+            phi_r.len()
         );
     }
     if rows == 0 {
         anyhow::bail!("the sweep has no rows");
     }
-    // Every angle on its own: a sweep is valid when each of its θ_i and θ_r values is.
+    // Every angle on its own: a sweep is valid when each of its θ_i, θ_r and φ_r values is.
     for &ti in theta_i {
         Direction::from_degrees_checked("theta_i_deg", ti, phi_i)?;
     }
+    // (A zenith's validity does not depend on the azimuth, nor an azimuth's on the zenith.)
     for &tr in theta_r {
-        Direction::from_degrees_checked("theta_r_deg", tr, phi_r)?;
+        Direction::from_signed_degrees_checked("theta_r_deg", tr, phi_r[0])?;
+    }
+    for &pr in phi_r {
+        Direction::from_signed_degrees_checked("theta_r_deg", theta_r[0], pr)?;
     }
     let headers = ["theta_i_deg", "phi_i_deg", "theta_r_deg", "phi_r_deg"]
         .map(str::to_owned)
         .to_vec();
+    let signed = theta_r.iter().filter(|&&tr| tr < 0.0).count() * theta_i.len() * phi_r.len();
     Ok(GeometryTable {
         headers,
         rows: Rows::Sweep {
             theta_i: theta_i.to_vec(),
             phi_i,
             theta_r: theta_r.to_vec(),
-            phi_r,
+            phi_r: phi_r.to_vec(),
         },
+        notes: signed_note("--theta-r", signed).into_iter().collect(),
     })
+}
+
+/// The note on rows read with θ_r < 0, if there were any.
+fn signed_note(place: &str, rows: usize) -> Option<String> {
+    (rows > 0).then(|| signed_zenith_note(place, rows))
 }
 
 /// Writes theta_deg,e0,e1,e2,e3 and returns the angles where the hemispherical reflectance
@@ -422,10 +458,16 @@ mod tests {
     #[test]
     fn sweeps_are_bounded_and_checked_before_any_row() {
         let many: Vec<f64> = (0..4000).map(|i| i as f64 * 0.01).collect();
-        let err = sweep_table(&many, 0.0, &many, 180.0).err().unwrap();
+        let err = sweep_table(&many, 0.0, &many, &[180.0]).err().unwrap();
         assert!(err.to_string().contains("at most 10000000"), "{err}");
-        assert!(sweep_table(&[10.0], 0.0, &[10.0, 95.0], 180.0).is_err());
-        let table = sweep_table(&[10.0, 20.0], 0.0, &[30.0], 180.0).unwrap();
+        // The bound holds for the product with the φ_r sweep too.
+        let err = sweep_table(&many[..100], 0.0, &many[..1000], &many[..101])
+            .err()
+            .unwrap();
+        assert!(err.to_string().contains("100 × 1000 × 101"), "{err}");
+        assert!(sweep_table(&[10.0], 0.0, &[10.0, 95.0], &[180.0]).is_err());
+        assert!(sweep_table(&[10.0], 0.0, &[10.0], &[180.0, f64::NAN]).is_err());
+        let table = sweep_table(&[10.0, 20.0], 0.0, &[30.0], &[180.0]).unwrap();
         let mut out = Vec::new();
         write_mueller_csv(&model(), &table, &mut out).unwrap();
         let text = String::from_utf8(out).unwrap();

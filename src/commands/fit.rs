@@ -31,7 +31,7 @@ pub fn fit_and_write(
     reports_dir: &Path,
     progress: bool,
 ) -> anyhow::Result<FitWritten> {
-    let outcomes = fit_inputs(inputs, options, fits_dir, progress)?;
+    let outcomes = fit_inputs(inputs, options, progress)?;
     let mut entries = Vec::new();
     let mut report_files = Vec::new();
     let mut reports = Vec::new();

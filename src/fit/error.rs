@@ -15,14 +15,9 @@ pub enum FitError {
     /// Inconsistent or invalid fit options.
     #[error("invalid fit options: {0}")]
     Options(String),
-    /// Two inputs would write the same library entry.
-    #[error("{} and {} both hold material '{material}' and would both write {}", first.display(), second.display(), target.display())]
-    DuplicateMaterial {
-        material: String,
-        first: PathBuf,
-        second: PathBuf,
-        target: PathBuf,
-    },
+    /// Two inputs of one material that cannot be merged into one measurement set.
+    #[error(transparent)]
+    Merge(#[from] crate::measure::MergeError),
     /// An optimizer failed (a bug or a degenerate problem, not bad input).
     #[error("{}: the {stage} stage failed: {message}", file.display())]
     Optimizer {

@@ -6,9 +6,10 @@ use super::options::FitOptions;
 use super::outcome::{fit_measurement, FitOutcome};
 use super::space::ModelSpace;
 use super::FitError;
-use crate::measure::{collect_measurement_files, read_measurement_csv, MeasurementSet};
+use crate::measure::{
+    collect_measurement_files, merge_repeat_measurements, read_measurement_csv, MeasurementSet,
+};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
@@ -16,7 +17,8 @@ use std::path::{Path, PathBuf};
 /// chosen model to `fits_dir/<material>.toml` with [`crate::material::Material::save`].
 ///
 /// Nothing is written unless every input reads, validates and fits: malformed files, options
-/// that make no valid model, and two files of the same material are refused up front. A
+/// that make no valid model, and files of one material that cannot be merged as repeat
+/// measurements are refused up front (those that can are merged, with a note in the set). A
 /// progress bar is drawn on stderr when `progress` is set and stderr is a terminal.
 pub fn fit_files(
     inputs: &[PathBuf],
@@ -24,7 +26,7 @@ pub fn fit_files(
     fits_dir: &Path,
     progress: bool,
 ) -> Result<Vec<FitOutcome>, FitError> {
-    let outcomes = fit_inputs(inputs, options, fits_dir, progress)?;
+    let outcomes = fit_inputs(inputs, options, progress)?;
     for outcome in &outcomes {
         let path = fits_dir.join(format!("{}.toml", outcome.material.name));
         outcome.material.save(&path)?;
@@ -33,17 +35,14 @@ pub fn fit_files(
 }
 
 /// [`fit_files`] without writing: every outcome, for a caller that writes the library entries
-/// together with other outputs (`irpol fit` adds reports and an index). `fits_dir` only names
-/// the target of a duplicate material in the error.
+/// together with other outputs (`irpol fit` adds reports and an index).
 pub fn fit_inputs(
     inputs: &[PathBuf],
     options: &FitOptions,
-    fits_dir: &Path,
     progress: bool,
 ) -> Result<Vec<FitOutcome>, FitError> {
     let sets = read_all(inputs)?;
     validate_options(options)?;
-    check_unique_materials(&sets, fits_dir)?;
 
     let bar = (progress && std::io::stderr().is_terminal()).then(|| {
         let bar = ProgressBar::new(sets.len() as u64);
@@ -80,11 +79,13 @@ fn read_all(inputs: &[PathBuf]) -> Result<Vec<MeasurementSet>, FitError> {
         return Err(FitError::Options("no measurement file given".into()));
     }
     let files = collect_measurement_files(inputs)?;
-    let mut sets = Vec::with_capacity(files.len());
-    for file in &files {
-        let set = read_measurement_csv(file)?;
-        MeasurementData::new(&set)?;
-        sets.push(set);
+    let sets = files
+        .iter()
+        .map(|file| read_measurement_csv(file))
+        .collect::<Result<Vec<_>, _>>()?;
+    let sets = merge_materials(sets)?;
+    for set in &sets {
+        MeasurementData::new(set)?;
     }
     Ok(sets)
 }
@@ -104,17 +105,19 @@ fn validate_options(options: &FitOptions) -> Result<(), FitError> {
     Ok(())
 }
 
-fn check_unique_materials(sets: &[MeasurementSet], fits_dir: &Path) -> Result<(), FitError> {
-    let mut seen: BTreeMap<&str, &Path> = BTreeMap::new();
+/// The sets of each material, in the order the materials first appear, files of one material
+/// merged as repeat measurements (DESIGN §1.9).
+fn merge_materials(sets: Vec<MeasurementSet>) -> Result<Vec<MeasurementSet>, FitError> {
+    let mut groups: Vec<Vec<MeasurementSet>> = Vec::new();
     for set in sets {
-        if let Some(first) = seen.insert(&set.material, &set.source) {
-            return Err(FitError::DuplicateMaterial {
-                material: set.material.clone(),
-                first: first.to_owned(),
-                second: set.source.clone(),
-                target: fits_dir.join(format!("{}.toml", set.material)),
-            });
+        match groups.iter_mut().find(|g| g[0].material == set.material) {
+            Some(group) => group.push(set),
+            None => groups.push(vec![set]),
         }
     }
-    Ok(())
+    let mut merged = Vec::with_capacity(groups.len());
+    for group in groups {
+        merged.extend(merge_repeat_measurements(group)?);
+    }
+    Ok(merged)
 }

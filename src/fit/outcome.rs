@@ -8,7 +8,7 @@ use super::options::FitOptions;
 use super::parameters::{DistributionKind, Parameter};
 use super::stages::Stage;
 use super::FitError;
-use crate::material::{AlternativeFit, FitRecord, Material};
+use crate::material::{AlternativeFit, FitRecord, Material, MergedSource};
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::pbrdf::SlopeDistribution;
 use std::collections::BTreeMap;
@@ -121,6 +121,15 @@ fn fit_record(
     FitRecord {
         source: set.source.clone(),
         source_sha256: set.sha256.clone(),
+        merged_sources: set
+            .merged
+            .iter()
+            .map(|file| MergedSource {
+                source: file.path.clone(),
+                source_sha256: file.sha256.clone(),
+                points: file.rows,
+            })
+            .collect(),
         points: set.points.len(),
         elements: set
             .elements

@@ -1,6 +1,8 @@
 //! The material library: one TOML file per material (DESIGN §2.2) holding the pBRDF model, how it
 //! was fitted, and its uncertainties. Written atomically; read by `render` and `report`.
 
+mod comments;
+
 use crate::optics::{RefractiveIndex, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
 use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};
 use crate::text::{number, shown, shown_at_most, significant};
@@ -122,6 +124,11 @@ pub struct FitRecord {
     /// The measurement file, as given to `irpol fit`, and the SHA-256 of its bytes.
     pub source: PathBuf,
     pub source_sha256: String,
+    /// Further files of the same material and wavelength fitted with `source` as repeat
+    /// measurements, in the order their rows follow its rows; absent for a fit of one file.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub merged_sources: Vec<MergedSource>,
+    /// Measured geometries (rows) used, over all source files.
     pub points: usize,
     /// Mueller elements used, e.g. ["m00", "m01", …].
     pub elements: Vec<String>,
@@ -204,6 +211,17 @@ impl ConfidenceBound {
     }
 }
 
+/// A measurement file merged into a fit after [`FitRecord::source`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MergedSource {
+    /// The file as given to `irpol fit`, and the SHA-256 of its bytes.
+    pub source: PathBuf,
+    pub source_sha256: String,
+    /// Its rows.
+    pub points: usize,
+}
+
 /// The other distribution's best fit on the same data (model comparison by AIC/BIC).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -266,11 +284,14 @@ impl Material {
 
     /// The TOML text of the library entry (what [`Material::save`] writes); `path` only names
     /// the file in the error.
+    /// The file explains itself: `#` comments give each field's unit and meaning.
     pub fn to_toml(&self, path: &Path) -> Result<String, MaterialError> {
-        toml::to_string_pretty(self).map_err(|e| MaterialError::Write {
+        let error = |e: &dyn std::fmt::Display| MaterialError::Write {
             path: path.to_owned(),
-            source: std::io::Error::other(e),
-        })
+            source: std::io::Error::other(e.to_string()),
+        };
+        let text = toml::to_string_pretty(self).map_err(|e| error(&e))?;
+        comments::commented(&text).map_err(|e| error(&e))
     }
 
     /// Writes the TOML atomically: a temporary file in the same folder, then a rename, so a failed
@@ -420,6 +441,91 @@ mod tests {
             .to_string()
             .contains("'nope'"));
         assert_eq!(list_library(dir.path()).unwrap().len(), 1);
+    }
+
+    /// Issue 16 item 11: a written material explains each field in `#` comments, and the
+    /// comments change nothing that is read back.
+    #[test]
+    fn written_files_explain_every_field_and_read_back_unchanged() {
+        let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("fits/paper_paint.toml");
+        let mut material = Material::load(&shipped).unwrap();
+        material
+            .fit
+            .as_mut()
+            .unwrap()
+            .merged_sources
+            .push(MergedSource {
+                source: "measurements/paper_paint_repeat.csv".into(),
+                source_sha256: "0".repeat(64),
+                points: 12,
+            });
+        material.fit.as_mut().unwrap().profile_bounds.insert(
+            "k".into(),
+            ConfidenceBound {
+                lower: None,
+                upper: Some(0.03),
+                confidence: 0.95,
+            },
+        );
+        let path = Path::new("paper_paint.toml");
+        let text = material.to_toml(path).unwrap();
+        assert_eq!(Material::from_toml(&text, path).unwrap(), material);
+        assert_eq!(
+            Material::from_toml(&text, path)
+                .unwrap()
+                .to_toml(path)
+                .unwrap(),
+            text
+        );
+        assert!(
+            text.contains(
+                "# slope parameter σ (dimensionless): Gaussian rms slope per axis; \
+                           Cauchy a = 2σ²"
+            ) && text.contains("\nsigma = 0.0999"),
+            "{text}"
+        );
+        let document: toml_edit::DocumentMut = text.parse().unwrap();
+        assert_every_field_explained(document.as_table(), "");
+    }
+
+    fn is_comment(decor: &toml_edit::Decor) -> bool {
+        decor
+            .prefix()
+            .and_then(|p| p.as_str())
+            .is_some_and(|p| p.trim_start().starts_with('#'))
+    }
+
+    /// Every table has a comment block; every key of a table with fixed keys has its line.
+    fn assert_every_field_explained(table: &toml_edit::Table, path: &str) {
+        let keys = comments::explained_keys(path);
+        for (key, item) in table.iter() {
+            let path = [path, key]
+                .iter()
+                .filter(|p| !p.is_empty())
+                .copied()
+                .collect::<Vec<_>>();
+            let path = path.join(".");
+            let tables: Vec<&toml_edit::Table> = match item {
+                toml_edit::Item::Table(t) => vec![t],
+                toml_edit::Item::ArrayOfTables(a) => a.iter().collect(),
+                _ => {
+                    if let Some(keys) = &keys {
+                        assert!(keys.contains(&key), "{path} has no comment");
+                        assert!(is_comment(table.key(key).unwrap().leaf_decor()), "{path}");
+                    }
+                    continue;
+                }
+            };
+            // An implicit table ([fit.profile_bounds] above [fit.profile_bounds.k]) has no header
+            // to carry a comment; its subtables do.
+            if !tables[0].is_implicit() {
+                assert!(comments::has_block(&path), "[{path}] has no comment block");
+                assert!(is_comment(tables[0].decor()), "[{path}]");
+            }
+            for t in tables {
+                assert_every_field_explained(t, &path);
+            }
+        }
     }
 
     #[test]

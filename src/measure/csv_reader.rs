@@ -14,6 +14,7 @@ use super::error::{MeasureError, MeasureErrorKind, Refusal};
 use super::fields::{split_fields, Field};
 use super::metadata::{split_metadata_line, wavelength_in_range, HeaderWavelength, Metadata};
 use super::{MeasurementPoint, MeasurementSet};
+use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
 use crate::text::shown;
 
 /// Default azimuths when the columns are absent: the plane of incidence, with the receiver on
@@ -56,6 +57,10 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
             .map(|stem| stem.to_string_lossy().into_owned())
             .unwrap_or_default(),
     };
+    let notes = (parsed.signed_rows > 0)
+        .then(|| signed_zenith_note(&source.display().to_string(), parsed.signed_rows))
+        .into_iter()
+        .collect();
     Ok(MeasurementSet {
         source: source.to_path_buf(),
         sha256,
@@ -64,6 +69,8 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
         metadata: parsed.metadata.entries,
         elements: parsed.layout.elements,
         points: parsed.points,
+        merged: Vec::new(),
+        notes,
     })
 }
 
@@ -111,6 +118,8 @@ struct ParsedText {
     layout: Layout,
     wavelength_um: f64,
     points: Vec<MeasurementPoint>,
+    /// Rows whose θ_r was negative.
+    signed_rows: usize,
 }
 
 /// A line of the file, numbered from 1, without its terminator.
@@ -146,9 +155,10 @@ fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
         (None, true) => WavelengthCheck::AgainstFirstRow(None),
         (None, false) => return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength)),
     };
-    let points = content
+    let mut points = content
         .map(|&(number, line)| parse_row(number, line, &layout, &mut wavelength))
         .collect::<Result<Vec<_>, _>>()?;
+    let signed_rows = fold_signed_detector_angles(&mut points);
     if points.is_empty() {
         return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
     }
@@ -178,7 +188,20 @@ fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
         layout,
         wavelength_um,
         points,
+        signed_rows,
     })
+}
+
+/// Reads each row's θ_r < 0 as the detector across the normal, (|θ_r|, φ_r + 180°), once all
+/// of the row's columns are known; returns how many rows were so read.
+fn fold_signed_detector_angles(points: &mut [MeasurementPoint]) -> usize {
+    let mut folded = 0;
+    for point in points.iter_mut().filter(|p| p.theta_r_deg < 0.0) {
+        (point.theta_r_deg, point.phi_r_deg) =
+            fold_signed_zenith(point.theta_r_deg, point.phi_r_deg);
+        folded += 1;
+    }
+    folded
 }
 
 fn fields_of(line_number: u64, line: &str) -> Result<Vec<Field<'_>>, Refusal> {
@@ -275,20 +298,25 @@ fn parse_row(
             Err(kind) => return refuse(kind),
         };
         match quantity {
-            Quantity::ThetaI | Quantity::ThetaR => {
-                // Zenith angles of directions above the surface; 90° is grazing and leaves the
-                // BRDF's 1/cosθ undefined (DESIGN §1.3).
+            // Zenith angles of directions above the surface; 90° is grazing and leaves the
+            // BRDF's 1/cosθ undefined (DESIGN §1.3). The detector's may be signed (in-plane
+            // scans are written −80…80°); parse_text folds the negative ones.
+            Quantity::ThetaI => {
                 if !(0.0..90.0).contains(&value) {
                     return refuse(MeasureErrorKind::ThetaOutOfRange {
                         column: name.clone(),
                         value: shown(text),
                     });
                 }
-                if quantity == Quantity::ThetaI {
-                    point.theta_i_deg = value;
-                } else {
-                    point.theta_r_deg = value;
+                point.theta_i_deg = value;
+            }
+            Quantity::ThetaR => {
+                if !(value > -90.0 && value < 90.0) {
+                    return refuse(MeasureErrorKind::DetectorThetaOutOfRange {
+                        value: shown(text),
+                    });
                 }
+                point.theta_r_deg = value;
             }
             Quantity::PhiI => point.phi_i_deg = value,
             Quantity::PhiR => point.phi_r_deg = value,
@@ -458,6 +486,42 @@ mod tests {
         let set = parse(text).unwrap();
         assert_eq!(set.points[0].values, vec![0.5]);
         assert_eq!(set.wavelength_um, 8.0);
+    }
+
+    /// Issue 16 item 2: in-plane scans are written −80…80°; θ_r < 0 is the detector across the
+    /// normal, whatever the column order, with one note for the file.
+    #[test]
+    fn signed_detector_angles_are_read_across_the_normal() {
+        let set = parse(
+            "# wavelength_um: 10\nphi_r_deg,theta_r_deg,theta_i_deg,m00\n\
+             180,-30,40,0.1\n90,-80,40,0.1\n180,30,40,0.1\n",
+        )
+        .unwrap();
+        let angles: Vec<(f64, f64)> = set
+            .points
+            .iter()
+            .map(|p| (p.theta_r_deg, p.phi_r_deg))
+            .collect();
+        assert_eq!(angles, [(30.0, 0.0), (80.0, 270.0), (30.0, 180.0)]);
+        assert_eq!(
+            set.notes,
+            ["mem/sample.csv: 2 rows with θ_r < 0 read as (|θ_r|, φ_r + 180°)"]
+        );
+        assert!(
+            parse("# wavelength_um: 10\ntheta_i_deg,theta_r_deg,m00\n40,30,0.1\n")
+                .unwrap()
+                .notes
+                .is_empty()
+        );
+        assert_eq!(
+            message("# wavelength_um: 10\ntheta_i_deg,theta_r_deg,m00\n40,-95,0.1\n"),
+            "mem/sample.csv:3:4: column 'theta_r_deg': -95 is outside (−90°, 90°) (detector \
+             zenith angles; a negative one is read as (|θ_r|, φ_r + 180°))"
+        );
+        assert!(
+            message("# wavelength_um: 10\ntheta_i_deg,theta_r_deg,m00\n-1,30,0.1\n")
+                .contains("column 'theta_i_deg': -1 is outside [0°, 90°)")
+        );
     }
 
     #[test]

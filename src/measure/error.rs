@@ -94,6 +94,8 @@ pub enum MeasureErrorKind {
     NotFinite { column: String, value: String },
     #[error("column '{column}': {value} is outside [0°, 90°) (zenith angles of the hemisphere above the surface)")]
     ThetaOutOfRange { column: String, value: String },
+    #[error("column 'theta_r_deg': {value} is outside (−90°, 90°) (detector zenith angles; a negative one is read as (|θ_r|, φ_r + 180°))")]
+    DetectorThetaOutOfRange { value: String },
     #[error("column 'm00': {value} is negative, but m00 (the unpolarized BRDF, sr⁻¹) is ≥ 0")]
     NegativeM00 { value: String },
     #[error("column '{column}': {value} is not a positive uncertainty")]

@@ -10,7 +10,8 @@
 //! theta_i_deg,phi_i_deg,theta_r_deg,phi_r_deg,m00,m01,u_m00
 //! 60,0,55,180,1.92e-01,-3.1e-02,2e-03
 //! ```
-//! Required columns: theta_i_deg, theta_r_deg, m00. Optional: phi_i_deg (default 0°),
+//! Required columns: theta_i_deg, theta_r_deg (signed: θ_r < 0 is read as (|θ_r|, φ_r + 180°),
+//! with a note), m00. Optional: phi_i_deg (default 0°),
 //! phi_r_deg (default 180°), wavelength_um (else the `# wavelength_um:` header; both must agree),
 //! any of m01…m33, and absolute 1-σ uncertainties u_m00…u_m33 for any subset of the elements
 //! present. Mueller elements are BRDF values in sr⁻¹ in SCATMECH's psps convention (DESIGN §1.3),
@@ -21,6 +22,7 @@ mod csv_reader;
 mod error;
 mod fields;
 mod files;
+mod merge;
 mod metadata;
 
 use std::collections::BTreeMap;
@@ -29,6 +31,7 @@ use std::path::PathBuf;
 pub use csv_reader::{parse_measurement_csv, read_measurement_csv};
 pub use error::{Delimiter, MeasureError, MeasureErrorKind};
 pub use files::collect_measurement_files;
+pub use merge::{merge_repeat_measurements, MergeError};
 
 /// Column names of the 16 Mueller elements; element (r, c) has index r*4 + c (row-major).
 pub const MUELLER_ELEMENT_NAMES: [&str; 16] = [
@@ -49,7 +52,8 @@ pub struct MeasurementPoint {
     pub theta_i_deg: f64,
     /// Incidence azimuth, degrees (0 when the file has no phi_i_deg column).
     pub phi_i_deg: f64,
-    /// Receiver zenith angle, degrees, in [0, 90).
+    /// Receiver zenith angle, degrees, in [0, 90) (a negative value in the file is read as
+    /// (|θ_r|, φ_r + 180°)).
     pub theta_r_deg: f64,
     /// Receiver azimuth, degrees (180, the specular side, when the file has no phi_r_deg column).
     pub phi_r_deg: f64,
@@ -80,6 +84,24 @@ pub struct MeasurementSet {
     pub metadata: BTreeMap<String, String>,
     /// Mueller indices (r*4 + c) present in the file, ascending, so m00 (0) is always first.
     pub elements: Vec<usize>,
-    /// The data rows in file order; never empty.
+    /// The data rows in file order (after merging, `source`'s rows first); never empty.
     pub points: Vec<MeasurementPoint>,
+    /// Further files of the same material and wavelength merged after `source` as repeat
+    /// measurements ([`merge_repeat_measurements`]); empty for a set read from one file.
+    pub merged: Vec<SourceFile>,
+    /// What the reader did that the user should know (rows with θ_r < 0 read as (|θ_r|,
+    /// φ_r + 180°), files merged), one line each, for the caller to print: the library never
+    /// prints.
+    pub notes: Vec<String>,
+}
+
+/// A measurement file merged into a [`MeasurementSet`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourceFile {
+    /// The path as given by the caller.
+    pub path: PathBuf,
+    /// Lower-case hex SHA-256 of the file's bytes.
+    pub sha256: String,
+    /// Its data rows.
+    pub rows: usize,
 }

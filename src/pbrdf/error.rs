@@ -18,6 +18,8 @@ pub enum ModelError {
     Diffuse(f64),
     #[error("{name} = {}° is invalid: zenith angles must be finite and within [0°, 90°)", number(*.value))]
     Zenith { name: &'static str, value: f64 },
+    #[error("{name} = {}° is invalid: detector zenith angles must be finite and within (−90°, 90°) (a negative one is the other side of the normal)", number(*.value))]
+    DetectorZenith { name: &'static str, value: f64 },
     #[error("{name} = {}° is invalid: azimuths must be finite", number(*.value))]
     Azimuth { name: &'static str, value: f64 },
     #[error("the directional-hemispherical reflectance at θ = {theta_deg:.2}° is {reflectance:.6} > 1: this model is not energy conserving there (no shadowing at grazing angles?); use shadowing = smith")]

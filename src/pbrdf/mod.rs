@@ -16,6 +16,7 @@ mod shadowing;
 pub use crate::optics::Direction;
 pub use distribution::SlopeDistribution;
 pub use error::ModelError;
+pub use geometry::{fold_signed_zenith, signed_zenith_note};
 pub use hemisphere::{cosine_hemisphere_rule, HemisphereQuadrature};
 pub use model::{Pbrdf, ScatteringGeometry};
 pub use shadowing::Shadowing;

@@ -24,7 +24,10 @@ pub(crate) use table::{
 use super::paper_figures::encode_png;
 use super::{register_fonts, ReportError, FONT};
 use crate::material::{write_atomically, FitRecord, Material};
-use crate::measure::{parse_measurement_csv, MeasureError, MeasureErrorKind, MeasurementSet};
+use crate::measure::{
+    merge_repeat_measurements, parse_measurement_csv, MeasureError, MeasureErrorKind,
+    MeasurementSet,
+};
 use data::ReportData;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -105,9 +108,9 @@ pub fn encode_fit_report(
     })
 }
 
-/// Rebuilds the report of a library entry from its recorded source CSV (`irpol report
-/// <material.toml>`), refusing when the material has no fit, the CSV is gone or changed since
-/// the fit, or no longer reads.
+/// Rebuilds the report of a library entry from its recorded source CSVs (`irpol report
+/// <material.toml>`; several when the fit merged repeat measurements), refusing when the
+/// material has no fit, a CSV is gone or changed since the fit, or no longer reads.
 pub fn rebuild_report(
     material_path: &Path,
     reports_dir: &Path,
@@ -116,8 +119,15 @@ pub fn rebuild_report(
     let fit = material.fit.as_ref().ok_or_else(|| ReportError::NoFit {
         material: material_path.to_owned(),
     })?;
-    let (csv, bytes) = verified_source(material_path, fit)?;
-    let set = parse_measurement_csv(&csv, &bytes)?;
+    let sets = verified_source(material_path, fit)?
+        .into_iter()
+        .map(|(csv, bytes)| parse_measurement_csv(&csv, &bytes))
+        .collect::<Result<Vec<_>, _>>()?;
+    let set = merge_repeat_measurements(sets)
+        .map_err(crate::fit::FitError::from)?
+        .ok_or_else(|| ReportError::NoFit {
+            material: material_path.to_owned(),
+        })?;
     write_fit_report(&material, &set, reports_dir)
 }
 
@@ -137,14 +147,31 @@ fn source_candidates(material_path: &Path, source: &Path) -> Vec<PathBuf> {
     candidates
 }
 
-/// Finds the fit's source CSV and checks it is byte-for-byte the file that was fitted; returns
-/// its path and bytes. Of several candidates the first with the recorded hash wins (a same-named
-/// file elsewhere is not the source); if none has it, the first existing one is reported changed.
+/// Finds each of the fit's source CSVs (the source, then any merged with it) and checks it is
+/// byte-for-byte the file that was fitted; returns their paths and bytes in that order.
 pub(crate) fn verified_source(
     material_path: &Path,
     fit: &FitRecord,
+) -> Result<Vec<(PathBuf, Vec<u8>)>, ReportError> {
+    std::iter::once((&fit.source, &fit.source_sha256))
+        .chain(
+            fit.merged_sources
+                .iter()
+                .map(|m| (&m.source, &m.source_sha256)),
+        )
+        .map(|(source, sha256)| verified_file(material_path, source, sha256))
+        .collect()
+}
+
+/// One source CSV with the recorded hash. Of several candidates the first with the recorded
+/// hash wins (a same-named file elsewhere is not the source); if none has it, the first existing
+/// one is reported changed.
+fn verified_file(
+    material_path: &Path,
+    source: &Path,
+    recorded: &str,
 ) -> Result<(PathBuf, Vec<u8>), ReportError> {
-    let candidates = source_candidates(material_path, &fit.source);
+    let candidates = source_candidates(material_path, source);
     let mut first_changed = None;
     for csv in candidates.iter().filter(|p| p.is_file()) {
         let bytes = std::fs::read(csv).map_err(|e| MeasureError {
@@ -159,19 +186,19 @@ pub(crate) fn verified_source(
             .iter()
             .map(|b| format!("{b:02x}"))
             .collect();
-        if actual.eq_ignore_ascii_case(fit.source_sha256.trim()) {
+        if actual.eq_ignore_ascii_case(recorded.trim()) {
             return Ok((csv.clone(), bytes));
         }
         first_changed.get_or_insert(ReportError::SourceChanged {
             csv: csv.clone(),
             actual,
-            recorded: fit.source_sha256.clone(),
+            recorded: recorded.to_owned(),
             material: material_path.to_owned(),
         });
     }
     Err(first_changed.unwrap_or_else(|| ReportError::SourceMissing {
         material: material_path.to_owned(),
-        csv: fit.source.clone(),
+        csv: source.to_owned(),
         tried: candidates
             .iter()
             .map(|p| p.display().to_string())

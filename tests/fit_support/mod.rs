@@ -97,6 +97,8 @@ pub fn synthetic_set(
         metadata: BTreeMap::new(),
         elements: elements.to_vec(),
         points,
+        merged: Vec::new(),
+        notes: Vec::new(),
     }
 }
 

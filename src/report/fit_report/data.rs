@@ -580,6 +580,8 @@ mod tests {
             metadata: BTreeMap::new(),
             elements: vec![0, 4],
             points,
+            merged: Vec::new(),
+            notes: Vec::new(),
         }
     }
 

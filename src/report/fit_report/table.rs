@@ -317,9 +317,17 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
     ));
     rows.push(Row::Text(
         format!(
-            "source {} (sha256 {})",
+            "source {} (sha256 {}){}",
             fit.source.display(),
-            sha_prefix(&fit.source_sha256)
+            sha_prefix(&fit.source_sha256),
+            fit.merged_sources
+                .iter()
+                .map(|m| format!(
+                    " + {} ({})",
+                    m.source.display(),
+                    sha_prefix(&m.source_sha256)
+                ))
+                .collect::<String>()
         ),
         Tone::Muted,
     ));

@@ -1,0 +1,224 @@
+//! `#` comments that explain a material TOML to whoever opens it (issue 16 item 11): a line
+//! above each key of the fixed tables, with its unit and meaning, and a block above each table.
+//! Tables whose keys vary (per Mueller element, per parameter) carry only their block. The
+//! comments are added to the serialized document with `toml_edit`, so the values are exactly
+//! what serde wrote; docs/materials.md has the longer explanations.
+
+use toml_edit::{DocumentMut, Item, Table};
+
+/// Above the first key of the file.
+const HEADER: &str =
+    "irpol material library entry: the pBRDF model (DESIGN §1.3) and how it was fitted.\n\
+Every field is explained in docs/materials.md; values are as the fit wrote them.";
+
+const TOP: &[(&str, &str)] = &[
+    (
+        "name",
+        "the material's name (the measurement's '# material:' line)",
+    ),
+    ("tool_version", "the irpol version that wrote this file"),
+];
+
+/// The comment block above each table, by its dotted path.
+const TABLES: &[(&str, &str)] = &[
+    (
+        "model",
+        "The pBRDF: F = P(θ) G M(β) / (4 cosθ cosθ_i cosθ_r) + (ρ_d/π) diag(1,0,0,0), in sr⁻¹.\n\
+               The renderer and `irpol eval` read only this table.",
+    ),
+    (
+        "fit",
+        "How the model was fitted (provenance, optimizer, quality); `irpol report` and\n\
+             `irpol library` read it, the renderer does not.",
+    ),
+    (
+        "fit.fixed_parameters",
+        "Parameters held fixed during the fit (--fix, or left out of --free), at these values.",
+    ),
+    (
+        "fit.merged_sources",
+        "Further measurement files of this material and wavelength fitted with `source` as\n\
+                            repeat measurements (their rows follow its rows).",
+    ),
+    (
+        "fit.settings",
+        "What reproduces the fit besides optimizer and seed: bounds, distribution choice,\n\
+                      each stage's stopping rules, robust loss, where the uncertainties came from.",
+    ),
+    (
+        "fit.rmse",
+        "Root-mean-square residual (model − measured) per Mueller element, sr⁻¹.",
+    ),
+    (
+        "fit.uncertainty",
+        "1-σ uncertainty of each free parameter, in its own unit: from the Jacobian at the\n\
+                         optimum, scaled by the reduced χ².",
+    ),
+    (
+        "fit.alternative",
+        "The other slope distribution's best fit on the same data, for comparison.",
+    ),
+    ("fit.alternative.model", "Its model (keys as in [model])."),
+    (
+        "fit.profile_bounds.*",
+        "What the data allow for a parameter whose ± would mislead (undetermined, or bounded\n\
+         from one side only): one-sided profile-likelihood bounds (docs/materials.md).",
+    ),
+];
+
+const MODEL: &[(&str, &str)] = &[
+    ("distribution", "facet slope distribution P(θ): \"cauchy\" (Student-t, Wellems 2006) or \"gaussian\" (Beckmann)"),
+    ("sigma", "slope parameter σ (dimensionless): Gaussian rms slope per axis; Cauchy a = 2σ² (q = 2 is GGX, α = √2σ)"),
+    ("q", "Cauchy tail exponent q (> 1; > 1.5 with Smith): small q puts more facets at steep tilts"),
+    ("shadowing", "shadowing/masking G: \"none\" (G = 1), \"torrance-sparrow\" or \"smith\" (energy conserving)"),
+    ("n", "real part n of the complex refractive index N = n + ik at wavelength_um"),
+    ("k", "extinction coefficient k (imaginary part of N, ≥ 0): absorption"),
+    ("rho_d", "unpolarized diffuse reflectance ρ_d (0–1): adds ρ_d/π to m00 only"),
+    ("wavelength_um", "wavelength of the measurement the model was fitted to, µm"),
+];
+
+const FIT: &[(&str, &str)] = &[
+    ("source", "the measurement CSV as given to `irpol fit` (relative to where it ran)"),
+    ("source_sha256", "SHA-256 of its bytes: `irpol report` refuses to rebuild from a changed file"),
+    ("points", "measured geometries (rows) used, over all source files"),
+    ("elements", "Mueller elements fitted (the columns present)"),
+    ("free_parameters", "parameters the fit varied (--free); the others are held at their [model] values"),
+    ("optimizer", "optimizer stages: ga (seeded genetic search), nm (Nelder–Mead), lm (Levenberg–Marquardt)"),
+    ("seed", "seed of the genetic stage"),
+    ("iterations", "optimizer iterations over all stages"),
+    ("evaluations", "model evaluations over all stages"),
+    ("cost", "χ² = Σ ((model − measured)/σ)² over every element of every row (a robust loss: its sum)"),
+    ("reduced_chi2", "cost / degrees_of_freedom: ≈ 1 when the model fits within the stated uncertainties"),
+    ("degrees_of_freedom", "observations (points × elements) minus free parameters"),
+    ("aic", "Akaike information criterion, cost + 2p (p free parameters): lower is better"),
+    ("bic", "Bayesian information criterion, cost + p ln N (N observations): lower is better"),
+    ("termination", "why the last optimizer stage stopped"),
+    ("correlation", "correlation matrix of the free parameters, rows and columns in free_parameters order"),
+    ("undetermined", "free parameters the data do not determine (no sensitivity, |ρ| > 0.999 or a huge error)"),
+    ("at_bound", "free parameters resting on a bound of their search interval"),
+    ("model_choice", "which slope distribution was kept, by ΔAIC and ΔBIC"),
+    ("convergence", "best cost after each genetic generation (the first global_iterations), then each local iteration"),
+    ("global_iterations", "how many entries of convergence are genetic generations"),
+];
+
+const MERGED_SOURCE: &[(&str, &str)] = &[
+    (
+        "source",
+        "a further measurement CSV as given to `irpol fit`",
+    ),
+    ("source_sha256", "SHA-256 of its bytes"),
+    ("points", "its rows"),
+];
+
+const ALTERNATIVE: &[(&str, &str)] = &[
+    ("cost", "its χ²"),
+    ("reduced_chi2", "its cost / degrees of freedom"),
+    ("aic", "its Akaike information criterion"),
+    ("bic", "its Bayesian information criterion"),
+];
+
+const PROFILE_BOUND: &[(&str, &str)] = &[
+    (
+        "lower",
+        "the parameter is above this (absent: the data allow the search interval's lower end)",
+    ),
+    (
+        "upper",
+        "the parameter is below this (absent: the data allow the search interval's upper end)",
+    ),
+    ("confidence", "the confidence of each side's bound"),
+];
+
+/// The keys explained line by line, by table path; other tables get only their block. A path
+/// ending in `.*` stands for every subtable of its parent (one per parameter).
+const KEYED: &[(&str, &[(&str, &str)])] = &[
+    ("model", MODEL),
+    ("fit", FIT),
+    ("fit.merged_sources", MERGED_SOURCE),
+    ("fit.alternative", ALTERNATIVE),
+    ("fit.alternative.model", MODEL),
+    ("fit.profile_bounds.*", PROFILE_BOUND),
+];
+
+/// The entry of `entries` for the table at `path`: its own, or its parent's `.*` entry.
+fn entry_for<'e, T>(entries: &'e [(&str, T)], path: &str) -> Option<&'e T> {
+    let wildcard = path
+        .rsplit_once('.')
+        .map(|(parent, _)| format!("{parent}.*"));
+    entries
+        .iter()
+        .find(|(p, _)| *p == path || Some(*p) == wildcard.as_deref())
+        .map(|(_, entry)| entry)
+}
+
+/// `text` (a serialized material) with the comments added; the values are untouched.
+pub(super) fn commented(text: &str) -> Result<String, toml_edit::TomlError> {
+    let mut document: DocumentMut = text.parse()?;
+    let root = document.as_table_mut();
+    explain_keys(root, TOP);
+    if let Some(mut name) = root.key_mut(TOP[0].0) {
+        let explained = comment_lines(TOP[0].1);
+        name.leaf_decor_mut()
+            .set_prefix(format!("{}\n{explained}", comment_lines(HEADER)));
+    }
+    decorate_tables(root, "");
+    Ok(document.to_string())
+}
+
+/// Comments the subtables of `table` (whose dotted path is `path`) and their keys, recursively.
+fn decorate_tables(table: &mut Table, path: &str) {
+    for (key, item) in table.iter_mut() {
+        let path = if path.is_empty() {
+            key.get().to_owned()
+        } else {
+            format!("{path}.{}", key.get())
+        };
+        let tables: Vec<&mut Table> = match item {
+            Item::Table(table) => vec![table],
+            Item::ArrayOfTables(array) => array.iter_mut().collect(),
+            _ => continue,
+        };
+        for (index, table) in tables.into_iter().enumerate() {
+            if let (0, Some(block)) = (index, entry_for(TABLES, &path)) {
+                table
+                    .decor_mut()
+                    .set_prefix(format!("\n{}", comment_lines(block)));
+            }
+            if let Some(keys) = entry_for(KEYED, &path) {
+                explain_keys(table, keys);
+            }
+            decorate_tables(table, &path);
+        }
+    }
+}
+
+/// A comment line above each key of `table` that `comments` explains.
+fn explain_keys(table: &mut Table, comments: &[(&str, &str)]) {
+    for (key, comment) in comments {
+        if let Some(mut key) = table.key_mut(key) {
+            key.leaf_decor_mut().set_prefix(comment_lines(comment));
+        }
+    }
+}
+
+/// `text` as `# ` lines, each ending in a newline.
+fn comment_lines(text: &str) -> String {
+    text.lines()
+        .map(|line| format!("# {}\n", line.trim_start()))
+        .collect()
+}
+
+#[cfg(test)]
+pub(super) fn explained_keys(path: &str) -> Option<Vec<&'static str>> {
+    let keys = if path.is_empty() {
+        Some(TOP)
+    } else {
+        entry_for(KEYED, path).copied()
+    };
+    keys.map(|keys| keys.iter().map(|(key, _)| *key).collect())
+}
+
+#[cfg(test)]
+pub(super) fn has_block(path: &str) -> bool {
+    entry_for(TABLES, path).is_some()
+}
