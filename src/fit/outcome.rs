@@ -121,6 +121,7 @@ fn fit_record(
     FitRecord {
         source: set.source.clone(),
         source_sha256: set.sha256.clone(),
+        source_data: Some(set.source_data(0)),
         points: set.points.len(),
         elements: set
             .elements

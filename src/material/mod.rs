@@ -122,6 +122,9 @@ pub struct FitRecord {
     /// The measurement file, as given to `irpol fit`, and the SHA-256 of its bytes.
     pub source: PathBuf,
     pub source_sha256: String,
+    /// The fingerprint of the source's parsed data (absent in files written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source_data: Option<crate::measure::SourceData>,
     pub points: usize,
     /// Mueller elements used, e.g. ["m00", "m01", …].
     pub elements: Vec<String>,

@@ -21,14 +21,17 @@ mod csv_reader;
 mod error;
 mod fields;
 mod files;
+mod fingerprint;
 mod metadata;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+pub(crate) use csv_reader::hex;
 pub use csv_reader::{parse_measurement_csv, read_measurement_csv};
 pub use error::{Delimiter, MeasureError, MeasureErrorKind};
 pub use files::collect_measurement_files;
+pub use fingerprint::SourceData;
 
 /// Column names of the 16 Mueller elements; element (r, c) has index r*4 + c (row-major).
 pub const MUELLER_ELEMENT_NAMES: [&str; 16] = [

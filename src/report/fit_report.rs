@@ -24,7 +24,7 @@ pub(crate) use table::{
 use super::paper_figures::encode_png;
 use super::{register_fonts, ReportError, FONT};
 use crate::material::{write_atomically, FitRecord, Material};
-use crate::measure::{parse_measurement_csv, MeasureError, MeasureErrorKind, MeasurementSet};
+use crate::measure::{hex, parse_measurement_csv, MeasureError, MeasureErrorKind, MeasurementSet};
 use data::ReportData;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -116,8 +116,7 @@ pub fn rebuild_report(
     let fit = material.fit.as_ref().ok_or_else(|| ReportError::NoFit {
         material: material_path.to_owned(),
     })?;
-    let (csv, bytes) = verified_source(material_path, fit)?;
-    let set = parse_measurement_csv(&csv, &bytes)?;
+    let (_, set) = verified_source(material_path, fit)?;
     write_fit_report(&material, &set, reports_dir)
 }
 
@@ -137,13 +136,16 @@ fn source_candidates(material_path: &Path, source: &Path) -> Vec<PathBuf> {
     candidates
 }
 
-/// Finds the fit's source CSV and checks it is byte-for-byte the file that was fitted; returns
-/// its path and bytes. Of several candidates the first with the recorded hash wins (a same-named
-/// file elsewhere is not the source); if none has it, the first existing one is reported changed.
+/// Finds the fit's source CSV and checks it holds the data that was fitted; returns its path and
+/// parsed data. The bytes may differ (a comment, blank lines, number spelling) when the record has
+/// the data's fingerprint and the parsed data match it; a record without one (written before
+/// fingerprints) needs the very bytes. Of several candidates the first that matches wins (a
+/// same-named file elsewhere is not the source); if none does, the first existing one is
+/// reported changed.
 pub(crate) fn verified_source(
     material_path: &Path,
     fit: &FitRecord,
-) -> Result<(PathBuf, Vec<u8>), ReportError> {
+) -> Result<(PathBuf, MeasurementSet), ReportError> {
     let candidates = source_candidates(material_path, &fit.source);
     let mut first_changed = None;
     for csv in candidates.iter().filter(|p| p.is_file()) {
@@ -155,19 +157,29 @@ pub(crate) fn verified_source(
                 reason: e.to_string(),
             },
         })?;
-        let actual: String = Sha256::digest(&bytes)
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
-        if actual.eq_ignore_ascii_case(fit.source_sha256.trim()) {
-            return Ok((csv.clone(), bytes));
-        }
-        first_changed.get_or_insert(ReportError::SourceChanged {
-            csv: csv.clone(),
-            actual,
-            recorded: fit.source_sha256.clone(),
-            material: material_path.to_owned(),
-        });
+        let same_bytes =
+            hex(&Sha256::digest(&bytes)).eq_ignore_ascii_case(fit.source_sha256.trim());
+        let error = match (&fit.source_data, same_bytes) {
+            (_, true) => return Ok((csv.clone(), parse_measurement_csv(csv, &bytes)?)),
+            (Some(recorded), false) => {
+                let set = parse_measurement_csv(csv, &bytes)?;
+                let now = set.source_data(recorded.rows_per_digest);
+                if now.sha256 == recorded.sha256 {
+                    return Ok((csv.clone(), set));
+                }
+                ReportError::SourceDataChanged {
+                    csv: csv.clone(),
+                    what: recorded.describe_change(&now),
+                    material: material_path.to_owned(),
+                }
+            }
+            (None, false) => ReportError::SourceChanged {
+                csv: csv.clone(),
+                recorded: fit.source_sha256.clone(),
+                material: material_path.to_owned(),
+            },
+        };
+        first_changed.get_or_insert(error);
     }
     Err(first_changed.unwrap_or_else(|| ReportError::SourceMissing {
         material: material_path.to_owned(),
