@@ -81,11 +81,12 @@ fn canonical(value: f64) -> u64 {
 fn value_columns(set: &MeasurementSet) -> Vec<String> {
     let names = set.elements.iter().map(|&e| MUELLER_ELEMENT_NAMES[e]);
     let first = set.points.first();
-    let uncertain = set.elements.iter().enumerate().filter_map(|(column, &e)| {
-        first
-            .is_some_and(|p| p.uncertainties[column].is_some())
-            .then(|| format!("u_{}", MUELLER_ELEMENT_NAMES[e]))
-    });
+    let uncertain = set
+        .elements
+        .iter()
+        .enumerate()
+        .filter(|&(column, _)| first.is_some_and(|p| p.uncertainties[column].is_some()))
+        .map(|(_, &e)| format!("u_{}", MUELLER_ELEMENT_NAMES[e]));
     names.map(str::to_owned).chain(uncertain).collect()
 }
 
