@@ -5,7 +5,9 @@
 mod report_support;
 
 use irpol::material::Material;
-use irpol::report::fit_report::{rebuild_report, write_fit_report, REPORT_SIZE};
+use irpol::report::fit_report::{
+    panel_size, rebuild_report, write_fit_report, PANELS, REPORT_SIZE,
+};
 use report_support::{fitted_material, synthetic_set, LINEAR};
 use std::path::{Path, PathBuf};
 
@@ -14,7 +16,7 @@ fn count_pixels(png: &image::RgbImage, color: [u8; 3]) -> usize {
 }
 
 #[test]
-fn a_report_is_a_2400_by_1800_png_and_an_svg_with_labelled_axes() {
+fn a_report_is_a_3000_by_1800_png_and_an_svg_with_labelled_axes() {
     let dir = tempfile::tempdir().unwrap();
     let all: Vec<usize> = (0..16).collect();
     let (csv, set) = synthetic_set(dir.path(), "gloss_paint", &all);
@@ -24,7 +26,7 @@ fn a_report_is_a_2400_by_1800_png_and_an_svg_with_labelled_axes() {
     let paths = write_fit_report(&material, &set, &out).unwrap();
     let elapsed = started.elapsed();
     assert_eq!(
-        paths,
+        paths[..2],
         [out.join("gloss_paint.png"), out.join("gloss_paint.svg")]
     );
 
@@ -146,7 +148,7 @@ fn rebuild_finds_the_source_beside_the_library_and_redraws_the_report() {
     let reports = dir.path().join("reports");
     let paths = rebuild_report(&toml, &reports).unwrap();
     assert_eq!(
-        paths,
+        paths[..2],
         [reports.join("paint.png"), reports.join("paint.svg")]
     );
     assert_eq!(image::open(&paths[0]).unwrap().width(), REPORT_SIZE.0);
@@ -195,22 +197,20 @@ fn rebuild_refuses_a_missing_source_csv_and_says_where_it_looked() {
 }
 
 #[test]
-fn rebuild_refuses_a_source_csv_changed_since_the_fit() {
+fn rebuild_refuses_a_changed_source_csv_when_the_entry_has_only_its_byte_hash() {
     let (dir, csv, toml) = project("paint");
     let recorded = Material::load(&toml).unwrap().fit.unwrap().source_sha256;
     let mut text = std::fs::read_to_string(&csv).unwrap();
     text.push_str("# edited after the fit\n");
     std::fs::write(&csv, &text).unwrap();
     let message = rebuild_error(&toml, dir.path());
-    let actual = irpol::measure::parse_measurement_csv(&csv, text.as_bytes())
-        .unwrap()
-        .sha256;
-    assert_ne!(actual, recorded);
+    // This record (as entries written before the data fingerprint) has only the byte hash.
     assert_eq!(
         message,
         format!(
-            "{}: source CSV changed since the fit: sha256 {actual} ≠ {recorded} recorded in {}; \
-             refit it with `irpol fit`",
+            "{}: source CSV changed since the fit: its bytes are not those of sha256 {recorded} \
+             recorded in {}, which records no fingerprint of the data to compare (written before \
+             irpol kept one); refit it with `irpol fit`",
             csv.display(),
             toml.display()
         )
@@ -254,4 +254,49 @@ fn rebuild_passes_a_broken_material_file_through() {
         message.contains("bad.toml: not a valid material TOML"),
         "{message}"
     );
+}
+
+#[test]
+fn each_panel_is_also_its_own_png_beside_the_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, set) = synthetic_set(dir.path(), "gloss_paint", &LINEAR);
+    let material = fitted_material("gloss_paint", &set, &csv);
+    let out = dir.path().join("reports");
+    let paths = write_fit_report(&material, &set, &out).unwrap();
+    assert_eq!(paths.len(), 2 + PANELS.len());
+    for (spec, path) in PANELS.iter().zip(&paths[2..]) {
+        assert_eq!(
+            *path,
+            out.join("gloss_paint").join(format!("{}.png", spec.name))
+        );
+        let png = image::open(path).unwrap().to_rgb8();
+        assert_eq!(png.dimensions(), panel_size(spec), "{}", spec.name);
+        let ink = png.len() / 3 - count_pixels(&png, [255, 255, 255]);
+        assert!(ink > 5_000, "{}: {ink} inked pixels", spec.name);
+    }
+}
+
+#[test]
+fn the_correlation_matrix_names_its_parameters_and_prints_its_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, set) = synthetic_set(dir.path(), "gloss_paint", &LINEAR);
+    let material = fitted_material("gloss_paint", &set, &csv);
+    let paths = write_fit_report(&material, &set, dir.path()).unwrap();
+    let svg = std::fs::read_to_string(&paths[1]).unwrap();
+    let texts: Vec<&str> = svg
+        .split("</text>")
+        .filter_map(|t| t.rsplit('>').next().map(str::trim))
+        .collect();
+    let count = |label: &str| texts.iter().filter(|t| **t == label).count();
+    assert_eq!(count("(j) Correlation of the fitted parameters"), 1);
+    // ρ(σ, q) = 0.87 both sides of the diagonal, five ones on it, the rest zero.
+    assert_eq!(count("+0.87"), 2);
+    assert_eq!(count("+1.00"), 5);
+    assert_eq!(count("+0.00"), 18);
+    // The symbols label both axes (besides their rows in the parameter table).
+    for symbol in ["σ", "q", "n", "k", "ρd"] {
+        assert!(count(symbol) >= 3, "{symbol}: {}", count(symbol));
+    }
+    // The colour bar's ends.
+    assert!(count("+1") == 1 && count("−1") == 1);
 }

@@ -121,12 +121,14 @@ fn fit_record(
     FitRecord {
         source: set.source.clone(),
         source_sha256: set.sha256.clone(),
+        source_data: Some(set.source_data(0)),
         merged_sources: set
             .merged
             .iter()
             .map(|file| MergedSource {
                 source: file.path.clone(),
                 source_sha256: file.sha256.clone(),
+                source_data: Some(file.data.clone()),
                 points: file.rows,
             })
             .collect(),

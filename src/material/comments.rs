@@ -41,6 +41,15 @@ const TABLES: &[(&str, &str)] = &[
                             repeat measurements (their rows follow its rows).",
     ),
     (
+        "fit.source_data",
+        "The fingerprint of the source's parsed data (values, not bytes): `irpol report` rebuilds\n\
+         after comment or layout edits and says which rows changed otherwise.",
+    ),
+    (
+        "fit.merged_sources.source_data",
+        "The fingerprint of this file's parsed data (as [fit.source_data]).",
+    ),
+    (
         "fit.settings",
         "What reproduces the fit besides optimizer and seed: bounds, distribution choice,\n\
                       each stage's stopping rules, robust loss, where the uncertainties came from.",

@@ -124,6 +124,9 @@ pub struct FitRecord {
     /// The measurement file, as given to `irpol fit`, and the SHA-256 of its bytes.
     pub source: PathBuf,
     pub source_sha256: String,
+    /// The fingerprint of the source's parsed data (absent in files written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source_data: Option<crate::measure::SourceData>,
     /// Further files of the same material and wavelength fitted with `source` as repeat
     /// measurements, in the order their rows follow its rows; absent for a fit of one file.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -218,6 +221,9 @@ pub struct MergedSource {
     /// The file as given to `irpol fit`, and the SHA-256 of its bytes.
     pub source: PathBuf,
     pub source_sha256: String,
+    /// The fingerprint of its parsed data (as [`FitRecord::source_data`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source_data: Option<crate::measure::SourceData>,
     /// Its rows.
     pub points: usize,
 }
@@ -449,6 +455,8 @@ mod tests {
     fn written_files_explain_every_field_and_read_back_unchanged() {
         let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("fits/paper_paint.toml");
         let mut material = Material::load(&shipped).unwrap();
+        let source_data = material.fit.as_ref().unwrap().source_data.clone();
+        assert!(source_data.is_some(), "the shipped fit records its data");
         material
             .fit
             .as_mut()
@@ -457,6 +465,7 @@ mod tests {
             .push(MergedSource {
                 source: "measurements/paper_paint_repeat.csv".into(),
                 source_sha256: "0".repeat(64),
+                source_data,
                 points: 12,
             });
         material.fit.as_mut().unwrap().profile_bounds.insert(

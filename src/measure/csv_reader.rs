@@ -74,7 +74,7 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
     })
 }
 
-fn hex(bytes: &[u8]) -> String {
+pub(crate) fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 

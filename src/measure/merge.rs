@@ -41,6 +41,7 @@ pub fn merge_repeat_measurements(
             path: set.source.clone(),
             sha256: set.sha256.clone(),
             rows: set.points.len(),
+            data: set.source_data(0),
         });
         merged.points.append(&mut set.points);
         merged.notes.append(&mut set.notes);
@@ -131,8 +132,9 @@ mod tests {
             merged.merged,
             vec![SourceFile {
                 path: "b.csv".into(),
-                sha256: b.sha256,
-                rows: 1
+                sha256: b.sha256.clone(),
+                rows: 1,
+                data: b.source_data(0),
             }]
         );
         assert_eq!(

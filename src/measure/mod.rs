@@ -22,15 +22,18 @@ mod csv_reader;
 mod error;
 mod fields;
 mod files;
+mod fingerprint;
 mod merge;
 mod metadata;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+pub(crate) use csv_reader::hex;
 pub use csv_reader::{parse_measurement_csv, read_measurement_csv};
 pub use error::{Delimiter, MeasureError, MeasureErrorKind};
 pub use files::collect_measurement_files;
+pub use fingerprint::SourceData;
 pub use merge::{merge_repeat_measurements, MergeError};
 
 /// Column names of the 16 Mueller elements; element (r, c) has index r*4 + c (row-major).
@@ -104,4 +107,7 @@ pub struct SourceFile {
     pub sha256: String,
     /// Its data rows.
     pub rows: usize,
+    /// The fingerprint of its parsed data, taken before the merge (its own wavelength, which may
+    /// differ from the set's by up to 1e-6 µm).
+    pub data: SourceData,
 }

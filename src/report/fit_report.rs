@@ -1,12 +1,14 @@
-//! Fit reports (DESIGN §4, `irpol fit … --reports`, `irpol report`): one 2400 × 1800 figure per
-//! material, as PNG and SVG, that a researcher can put in a paper. It recomputes every model curve
+//! Fit reports (DESIGN §4, `irpol fit … --reports`, `irpol report`): one 3000 × 1800 figure per
+//! material, as PNG and SVG, that a researcher can put in a paper, and each panel as its own PNG
+//! (`<material>/<panel>.png`). It recomputes every model curve
 //! from the material's pBRDF, so the same (material, measurement) always gives the same figure.
 //!
 //! Panels: (a) m00 in the plane of incidence, (b) m00 on the out-of-plane rings, (c) the
 //! parameter table, (d) the linear-polarization block normalized by m00, (e) the DoLP for
 //! unpolarized illumination, (f) the polarized emissivity, (g) normalized residuals, (h) their
-//! histogram, (i) the optimizer's convergence. The competing distribution's best fit is dashed.
+//! histogram, (i) the optimizer's convergence, (j) the parameters' correlation matrix. The competing distribution's best fit is dashed.
 
+mod correlation;
 mod data;
 mod diagnostics;
 mod profiles;
@@ -25,8 +27,8 @@ use super::paper_figures::encode_png;
 use super::{register_fonts, ReportError, FONT};
 use crate::material::{write_atomically, FitRecord, Material};
 use crate::measure::{
-    merge_repeat_measurements, parse_measurement_csv, MeasureError, MeasureErrorKind,
-    MeasurementSet,
+    hex, merge_repeat_measurements, parse_measurement_csv, MeasureError, MeasureErrorKind,
+    MeasurementSet, SourceData,
 };
 use data::ReportData;
 use plotters::coord::Shift;
@@ -43,8 +45,8 @@ use style::{
     LineKind, Marker, YAxis, TITLE_SIZE,
 };
 
-/// Pixel size of the report figure.
-pub const REPORT_SIZE: (u32, u32) = (2400, 1800);
+/// Pixel size of the report figure: five columns of panels in three rows.
+pub const REPORT_SIZE: (u32, u32) = (3000, 1800);
 const HEADER_HEIGHT: i32 = 100;
 const COLUMN_WIDTH: i32 = 600;
 
@@ -54,12 +56,70 @@ const LINEAR_BLOCK: [usize; 8] = [1, 2, 4, 5, 6, 8, 9, 10];
 /// on the rings, where they carry information.
 const ZERO_IN_PLANE: [usize; 4] = [2, 6, 8, 9];
 
-/// A fit report encoded in memory, not yet written: the PNG and SVG files and their bytes.
+/// A fit report encoded in memory, not yet written: the PNG and SVG files and their bytes, the
+/// composite figure's PNG first.
 pub struct EncodedReport {
     pub files: Vec<(PathBuf, Vec<u8>)>,
 }
 
-/// Writes `<out_dir>/<material>.png` and `.svg`; returns their paths.
+/// The panels: what each draws, its file name and its place in the grid (column, row, columns
+/// spanned).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PanelKind {
+    InPlane,
+    Rings,
+    Table,
+    LinearBlock,
+    Dolp,
+    Emissivity,
+    Correlation,
+    Residuals,
+    Histogram,
+    Convergence,
+}
+
+pub struct PanelSpec {
+    pub kind: PanelKind,
+    /// The panel's own file, `<material>/<name>.png`.
+    pub name: &'static str,
+    pub column: i32,
+    pub row: i32,
+    pub span: i32,
+}
+
+pub const PANELS: [PanelSpec; 10] = {
+    use PanelKind::*;
+    const fn at(
+        kind: PanelKind,
+        name: &'static str,
+        column: i32,
+        row: i32,
+        span: i32,
+    ) -> PanelSpec {
+        PanelSpec {
+            kind,
+            name,
+            column,
+            row,
+            span,
+        }
+    }
+    [
+        at(InPlane, "a_in_plane_m00", 0, 0, 2),
+        at(Rings, "b_rings_m00", 2, 0, 1),
+        at(Table, "c_parameters", 3, 0, 2),
+        at(LinearBlock, "d_linear_block", 0, 1, 2),
+        at(Dolp, "e_dolp", 2, 1, 1),
+        at(Emissivity, "f_emissivity", 3, 1, 1),
+        at(Correlation, "j_correlation", 4, 1, 1),
+        at(Residuals, "g_residuals", 0, 2, 3),
+        at(Histogram, "h_residual_histogram", 3, 2, 1),
+        at(Convergence, "i_convergence", 4, 2, 1),
+    ]
+};
+
+/// Writes `<out_dir>/<material>.png` and `.svg` and each panel as `<out_dir>/<material>/<panel>.png`
+/// (each file atomically); returns their paths.
 pub fn write_fit_report(
     material: &Material,
     set: &MeasurementSet,
@@ -67,6 +127,12 @@ pub fn write_fit_report(
 ) -> Result<Vec<PathBuf>, ReportError> {
     let report = encode_fit_report(material, set, out_dir)?;
     for (path, bytes) in &report.files {
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir).map_err(|source| ReportError::Write {
+                path: dir.to_owned(),
+                source,
+            })?;
+        }
         write_atomically(path, bytes).map_err(|source| ReportError::Write {
             path: path.clone(),
             source,
@@ -75,8 +141,9 @@ pub fn write_fit_report(
     Ok(report.files.into_iter().map(|(path, _)| path).collect())
 }
 
-/// Draws the report of `material` against `set` as `<out_dir>/<material>.png` and `.svg`, in
-/// memory, so that a caller writing several outputs can write none of them if one fails.
+/// Draws the report of `material` against `set` as `<out_dir>/<material>.png` and `.svg` and
+/// its panels as `<out_dir>/<material>/<panel>.png`, in memory, so that a caller writing several
+/// outputs can write none of them if one fails.
 pub fn encode_fit_report(
     material: &Material,
     set: &MeasurementSet,
@@ -86,26 +153,52 @@ pub fn encode_fit_report(
     let png = out_dir.join(format!("{stem}.png"));
     let svg = out_dir.join(format!("{stem}.svg"));
     let data = ReportData::new(material, set)?;
-    let draw_error = |path: &Path, e: &dyn std::fmt::Display| ReportError::Draw {
-        path: path.to_owned(),
-        message: e.to_string(),
-    };
-
     let (width, height) = REPORT_SIZE;
-    let mut rgb = vec![0u8; (width * height * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
-        draw_report(&root, material, set, &data).map_err(|e| draw_error(&png, &e))?;
-    }
+    let png_bytes = encode_bitmap(&png, (width, height), |root| {
+        draw_report(root, material, set, &data, false)
+    })?;
     let mut svg_text = String::new();
     {
         let root = SVGBackend::with_string(&mut svg_text, (width, height)).into_drawing_area();
-        draw_report(&root, material, set, &data).map_err(|e| draw_error(&svg, &e))?;
+        draw_report(&root, material, set, &data, true).map_err(|e| draw_error(&svg, &e))?;
     }
-    let png_bytes = encode_png(&rgb, width, height).map_err(|e| draw_error(&png, &e))?;
-    Ok(EncodedReport {
-        files: vec![(png, png_bytes), (svg, svg_text.into_bytes())],
-    })
+    // plotters labels embedded PNGs `data:png`, which is no media type; viewers want image/png.
+    // (Text is escaped, so the attribute cannot occur in the figure's text.)
+    let svg_text = svg_text.replace("href=\"data:png;base64,", "href=\"data:image/png;base64,");
+    let mut files = vec![(png, png_bytes), (svg, svg_text.into_bytes())];
+    for spec in &PANELS {
+        let path = out_dir.join(stem).join(format!("{}.png", spec.name));
+        let size = panel_size(spec);
+        let bytes = encode_bitmap(&path, size, |root| {
+            register_fonts();
+            root.fill(&WHITE)?;
+            draw_panel(spec.kind, root, material, &data, false)?;
+            root.present()
+        })?;
+        files.push((path, bytes));
+    }
+    Ok(EncodedReport { files })
+}
+
+fn draw_error(path: &Path, e: &dyn std::fmt::Display) -> ReportError {
+    ReportError::Draw {
+        path: path.to_owned(),
+        message: e.to_string(),
+    }
+}
+
+/// Draws into an RGB bitmap of `size` and encodes it as PNG bytes for `path`.
+fn encode_bitmap(
+    path: &Path,
+    (width, height): (u32, u32),
+    draw: impl for<'a> FnOnce(&DrawingArea<BitMapBackend<'a>, Shift>) -> DrawResult<BitMapBackend<'a>>,
+) -> Result<Vec<u8>, ReportError> {
+    let mut rgb = vec![0u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
+        draw(&root).map_err(|e| draw_error(path, &e))?;
+    }
+    encode_png(&rgb, width, height).map_err(|e| draw_error(path, &e))
 }
 
 /// Rebuilds the report of a library entry from its recorded source CSVs (`irpol report
@@ -119,10 +212,7 @@ pub fn rebuild_report(
     let fit = material.fit.as_ref().ok_or_else(|| ReportError::NoFit {
         material: material_path.to_owned(),
     })?;
-    let sets = verified_source(material_path, fit)?
-        .into_iter()
-        .map(|(csv, bytes)| parse_measurement_csv(&csv, &bytes))
-        .collect::<Result<Vec<_>, _>>()?;
+    let sets = verified_source(material_path, fit)?;
     let set = merge_repeat_measurements(sets)
         .map_err(crate::fit::FitError::from)?
         .ok_or_else(|| ReportError::NoFit {
@@ -147,30 +237,33 @@ fn source_candidates(material_path: &Path, source: &Path) -> Vec<PathBuf> {
     candidates
 }
 
-/// Finds each of the fit's source CSVs (the source, then any merged with it) and checks it is
-/// byte-for-byte the file that was fitted; returns their paths and bytes in that order.
+/// Finds each of the fit's source CSVs (the source, then any merged with it) and checks it holds
+/// the data that was fitted; returns each one's parsed data, in that order.
 pub(crate) fn verified_source(
     material_path: &Path,
     fit: &FitRecord,
-) -> Result<Vec<(PathBuf, Vec<u8>)>, ReportError> {
-    std::iter::once((&fit.source, &fit.source_sha256))
+) -> Result<Vec<MeasurementSet>, ReportError> {
+    std::iter::once((&fit.source, &fit.source_sha256, &fit.source_data))
         .chain(
             fit.merged_sources
                 .iter()
-                .map(|m| (&m.source, &m.source_sha256)),
+                .map(|m| (&m.source, &m.source_sha256, &m.source_data)),
         )
-        .map(|(source, sha256)| verified_file(material_path, source, sha256))
+        .map(|(source, sha256, data)| verified_file(material_path, source, sha256, data.as_ref()))
         .collect()
 }
 
-/// One source CSV with the recorded hash. Of several candidates the first with the recorded
-/// hash wins (a same-named file elsewhere is not the source); if none has it, the first existing
-/// one is reported changed.
+/// One source CSV, checked against its recorded hash and data fingerprint. The bytes may differ
+/// (a comment, blank lines, number spelling) when the record has the data's fingerprint and the
+/// parsed data match it; a record without one (written before fingerprints) needs the very
+/// bytes. Of several candidates the first that matches wins (a same-named file elsewhere is not
+/// the source); if none does, the first existing one is reported changed.
 fn verified_file(
     material_path: &Path,
     source: &Path,
-    recorded: &str,
-) -> Result<(PathBuf, Vec<u8>), ReportError> {
+    recorded_sha256: &str,
+    recorded_data: Option<&SourceData>,
+) -> Result<MeasurementSet, ReportError> {
     let candidates = source_candidates(material_path, source);
     let mut first_changed = None;
     for csv in candidates.iter().filter(|p| p.is_file()) {
@@ -182,19 +275,28 @@ fn verified_file(
                 reason: e.to_string(),
             },
         })?;
-        let actual: String = Sha256::digest(&bytes)
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
-        if actual.eq_ignore_ascii_case(recorded.trim()) {
-            return Ok((csv.clone(), bytes));
-        }
-        first_changed.get_or_insert(ReportError::SourceChanged {
-            csv: csv.clone(),
-            actual,
-            recorded: recorded.to_owned(),
-            material: material_path.to_owned(),
-        });
+        let same_bytes = hex(&Sha256::digest(&bytes)).eq_ignore_ascii_case(recorded_sha256.trim());
+        let error = match (recorded_data, same_bytes) {
+            (_, true) => return Ok(parse_measurement_csv(csv, &bytes)?),
+            (Some(recorded), false) => {
+                let set = parse_measurement_csv(csv, &bytes)?;
+                let now = set.source_data(recorded.rows_per_digest);
+                if now.sha256 == recorded.sha256 {
+                    return Ok(set);
+                }
+                ReportError::SourceDataChanged {
+                    csv: csv.clone(),
+                    what: recorded.describe_change(&now),
+                    material: material_path.to_owned(),
+                }
+            }
+            (None, false) => ReportError::SourceChanged {
+                csv: csv.clone(),
+                recorded: recorded_sha256.to_owned(),
+                material: material_path.to_owned(),
+            },
+        };
+        first_changed.get_or_insert(error);
     }
     Err(first_changed.unwrap_or_else(|| ReportError::SourceMissing {
         material: material_path.to_owned(),
@@ -223,18 +325,49 @@ fn report_stem(name: &str) -> Result<&str, ReportError> {
     }
 }
 
-/// The panel at grid column `column` (0–3), row `row` (0–2), `span` columns wide.
+/// Height of a row of panels.
+const ROW_HEIGHT: i32 = (REPORT_SIZE.1 as i32 - HEADER_HEIGHT) / 3;
+
+/// Pixel size of a panel, in the figure and as its own file.
+pub fn panel_size(spec: &PanelSpec) -> (u32, u32) {
+    ((spec.span * COLUMN_WIDTH) as u32, ROW_HEIGHT as u32)
+}
+
+/// The area of `spec` in the figure.
 fn panel<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    column: i32,
-    row: i32,
-    span: i32,
+    spec: &PanelSpec,
 ) -> DrawingArea<DB, Shift> {
-    let row_height = (REPORT_SIZE.1 as i32 - HEADER_HEIGHT) / 3;
+    let (width, height) = panel_size(spec);
     root.clone().shrink(
-        (column * COLUMN_WIDTH, HEADER_HEIGHT + row * row_height),
-        (span * COLUMN_WIDTH, row_height),
+        (
+            spec.column * COLUMN_WIDTH,
+            HEADER_HEIGHT + spec.row * ROW_HEIGHT,
+        ),
+        (width, height),
     )
+}
+
+/// Draws one panel into `area`; `raster` (a vector figure) embeds dense scatter as an image.
+fn draw_panel<DB: DrawingBackend>(
+    kind: PanelKind,
+    area: &DrawingArea<DB, Shift>,
+    material: &Material,
+    data: &ReportData,
+    raster: bool,
+) -> DrawResult<DB> {
+    match kind {
+        PanelKind::InPlane => draw_in_plane_m00(area, data),
+        PanelKind::Rings => draw_rings_m00(area, data),
+        PanelKind::Table => table::draw_table(area, material),
+        PanelKind::LinearBlock => draw_linear_block(area, data),
+        PanelKind::Dolp => draw_dolp(area, data),
+        PanelKind::Emissivity => diagnostics::draw_emissivity(area, data),
+        PanelKind::Correlation => correlation::draw_correlation(area, material.fit.as_ref()),
+        PanelKind::Residuals => diagnostics::draw_residuals(area, data, raster),
+        PanelKind::Histogram => diagnostics::draw_histogram(area, data),
+        PanelKind::Convergence => diagnostics::draw_convergence(area, material.fit.as_ref()),
+    }
 }
 
 fn draw_report<DB: DrawingBackend>(
@@ -242,19 +375,14 @@ fn draw_report<DB: DrawingBackend>(
     material: &Material,
     set: &MeasurementSet,
     data: &ReportData,
+    raster: bool,
 ) -> DrawResult<DB> {
     register_fonts();
     root.fill(&WHITE)?;
     draw_header(root, material, set, data)?;
-    draw_in_plane_m00(&panel(root, 0, 0, 2), data)?;
-    draw_rings_m00(&panel(root, 2, 0, 1), data)?;
-    table::draw_table(&panel(root, 3, 0, 1), material)?;
-    draw_linear_block(&panel(root, 0, 1, 2), data)?;
-    draw_dolp(&panel(root, 2, 1, 1), data)?;
-    diagnostics::draw_emissivity(&panel(root, 3, 1, 1), data)?;
-    diagnostics::draw_residuals(&panel(root, 0, 2, 2), data)?;
-    diagnostics::draw_histogram(&panel(root, 2, 2, 1), data)?;
-    diagnostics::draw_convergence(&panel(root, 3, 2, 1), material.fit.as_ref())?;
+    for spec in &PANELS {
+        draw_panel(spec.kind, &panel(root, spec), material, data, raster)?;
+    }
     root.present()
 }
 

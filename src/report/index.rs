@@ -141,7 +141,7 @@ fn provenance(material_path: &Path, material: &Material) -> (String, &'static st
     };
     match verified_source(material_path, fit) {
         Ok(_) => ("source unchanged".into(), "ok"),
-        Err(ReportError::SourceChanged { .. }) => {
+        Err(ReportError::SourceChanged { .. } | ReportError::SourceDataChanged { .. }) => {
             ("source CSV changed since the fit".into(), "warn")
         }
         Err(ReportError::SourceMissing { .. }) => ("source CSV not found".into(), "warn"),

@@ -52,11 +52,16 @@ pub enum ReportError {
         csv: std::path::PathBuf,
         tried: String,
     },
-    #[error("{csv}: source CSV changed since the fit: sha256 {actual} ≠ {recorded} recorded in {material}; refit it with `irpol fit`")]
+    #[error("{csv}: source CSV changed since the fit: its bytes are not those of sha256 {recorded} recorded in {material}, which records no fingerprint of the data to compare (written before irpol kept one); refit it with `irpol fit`")]
     SourceChanged {
         csv: std::path::PathBuf,
-        actual: String,
         recorded: String,
+        material: std::path::PathBuf,
+    },
+    #[error("{csv}: the data changed since the fit recorded in {material}: {what}; refit it with `irpol fit`")]
+    SourceDataChanged {
+        csv: std::path::PathBuf,
+        what: String,
         material: std::path::PathBuf,
     },
     #[error("material name '{name}' cannot name a report file: it must be a plain file name without folders")]

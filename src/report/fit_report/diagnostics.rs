@@ -48,7 +48,13 @@ fn chart_builder<'a, 'b, DB: DrawingBackend>(
 }
 
 /// (data − model)/σ of every measured element against the signed detector zenith.
-pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) -> DrawResult<DB> {
+/// With `raster` (a vector figure), more than [`RASTER_SCATTER_POINTS`] residuals are drawn as
+/// one embedded image rather than one element each.
+pub fn draw_residuals<DB: DrawingBackend>(
+    area: &Area<DB>,
+    data: &ReportData,
+    raster: bool,
+) -> DrawResult<DB> {
     let caption = "(g) Normalized residuals (data − model)/σ, chosen model";
     if data.residuals.is_empty() {
         return draw_note(area, caption, "no residuals");
@@ -66,36 +72,15 @@ pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
         .filter(|r| r.value.is_nan() || r.value.abs() > bound)
         .count();
     let mut chart = chart_builder(area, caption).build_cartesian_2d(-90.0..90.0, -bound..bound)?;
-    chart
-        .configure_mesh()
-        .x_labels(13)
-        .y_labels(9)
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.0}"))
-        .x_desc("detector zenith θr (°): + forward (specular) half, − backward half")
-        .y_desc("(data − model)/σ")
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_DESC_SIZE))
-        .light_line_style(RGBColor(235, 235, 235))
-        .bold_line_style(RGBColor(215, 215, 215))
-        .draw()?;
+    residual_mesh(&mut chart)?;
     draw_residual_guides(&mut chart)?;
     if data.residuals.len() > MAX_RESIDUAL_POINTS {
         return draw_residual_density(area, &mut chart, data, bound, hidden);
     }
-    // Draw the many polarization residuals first so that m00 stays visible on top.
-    for class in [2, 1, 0] {
-        let points: Vec<&Residual> = data
-            .residuals
-            .iter()
-            .filter(|r| element_class(r.element) == class && r.value.abs() <= bound)
-            .collect();
-        let color = CLASS_COLORS[class].mix(if class == 0 { 0.8 } else { 0.45 });
-        chart.draw_series(
-            points
-                .iter()
-                .map(|r| Circle::new((r.forward_zenith, r.value), 2, color.filled())),
-        )?;
+    if raster && data.residuals.len() > RASTER_SCATTER_POINTS {
+        draw_scatter_as_image(area, &chart, data, bound)?;
+    } else {
+        draw_residual_scatter(&mut chart, data, bound)?;
     }
     let mut entries: Vec<LegendEntry> = (0..3)
         .filter(|&class| {
@@ -119,6 +104,62 @@ pub fn draw_residuals<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
         hidden,
         bound,
     )
+}
+
+/// Most residuals a vector figure's panel (g) draws as elements; beyond it, the scatter (with its
+/// grid and guides) is one embedded PNG: 10⁴ SVG circles cost ~1 MB, the image ~0.1 MB.
+pub const RASTER_SCATTER_POINTS: usize = 2_000;
+
+type Chart2d<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The residuals within ±`bound` as dots, the polarization classes first so that m00 stays
+/// visible on top.
+fn draw_residual_scatter<DB: DrawingBackend>(
+    chart: &mut Chart2d<'_, DB>,
+    data: &ReportData,
+    bound: f64,
+) -> DrawResult<DB> {
+    for class in [2, 1, 0] {
+        let points: Vec<&Residual> = data
+            .residuals
+            .iter()
+            .filter(|r| element_class(r.element) == class && r.value.abs() <= bound)
+            .collect();
+        let color = CLASS_COLORS[class].mix(if class == 0 { 0.8 } else { 0.45 });
+        chart.draw_series(
+            points
+                .iter()
+                .map(|r| Circle::new((r.forward_zenith, r.value), 2, color.filled())),
+        )?;
+    }
+    Ok(())
+}
+
+/// The plotting area of `chart` redrawn in a bitmap (white, grid, guides, the residual dots) and
+/// placed over it as one image.
+fn draw_scatter_as_image<DB: DrawingBackend>(
+    area: &Area<DB>,
+    chart: &Chart2d<'_, DB>,
+    data: &ReportData,
+    bound: f64,
+) -> DrawResult<DB> {
+    let (x, y) = chart.plotting_area().get_pixel_range();
+    let (base_x, base_y) = area.get_base_pixel();
+    let size = ((x.end - x.start) as u32, (y.end - y.start) as u32);
+    let mut image = BitMapElement::<(i32, i32)>::new((x.start - base_x, y.start - base_y), size);
+    // A bitmap in memory cannot fail to draw; its error type is not the figure's.
+    let in_bitmap = |_| DrawingAreaErrorKind::LayoutError;
+    {
+        let root = image.as_bitmap_backend().into_drawing_area();
+        root.fill(&WHITE).map_err(in_bitmap)?;
+        let mut inner = ChartBuilder::on(&root)
+            .build_cartesian_2d(-90.0..90.0, -bound..bound)
+            .map_err(in_bitmap)?;
+        residual_mesh(&mut inner).map_err(in_bitmap)?;
+        draw_residual_guides(&mut inner).map_err(in_bitmap)?;
+        draw_residual_scatter(&mut inner, data, bound).map_err(in_bitmap)?;
+    }
+    area.draw(&image)
 }
 
 /// Most residuals panel (g) draws one by one; beyond it, it draws their density as a 2-D
@@ -176,10 +217,26 @@ fn residual_legend<DB: DrawingBackend>(
     draw_legend_top_right(area, plot, &entries, 8)
 }
 
+/// The grid, ticks and axis titles of the residual panel (only the grid in a chart without
+/// label areas, as the bitmap of [`draw_scatter_as_image`]).
+fn residual_mesh<DB: DrawingBackend>(chart: &mut Chart2d<'_, DB>) -> DrawResult<DB> {
+    chart
+        .configure_mesh()
+        .x_labels(13)
+        .y_labels(9)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .x_desc("detector zenith θr (°): + forward (specular) half, − backward half")
+        .y_desc("(data − model)/σ")
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_DESC_SIZE))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .draw()
+}
+
 /// The zero line and the ±3σ guides of a residual panel (θ_r from −90° to 90°).
-fn draw_residual_guides<DB: DrawingBackend>(
-    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
-) -> DrawResult<DB> {
+fn draw_residual_guides<DB: DrawingBackend>(chart: &mut Chart2d<'_, DB>) -> DrawResult<DB> {
     chart.draw_series(LineSeries::new(
         [(-90.0, 0.0), (90.0, 0.0)],
         GREY.stroke_width(1),
@@ -197,7 +254,7 @@ fn draw_residual_guides<DB: DrawingBackend>(
 
 fn draw_residual_density<DB: DrawingBackend>(
     area: &Area<DB>,
-    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    chart: &mut Chart2d<'_, DB>,
     data: &ReportData,
     bound: f64,
     hidden: usize,

@@ -335,7 +335,7 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
 }
 
 /// The table's symbol of a parameter name ("sigma" → "σ").
-fn symbol(name: &str) -> &str {
+pub fn symbol(name: &str) -> &str {
     match name {
         "sigma" => "σ",
         "rho_d" | "rho" => "ρd",
