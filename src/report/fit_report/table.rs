@@ -371,15 +371,13 @@ fn strongest_correlation(fit: &FitRecord) -> Option<String> {
     })
 }
 
-/// Draws the table into `area` under a caption; long text wraps at the area's width.
+/// The table drawn into `area`: the caption, then [`layout_table`]'s pieces, a rule under each
+/// heading.
 pub fn draw_table<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     material: &Material,
 ) -> DrawResult<DB> {
     let (width, _) = area.dim_in_pixel();
-    let left = 18;
-    let right = width as i32 - 12;
-    let stops = [left, left + 105, left + 245, left + 395];
     let caption = (FONT, CAPTION_SIZE)
         .into_font()
         .color(&BLACK)
@@ -389,38 +387,155 @@ pub fn draw_table<DB: DrawingBackend>(
         &caption,
         (width as i32 / 2, 12),
     )?;
-    let size = LEGEND_SIZE;
+    let layout = layout_table(area, material)?;
+    for piece in &layout.pieces {
+        area.draw_text(&piece.text, &piece.style(), (piece.x, piece.y))?;
+        if piece.kind == PieceKind::Heading {
+            let rule_y = piece.y + layout.line - 3;
+            area.draw(&PathElement::new(
+                vec![(TABLE_LEFT, rule_y), (layout.right, rule_y)],
+                RGBColor(190, 190, 190).stroke_width(1),
+            ))?;
+        }
+    }
+    Ok(())
+}
+
+/// Left margin of the table, and the gap between its columns, in pixels.
+const TABLE_LEFT: i32 = 18;
+const COLUMN_GAP: i32 = 18;
+/// The table's first row, below the caption.
+const TABLE_TOP: i32 = 50;
+/// The smallest font the table shrinks to when a long table does not fit its panel.
+const MIN_TABLE_SIZE: i32 = 10;
+
+/// What a piece of the table is, which sets its font.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PieceKind {
+    Heading,
+    Text(Tone),
+}
+
+/// One piece of text of the table at its place (top-left corner, pixels).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Piece {
+    pub text: String,
+    pub x: i32,
+    pub y: i32,
+    pub size: i32,
+    pub kind: PieceKind,
+}
+
+impl Piece {
+    fn style(&self) -> TextStyle<'static> {
+        match self.kind {
+            PieceKind::Heading => (FONT, self.size + 2, FontStyle::Bold)
+                .into_font()
+                .color(&BLACK),
+            PieceKind::Text(tone) => tone_style(tone, self.size),
+        }
+    }
+}
+
+/// The table's pieces and its line height and right edge.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TableLayout {
+    pub pieces: Vec<Piece>,
+    pub line: i32,
+    pub right: i32,
+}
+
+/// Lays the table out in `area`: each column as wide as its widest cell plus a gap (fixed stops
+/// let a long label or value run into its neighbour), free text wrapped to the width, and the
+/// font shrunk step by step until the widest row and the last line fit the panel.
+pub fn layout_table<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    material: &Material,
+) -> Result<TableLayout, DrawingAreaErrorKind<DB::ErrorType>> {
+    let (width, height) = area.dim_in_pixel();
+    let rows = table_rows(material);
+    let mut size = LEGEND_SIZE;
+    loop {
+        let layout = layout_at(area, &rows, size, width as i32 - 12)?;
+        let fits = layout.pieces.iter().all(|piece| {
+            area.estimate_text_size(&piece.text, &piece.style())
+                .is_ok_and(|(w, h)| {
+                    piece.x + w as i32 <= layout.right && piece.y + h as i32 <= height as i32
+                })
+        });
+        if fits || size <= MIN_TABLE_SIZE {
+            return Ok(layout);
+        }
+        size -= 1;
+    }
+}
+
+/// [`layout_table`] at one font size, with text running up to `right`.
+fn layout_at<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    rows: &[Row],
+    size: i32,
+    right: i32,
+) -> Result<TableLayout, DrawingAreaErrorKind<DB::ErrorType>> {
     let line = size + 8;
-    let mut y = 50;
-    for row in table_rows(material) {
+    let mut widths: Vec<i32> = Vec::new();
+    for row in rows {
+        if let Row::Cells(cells, tone) = row {
+            for (i, cell) in cells.iter().enumerate() {
+                let w = area.estimate_text_size(cell, &tone_style(*tone, size))?.0 as i32;
+                match widths.get_mut(i) {
+                    Some(widest) => *widest = (*widest).max(w),
+                    None => widths.push(w),
+                }
+            }
+        }
+    }
+    let stops: Vec<i32> = widths
+        .iter()
+        .scan(TABLE_LEFT, |x, w| {
+            let stop = *x;
+            *x += w + COLUMN_GAP;
+            Some(stop)
+        })
+        .collect();
+    let mut pieces = Vec::new();
+    let mut y = TABLE_TOP;
+    let mut place = |text: &str, x: i32, y: i32, kind: PieceKind| {
+        pieces.push(Piece {
+            text: text.to_owned(),
+            x,
+            y,
+            size,
+            kind,
+        })
+    };
+    for row in rows {
         match row {
             Row::Heading(text) => {
                 y += 4;
-                let style = (FONT, size + 2, FontStyle::Bold).into_font().color(&BLACK);
-                area.draw_text(&text, &style.into_text_style(area), (left, y))?;
-                area.draw(&PathElement::new(
-                    vec![(left, y + line - 3), (right, y + line - 3)],
-                    RGBColor(190, 190, 190).stroke_width(1),
-                ))?;
+                place(text, TABLE_LEFT, y, PieceKind::Heading);
                 y += line + 2;
             }
             Row::Cells(cells, tone) => {
-                let style = tone_style(tone, size);
                 for (cell, &x) in cells.iter().zip(&stops) {
-                    area.draw_text(cell, &style, (x, y))?;
+                    place(cell, x, y, PieceKind::Text(*tone));
                 }
                 y += line;
             }
             Row::Text(text, tone) => {
-                let style = tone_style(tone, size);
-                for piece in wrap(area, &text, &style, (right - left) as u32)? {
-                    area.draw_text(&piece, &style, (left, y))?;
+                let style = tone_style(*tone, size);
+                for piece in wrap(area, text, &style, (right - TABLE_LEFT) as u32)? {
+                    place(&piece, TABLE_LEFT, y, PieceKind::Text(*tone));
                     y += line;
                 }
             }
         }
     }
-    Ok(())
+    Ok(TableLayout {
+        pieces,
+        line,
+        right,
+    })
 }
 
 fn tone_style(tone: Tone, size: i32) -> TextStyle<'static> {
@@ -572,6 +687,53 @@ mod tests {
             Tone::Normal
         )));
         assert_eq!(cells("cost χ²").0[1], "18.00");
+    }
+
+    /// Issue 16 item 10: no text of the table overlaps another or leaves the panel, whatever the
+    /// labels' lengths (fixed column stops let "cost, huber(1.5)" run into its value), and a
+    /// panel too small for the full size shrinks the font instead of cutting rows off.
+    #[test]
+    fn table_text_never_overlaps_or_leaves_its_panel() {
+        crate::report::register_fonts();
+        let mut m = material(24.0, 36.5);
+        let fit = m.fit.as_mut().unwrap();
+        fit.settings
+            .insert("robust_loss".into(), "huber(1.5)".into());
+        fit.uncertainty.insert("sigma".into(), 1.234e-9);
+        m.name = "a_rather_long_material_name_from_a_goniometer_export".into();
+        for (width, height) in [(1200, 600), (600, 560), (520, 480)] {
+            let mut svg = String::new();
+            let area = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+            let layout = layout_table(&area, &m).unwrap();
+            let extent = |piece: &Piece| {
+                let (w, h) = area
+                    .estimate_text_size(&piece.text, &piece.style())
+                    .unwrap();
+                (piece.x, piece.x + w as i32, piece.y, piece.y + h as i32)
+            };
+            for piece in &layout.pieces {
+                let (_, right, _, bottom) = extent(piece);
+                assert!(
+                    right <= layout.right,
+                    "{width}×{height}: {piece:?} runs off"
+                );
+                assert!(bottom <= height as i32, "{width}×{height}: {piece:?} below");
+            }
+            for (i, a) in layout.pieces.iter().enumerate() {
+                for b in &layout.pieces[i + 1..] {
+                    let ((a0, a1, ay, _), (b0, b1, by, _)) = (extent(a), extent(b));
+                    let overlap = ay == by && a0 < b1 && b0 < a1;
+                    assert!(!overlap, "{width}×{height}: {a:?} overlaps {b:?}");
+                }
+            }
+            // The report's own panel (two columns of the 3000 × 1800 figure) needs no shrinking.
+            let size = layout.pieces[0].size;
+            assert_eq!(
+                size == LEGEND_SIZE,
+                width == 1200,
+                "{width}×{height}: size {size}"
+            );
+        }
     }
 
     #[test]
