@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::irpol;
+use common::{fit_into, irpol};
 
 /// A column of CSV output, after its `#` header lines.
 fn column(csv: &str, name: &str) -> Vec<f64> {
@@ -267,34 +267,24 @@ fn fixed_parameters_are_recorded_and_contradictions_refused() {
     let dir = tempfile::tempdir().unwrap();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let csv = root.join("measurements/rough_paint.csv");
-    let (fits, reports) = (dir.path().join("fits"), dir.path().join("reports"));
-    let base = [
-        "fit",
-        csv.to_str().unwrap(),
-        "--distribution",
-        "cauchy",
-        "--out",
-        fits.to_str().unwrap(),
-        "--reports",
-        reports.to_str().unwrap(),
-    ];
-    let mut args = base.to_vec();
-    args.extend(["--free", "sigma,q,n", "--fix", "k=0.05"]);
-    let (ok, stdout, stderr) = irpol(&args);
+    let fit = |extra: &[&str]| {
+        let mut args = vec!["--distribution", "cauchy"];
+        args.extend_from_slice(extra);
+        fit_into(dir.path(), &[&csv], &args)
+    };
+    let (ok, stdout, stderr) = fit(&["--free", "sigma,q,n", "--fix", "k=0.05"]);
     assert!(ok, "{stderr}");
     assert!(
         stdout.contains("(fixed: k=0.05") && stdout.contains("rho_d=0)"),
         "{stdout}"
     );
-    let toml = std::fs::read_to_string(fits.join("rough_paint.toml")).unwrap();
+    let toml = std::fs::read_to_string(dir.path().join("fits/rough_paint.toml")).unwrap();
     assert!(
         toml.contains("[fit.fixed_parameters]") && toml.contains("k = 0.05"),
         "{toml}"
     );
 
-    let mut args = base.to_vec();
-    args.extend(["--free", "sigma,q,n,k", "--fix", "k=0.05"]);
-    let (ok, _, stderr) = irpol(&args);
+    let (ok, _, stderr) = fit(&["--free", "sigma,q,n,k", "--fix", "k=0.05"]);
     assert!(
         !ok && stderr.contains("k is both free and fixed"),
         "{stderr}"

@@ -6,7 +6,7 @@
 mod common;
 mod fit_support;
 
-use common::irpol;
+use common::fit_into;
 use fit_support::{goniometer_geometry, model, synthetic_set, to_csv, LINEAR_ELEMENTS};
 use irpol::fit::{
     fit_measurement, DistributionKind, FitOptions, Parameter, ONE_SIDED_95_DELTA_CHI2,
@@ -85,22 +85,11 @@ fn the_summary_line_and_the_toml_state_the_bound() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("clear_coat.csv");
     std::fs::write(&csv, to_csv(&transparent_set(), true)).unwrap();
-    let fits = dir.path().join("fits");
-    let reports = dir.path().join("reports");
-    let (ok, stdout, stderr) = irpol(&[
-        "fit",
-        csv.to_str().unwrap(),
-        "--distribution",
-        "cauchy",
-        "--out",
-        fits.to_str().unwrap(),
-        "--reports",
-        reports.to_str().unwrap(),
-    ]);
+    let (ok, stdout, stderr) = fit_into(dir.path(), &[&csv], &["--distribution", "cauchy"]);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("[bounded only: k < 0."), "{stdout}");
     assert!(!stdout.contains(" k="), "no ± for k: {stdout}");
-    let toml = std::fs::read_to_string(fits.join("clear_coat.toml")).unwrap();
+    let toml = std::fs::read_to_string(dir.path().join("fits/clear_coat.toml")).unwrap();
     assert!(toml.contains("[fit.profile_bounds.k]"), "{toml}");
     assert!(toml.contains("confidence = 0.95"), "{toml}");
 }

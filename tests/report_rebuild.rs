@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::irpol;
+use common::{fit_into, irpol};
 use std::path::{Path, PathBuf};
 
 struct Project {
@@ -22,14 +22,7 @@ fn fitted_project() -> Project {
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("measurements/paper_paint.csv");
     std::fs::copy(shipped, &csv).unwrap();
     let (fits, reports) = (dir.path().join("fits"), dir.path().join("reports"));
-    let (ok, _, stderr) = irpol(&[
-        "fit",
-        csv.to_str().unwrap(),
-        "--out",
-        fits.to_str().unwrap(),
-        "--reports",
-        reports.to_str().unwrap(),
-    ]);
+    let (ok, _, stderr) = fit_into(dir.path(), &[&csv], &[]);
     assert!(ok, "{stderr}");
     Project {
         toml: fits.join("paper_paint.toml"),

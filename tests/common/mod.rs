@@ -174,3 +174,14 @@ pub fn irpol(args: &[&str]) -> (bool, String, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// `irpol fit INPUTS… EXTRA… --out DIR/fits --reports DIR/reports`: success, stdout, stderr.
+pub fn fit_into(dir: &Path, inputs: &[&Path], extra: &[&str]) -> (bool, String, String) {
+    let (fits, reports) = (dir.join("fits"), dir.join("reports"));
+    let mut args = vec!["fit"];
+    args.extend(inputs.iter().map(|p| p.to_str().unwrap()));
+    args.extend_from_slice(extra);
+    args.extend(["--out", fits.to_str().unwrap()]);
+    args.extend(["--reports", reports.to_str().unwrap()]);
+    irpol(&args)
+}
