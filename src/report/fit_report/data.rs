@@ -6,7 +6,7 @@
 use crate::fit::MeasurementData;
 use crate::material::Material;
 use crate::measure::MeasurementSet;
-use crate::optics::{Mueller, Stokes};
+use crate::optics::{rotation_between_frames, stokes_rotator, Mueller, Stokes};
 use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
 
 use super::super::ReportError;
@@ -39,12 +39,12 @@ pub struct PointView {
     pub ring: Option<usize>,
     /// φ_r − φ_i in [0°, 360°).
     pub relative_azimuth: f64,
-    /// θ_r signed by hemisphere: + when the detector is on the forward (specular) half,
-    /// 90° ≤ φ_r − φ_i ≤ 270°. Equals `signed_zenith` in the plane.
-    pub forward_zenith: f64,
-    /// The measured elements by Mueller index r*4 + c.
+    /// The measured elements by Mueller index r*4 + c, in the psps frame the point is drawn in: its
+    /// own, except at the normal (θ_r = 0), where they are turned into the in-plane profile's
+    /// frame ([`in_plane_frame_at_normal`]); elements that cannot be turned are `None` there.
+    /// [`ReportData::residuals`] are taken before, in the row's own frame.
     pub readings: [Option<Reading>; 16],
-    /// The chosen model at this geometry.
+    /// The chosen model at this geometry, in the same frame as `readings`.
     pub model: Mueller,
 }
 
@@ -67,9 +67,11 @@ pub struct Ring {
     pub sweep: ModelSweep,
 }
 
-/// One normalized residual (data − model)/σ.
+/// One normalized residual (data − model)/σ, both in the measured row's own psps frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Residual {
+    /// θ_r signed by hemisphere: + when the detector is on the forward (specular) half,
+    /// 90° ≤ φ_r − φ_i ≤ 270°. Equals the point's signed zenith in the plane.
     pub forward_zenith: f64,
     pub element: usize,
     pub value: f64,
@@ -131,6 +133,7 @@ impl ReportData {
         let elements_per_point = set.elements.len();
 
         let mut points = Vec::with_capacity(set.points.len());
+        let mut residuals = Vec::with_capacity(set.points.len() * elements_per_point);
         for (point, p) in set.points.iter().enumerate() {
             let incident = checked_direction("theta_i_deg", p.theta_i_deg, p.phi_i_deg)?;
             let scattered = checked_direction("theta_r_deg", p.theta_r_deg, p.phi_r_deg)?;
@@ -149,14 +152,22 @@ impl ReportData {
                 let (_, sigma) = weights.observation(point * elements_per_point + column);
                 readings[element] = Some(Reading { value, sigma });
             }
+            let model = chosen.pbrdf.mueller(&incident, &scattered);
+            // Residuals in the row's own frame: the model is evaluated at the row's own φ_r, as
+            // the fit compared them.
+            residuals.extend(normalized_residuals(&readings, &model, forward_zenith));
+            let (readings, model) = if at_normal(p.theta_r_deg) {
+                in_plane_frame_at_normal(&readings, &model, p.phi_i_deg, p.phi_r_deg)
+            } else {
+                (readings, model)
+            };
             points.push(PointView {
                 incidence: position_of(&incidences, p.theta_i_deg),
                 signed_zenith,
                 ring: None,
                 relative_azimuth,
-                forward_zenith,
                 readings,
-                model: chosen.pbrdf.mueller(&incident, &scattered),
+                model,
             });
         }
 
@@ -182,18 +193,6 @@ impl ReportData {
             .map(|&incidence| {
                 has_in_plane[incidence]
                     .then(|| in_plane_sweep(incidences[incidence], &chosen, alternative.as_ref()))
-            })
-            .collect();
-        let residuals = points
-            .iter()
-            .flat_map(|p| {
-                p.readings.iter().enumerate().filter_map(|(element, r)| {
-                    r.map(|r| Residual {
-                        forward_zenith: p.forward_zenith,
-                        element,
-                        value: (r.value - p.model[(element / 4, element % 4)]) / r.sigma,
-                    })
-                })
             })
             .collect();
         let emissivity = emissivity_curves(&chosen, alternative.as_ref());
@@ -274,17 +273,116 @@ fn checked_direction(name: &'static str, theta: f64, phi: f64) -> Result<Directi
     Ok(Direction::from_degrees_checked(name, theta, phi)?)
 }
 
+/// (data − model)/σ for each measured element, in the frame both are given in.
+fn normalized_residuals<'a>(
+    readings: &'a [Option<Reading>; 16],
+    model: &'a Mueller,
+    forward_zenith: f64,
+) -> impl Iterator<Item = Residual> + 'a {
+    readings.iter().enumerate().filter_map(move |(element, r)| {
+        r.map(|r| Residual {
+            forward_zenith,
+            element,
+            value: (r.value - model[(element / 4, element % 4)]) / r.sigma,
+        })
+    })
+}
+
+/// A detector at the normal (θ_r = 0 to a microdegree): its φ_r is arbitrary, so it lies in
+/// every plane, the plane of incidence included.
+fn at_normal(theta_r_deg: f64) -> bool {
+    theta_r_deg.abs() < SAME_ANGLE_DEG
+}
+
 /// Signed detector zenith when (θ_r, φ_r − φ_i) lies in the plane of incidence.
 fn in_plane_zenith(theta_r_deg: f64, relative_azimuth: f64) -> Option<f64> {
     let off_specular = (relative_azimuth - 180.0).abs();
     let off_source = relative_azimuth.min(360.0 - relative_azimuth);
-    if theta_r_deg.abs() < SAME_ANGLE_DEG || off_specular < SAME_ANGLE_DEG {
+    if at_normal(theta_r_deg) || off_specular < SAME_ANGLE_DEG {
         Some(theta_r_deg)
     } else if off_source < SAME_ANGLE_DEG {
         Some(-theta_r_deg)
     } else {
         None
     }
+}
+
+/// φ_r − φ_i of the in-plane profile at signed detector zenith `zenith`: the specular side
+/// (180°) for zenith ≥ 0, the source side (0°) below. At zenith 0 (the normal) its psps frame is
+/// therefore the limit θ_r → 0⁺ along φ_i + 180° (DESIGN §1.3).
+fn in_plane_relative_azimuth(zenith: f64) -> f64 {
+    if zenith >= 0.0 {
+        180.0
+    } else {
+        0.0
+    }
+}
+
+/// Largest |mixing weight| of the frame turn of [`in_plane_frame_at_normal`] treated as zero:
+/// the sin 2η or cos 2η of a turn within [`SAME_ANGLE_DEG`] of a multiple of 90° (sin 2e-6° ≈
+/// 3.49e-8), where rounding of 90° in radians leaves ~1e-16 instead of 0.
+const NEGLIGIBLE_MIXING: f64 = 3.5e-8;
+
+/// The turn η of the outgoing psps frame of a detector at the normal from its own azimuth φ_r
+/// to the in-plane profile's (φ_i + 180°, [`in_plane_relative_azimuth`]). At θ_r = 0 light leaves
+/// along k = ẑ and each frame is the limit θ_r → 0⁺ along its azimuth φ (DESIGN §1.3), with
+/// s = lim unit(ẑ × k) = ê_φ = (−sin φ, cos φ, 0) ([`Direction::azimuthal_axis`]); η is the angle
+/// from the row's s toward its p = k × s at which the in-plane s lies (optics::frame).
+fn normal_detector_turn(phi_i_deg: f64, phi_r_deg: f64) -> f64 {
+    let own = Direction::from_angles(0.0, phi_r_deg.to_radians());
+    let in_plane_phi = phi_i_deg + in_plane_relative_azimuth(0.0);
+    let in_plane = Direction::from_angles(0.0, in_plane_phi.to_radians());
+    rotation_between_frames(&own.azimuthal_axis, &in_plane.azimuthal_axis, &own.vector)
+}
+
+/// A row measured with the detector at the normal, re-expressed in the psps frame of the
+/// in-plane profile (the frame the in-plane model curves are drawn in at θ_r = 0), so that it
+/// can be drawn there whatever its φ_r: M' = L(η) M with L = `stokes_rotator` and η from
+/// [`normal_detector_turn`]. Only the outgoing (row) side turns; the incident side is the scan's.
+///
+/// L(η) mixes rows 1 and 2 of each column (m1c' = cos2η m1c + sin2η m2c, m2c' = −sin2η m1c +
+/// cos2η m2c); rows 0 and 3 stay as they are. A turned element is formed only when every
+/// element it mixes in with a non-negligible weight was measured (a row with m10 but not m20
+/// at φ_r − φ_i = 135° has no in-plane m10, and it is left out of the in-plane polarization
+/// panels rather than drawn from half its partners); at a turn of a multiple of 90° each element
+/// is its own partner (m10' = ±m10). m00 never turns. The 1-σ of a turned element is that of
+/// independent errors, √(Σ (L_rj σ_jc)²). Points at the normal are never on a ring
+/// ([`find_rings`] skips groups without an off-plane point), so only the in-plane panels see
+/// the turned values; the residual panels use the row's own frame.
+fn in_plane_frame_at_normal(
+    readings: &[Option<Reading>; 16],
+    model: &Mueller,
+    phi_i_deg: f64,
+    phi_r_deg: f64,
+) -> ([Option<Reading>; 16], Mueller) {
+    let turn = stokes_rotator(normal_detector_turn(phi_i_deg, phi_r_deg));
+    let mut turned = [None; 16];
+    for (element, slot) in turned.iter_mut().enumerate() {
+        let (row, column) = (element / 4, element % 4);
+        let mut value = 0.0;
+        let mut variance = 0.0;
+        let mut complete = true;
+        for partner in 0..4 {
+            let weight = turn[(row, partner)];
+            if weight.abs() <= NEGLIGIBLE_MIXING {
+                continue;
+            }
+            match readings[partner * 4 + column] {
+                Some(r) => {
+                    value += weight * r.value;
+                    variance += (weight * r.sigma).powi(2);
+                }
+                None => complete = false,
+            }
+        }
+        if complete && readings[element].is_some() {
+            *slot = Some(Reading {
+                value,
+                sigma: variance.sqrt(),
+            });
+        }
+    }
+    (turned, turn * model)
 }
 
 fn distinct_sorted(values: impl Iterator<Item = f64>) -> Vec<f64> {
@@ -464,7 +562,7 @@ fn in_plane_sweep(
     sweep(
         in_plane_grid(theta_i_deg),
         |zenith| {
-            let phi_r = if zenith >= 0.0 { 180f64 } else { 0.0 };
+            let phi_r = in_plane_relative_azimuth(zenith);
             let scattered = Direction::from_angles(zenith.abs().to_radians(), phi_r.to_radians());
             (incident, scattered)
         },
@@ -512,6 +610,7 @@ mod tests {
     use crate::material::{AlternativeFit, ModelSpec};
     use crate::measure::MeasurementPoint;
     use crate::pbrdf::{Shadowing, SlopeDistribution};
+    use crate::report::fit_report::profiles::{profile_series, Domain, Quantity};
     use crate::report::fit_report::test_records::fit_record;
     use std::collections::BTreeMap;
 
@@ -585,6 +684,23 @@ mod tests {
         }
     }
 
+    /// The chosen model's own values of `elements` at the given (θ_i, φ_i, θ_r, φ_r), each with a
+    /// 1-σ of 1e-4 sr⁻¹.
+    fn model_set(geometry: &[(f64, f64, f64, f64)], elements: &[usize]) -> MeasurementSet {
+        let mut set = set_of(geometry, exact, [None, None]);
+        let model = material(false).pbrdf().unwrap();
+        for p in &mut set.points {
+            let m = model.mueller(
+                &Direction::from_angles(p.theta_i_deg.to_radians(), p.phi_i_deg.to_radians()),
+                &Direction::from_angles(p.theta_r_deg.to_radians(), p.phi_r_deg.to_radians()),
+            );
+            p.values = elements.iter().map(|&e| m[(e / 4, e % 4)]).collect();
+            p.uncertainties = vec![Some(1e-4); elements.len()];
+        }
+        set.elements = elements.to_vec();
+        set
+    }
+
     fn exact(m: &Mueller) -> [f64; 2] {
         [m[(0, 0)], m[(1, 0)]]
     }
@@ -622,7 +738,13 @@ mod tests {
                 None
             ]
         );
-        let forward: Vec<f64> = data.points.iter().map(|p| p.forward_zenith).collect();
+        // Two residuals (m00, m10) per point, each at the point's hemisphere-signed θ_r.
+        let forward: Vec<f64> = data
+            .residuals
+            .iter()
+            .step_by(2)
+            .map(|r| r.forward_zenith)
+            .collect();
         assert_eq!(
             forward[3..6],
             [-45.0, 45.0, 45.0],
@@ -743,5 +865,105 @@ mod tests {
         assert_eq!(e.chosen[30], direct);
         // Isotropic surface: emission is p-polarized (ε1 < 0) away from the normal.
         assert!(e.chosen[1..].iter().all(|s| s[1] < 0.0 && s[0] < 1.0));
+    }
+    /// The chosen model's in-plane curve at θ_r = 0 (the normal), for the first incidence angle.
+    fn in_plane_curve_at_normal(data: &ReportData) -> Mueller {
+        let sweep = data.in_plane[0].as_ref().unwrap();
+        let zero = sweep.x.iter().position(|&x| x == 0.0).unwrap();
+        sweep.chosen[zero]
+    }
+
+    #[test]
+    fn a_detector_at_the_normal_is_drawn_in_the_in_plane_frame_whatever_its_azimuth() {
+        // φ_r − φ_i = 90° (a quarter turn of the frame), 135° (m10 and m20 mix) and, with
+        // φ_i ≠ 0, 230°; the in-plane profile's frame at θ_r = 0 is the limit along φ_i + 180°.
+        let geometry = [
+            (40.0, 0.0, 0.0, 90.0),
+            (40.0, 0.0, 0.0, 135.0),
+            (40.0, 20.0, 0.0, 250.0),
+        ];
+        let linear = [0, 1, 2, 4, 5, 6, 8, 9, 10];
+        let set = model_set(&geometry, &linear);
+        let data = ReportData::new(&material(false), &set).unwrap();
+        let curve = in_plane_curve_at_normal(&data);
+        let m00 = curve[(0, 0)];
+        assert!(curve[(1, 0)].abs() > 0.05 * m00, "a polarizing model");
+        for (p, row) in data.points.iter().zip(&set.points) {
+            assert_eq!(p.signed_zenith, Some(0.0));
+            let measured = p.readings[0].unwrap().value;
+            assert_eq!(measured, row.values[0], "m00 does not turn");
+            for &e in &linear {
+                let (r, c) = (e / 4, e % 4);
+                let ratio = p.readings[e].unwrap().value / measured;
+                let want = curve[(r, c)] / m00;
+                assert!(
+                    (ratio - want).abs() < 1e-12,
+                    "{e} at {row:?}: {ratio} vs {want}"
+                );
+                let model = p.model[(r, c)] / p.model[(0, 0)];
+                assert!((model - want).abs() < 1e-12, "model {e}: {model} vs {want}");
+            }
+            // The panels see the same: the point sits on the curve at 0.
+            let (series, _) = profile_series(&data, Quantity::Ratio(4), Domain::InPlane);
+            assert!(series[0]
+                .points
+                .iter()
+                .all(|q| q.x == 0.0 && (q.value - curve[(1, 0)] / m00).abs() < 1e-12));
+        }
+        // Unturned, the rows disagree with the curve: m10 flips sign at 90°, and at 135° the
+        // polarization sits in m20, which the in-plane model has none of.
+        let raw = |point: usize, e: usize| {
+            set.points[point].values[linear.iter().position(|&x| x == e).unwrap()]
+        };
+        assert!((raw(0, 4) + curve[(1, 0)]).abs() < 1e-12 * m00);
+        assert!(raw(1, 4).abs() < 1e-12 * m00 && raw(1, 8).abs() > 0.05 * m00);
+        assert!(curve[(2, 0)].abs() < 1e-15 * m00);
+        // Residuals stay data − model in the row's own frame: zero for the model's own values.
+        assert!(data.residuals.iter().all(|r| r.value.abs() < 1e-9));
+        assert_eq!(data.residuals.len(), geometry.len() * linear.len());
+    }
+
+    #[test]
+    fn an_element_is_turned_only_with_the_partners_it_mixes_with() {
+        // m00 and m10 without m20: at 90° m10' = −m10 needs no partner; at 135° m10' = m20,
+        // which was not measured, so that row has no in-plane m10 (m00 stays).
+        let set = model_set(&[(40.0, 0.0, 0.0, 90.0), (40.0, 0.0, 0.0, 135.0)], &[0, 4]);
+        let data = ReportData::new(&material(false), &set).unwrap();
+        let curve = in_plane_curve_at_normal(&data);
+        let quarter = &data.points[0];
+        let m10 = quarter.readings[4].unwrap();
+        assert_eq!(m10.value, -set.points[0].values[1]);
+        assert!(
+            (m10.value / quarter.readings[0].unwrap().value - curve[(1, 0)] / curve[(0, 0)]).abs()
+                < 1e-12
+        );
+        assert!((m10.sigma - 1e-4).abs() < 1e-18);
+        let eighth = &data.points[1];
+        assert_eq!(eighth.readings[4], None);
+        assert_eq!(
+            eighth.readings[0].map(|r| r.value),
+            Some(set.points[1].values[0])
+        );
+        let (series, _) = profile_series(&data, Quantity::Ratio(4), Domain::InPlane);
+        assert_eq!(
+            series[0].points.len(),
+            1,
+            "only the row that could be turned"
+        );
+        let (series, _) = profile_series(&data, Quantity::M00, Domain::InPlane);
+        assert_eq!(series[0].points.len(), 2);
+        // Both rows keep their residuals in their own frames.
+        assert_eq!(data.residuals.len(), 4);
+    }
+
+    #[test]
+    fn the_frame_turn_at_the_normal_follows_the_azimuth() {
+        // At k = ẑ, s = ê_φ and p = ẑ × ê_φ = (−cos φ, −sin φ, 0) = ê_(φ+90°): the s axes of
+        // azimuths φ_r and φ_i + 180° differ by η = φ_i + 180° − φ_r, counted from s toward p.
+        let quarter = normal_detector_turn(0.0, 90.0);
+        assert!((quarter - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+        let turn = normal_detector_turn(20.0, 250.0);
+        assert!((turn - (-50f64).to_radians()).abs() < 1e-14);
+        assert!(normal_detector_turn(10.0, 190.0).abs() < 1e-15);
     }
 }

@@ -525,7 +525,6 @@ mod tests {
             signed_zenith: Some(10.0),
             ring: None,
             relative_azimuth: 180.0,
-            forward_zenith: 10.0,
             readings: all,
             model: Mueller::zeros(),
         }
