@@ -38,6 +38,7 @@ use plotters::style::FontStyle;
 use profiles::{
     draw_profile, linear_axis, log_axis, profile_series, Domain, Profile, Quantity, BIN_DEGREES,
 };
+use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use style::{
@@ -154,30 +155,56 @@ pub fn encode_fit_report(
     let svg = out_dir.join(format!("{stem}.svg"));
     let data = ReportData::new(material, set)?;
     let (width, height) = REPORT_SIZE;
-    let png_bytes = encode_bitmap(&png, (width, height), |root| {
-        draw_report(root, material, set, &data, false)
-    })?;
+    // The figure, its SVG and the panels are independent drawings: encoded in parallel (PNG
+    // compression dominates the report's time).
+    let ((png_bytes, svg_text), panels) = rayon::join(
+        || {
+            rayon::join(
+                || {
+                    encode_bitmap(&png, (width, height), |root| {
+                        draw_report(root, material, set, &data, false)
+                    })
+                },
+                || encode_svg(&svg, (width, height), material, set, &data),
+            )
+        },
+        || {
+            PANELS
+                .par_iter()
+                .map(|spec| {
+                    let path = out_dir.join(stem).join(format!("{}.png", spec.name));
+                    let bytes = encode_bitmap(&path, panel_size(spec), |root| {
+                        register_fonts();
+                        root.fill(&WHITE)?;
+                        draw_panel(spec.kind, root, material, &data, false)?;
+                        root.present()
+                    })?;
+                    Ok((path, bytes))
+                })
+                .collect::<Result<Vec<_>, ReportError>>()
+        },
+    );
+    let mut files = vec![(png, png_bytes?), (svg, svg_text?.into_bytes())];
+    files.extend(panels?);
+    Ok(EncodedReport { files })
+}
+
+/// The figure as SVG text.
+fn encode_svg(
+    path: &Path,
+    size: (u32, u32),
+    material: &Material,
+    set: &MeasurementSet,
+    data: &ReportData,
+) -> Result<String, ReportError> {
     let mut svg_text = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg_text, (width, height)).into_drawing_area();
-        draw_report(&root, material, set, &data, true).map_err(|e| draw_error(&svg, &e))?;
+        let root = SVGBackend::with_string(&mut svg_text, size).into_drawing_area();
+        draw_report(&root, material, set, data, true).map_err(|e| draw_error(path, &e))?;
     }
     // plotters labels embedded PNGs `data:png`, which is no media type; viewers want image/png.
     // (Text is escaped, so the attribute cannot occur in the figure's text.)
-    let svg_text = svg_text.replace("href=\"data:png;base64,", "href=\"data:image/png;base64,");
-    let mut files = vec![(png, png_bytes), (svg, svg_text.into_bytes())];
-    for spec in &PANELS {
-        let path = out_dir.join(stem).join(format!("{}.png", spec.name));
-        let size = panel_size(spec);
-        let bytes = encode_bitmap(&path, size, |root| {
-            register_fonts();
-            root.fill(&WHITE)?;
-            draw_panel(spec.kind, root, material, &data, false)?;
-            root.present()
-        })?;
-        files.push((path, bytes));
-    }
-    Ok(EncodedReport { files })
+    Ok(svg_text.replace("href=\"data:png;base64,", "href=\"data:image/png;base64,"))
 }
 
 fn draw_error(path: &Path, e: &dyn std::fmt::Display) -> ReportError {
