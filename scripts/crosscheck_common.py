@@ -55,7 +55,7 @@ PARAMETERS = ("sigma", "q", "n", "k", "rho_d")
 BOUNDS = {
     "sigma": (0.005, 1.5),
     "q": (1.51, 50.0),  # 1.05 without Smith; Smith's Cauchy Lambda needs q > 3/2 (DESIGN §1.3)
-    "n": (1.0, 6.0),
+    "n": (0.05, 10.0),
     "k": (0.0, 50.0),
     "rho_d": (0.0, 1.0),
 }

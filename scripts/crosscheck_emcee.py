@@ -7,7 +7,7 @@ For each file:
    crosscheck_nlopt.py) and runs `irpol fit FILE` into temporary folders;
 2. samples the posterior of irpol's free parameters for the distribution irpol chose, with Smith
    shadowing: flat priors on the physical parameters within irpol's bounds (sigma in [0.005, 1.5],
-   q in [1.51, 50], n in [1, 6], k in [0, 50], rho_d in [0, 1]) and log-likelihood -chi2/2,
+   q in [1.51, 50], n in [0.05, 10], k in [0, 50], rho_d in [0, 1]) and log-likelihood -chi2/2,
    chi2 = sum(((model - data)/u)^2) over every Mueller element in the file with the file's u_
    columns.  emcee's EnsembleSampler with differential-evolution moves (80 % DEMove,
    20 % DESnookerMove), the log-probability vectorized over walkers.  Walkers start from a

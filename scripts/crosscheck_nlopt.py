@@ -10,7 +10,7 @@ For each measurement file:
 3. minimizes the same weighted least squares, chi2 = sum(((model - data)/u)^2) over every Mueller
    element in the file (u from its u_ columns), with NLopt, using the distribution irpol chose,
    Smith shadowing and irpol's default free parameters (sigma, q, n, k, rho_d; no q for the
-   Gaussian), bounds (sigma in [0.005, 1.5], q in [1.51, 50] with Smith, n in [1, 6], k in [0, 50],
+   Gaussian), bounds (sigma in [0.005, 1.5], q in [1.51, 50] with Smith, n in [0.05, 10], k in [0, 50],
    rho_d in [0, 1]) and search coordinates (ln sigma, ln(q - 1), n, asinh(k/0.1), rho_d):
      (a) "NM":      LN_NELDERMEAD from irpol's local start sigma 0.2, q 3, n 1.8, k 0.1, rho_d 0.02,
                     initial step 10 % of each search-box width, restarted from its own result until a

@@ -96,6 +96,37 @@ fn noise_free_data_are_recovered_exactly_for_every_shadowing() {
     });
 }
 
+/// Near an absorption band n falls below 1 (silicate glass at 8–8.5 µm, DESIGN §1.9): a surface
+/// with N = 0.6 + 0.4i is recovered, which the old n ∈ [1, 6] search interval could not hold.
+#[test]
+fn an_index_below_one_is_recovered() {
+    let truth = model(
+        SlopeDistribution::Cauchy { sigma: SIGMA, q: Q },
+        Shadowing::Smith,
+        0.6,
+        0.4,
+        RHO_D,
+    );
+    let set = synthetic_set(
+        "reststrahlen",
+        &truth,
+        &goniometer_geometry(),
+        &LINEAR_ELEMENTS,
+        1.0,
+        11,
+    );
+    let fit = fit_measurement(&set, &options(DistributionKind::Cauchy, Shadowing::Smith))
+        .unwrap()
+        .chosen;
+    for (parameter, value) in [(Parameter::N, 0.6), (Parameter::K, 0.4)] {
+        let (got, error) = (fit.value(parameter), fit.error(parameter).unwrap());
+        assert!(
+            (got - value).abs() < 4.0 * error && error < 0.01 * value,
+            "{parameter} = {got} ± {error}, true {value}"
+        );
+    }
+}
+
 #[test]
 fn without_u_columns_the_default_noise_model_weights_the_fit() {
     let mut set = cauchy_set(Shadowing::Smith, 1.0, 3);

@@ -8,7 +8,7 @@
 //! |-----------|-------------------------------------|--------------------|-----------------------------------|
 //! | σ         | [0.005, 1.5]                        | ln σ               | roughness spans decades           |
 //! | q         | [1.05, 50] ([1.51, 50] with Smith)  | ln(q − 1)          | tail weight goes as 1/(q − 1)     |
-//! | n         | [1, 6]                              | n                  | dielectrics of the LWIR           |
+//! | n         | [0.05, 10]                          | n                  | below 1 near absorption bands     |
 //! | k         | [0, 50]                             | asinh(k / 0.1)     | linear near 0, logarithmic above  |
 //! | ρ_d       | [0, 1]                              | ρ_d                | enters m00 linearly               |
 //!
@@ -241,7 +241,7 @@ impl Default for ParameterBounds {
         ParameterBounds {
             sigma: Interval::new(0.005, 1.5),
             q: Interval::new(1.05, 50.0),
-            n: Interval::new(1.0, 6.0),
+            n: Interval::new(0.05, 10.0),
             k: Interval::new(0.0, 50.0),
             rho_d: Interval::new(0.0, 1.0),
         }
