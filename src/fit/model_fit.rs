@@ -102,6 +102,46 @@ fn starting_values(space: &ModelSpace, options: &FitOptions) -> Result<Parameter
     Ok(values)
 }
 
+/// The family `kind` with the free parameters, fixed values and bounds of `options`.
+fn model_space(kind: DistributionKind, options: &FitOptions) -> Result<ModelSpace, FitError> {
+    ModelSpace::new(
+        kind,
+        options.shadowing,
+        &options.free_parameters()?,
+        options.base_values(),
+        &options.bounds,
+    )
+}
+
+impl ModelFit {
+    /// Adds the profile-likelihood bounds of the parameters whose ± would mislead
+    /// ([`super::profile`]) to the uncertainty. Each bound costs dozens of local fits, so only
+    /// the fit that is kept gets them, after the distributions are compared.
+    pub(crate) fn add_profile_bounds(
+        &mut self,
+        data: &MeasurementData,
+        options: &FitOptions,
+    ) -> Result<(), FitError> {
+        let space = model_space(self.distribution, options)?;
+        let objective = Objective::new(data, &space, options.robust);
+        let mut values = options.base_values();
+        for (&p, &value) in self.free.iter().zip(&self.values) {
+            values.set(p, value);
+        }
+        let best = space.search(&values);
+        let settings = &options.settings.levenberg_marquardt;
+        let reduced_chi2 = self.reduced_chi2;
+        self.uncertainty.profile_bounds = parameters_to_profile(&space, &values, &self.uncertainty)
+            .par_iter()
+            .map(|&p| {
+                let bound = profile_bounds(&objective, &best, reduced_chi2, p, settings);
+                (p, bound)
+            })
+            .collect();
+        Ok(())
+    }
+}
+
 /// Fits the `kind` family to a prepared measurement.
 pub(crate) fn fit_model(
     set: &MeasurementSet,
@@ -109,13 +149,7 @@ pub(crate) fn fit_model(
     kind: DistributionKind,
     options: &FitOptions,
 ) -> Result<ModelFit, FitError> {
-    let space = ModelSpace::new(
-        kind,
-        options.shadowing,
-        &options.free_parameters()?,
-        options.base_values(),
-        &options.bounds,
-    )?;
+    let space = model_space(kind, options)?;
     let observations = data.observations();
     if observations <= space.dimension() {
         return Err(FitError::Measurement {
@@ -156,18 +190,7 @@ pub(crate) fn fit_model(
     let free_count = space.dimension();
     let degrees_of_freedom = observations - free_count;
     let reduced_chi2 = chi2 / degrees_of_freedom as f64;
-    let mut uncertainty = estimate(&objective, &best, reduced_chi2);
-    // Where the linearized error means nothing, say what the data do allow.
-    uncertainty.profile_bounds = parameters_to_profile(&space, &values, &uncertainty)
-        .par_iter()
-        .map(|&p| {
-            let settings = &options.settings.levenberg_marquardt;
-            (
-                p,
-                profile_bounds(&objective, &best, reduced_chi2, p, settings),
-            )
-        })
-        .collect();
+    let uncertainty = estimate(&objective, &best, reduced_chi2);
     Ok(ModelFit {
         distribution: kind,
         model: space.model_spec(&values, set.wavelength_um),

@@ -60,6 +60,8 @@ pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<Fit
             }
         }
     };
+    let mut chosen = chosen;
+    chosen.add_profile_bounds(&data, options)?;
     let material = Material {
         name: set.material.clone(),
         tool_version: format!("irpol {}", env!("CARGO_PKG_VERSION")),
