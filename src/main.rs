@@ -472,58 +472,67 @@ fn fit_and_summarize(
         note_all(&outcome.measurement.notes);
     }
     for (outcome, entry) in written.outcomes.iter().zip(&written.entries) {
-        let chosen = &outcome.chosen;
-        let bounds = outcome.material.fit.as_ref().map(|fit| &fit.profile_bounds);
-        let bound = |p: &irpol::fit::Parameter| bounds.and_then(|b| b.get(p.name()));
-        // Where the ± means nothing (undetermined, or bounded from one side only), the profile
-        // bound is listed instead.
-        let parameters: Vec<String> = chosen
-            .free
-            .iter()
-            .zip(&chosen.values)
-            .filter(|(p, _)| bound(p).is_none())
-            .map(|(p, v)| match chosen.error(*p) {
-                Some(e) => format!("{}={}±{e:.1e}", p.name(), significant(*v, 6)),
-                None => format!("{}={}", p.name(), significant(*v, 6)),
-            })
-            .collect();
-        let undetermined: Vec<String> = chosen
-            .free
-            .iter()
-            .filter_map(|p| bound(p).map(|b| b.describe(p.name())))
-            .collect();
-        let undetermined = if undetermined.is_empty() {
-            String::new()
-        } else {
-            format!(" [bounded only: {}]", undetermined.join(", "))
-        };
-        let comparison = outcome
-            .comparison
-            .as_ref()
-            .map_or(String::new(), |c| format!("; {}", c.summary()));
-        let fixed: Vec<String> = irpol::fit::fixed_values(chosen)
-            .iter()
-            .map(|(name, v)| format!("{name}={}", significant(*v, 6)))
-            .collect();
-        let fixed = if fixed.is_empty() {
-            String::new()
-        } else {
-            format!(" (fixed: {})", fixed.join(" "))
-        };
-        say!(
-            "{}: {} {}{undetermined}{fixed} χ²_red={:.3}{comparison} → {}",
-            outcome.material.name,
-            chosen.distribution.name(),
-            parameters.join(" "),
-            chosen.reduced_chi2,
-            entry.display()
-        );
+        say!("{}", fit_summary_line(outcome, entry));
     }
     for report in &written.reports {
         say!("  report {}", report.display());
     }
     say!("  index  {}", written.index.display());
     Ok(())
+}
+
+/// `name: family σ=…±… … [bounded only: …] (fixed: …) χ²_red=…; comparison → entry`: the
+/// parameters with their errors, except where the ± means nothing (undetermined, or bounded
+/// from one side only) and the record's profile bound is listed instead; the parameters held
+/// fixed as the record states them.
+fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
+    let chosen = &outcome.chosen;
+    let record = outcome.material.fit.as_ref();
+    let bound = |p: &irpol::fit::Parameter| record.and_then(|r| r.profile_bounds.get(p.name()));
+    let parameters: Vec<String> = chosen
+        .free
+        .iter()
+        .zip(&chosen.values)
+        .filter(|(p, _)| bound(p).is_none())
+        .map(|(p, v)| match chosen.error(*p) {
+            Some(e) => format!("{}={}±{e:.1e}", p.name(), significant(*v, 6)),
+            None => format!("{}={}", p.name(), significant(*v, 6)),
+        })
+        .collect();
+    let bounded: Vec<String> = chosen
+        .free
+        .iter()
+        .filter_map(|p| bound(p).map(|b| b.describe(p.name())))
+        .collect();
+    let fixed: Vec<String> = record
+        .map(|r| &r.fixed_parameters)
+        .into_iter()
+        .flatten()
+        .map(|(name, v)| format!("{name}={}", significant(*v, 6)))
+        .collect();
+    let comparison = outcome
+        .comparison
+        .as_ref()
+        .map_or(String::new(), |c| format!("; {}", c.summary()));
+    format!(
+        "{}: {} {}{}{} χ²_red={:.3}{comparison} → {}",
+        outcome.material.name,
+        chosen.distribution.name(),
+        parameters.join(" "),
+        listed(" [bounded only: ", &bounded, ", ", "]"),
+        listed(" (fixed: ", &fixed, " ", ")"),
+        chosen.reduced_chi2,
+        entry.display()
+    )
+}
+
+/// `items` joined by `separator` between `open` and `close`, or nothing when there are none.
+fn listed(open: &str, items: &[String], separator: &str, close: &str) -> String {
+    if items.is_empty() {
+        String::new()
+    } else {
+        format!("{open}{}{close}", items.join(separator))
+    }
 }
 
 fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {

@@ -129,7 +129,7 @@ pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> anyhow::Result<Geometr
     }
     table
         .notes
-        .extend(signed_note(&path.display().to_string(), signed));
+        .extend(signed_zenith_note(&path.display().to_string(), signed));
     Ok(table)
 }
 
@@ -359,13 +359,10 @@ pub fn sweep_table(
             theta_r: theta_r.to_vec(),
             phi_r: phi_r.to_vec(),
         },
-        notes: signed_note("--theta-r", signed).into_iter().collect(),
+        notes: signed_zenith_note("--theta-r", signed)
+            .into_iter()
+            .collect(),
     })
-}
-
-/// The note on rows read with θ_r < 0, if there were any.
-fn signed_note(place: &str, rows: usize) -> Option<String> {
-    (rows > 0).then(|| signed_zenith_note(place, rows))
 }
 
 /// Writes theta_deg,e0,e1,e2,e3 and returns the angles where the hemispherical reflectance

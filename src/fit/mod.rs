@@ -46,7 +46,7 @@ pub use nelder_mead::NelderMeadSettings;
 pub use objective::{BoxCost, Objective};
 pub use optimize::OptimizerSettings;
 pub use options::{parse_parameter_list, parse_parameter_values, FitOptions};
-pub use outcome::{fit_measurement, fixed_values, FitOutcome};
+pub use outcome::{fit_measurement, FitOutcome};
 pub use parameters::{
     DistributionKind, Interval, Parameter, ParameterBounds, ParameterValues, SMITH_MIN_Q,
 };

@@ -10,7 +10,6 @@ use super::stages::Stage;
 use super::FitError;
 use crate::material::{AlternativeFit, FitRecord, Material, MergedSource};
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
-use crate::pbrdf::SlopeDistribution;
 use std::collections::BTreeMap;
 
 /// Everything a fit report needs about one measurement.
@@ -90,22 +89,11 @@ fn names(parameters: &[Parameter]) -> Vec<String> {
 
 /// The chosen family's parameters held fixed, with their values (issue 16 item 8: `--free` fixes
 /// the others, and the record and the summary line say at what).
-pub fn fixed_values(chosen: &ModelFit) -> BTreeMap<String, f64> {
-    let m = &chosen.model;
+fn fixed_values(chosen: &ModelFit) -> BTreeMap<String, f64> {
     Parameter::ALL
         .iter()
         .filter(|p| chosen.distribution.has(**p) && !chosen.free.contains(p))
-        .map(|&p| {
-            let value = match (p, m.distribution) {
-                (Parameter::Sigma, d) => d.sigma(),
-                (Parameter::Q, SlopeDistribution::Cauchy { q, .. }) => q,
-                (Parameter::Q, SlopeDistribution::Gaussian { .. }) => f64::NAN,
-                (Parameter::N, _) => m.n,
-                (Parameter::K, _) => m.k,
-                (Parameter::RhoD, _) => m.rho_d,
-            };
-            (p.name().to_owned(), value)
-        })
+        .map(|&p| (p.name().to_owned(), chosen.value(p)))
         .collect()
 }
 

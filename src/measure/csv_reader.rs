@@ -57,8 +57,7 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
             .map(|stem| stem.to_string_lossy().into_owned())
             .unwrap_or_default(),
     };
-    let notes = (parsed.signed_rows > 0)
-        .then(|| signed_zenith_note(&source.display().to_string(), parsed.signed_rows))
+    let notes = signed_zenith_note(&source.display().to_string(), parsed.signed_rows)
         .into_iter()
         .collect();
     Ok(MeasurementSet {

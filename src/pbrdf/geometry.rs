@@ -64,10 +64,10 @@ pub fn fold_signed_zenith(theta_deg: f64, phi_deg: f64) -> (f64, f64) {
 }
 
 /// What a reader of signed detector angles tells the user (once per file or command, not per
-/// row): `place` names the file or the flag.
-pub fn signed_zenith_note(place: &str, rows: usize) -> String {
-    let rows = crate::text::counted(rows, "row");
-    format!("{place}: {rows} with θ_r < 0 read as (|θ_r|, φ_r + 180°)")
+/// row), if any of its `rows` had θ_r < 0: `place` names the file or the flag.
+pub fn signed_zenith_note(place: &str, rows: usize) -> Option<String> {
+    let counted = crate::text::counted(rows, "row");
+    (rows > 0).then(|| format!("{place}: {counted} with θ_r < 0 read as (|θ_r|, φ_r + 180°)"))
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! columns in `free_parameters` order), each cell coloured by ρ on a blue–white–red scale and
 //! labelled with its value, the parameter symbols on both axes and a colour bar from −1 to +1.
 
-use super::style::{draw_note, DrawResult, CAPTION_SIZE, LEGEND_SIZE, TICK_SIZE};
+use super::style::{draw_framed_box, draw_note, DrawResult, CAPTION_SIZE, LEGEND_SIZE, TICK_SIZE};
 use super::table::symbol;
 use crate::material::FitRecord;
 use crate::report::FONT;
@@ -82,14 +82,12 @@ pub fn draw_correlation<DB: DrawingBackend>(
     for (i, row) in fit.correlation.iter().take(names.len()).enumerate() {
         for (j, &rho) in row.iter().take(names.len()).enumerate() {
             let (x, y) = (left + cell * j as i32, top + cell * i as i32);
-            area.draw(&Rectangle::new(
+            draw_framed_box(
+                area,
                 [(x, y), (x + cell, y + cell)],
                 correlation_color(rho).filled(),
-            ))?;
-            area.draw(&Rectangle::new(
-                [(x, y), (x + cell, y + cell)],
-                RGBColor(150, 150, 150).stroke_width(1),
-            ))?;
+                RGBColor(150, 150, 150),
+            )?;
             let ink = if rho.abs() > 0.6 { WHITE } else { BLACK };
             let style = (FONT, LEGEND_SIZE)
                 .into_font()

@@ -181,14 +181,12 @@ pub fn draw_legend_column<DB: DrawingBackend>(
     (x, y): (i32, i32),
 ) -> DrawResult<DB> {
     let (width, height) = legend_size(area, entries)?;
-    area.draw(&Rectangle::new(
+    draw_framed_box(
+        area,
         [(x, y), (x + width, y + height)],
         WHITE.mix(0.9).filled(),
-    ))?;
-    area.draw(&Rectangle::new(
-        [(x, y), (x + width, y + height)],
-        RGBColor(170, 170, 170).stroke_width(1),
-    ))?;
+        RGBColor(170, 170, 170),
+    )?;
     let style = (FONT, LEGEND_SIZE)
         .into_font()
         .color(&BLACK)
@@ -261,6 +259,17 @@ pub fn draw_note<DB: DrawingBackend>(
         RGBColor(200, 200, 200).stroke_width(1),
     ))?;
     Ok(())
+}
+
+/// A rectangle filled with `fill` and outlined one pixel wide in `outline`.
+pub fn draw_framed_box<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    corners: [(i32, i32); 2],
+    fill: ShapeStyle,
+    outline: RGBColor,
+) -> DrawResult<DB> {
+    area.draw(&Rectangle::new(corners, fill))?;
+    area.draw(&Rectangle::new(corners, outline.stroke_width(1)))
 }
 
 /// The y axis of a profile panel.
