@@ -3,8 +3,9 @@
 
 use super::data::{ReportData, Residual};
 use super::style::{
-    draw_legend_column, draw_legend_top_right, draw_note, log_tick, sane_log_range, DrawResult,
-    LegendEntry, LineKind, Marker, AXIS_DESC_SIZE, CAPTION_SIZE, GREY, LEGEND_SIZE, TICK_SIZE,
+    draw_legend_column, draw_legend_top_right, draw_note, log_tick, report_mesh_style,
+    sane_log_range, DrawResult, LegendEntry, LineKind, Marker, AXIS_DESC_SIZE, CAPTION_SIZE, GREY,
+    LEGEND_SIZE, TICK_SIZE,
 };
 use crate::material::FitRecord;
 use crate::report::FONT;
@@ -220,19 +221,14 @@ fn residual_legend<DB: DrawingBackend>(
 /// The grid, ticks and axis titles of the residual panel (only the grid in a chart without
 /// label areas, as the bitmap of [`draw_scatter_as_image`]).
 fn residual_mesh<DB: DrawingBackend>(chart: &mut Chart2d<'_, DB>) -> DrawResult<DB> {
-    chart
-        .configure_mesh()
-        .x_labels(13)
+    let mesh = &mut chart.configure_mesh();
+    mesh.x_labels(13)
         .y_labels(9)
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&|v| format!("{v:.0}"))
         .x_desc("detector zenith θr (°): + forward (specular) half, − backward half")
-        .y_desc("(data − model)/σ")
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_DESC_SIZE))
-        .light_line_style(RGBColor(235, 235, 235))
-        .bold_line_style(RGBColor(215, 215, 215))
-        .draw()
+        .y_desc("(data − model)/σ");
+    report_mesh_style(mesh, TICK_SIZE, AXIS_DESC_SIZE).draw()
 }
 
 /// The zero line and the ±3σ guides of a residual panel (θ_r from −90° to 90°).
@@ -434,9 +430,8 @@ pub fn draw_convergence<DB: DrawingBackend>(
     let last = (fit.convergence.len() - 1) as f64;
     let mut chart = chart_builder(area, caption)
         .build_cartesian_2d(0.0..last.max(1.0), (low..high).log_scale())?;
-    chart
-        .configure_mesh()
-        .x_labels(8)
+    let mesh = &mut chart.configure_mesh();
+    mesh.x_labels(8)
         .y_labels(8)
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&log_tick)
@@ -444,12 +439,8 @@ pub fn draw_convergence<DB: DrawingBackend>(
         .y_desc(match robust {
             Some(loss) => format!("best cost Σρ(r), {loss} loss, r = (data − model)/σ"),
             None => "best cost χ² = Σ ((data − model)/σ)²".to_owned(),
-        })
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_DESC_SIZE))
-        .light_line_style(RGBColor(235, 235, 235))
-        .bold_line_style(RGBColor(215, 215, 215))
-        .draw()?;
+        });
+    report_mesh_style(mesh, TICK_SIZE, AXIS_DESC_SIZE).draw()?;
     let global_color = RGBColor(31, 119, 180);
     let local_color = RGBColor(214, 39, 40);
     let split = global.min(costs.len());
@@ -555,19 +546,14 @@ pub fn draw_emissivity<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) -
         .right_y_label_area_size(78)
         .build_cartesian_2d(0.0..90.0, e0_range.clone())?
         .set_secondary_coord(0.0..90.0, e1_range);
-    chart
-        .configure_mesh()
-        .x_labels(10)
+    let mesh = &mut chart.configure_mesh();
+    mesh.x_labels(10)
         .y_labels(8)
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&|v| format!("{v:.2}"))
         .x_desc("emission angle θe (°)")
-        .y_desc("ε0 (black, left axis)")
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_DESC_SIZE))
-        .light_line_style(RGBColor(235, 235, 235))
-        .bold_line_style(RGBColor(215, 215, 215))
-        .draw()?;
+        .y_desc("ε0 (black, left axis)");
+    report_mesh_style(mesh, TICK_SIZE, AXIS_DESC_SIZE).draw()?;
     let e1_color = RGBColor(214, 39, 40);
     chart
         .configure_secondary_axes()

@@ -4,8 +4,9 @@
 
 use super::data::{ModelSweep, PointView, ReportData};
 use super::style::{
-    incidence_color, log_tick, sane_linear_range, sane_log_range, DrawResult, Marker, YAxis,
-    AXIS_DESC_SIZE, CAPTION_SIZE, MAX_LOG_DECADES, SMALL_CAPTION_SIZE, SMALL_TICK_SIZE, TICK_SIZE,
+    incidence_color, log_tick, report_mesh_style, sane_linear_range, sane_log_range, DrawResult,
+    Marker, YAxis, AXIS_DESC_SIZE, CAPTION_SIZE, MAX_LOG_DECADES, SMALL_CAPTION_SIZE,
+    SMALL_TICK_SIZE, TICK_SIZE,
 };
 use crate::measure::MUELLER_ELEMENT_NAMES;
 use crate::optics::Mueller;
@@ -452,18 +453,13 @@ fn draw_axes<DB: DrawingBackend, Y: Ranged<ValueType = f64> + ValueFormatter<f64
     } else {
         (TICK_SIZE, AXIS_DESC_SIZE)
     };
-    chart
-        .configure_mesh()
-        .y_labels(if profile.compact { 5 } else { 8 })
+    let mesh = &mut chart.configure_mesh();
+    mesh.y_labels(if profile.compact { 5 } else { 8 })
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(y_format)
         .x_desc(profile.x_desc.as_str())
-        .y_desc(profile.y_desc.as_str())
-        .label_style((FONT, tick))
-        .axis_desc_style((FONT, desc))
-        .light_line_style(RGBColor(235, 235, 235))
-        .bold_line_style(RGBColor(215, 215, 215))
-        .draw()
+        .y_desc(profile.y_desc.as_str());
+    report_mesh_style(mesh, tick, desc).draw()
 }
 
 fn draw_series<DB: DrawingBackend, Y: Ranged<ValueType = f64> + ValueFormatter<f64>>(

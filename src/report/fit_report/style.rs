@@ -261,6 +261,24 @@ pub fn draw_note<DB: DrawingBackend>(
     Ok(())
 }
 
+/// The report's axis look on a mesh: tick and axis-title fonts of `tick` and `desc` points, light
+/// and bold grid lines in two greys (one place for every panel's grid).
+pub fn report_mesh_style<'m, 'a, 'b, X, Y, DB>(
+    mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
+    tick: i32,
+    desc: i32,
+) -> &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>
+where
+    X: plotters::coord::ranged1d::Ranged<ValueType: std::fmt::Debug>,
+    Y: plotters::coord::ranged1d::Ranged<ValueType: std::fmt::Debug>,
+    DB: DrawingBackend,
+{
+    mesh.label_style((FONT, tick))
+        .axis_desc_style((FONT, desc))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(215, 215, 215))
+}
+
 /// A rectangle filled with `fill` and outlined one pixel wide in `outline`.
 pub fn draw_framed_box<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
