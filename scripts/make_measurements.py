@@ -22,11 +22,20 @@ Noise (seeded): m00 * (1 + 0.03 N(0,1)) (gaussian, multiplicative); other elemen
 (gaussian, additive, scaled by the noise-free m00).  The u_ columns are exactly these standard
 deviations (0.03 m00 and 0.01 m00 of the noise-free m00), so a weighted fit of the true model
 gives reduced chi^2 ~ 1.
+
+Spectral materials (DESIGN §1.9) share sigma, q, shadowing and rho_d over wavelength and take
+N = n + ik at each wavelength from a dispersion law evaluated here in Python (`Lorentz`, written
+from DESIGN §1.9, not from the Rust code).  SCATMECH is called once per wavelength with that
+wavelength's n, k (full double precision) and `lambda`.  The rows of all wavelengths go into one file
+with a `wavelength_um` column, one block per wavelength (ascending), and their noise comes from one
+seeded stream drawn in that order.  Seeds: --seed + index, MATERIALS first, then SPECTRAL_MATERIALS,
+so adding a material at the end leaves every existing file's bytes unchanged.
 """
 
 from __future__ import annotations
 
 import argparse
+import cmath
 import math
 import os
 import sys
@@ -68,6 +77,64 @@ MATERIALS = [
              "polished silicate glass near 10.6 um (n ~ 2.2, k ~ 0.1)"),
     Material("anodized_panel", sb.SurfaceParams("gaussian", 0.15, 0.0, 3.0, 1.0, "smith", 9.925), 0.01, False, 4, False,
              "bead-blasted anodized aluminium panel; its true slope distribution is Gaussian"),
+]
+
+
+@dataclass(frozen=True)
+class Lorentz:
+    """One Lorentz oscillator over wavenumber nu = 1/lambda (um^-1), exp(-i omega t) convention:
+    eps(nu) = eps_inf + strength nu0^2 / (nu0^2 - nu^2 - i gamma nu), nu0 = 1/resonance_um and
+    gamma = damping_um / resonance_um^2 (damping_um is the line width expressed in wavelength at the
+    resonance).  N = sqrt(eps) on the branch Im N >= 0 (k >= 0 absorbs)."""
+
+    eps_inf: float
+    strength: float
+    resonance_um: float
+    damping_um: float
+
+    def index(self, wavelength_um: float) -> complex:
+        nu = 1.0 / wavelength_um
+        nu0 = 1.0 / self.resonance_um
+        gamma = self.damping_um / (self.resonance_um * self.resonance_um)
+        eps = self.eps_inf + self.strength * nu0 * nu0 / complex(nu0 * nu0 - nu * nu, -gamma * nu)
+        root = cmath.sqrt(eps)
+        return -root if root.imag < 0 else root
+
+    def describe(self) -> str:
+        return (f"lorentz eps_inf={self.eps_inf:g} strength={self.strength:g} "
+                f"resonance_um={self.resonance_um:g} damping_um={self.damping_um:g}")
+
+
+@dataclass(frozen=True)
+class SpectralMaterial:
+    """One surface (sigma, q, shadowing, rho_d shared) measured at several wavelengths, N from `dispersion`."""
+
+    name: str
+    distribution: str
+    sigma: float
+    q: float
+    shadowing: str
+    dispersion: Lorentz
+    wavelengths_um: tuple[float, ...]  # ascending
+    rho_d: float
+    full_mueller: bool
+    fine_halfwidth_deg: int
+    specular_raster: bool
+    note: str
+
+    def at(self, wavelength_um: float) -> Material:
+        """The grey material this one is at one wavelength."""
+        N = self.dispersion.index(wavelength_um)
+        surface = sb.SurfaceParams(self.distribution, self.sigma, self.q, N.real, N.imag, self.shadowing,
+                                   wavelength_um)
+        return Material(self.name, surface, self.rho_d, self.full_mueller, self.fine_halfwidth_deg,
+                        self.specular_raster, self.note)
+
+
+SPECTRAL_MATERIALS = [
+    SpectralMaterial("silicate_glass", "cauchy", 0.06, 2.8, "smith", Lorentz(2.1, 0.8, 9.3, 0.744),
+                     (8.0, 8.5, 9.0, 9.5, 10.0, 10.6, 11.5, 12.5, 14.0), 0.0, True, 10, False,
+                     "polished silicate glass across its 9 um reststrahlen band (n < 1 at 8-8.5 um, k up to ~2)"),
 ]
 
 
@@ -121,7 +188,8 @@ def element(m: np.ndarray, name: str) -> np.ndarray:
     return m[:, int(name[1]), int(name[2])]
 
 
-def write_material(mat: Material, out_dir: str, rng: np.random.Generator, seed: int) -> tuple[int, str]:
+def noisy_rows(mat: Material, rng: np.random.Generator):
+    """Geometry (N, 4), element names, and per element the noisy values and their standard deviations."""
     g = goniometer_geometry(mat.fine_halfwidth_deg, mat.specular_raster)
     m = noise_free_mueller(mat, g)
     keep = m[:, 0, 0] >= M00_FLOOR
@@ -133,6 +201,43 @@ def write_material(mat: Material, out_dir: str, rng: np.random.Generator, seed: 
         sd = (REL_NOISE_M00 if name == "m00" else REL_NOISE_OTHERS) * m00
         values.append(element(m, name) + sd * rng.standard_normal(len(g)))
         sigmas.append(sd)
+    return g, names, values, sigmas
+
+
+def data_fields(values: list, sigmas: list, r: int) -> list[str]:
+    """Row r's element values (7 significant digits) and standard deviations (5)."""
+    fields = [f"{v[r]:.6e}" for v in values]
+    fields += [f"{s[r]:.4e}" for s in sigmas]
+    return fields
+
+
+def provenance_header(seed: int, note: str) -> list[str]:
+    """The header lines after the truth: noise, seed, generator, the material's note, what is absent."""
+    return [
+        "# noise: gaussian; m00 * (1 + 0.03 N(0,1)); other elements + 0.01 * m00 * N(0,1) (noise-free m00)",
+        "# uncertainty: u_ columns are the standard deviations of that noise (absolute, sr^-1)",
+        f"# noise_seed: {seed}",
+        "# generator: scripts/make_measurements.py with NIST SCATMECH (pyscatmech 0.1.10)"
+        " Shadowed_Facet_BRDF_Model + Lambertian_BRDF_Model",
+        f"# {note}",
+        "# synthetic data (phi_r = 180 is the specular side, DESIGN §1.1). Absent points are those within",
+        "# 3 deg of retro-reflection (detector shadows the source), with theta_r >= 88 deg, or with",
+        "# noise-free m00 < 1e-4 per sr (noise floor)",
+    ]
+
+
+def write_csv(path: str, header: list[str], columns: list[str], rows: list[list[str]]) -> None:
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write("\n".join(header) + "\n")
+        f.write(",".join(columns) + "\n")
+        for fields in rows:
+            f.write(",".join(fields) + "\n")
+    os.replace(tmp, path)
+
+
+def write_material(mat: Material, out_dir: str, rng: np.random.Generator, seed: int) -> tuple[int, str]:
+    g, names, values, sigmas = noisy_rows(mat, rng)
     p = mat.surface
     header = [
         f"# material: {mat.name}",
@@ -148,29 +253,57 @@ def write_material(mat: Material, out_dir: str, rng: np.random.Generator, seed: 
         f"# truth_k: {p.k:g}",
         f"# truth_rho_d: {mat.rho_d:g}",
         f"# truth_shadowing: {p.shadowing}",
-        "# noise: gaussian; m00 * (1 + 0.03 N(0,1)); other elements + 0.01 * m00 * N(0,1) (noise-free m00)",
-        "# uncertainty: u_ columns are the standard deviations of that noise (absolute, sr^-1)",
-        f"# noise_seed: {seed}",
-        "# generator: scripts/make_measurements.py with NIST SCATMECH (pyscatmech 0.1.10)"
-        " Shadowed_Facet_BRDF_Model + Lambertian_BRDF_Model",
-        f"# {mat.note}",
-        "# synthetic data (phi_r = 180 is the specular side, DESIGN §1.1). Absent points are those within",
-        "# 3 deg of retro-reflection (detector shadows the source), with theta_r >= 88 deg, or with",
-        "# noise-free m00 < 1e-4 per sr (noise floor)",
     ]
+    header += provenance_header(seed, mat.note)
     columns = ["theta_i_deg", "phi_i_deg", "theta_r_deg", "phi_r_deg"] + names + [f"u_{n}" for n in names]
+    rows = [[f"{x:g}" for x in g[r]] + data_fields(values, sigmas, r) for r in range(len(g))]
     path = os.path.join(out_dir, f"{mat.name}.csv")
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write("\n".join(header) + "\n")
-        f.write(",".join(columns) + "\n")
-        for r in range(len(g)):
-            fields = [f"{x:g}" for x in g[r]]
-            fields += [f"{v[r]:.6e}" for v in values]
-            fields += [f"{s[r]:.4e}" for s in sigmas]
-            f.write(",".join(fields) + "\n")
-    os.replace(tmp, path)
+    write_csv(path, header, columns, rows)
     return len(g), path
+
+
+def truth_n_k(spec: SpectralMaterial) -> str:
+    """`8.0:0.517774+0.543731i, 8.5:...`: N at every wavelength to 6 significant digits."""
+    parts = []
+    for wl in spec.wavelengths_um:
+        N = spec.dispersion.index(wl)
+        parts.append(f"{wl!r}:{N.real:.6g}+{N.imag:.6g}i")
+    return ", ".join(parts)
+
+
+def write_spectral_material(spec: SpectralMaterial, out_dir: str, rng: np.random.Generator,
+                            seed: int) -> tuple[list[int], str]:
+    """One file, one block of rows per wavelength (ascending), all noise from `rng` in that order."""
+    rows, counts = [], []
+    for wl in spec.wavelengths_um:
+        g, names, values, sigmas = noisy_rows(spec.at(wl), rng)
+        rows += [[f"{x:g}" for x in g[r]] + [f"{wl:g}"] + data_fields(values, sigmas, r) for r in range(len(g))]
+        counts.append(len(g))
+    header = [
+        f"# material: {spec.name}",
+        "# mueller_convention: psps",
+        f"# truth_distribution: {spec.distribution}",
+        f"# truth_sigma: {spec.sigma:g}",
+    ]
+    if spec.distribution == "cauchy":
+        header.append(f"# truth_q: {spec.q:g}")
+    header += [
+        f"# truth_dispersion: {spec.dispersion.describe()}",
+        f"# truth_n_k: {truth_n_k(spec)}",
+        f"# truth_rho_d: {spec.rho_d:g}",
+        f"# truth_shadowing: {spec.shadowing}",
+    ]
+    header += provenance_header(seed, spec.note)
+    header += [
+        "# spectral (DESIGN §1.9) with one block of rows per wavelength_um, ascending. n and k at each",
+        "# wavelength come from the truth_dispersion law (evaluated in make_measurements.py, full double",
+        "# precision; truth_n_k rounds them), sigma, q and rho_d are shared",
+    ]
+    columns = (["theta_i_deg", "phi_i_deg", "theta_r_deg", "phi_r_deg", "wavelength_um"]
+               + names + [f"u_{n}" for n in names])
+    path = os.path.join(out_dir, f"{spec.name}.csv")
+    write_csv(path, header, columns, rows)
+    return counts, path
 
 
 def main(argv=None) -> int:
@@ -184,6 +317,11 @@ def main(argv=None) -> int:
         seed = args.seed + i
         n, path = write_material(mat, out, np.random.default_rng(seed), seed)
         print(f"wrote {path}: {n} points")
+    for i, spec in enumerate(SPECTRAL_MATERIALS, start=len(MATERIALS)):
+        seed = args.seed + i
+        counts, path = write_spectral_material(spec, out, np.random.default_rng(seed), seed)
+        per = ", ".join(f"{wl:g} um: {c}" for wl, c in zip(spec.wavelengths_um, counts))
+        print(f"wrote {path}: {sum(counts)} points ({per})")
     return 0
 
 

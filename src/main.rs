@@ -21,6 +21,7 @@ use irpol::fit::{
     parse_parameter_list, parse_parameter_values, DistributionKind, FitOptions, Optimizer,
     RobustLoss,
 };
+use irpol::material::MaterialModel;
 use irpol::output::staged_folder::staging_folder;
 use irpol::output::thermal::ThermalSummary;
 use irpol::pbrdf::Shadowing;
@@ -232,6 +233,10 @@ struct ModelFlags {
     /// the material's own).
     #[arg(long)]
     shadowing: Option<String>,
+    /// Wavelength (µm) at which to evaluate a spectral --material (n, k, ρ_d interpolated in its
+    /// table; outside it is refused). A grey material is the same at every wavelength.
+    #[arg(long, value_name = "UM")]
+    wavelength: Option<f64>,
 }
 
 impl ModelFlags {
@@ -245,6 +250,7 @@ impl ModelFlags {
             k: self.k,
             rho: self.rho,
             shadowing: self.shadowing.clone(),
+            wavelength_um: self.wavelength,
         }
     }
 }
@@ -654,7 +660,7 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
         return Ok(());
     }
     say!(
-        "{:<18} {:<9} {:<17} {:>7} {:>6} {:>6} {:>6} {:>6} {:>7} {:>8}",
+        "{:<18} {:<9} {:<17} {:>9} {:>6} {:>6} {:>11} {:>11} {:>7} {:>8}",
         "material",
         "dist",
         "shadowing",
@@ -666,9 +672,27 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
         "ρ_d",
         "χ²_red"
     );
+    // A spectral material shows the range of its table: λ first–last, n, k, ρ_d min–max.
+    let span = |values: &[f64], digits: usize| {
+        let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if lo == hi {
+            format!("{lo:.digits$}")
+        } else {
+            format!("{lo:.digits$}–{hi:.digits$}")
+        }
+    };
     for (_, m) in materials {
-        let s = &m.model;
-        let q = match s.distribution {
+        let (wavelengths, n, k, rho_d) = match &m.model {
+            MaterialModel::Grey(s) => (vec![s.wavelength_um], vec![s.n], vec![s.k], vec![s.rho_d]),
+            MaterialModel::Spectral(s) => (
+                s.wavelength_um.clone(),
+                s.n.clone(),
+                s.k.clone(),
+                s.rho_d.clone(),
+            ),
+        };
+        let q = match m.model.distribution() {
             irpol::pbrdf::SlopeDistribution::Cauchy { q, .. } => format!("{q:.3}"),
             irpol::pbrdf::SlopeDistribution::Gaussian { .. } => "—".into(),
         };
@@ -677,16 +701,16 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
             .as_ref()
             .map_or("—".into(), |f| format!("{:.3}", f.reduced_chi2));
         say!(
-            "{:<18} {:<9} {:<17} {:>7.3} {:>6.3} {:>6} {:>6.3} {:>6.3} {:>7.4} {:>8}",
+            "{:<18} {:<9} {:<17} {:>9} {:>6.3} {:>6} {:>11} {:>11} {:>7} {:>8}",
             m.name,
-            s.distribution.name(),
-            s.shadowing.name(),
-            s.wavelength_um,
-            s.distribution.sigma(),
+            m.model.distribution().name(),
+            m.model.shadowing().name(),
+            span(&wavelengths, 3),
+            m.model.distribution().sigma(),
             q,
-            s.n,
-            s.k,
-            s.rho_d,
+            span(&n, 3),
+            span(&k, 3),
+            span(&rho_d, 4),
             chi2
         );
     }

@@ -51,7 +51,7 @@ fn every_input_of_a_folder_is_fitted_and_written_to_the_library() {
     for (outcome, sigma) in outcomes.iter().zip([0.08, 0.3]) {
         let saved = Material::load(&fits.join(format!("{}.toml", outcome.material.name))).unwrap();
         assert_eq!(saved, outcome.material);
-        assert!((saved.model.distribution.sigma() / sigma - 1.0).abs() < 0.03);
+        assert!((saved.model.distribution().sigma() / sigma - 1.0).abs() < 0.03);
         let record = saved.fit.unwrap();
         assert_eq!(
             record.source,

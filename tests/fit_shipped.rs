@@ -79,7 +79,7 @@ fn default_fits_recover_the_generating_parameters_and_distribution() {
                 "{name}: {comparison:?}"
             );
             assert_eq!(
-                outcome.material.model.distribution.name(),
+                outcome.material.model.distribution().name(),
                 truth.distribution.name()
             );
             assert!(

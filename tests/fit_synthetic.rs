@@ -172,7 +172,7 @@ fn fixed_parameters_keep_their_values_and_only_the_free_ones_move() {
         },
     )
     .unwrap();
-    let model = &outcome.material.model;
+    let model = outcome.material.grey_model().unwrap();
     assert_eq!((model.n, model.k), (1.7, 0.0));
     let record = outcome.material.fit.as_ref().unwrap();
     assert_eq!(record.free_parameters, ["sigma", "q", "rho_d"]);
@@ -195,7 +195,7 @@ fn fixed_parameters_keep_their_values_and_only_the_free_ones_move() {
     )
     .unwrap();
     assert_eq!(gaussian.chosen.free, [Parameter::Sigma, Parameter::N]);
-    assert_eq!(gaussian.material.model.k, 0.0); // default of a parameter neither free nor fixed
+    assert_eq!(gaussian.material.grey_model().unwrap().k, 0.0); // default of a parameter neither free nor fixed
 }
 
 #[test]

@@ -25,6 +25,8 @@ pub struct ModelArgs {
     pub k: Option<f64>,
     pub rho: Option<f64>,
     pub shadowing: Option<String>,
+    /// Where to evaluate a spectral material (µm); required for one, optional for a grey one.
+    pub wavelength_um: Option<f64>,
 }
 
 impl ModelArgs {
@@ -57,11 +59,30 @@ impl ModelArgs {
                     given.join(" ")
                 );
             }
-            let mut spec = Material::load(path)?.model;
+            let material = Material::load(path)?;
+            let mut spec = match (self.wavelength_um, material.model.spectral()) {
+                (Some(wavelength), _) => material.at(wavelength)?,
+                (None, None) => material.grey_model()?.clone(),
+                (None, Some(table)) => {
+                    let (first, last) = table.range_um();
+                    anyhow::bail!(
+                        "material '{}' is spectral ({}–{} µm): give --wavelength UM",
+                        material.name,
+                        crate::text::number(first),
+                        crate::text::number(last)
+                    )
+                }
+            };
             if let Some(shadowing) = shadowing {
                 spec.shadowing = shadowing;
             }
             return Ok(spec.pbrdf()?);
+        }
+        if self.wavelength_um.is_some() {
+            anyhow::bail!(
+                "--wavelength selects where a --material is evaluated; model parameters are \
+                 one wavelength's already"
+            );
         }
         let missing = |flag: &str| anyhow::anyhow!("missing --{flag} (or give --material FILE)");
         let sigma = self.sigma.ok_or_else(|| missing("sigma"))?;

@@ -64,7 +64,7 @@ pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<Fit
     let material = Material {
         name: set.material.clone(),
         tool_version: format!("irpol {}", env!("CARGO_PKG_VERSION")),
-        model: chosen.model.clone(),
+        model: crate::material::MaterialModel::Grey(chosen.model.clone()),
         fit: Some(fit_record(
             set,
             &data,

@@ -2,8 +2,12 @@
 //! was fitted, and its uncertainties. Written atomically; read by `render` and `report`.
 
 mod comments;
+mod spectral;
 
-use crate::optics::{RefractiveIndex, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
+use spectral::{check_wavelength, DistributionName};
+pub use spectral::{MaterialModel, OutsideTable, SpectralModel, SAME_WAVELENGTH_UM};
+
+use crate::optics::RefractiveIndex;
 use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};
 use crate::text::{number, shown, shown_at_most, significant};
 use serde::{Deserialize, Serialize};
@@ -25,6 +29,10 @@ pub enum MaterialError {
     Model { path: PathBuf, error: ModelError },
     #[error("material '{name}' is not in the library {dir} (no {dir}/{name}.toml)")]
     NotFound { name: String, dir: PathBuf },
+    #[error("material '{name}' is spectral: this needs a grey (single-wavelength) material")]
+    Spectral { name: String },
+    #[error("material '{name}': wavelength {error}")]
+    OutsideTable { name: String, error: OutsideTable },
     #[error("{path}: cannot write")]
     Write {
         path: PathBuf,
@@ -48,14 +56,6 @@ pub struct ModelSpec {
     pub wavelength_um: f64,
 }
 
-/// The distribution names of [`SlopeDistribution`] as written in a material file.
-#[derive(Clone, Copy, Debug, Deserialize)]
-#[serde(rename_all = "lowercase")]
-enum DistributionName {
-    Cauchy,
-    Gaussian,
-}
-
 /// [`ModelSpec`] as written in a material file: flat, every key known.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -75,26 +75,8 @@ impl TryFrom<RawModelSpec> for ModelSpec {
     type Error = String;
 
     fn try_from(raw: RawModelSpec) -> Result<ModelSpec, String> {
-        let distribution = match (raw.distribution, raw.q) {
-            (DistributionName::Cauchy, Some(q)) => SlopeDistribution::Cauchy {
-                sigma: raw.sigma,
-                q,
-            },
-            (DistributionName::Cauchy, None) => {
-                return Err("the cauchy distribution needs q".into())
-            }
-            (DistributionName::Gaussian, None) => SlopeDistribution::Gaussian { sigma: raw.sigma },
-            (DistributionName::Gaussian, Some(_)) => {
-                return Err("q applies to the cauchy distribution only".into())
-            }
-        };
-        let lambda = raw.wavelength_um;
-        if !(lambda.is_finite() && (MIN_WAVELENGTH_UM..=MAX_WAVELENGTH_UM).contains(&lambda)) {
-            return Err(format!(
-                "wavelength_um = {} is outside 0.1–1000 µm, the wavelengths irpol models",
-                number(lambda)
-            ));
-        }
+        let distribution = raw.distribution.with(raw.sigma, raw.q)?;
+        let lambda = check_wavelength(raw.wavelength_um)?;
         Ok(ModelSpec {
             distribution,
             shadowing: raw.shadowing,
@@ -245,7 +227,7 @@ pub struct AlternativeFit {
 pub struct Material {
     pub name: String,
     pub tool_version: String,
-    pub model: ModelSpec,
+    pub model: MaterialModel,
     pub fit: Option<FitRecord>,
 }
 
@@ -256,6 +238,17 @@ impl Material {
             source,
         })?;
         Material::from_toml(&text, path)
+    }
+
+    /// The model at `wavelength_um` ([`MaterialModel::at`]), refused outside a spectral table
+    /// with the material's name and the table's range.
+    pub fn at(&self, wavelength_um: f64) -> Result<ModelSpec, MaterialError> {
+        self.model
+            .at(wavelength_um)
+            .map_err(|error| MaterialError::OutsideTable {
+                name: self.name.clone(),
+                error,
+            })
     }
 
     /// [`Material::load`] of a file's text; `path` names it in messages.
@@ -276,7 +269,7 @@ impl Material {
         }
         material
             .model
-            .pbrdf()
+            .validate()
             .map_err(|error| MaterialError::Model {
                 path: path.to_owned(),
                 error,
@@ -284,8 +277,12 @@ impl Material {
         Ok(material)
     }
 
-    pub fn pbrdf(&self) -> Result<Pbrdf, ModelError> {
-        self.model.pbrdf()
+    /// The model of a grey material; a spectral one is refused (for what only grey materials
+    /// have: a single-wavelength fit report).
+    pub fn grey_model(&self) -> Result<&ModelSpec, MaterialError> {
+        self.model.grey().ok_or_else(|| MaterialError::Spectral {
+            name: self.name.clone(),
+        })
     }
 
     /// The TOML text of the library entry (what [`Material::save`] writes); `path` only names
@@ -396,14 +393,14 @@ mod tests {
         Material {
             name: "paper_paint".into(),
             tool_version: "irpol test".into(),
-            model: ModelSpec {
+            model: MaterialModel::Grey(ModelSpec {
                 distribution: SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
                 shadowing: Shadowing::Smith,
                 n: 1.2,
                 k: 0.2,
                 rho_d: 0.0,
                 wavelength_um: 9.925,
-            },
+            }),
             fit: None,
         }
     }

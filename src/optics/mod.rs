@@ -1,11 +1,13 @@
 //! Optics primitives: Fresnel coefficients of an absorbing medium, Jones/Mueller/Stokes algebra in
 //! the SCATMECH "psps" convention, and Planck band radiance. Nothing here knows about microfacets.
 
+mod dispersion;
 pub mod frame;
 mod fresnel;
 mod planck;
 mod polarization;
 
+pub use dispersion::{LorentzDispersion, LorentzOscillator};
 pub use frame::{rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame};
 pub use fresnel::{fresnel_amplitudes, FresnelFractions, RefractiveIndex};
 pub use planck::{

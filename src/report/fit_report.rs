@@ -424,8 +424,8 @@ fn draw_header<DB: DrawingBackend>(
     let title = format!(
         "Fit report: {}   —   {} slopes, {} shadowing, λ = {} µm, {} points × {} Mueller elements",
         material.name,
-        model.distribution.name(),
-        model.shadowing.name(),
+        model.distribution().name(),
+        model.shadowing().name(),
         format_plain(set.wavelength_um),
         set.points.len(),
         set.elements.len(),

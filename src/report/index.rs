@@ -8,7 +8,8 @@ use super::fit_report::{
     sha_prefix, verified_source,
 };
 use super::ReportError;
-use crate::material::{list_library, write_atomically, Material};
+use crate::material::{list_library, write_atomically, Material, MaterialModel};
+use crate::pbrdf::SlopeDistribution;
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
 
@@ -219,13 +220,7 @@ fn summary_table(html: &mut String, materials: &[(PathBuf, Material)]) {
     );
     for (path, material) in materials {
         let model = &material.model;
-        let cells: Vec<String> = parameters(model)
-            .into_iter()
-            .map(|(_, name, value)| match value {
-                Some(value) => escape_html(&parameter_text(material, name, value)),
-                None => "—".into(),
-            })
-            .collect();
+        let (wavelength, cells) = model_cells(material);
         let (chi2, points) = material.fit.as_ref().map_or(("—".into(), "—".into()), |f| {
             (format_plain(f.reduced_chi2), f.points.to_string())
         });
@@ -235,9 +230,9 @@ fn summary_table(html: &mut String, materials: &[(PathBuf, Material)]) {
             "<tr><td><a href=\"#{}\">{}</a></td><td>{}</td><td>{}</td><td class=\"num\">{}</td>",
             anchor(material),
             escape_html(&material.name),
-            model.distribution.name(),
-            model.shadowing.name(),
-            format_plain(model.wavelength_um)
+            model.distribution().name(),
+            model.shadowing().name(),
+            escape_html(&wavelength)
         );
         for cell in cells {
             let _ = write!(html, "<td class=\"num\">{cell}</td>");
@@ -252,6 +247,91 @@ fn summary_table(html: &mut String, materials: &[(PathBuf, Material)]) {
     html.push_str("</table>\n");
 }
 
+/// The summary table's λ cell and its σ, q, n, k, ρ_d cells (HTML-escaped). A spectral material
+/// shows its table's range: λ first–last, n, k, ρ_d min–max (its section lists every node).
+fn model_cells(material: &Material) -> (String, Vec<String>) {
+    let cell = |name: &str, value: Option<f64>| match value {
+        Some(value) => escape_html(&parameter_text(material, name, value)),
+        None => "—".into(),
+    };
+    match &material.model {
+        MaterialModel::Grey(model) => (
+            format_plain(model.wavelength_um),
+            parameters(model)
+                .into_iter()
+                .map(|(_, name, value)| cell(name, value))
+                .collect(),
+        ),
+        MaterialModel::Spectral(model) => {
+            let (first, last) = model.range_um();
+            let q = match model.distribution {
+                SlopeDistribution::Cauchy { q, .. } => Some(q),
+                SlopeDistribution::Gaussian { .. } => None,
+            };
+            (
+                format!("{}–{}", format_plain(first), format_plain(last)),
+                vec![
+                    cell("sigma", Some(model.distribution.sigma())),
+                    cell("q", q),
+                    escape_html(&span(&model.n)),
+                    escape_html(&span(&model.k)),
+                    escape_html(&span(&model.rho_d)),
+                ],
+            )
+        }
+    }
+}
+
+/// "min–max" of a table's values (one value if they are all equal).
+fn span(values: &[f64]) -> String {
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if lo == hi {
+        format_plain(lo)
+    } else {
+        format!("{}–{}", format_plain(lo), format_plain(hi))
+    }
+}
+
+/// The parameter table of a material's section: σ, q, n, k, ρ_d of a grey material; σ, q and
+/// then n, k, ρ_d at each wavelength of a spectral one.
+fn parameter_table(html: &mut String, material: &Material) {
+    html.push_str("<table>\n<tr><th>parameter</th><th>value ± 1σ</th></tr>\n");
+    let mut row = |symbol: &str, text: String| {
+        let _ = writeln!(
+            html,
+            "<tr><td>{}</td><td class=\"num\">{}</td></tr>",
+            escape_html(symbol),
+            escape_html(&text)
+        );
+    };
+    match &material.model {
+        MaterialModel::Grey(model) => {
+            for (symbol, name, value) in parameters(model) {
+                if let Some(value) = value {
+                    row(symbol, parameter_text(material, name, value));
+                }
+            }
+        }
+        MaterialModel::Spectral(model) => {
+            row(
+                "σ",
+                parameter_text(material, "sigma", model.distribution.sigma()),
+            );
+            if let SlopeDistribution::Cauchy { q, .. } = model.distribution {
+                row("q", parameter_text(material, "q", q));
+            }
+            for node in model.nodes() {
+                let at = format!("{} µm", format_plain(node.wavelength_um));
+                row(&format!("n ({at})"), format_plain(node.n));
+                row(&format!("k ({at})"), format_plain(node.k));
+                row(&format!("ρd ({at})"), format_plain(node.rho_d));
+            }
+        }
+    }
+    html.push_str("</table>\n");
+}
+
 fn material_section(
     html: &mut String,
     reports_dir: &Path,
@@ -260,30 +340,19 @@ fn material_section(
     has_report: bool,
 ) {
     let model = &material.model;
+    let wavelengths = model.wavelengths_um();
     let name = escape_html(&material.name);
     let _ = write!(
         html,
         "<section class=\"material\" id=\"{}\">\n<h2>{name}</h2>\n<p>{} slopes, {} shadowing, \
          λ = {} µm — <a href=\"{}\">material file</a></p>\n<div class=\"facts\">\n",
         anchor(material),
-        model.distribution.name(),
-        model.shadowing.name(),
-        format_plain(model.wavelength_um),
+        model.distribution().name(),
+        model.shadowing().name(),
+        escape_html(&span(&wavelengths)),
         escape_html(&url_of(&relative_to(reports_dir, path)))
     );
-
-    html.push_str("<table>\n<tr><th>parameter</th><th>value ± 1σ</th></tr>\n");
-    for (symbol, name, value) in parameters(model) {
-        if let Some(value) = value {
-            let _ = writeln!(
-                html,
-                "<tr><td>{}</td><td class=\"num\">{}</td></tr>",
-                escape_html(symbol),
-                escape_html(&parameter_text(material, name, value))
-            );
-        }
-    }
-    html.push_str("</table>\n");
+    parameter_table(html, material);
 
     match material.fit.as_ref() {
         Some(fit) => {

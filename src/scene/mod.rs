@@ -811,7 +811,12 @@ impl MaterialResolver<'_> {
                 return Ok(i);
             }
             let loaded = Material::load(&path).map_err(|e| e.to_string())?;
-            let pbrdf = loaded
+            // Band integration over a spectral table is not wired into the renderer yet: refuse
+            // rather than render one wavelength's index as if it held across the band.
+            let model = loaded
+                .grey_model()
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            let pbrdf = model
                 .pbrdf()
                 .map_err(|e| format!("{}: {e}", path.display()))?;
             (
@@ -820,7 +825,7 @@ impl MaterialResolver<'_> {
                     name: reference.to_owned(),
                     origin: path.display().to_string(),
                     pbrdf,
-                    wavelength_um: Some(loaded.model.wavelength_um),
+                    wavelength_um: Some(model.wavelength_um),
                 },
             )
         };

@@ -1,7 +1,7 @@
 //! Helpers shared by the render integration tests.
 #![allow(dead_code)]
 
-use irpol::material::{Material, ModelSpec};
+use irpol::material::{Material, MaterialModel, ModelSpec};
 use irpol::pbrdf::{Shadowing, SlopeDistribution};
 use std::path::Path;
 
@@ -59,14 +59,14 @@ pub fn write_truth_library(dir: &Path) {
         let material = Material {
             name: name.into(),
             tool_version: "test".into(),
-            model: ModelSpec {
+            model: MaterialModel::Grey(ModelSpec {
                 distribution,
                 shadowing: Shadowing::Smith,
                 n,
                 k,
                 rho_d,
                 wavelength_um,
-            },
+            }),
             fit: None,
         };
         material.save(&dir.join(format!("{name}.toml"))).unwrap();

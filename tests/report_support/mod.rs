@@ -206,7 +206,7 @@ pub fn fitted_material(name: &str, set: &MeasurementSet, source: &Path) -> Mater
     Material {
         name: name.to_owned(),
         tool_version: "irpol test".into(),
-        model: truth(),
+        model: irpol::material::MaterialModel::Grey(truth()),
         fit: Some(fit),
     }
 }

@@ -115,8 +115,8 @@ pub struct ReportData {
 impl ReportData {
     pub fn new(material: &Material, set: &MeasurementSet) -> Result<ReportData, ReportError> {
         let chosen = ModelCurveSource {
-            label: material.model.distribution.name().to_owned(),
-            pbrdf: material.pbrdf()?,
+            label: material.model.distribution().name().to_owned(),
+            pbrdf: material.grey_model()?.pbrdf()?,
         };
         let alternative = match material.fit.as_ref().and_then(|f| f.alternative.as_ref()) {
             Some(alt) => Some(ModelCurveSource {
@@ -640,7 +640,7 @@ mod tests {
         Material {
             name: "test".into(),
             tool_version: "test".into(),
-            model,
+            model: crate::material::MaterialModel::Grey(model),
             fit,
         }
     }
@@ -651,7 +651,7 @@ mod tests {
         value: impl Fn(&Mueller) -> [f64; 2],
         uncertainties: [Option<f64>; 2],
     ) -> MeasurementSet {
-        let model = material(false).pbrdf().unwrap();
+        let model = material(false).grey_model().unwrap().pbrdf().unwrap();
         let points = geometry
             .iter()
             .enumerate()
@@ -688,7 +688,7 @@ mod tests {
     /// 1-σ of 1e-4 sr⁻¹.
     fn model_set(geometry: &[(f64, f64, f64, f64)], elements: &[usize]) -> MeasurementSet {
         let mut set = set_of(geometry, exact, [None, None]);
-        let model = material(false).pbrdf().unwrap();
+        let model = material(false).grey_model().unwrap().pbrdf().unwrap();
         for p in &mut set.points {
             let m = model.mueller(
                 &Direction::from_angles(p.theta_i_deg.to_radians(), p.phi_i_deg.to_radians()),
@@ -836,7 +836,10 @@ mod tests {
                 &Direction::from_angles(30f64.to_radians(), std::f64::consts::PI),
             )
         };
-        assert_eq!(sweep.chosen[specular], at(&material.pbrdf().unwrap()));
+        assert_eq!(
+            sweep.chosen[specular],
+            at(&material.grey_model().unwrap().pbrdf().unwrap())
+        );
         let alternative = material.fit.as_ref().unwrap().alternative.as_ref().unwrap();
         assert_eq!(
             sweep.alternative.as_ref().unwrap()[specular],
@@ -849,7 +852,7 @@ mod tests {
             .iter()
             .position(|&x| (x + 30.0).abs() < 1e-9)
             .unwrap();
-        let expected = material.pbrdf().unwrap().mueller(
+        let expected = material.grey_model().unwrap().pbrdf().unwrap().mueller(
             &Direction::from_angles(30f64.to_radians(), 0.0),
             &Direction::from_angles(30f64.to_radians(), 0.0),
         );
@@ -859,6 +862,8 @@ mod tests {
         assert_eq!(e.theta_deg.first(), Some(&0.0));
         assert_eq!(e.theta_deg.last(), Some(&88.0));
         let direct = material
+            .grey_model()
+            .unwrap()
             .pbrdf()
             .unwrap()
             .emissivity(60f64.to_radians(), &HemisphereQuadrature::default());

@@ -117,7 +117,7 @@ pub fn is_free(fit: &FitRecord, name: &str) -> bool {
 pub fn preference(material: &Material) -> Option<String> {
     let fit = material.fit.as_ref()?;
     let alt = fit.alternative.as_ref()?;
-    let chosen = material.model.distribution.name();
+    let chosen = material.model.distribution().name();
     let other = alt.model.distribution.name();
     let delta_aic = alt.aic - fit.aic;
     let delta_bic = alt.bic - fit.bic;
@@ -155,7 +155,10 @@ pub fn sha_prefix(sha: &str) -> String {
 
 /// The rows of the table.
 pub fn table_rows(material: &Material) -> Vec<Row> {
-    let model = &material.model;
+    // A spectral material has its own report; ReportData::new refuses it before this.
+    let Some(model) = material.model.grey() else {
+        return Vec::new();
+    };
     let fit = material.fit.as_ref();
     let alternative = fit.and_then(|f| f.alternative.as_ref());
     let mut rows = vec![Row::Heading(format!(
@@ -640,7 +643,7 @@ mod tests {
                     bic: alternative_aic + 3.0,
                 },
             }))),
-            model,
+            model: crate::material::MaterialModel::Grey(model),
         }
     }
 

@@ -1,0 +1,356 @@
+//! The `[model]` of a material file: grey (one wavelength, as fitted from one measurement) or
+//! spectral (DESIGN §1.9, §2.6): n, k and ρ_d as tables over ascending wavelengths, σ, q and the
+//! shadowing shared (the surface's geometry does not depend on λ). Between table nodes n, k and ρ_d
+//! are linear in λ; outside the table the model is not defined and [`MaterialModel::at`] refuses.
+//! A grey model is the same at every wavelength.
+
+use super::ModelSpec;
+use crate::optics::{LorentzDispersion, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
+use crate::pbrdf::{ModelError, Shadowing, SlopeDistribution};
+use crate::text::number;
+use serde::{Deserialize, Serialize};
+
+/// Two table wavelengths closer than this (µm) are one wavelength (DESIGN §1.9).
+pub const SAME_WAVELENGTH_UM: f64 = 1e-6;
+
+/// A material's model over wavelength.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged, try_from = "RawModel")]
+pub enum MaterialModel {
+    /// One N = n + ik and ρ_d, used at every wavelength (`wavelength_um` is where it was measured).
+    Grey(ModelSpec),
+    Spectral(SpectralModel),
+}
+
+/// n, k and ρ_d tabulated over wavelength with shared σ, q and shadowing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpectralModel {
+    #[serde(flatten)]
+    pub distribution: SlopeDistribution,
+    pub shadowing: Shadowing,
+    /// Table wavelengths, µm, strictly ascending (at least two).
+    pub wavelength_um: Vec<f64>,
+    pub n: Vec<f64>,
+    pub k: Vec<f64>,
+    /// One per wavelength.
+    pub rho_d: Vec<f64>,
+    /// The dispersion law n, k were fitted with, when a law was (`fit --dispersion lorentz:N`);
+    /// `n`, `k` hold it evaluated at the table wavelengths, so readers need not know the law.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dispersion: Option<LorentzDispersion>,
+}
+
+/// A wavelength outside a spectral material's table.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("{} µm is outside its table, {}–{} µm", number(*.wavelength_um), number(*.first_um), number(*.last_um))]
+pub struct OutsideTable {
+    pub wavelength_um: f64,
+    pub first_um: f64,
+    pub last_um: f64,
+}
+
+impl SpectralModel {
+    /// The model at `wavelength_um`: n, k, ρ_d interpolated linearly between the two nearest
+    /// table nodes (exactly the node's values at a node).
+    pub fn at(&self, wavelength_um: f64) -> Result<ModelSpec, OutsideTable> {
+        let (first, last) = self.range_um();
+        if !(wavelength_um >= first && wavelength_um <= last) {
+            return Err(OutsideTable {
+                wavelength_um,
+                first_um: first,
+                last_um: last,
+            });
+        }
+        let upper = self
+            .wavelength_um
+            .partition_point(|&w| w < wavelength_um)
+            .clamp(1, self.wavelength_um.len() - 1);
+        let (a, b) = (upper - 1, upper);
+        let (wa, wb) = (self.wavelength_um[a], self.wavelength_um[b]);
+        let interpolate = |values: &[f64]| {
+            if wavelength_um == wa {
+                values[a]
+            } else if wavelength_um == wb {
+                values[b]
+            } else {
+                let f = (wavelength_um - wa) / (wb - wa);
+                values[a] + f * (values[b] - values[a])
+            }
+        };
+        Ok(ModelSpec {
+            distribution: self.distribution,
+            shadowing: self.shadowing,
+            n: interpolate(&self.n),
+            k: interpolate(&self.k),
+            rho_d: interpolate(&self.rho_d),
+            wavelength_um,
+        })
+    }
+
+    /// The first and last table wavelengths, µm.
+    pub fn range_um(&self) -> (f64, f64) {
+        (
+            self.wavelength_um[0],
+            self.wavelength_um[self.wavelength_um.len() - 1],
+        )
+    }
+
+    /// The model at each table node, in wavelength order.
+    pub fn nodes(&self) -> impl Iterator<Item = ModelSpec> + '_ {
+        self.wavelength_um
+            .iter()
+            .map(|&w| self.at(w).expect("a node is inside its own table"))
+    }
+}
+
+impl MaterialModel {
+    pub fn distribution(&self) -> SlopeDistribution {
+        match self {
+            MaterialModel::Grey(m) => m.distribution,
+            MaterialModel::Spectral(m) => m.distribution,
+        }
+    }
+
+    pub fn shadowing(&self) -> Shadowing {
+        match self {
+            MaterialModel::Grey(m) => m.shadowing,
+            MaterialModel::Spectral(m) => m.shadowing,
+        }
+    }
+
+    pub fn set_shadowing(&mut self, shadowing: Shadowing) {
+        match self {
+            MaterialModel::Grey(m) => m.shadowing = shadowing,
+            MaterialModel::Spectral(m) => m.shadowing = shadowing,
+        }
+    }
+
+    /// The grey model, or `None` for a spectral one.
+    pub fn grey(&self) -> Option<&ModelSpec> {
+        match self {
+            MaterialModel::Grey(m) => Some(m),
+            MaterialModel::Spectral(_) => None,
+        }
+    }
+
+    pub fn spectral(&self) -> Option<&SpectralModel> {
+        match self {
+            MaterialModel::Grey(_) => None,
+            MaterialModel::Spectral(m) => Some(m),
+        }
+    }
+
+    /// The model at `wavelength_um`: a grey model's own at any wavelength, a spectral one's
+    /// interpolated in its table ([`SpectralModel::at`]).
+    pub fn at(&self, wavelength_um: f64) -> Result<ModelSpec, OutsideTable> {
+        match self {
+            MaterialModel::Grey(m) => Ok(m.clone()),
+            MaterialModel::Spectral(m) => m.at(wavelength_um),
+        }
+    }
+
+    /// The wavelengths the model was measured at: one for a grey model, the table's for a
+    /// spectral one.
+    pub fn wavelengths_um(&self) -> Vec<f64> {
+        match self {
+            MaterialModel::Grey(m) => vec![m.wavelength_um],
+            MaterialModel::Spectral(m) => m.wavelength_um.clone(),
+        }
+    }
+
+    /// Checks that the model is valid at every table node (a grey model at its wavelength).
+    pub fn validate(&self) -> Result<(), ModelError> {
+        match self {
+            MaterialModel::Grey(m) => m.pbrdf().map(drop),
+            MaterialModel::Spectral(m) => m.nodes().try_for_each(|node| node.pbrdf().map(drop)),
+        }
+    }
+}
+
+/// A number or a list of numbers (a grey or a spectral key of `[model]`).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum OneOrMany {
+    One(f64),
+    Many(Vec<f64>),
+}
+
+/// `[model]` as written in a material file: flat, every key known.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawModel {
+    distribution: DistributionName,
+    sigma: f64,
+    q: Option<f64>,
+    shadowing: Shadowing,
+    n: OneOrMany,
+    k: OneOrMany,
+    rho_d: Option<OneOrMany>,
+    wavelength_um: OneOrMany,
+    dispersion: Option<LorentzDispersion>,
+}
+
+/// The distribution names of [`SlopeDistribution`] as written in a material file.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub(super) enum DistributionName {
+    Cauchy,
+    Gaussian,
+}
+
+impl DistributionName {
+    /// The distribution of a name, σ and q (which only the Cauchy one has).
+    pub(super) fn with(self, sigma: f64, q: Option<f64>) -> Result<SlopeDistribution, String> {
+        match (self, q) {
+            (DistributionName::Cauchy, Some(q)) => Ok(SlopeDistribution::Cauchy { sigma, q }),
+            (DistributionName::Cauchy, None) => Err("the cauchy distribution needs q".into()),
+            (DistributionName::Gaussian, None) => Ok(SlopeDistribution::Gaussian { sigma }),
+            (DistributionName::Gaussian, Some(_)) => {
+                Err("q applies to the cauchy distribution only".into())
+            }
+        }
+    }
+}
+
+/// Refuses a wavelength irpol does not model.
+pub(super) fn check_wavelength(lambda: f64) -> Result<f64, String> {
+    if lambda.is_finite() && (MIN_WAVELENGTH_UM..=MAX_WAVELENGTH_UM).contains(&lambda) {
+        Ok(lambda)
+    } else {
+        Err(format!(
+            "wavelength_um = {} is outside 0.1–1000 µm, the wavelengths irpol models",
+            number(lambda)
+        ))
+    }
+}
+
+impl TryFrom<RawModel> for MaterialModel {
+    type Error = String;
+
+    fn try_from(raw: RawModel) -> Result<MaterialModel, String> {
+        let distribution = raw.distribution.with(raw.sigma, raw.q)?;
+        let rho_d = raw.rho_d.unwrap_or(OneOrMany::One(0.0));
+        match (raw.wavelength_um, raw.n, raw.k, rho_d) {
+            (OneOrMany::One(w), OneOrMany::One(n), OneOrMany::One(k), OneOrMany::One(rho_d)) => {
+                if raw.dispersion.is_some() {
+                    return Err("a dispersion law needs tables: wavelength_um, n and k as \
+                                arrays"
+                        .into());
+                }
+                Ok(MaterialModel::Grey(ModelSpec {
+                    distribution,
+                    shadowing: raw.shadowing,
+                    n,
+                    k,
+                    rho_d,
+                    wavelength_um: check_wavelength(w)?,
+                }))
+            }
+            (OneOrMany::Many(wavelength_um), OneOrMany::Many(n), OneOrMany::Many(k), rho_d) => {
+                let rho_d = match rho_d {
+                    OneOrMany::One(r) => vec![r; wavelength_um.len()],
+                    OneOrMany::Many(r) => r,
+                };
+                let model = SpectralModel {
+                    distribution,
+                    shadowing: raw.shadowing,
+                    wavelength_um,
+                    n,
+                    k,
+                    rho_d,
+                    dispersion: raw.dispersion,
+                };
+                check_table(&model)?;
+                Ok(MaterialModel::Spectral(model))
+            }
+            _ => Err(
+                "wavelength_um, n and k must be all numbers (a grey material) or all \
+                      arrays of equal length (a spectral one)"
+                    .into(),
+            ),
+        }
+    }
+}
+
+/// Refuses a table that is not one: fewer than two nodes, unequal lengths, wavelengths out of
+/// range or not strictly ascending, an unphysical dispersion law.
+fn check_table(model: &SpectralModel) -> Result<(), String> {
+    let count = model.wavelength_um.len();
+    if count < 2 {
+        return Err(
+            "a spectral table needs at least two wavelengths (write numbers for a grey material)"
+                .into(),
+        );
+    }
+    for (name, len) in [
+        ("n", model.n.len()),
+        ("k", model.k.len()),
+        ("rho_d", model.rho_d.len()),
+    ] {
+        if len != count {
+            return Err(format!(
+                "{name} has {len} values for {count} wavelengths (wavelength_um)"
+            ));
+        }
+    }
+    for &w in &model.wavelength_um {
+        check_wavelength(w)?;
+    }
+    if let Some(pair) = model
+        .wavelength_um
+        .windows(2)
+        .find(|p| p[1] - p[0] <= SAME_WAVELENGTH_UM)
+    {
+        return Err(format!(
+            "wavelength_um must be strictly ascending ({} µm then {} µm)",
+            number(pair[0]),
+            number(pair[1])
+        ));
+    }
+    if let Some(law) = &model.dispersion {
+        law.validate().map_err(|e| format!("dispersion: {e}"))?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn glass() -> SpectralModel {
+        SpectralModel {
+            distribution: SlopeDistribution::Cauchy {
+                sigma: 0.06,
+                q: 2.8,
+            },
+            shadowing: Shadowing::Smith,
+            wavelength_um: vec![8.0, 9.0, 11.5],
+            n: vec![0.5, 1.4, 2.1],
+            k: vec![0.5, 2.1, 0.1],
+            rho_d: vec![0.0, 0.01, 0.02],
+            dispersion: None,
+        }
+    }
+
+    #[test]
+    fn between_nodes_the_table_is_linear_and_at_nodes_exact() {
+        let model = glass();
+        let at = model.at(8.5).unwrap();
+        assert!((at.n - 0.95).abs() < 1e-15 && (at.k - 1.3).abs() < 1e-15);
+        assert!((at.rho_d - 0.005).abs() < 1e-15 && at.wavelength_um == 8.5);
+        let node = model.at(11.5).unwrap();
+        assert_eq!((node.n, node.k, node.rho_d), (2.1, 0.1, 0.02));
+        let first = model.at(8.0).unwrap();
+        assert_eq!((first.n, first.k), (0.5, 0.5));
+        let outside = model.at(7.9).unwrap_err().to_string();
+        assert_eq!(outside, "7.9 µm is outside its table, 8–11.5 µm");
+        assert!(model.at(f64::NAN).is_err());
+    }
+
+    #[test]
+    fn a_grey_model_is_the_same_everywhere() {
+        let grey = MaterialModel::Grey(glass().at(9.0).unwrap());
+        assert_eq!(grey.at(13.0).unwrap(), grey.at(8.0).unwrap());
+        assert_eq!(grey.wavelengths_um(), vec![9.0]);
+    }
+}
