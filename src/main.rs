@@ -21,6 +21,7 @@ use irpol::fit::{
     parse_parameter_list, parse_parameter_values, DistributionKind, FitOptions, Optimizer,
     RobustLoss,
 };
+use irpol::fit::{Dispersion, MaterialFit};
 use irpol::material::MaterialModel;
 use irpol::output::staged_folder::staging_folder;
 use irpol::output::thermal::ThermalSummary;
@@ -108,6 +109,10 @@ enum Command {
         /// Robust loss on normalized residuals: huber or cauchy, optionally with a scale (huber:2).
         #[arg(long)]
         robust: Option<String>,
+        /// For a material measured at several wavelengths (a spectral set): n, k free at each
+        /// wavelength (table), or from a Lorentz law of N oscillators (lorentz:N).
+        #[arg(long, default_value = "table")]
+        dispersion: String,
         /// Library folder for the material TOMLs.
         #[arg(long, default_value = "fits")]
         out: PathBuf,
@@ -353,18 +358,22 @@ fn run(command: Command) -> anyhow::Result<()> {
             optimizer,
             seed,
             robust,
+            dispersion,
             out,
             reports,
         } => {
-            let options = fit_options(
-                distribution,
-                &shadowing,
-                free,
-                fix,
-                &optimizer,
-                seed,
-                robust,
-            )?;
+            let options = FitOptions {
+                dispersion: Dispersion::parse(&dispersion).map_err(anyhow::Error::msg)?,
+                ..fit_options(
+                    distribution,
+                    &shadowing,
+                    free,
+                    fix,
+                    &optimizer,
+                    seed,
+                    robust,
+                )?
+            };
             fit_and_summarize(&inputs, &options, &out, &reports)?;
         }
         Command::Report { material, reports } => {
@@ -475,16 +484,52 @@ fn fit_and_summarize(
     cli::signals::remove_on_interrupt(vec![], vec![fits_dir.to_owned(), reports_dir.to_owned()]);
     let written = fit_and_write(inputs, options, fits_dir, reports_dir, true)?;
     for outcome in &written.outcomes {
-        note_all(&outcome.measurement.notes);
+        note_all(&outcome.notes());
     }
     for (outcome, entry) in written.outcomes.iter().zip(&written.entries) {
-        say!("{}", fit_summary_line(outcome, entry));
+        let line = match outcome {
+            MaterialFit::Grey(outcome) => fit_summary_line(outcome, entry),
+            MaterialFit::Spectral(outcome) => spectral_summary_line(outcome, entry),
+        };
+        say!("{line}");
     }
     for report in &written.reports {
         say!("  report {}", report.display());
     }
     say!("  index  {}", written.index.display());
     Ok(())
+}
+
+/// `name: family, N wavelengths a–b µm, dispersion: σ=…±… q=…±… [law …] n a–b, k a–b
+/// χ²_red=… → entry`: the shared parameters with their errors and the table's range.
+fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path) -> String {
+    let chosen = &outcome.chosen;
+    let model = &chosen.model;
+    let shared: Vec<String> = chosen
+        .names
+        .iter()
+        .zip(chosen.values.iter().zip(&chosen.errors))
+        .filter(|(name, _)| !name.contains('('))
+        .map(|(name, (v, e))| format!("{name}={}±{e:.1e}", significant(*v, 6)))
+        .collect();
+    let range = |values: &[f64]| {
+        let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        format!("{}–{}", significant(lo, 3), significant(hi, 3))
+    };
+    let (first, last) = model.range_um();
+    format!(
+        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={:.3} → {}",
+        outcome.material.name,
+        chosen.distribution.name(),
+        chosen.dispersion,
+        model.wavelength_um.len(),
+        shared.join(" "),
+        range(&model.n),
+        range(&model.k),
+        chosen.reduced_chi2,
+        entry.display()
+    )
 }
 
 /// `name: family σ=…±… … [bounded only: …] (fixed: …) χ²_red=…; comparison → entry`: the

@@ -46,11 +46,15 @@ fn every_input_of_a_folder_is_fitted_and_written_to_the_library() {
     let fits = library.path().join("fits");
     let outcomes = fit_files(&[inputs.path().to_owned()], &options(), &fits, true).unwrap();
     // Folder files come sorted by name.
-    let names: Vec<&str> = outcomes.iter().map(|o| o.material.name.as_str()).collect();
+    let names: Vec<&str> = outcomes
+        .iter()
+        .map(|o| o.material().name.as_str())
+        .collect();
     assert_eq!(names, ["glossy", "matte"]);
     for (outcome, sigma) in outcomes.iter().zip([0.08, 0.3]) {
-        let saved = Material::load(&fits.join(format!("{}.toml", outcome.material.name))).unwrap();
-        assert_eq!(saved, outcome.material);
+        let saved =
+            Material::load(&fits.join(format!("{}.toml", outcome.material().name))).unwrap();
+        assert_eq!(&saved, outcome.material());
         assert!((saved.model.distribution().sigma() / sigma - 1.0).abs() < 0.03);
         let record = saved.fit.unwrap();
         assert_eq!(

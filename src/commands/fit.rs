@@ -4,17 +4,18 @@
 //! reports exactly as they were; the library entries are renamed into place last.
 
 use super::output_set::OutputSet;
-use crate::fit::{fit_inputs, FitOptions, FitOutcome};
+use crate::fit::{fit_inputs, FitOptions, MaterialFit};
 use crate::material::{list_library, Material};
 use crate::report::fit_report::encode_fit_report;
 use crate::report::index::library_index_html;
+use crate::report::spectral_report::encode_spectral_report;
 use crate::report::ReportError;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
 /// What a fit wrote.
 pub struct FitWritten {
-    pub outcomes: Vec<FitOutcome>,
+    pub outcomes: Vec<MaterialFit>,
     /// Each material's library entry.
     pub entries: Vec<PathBuf>,
     /// Each material's report figure (PNG; an SVG lies beside it).
@@ -36,10 +37,13 @@ pub fn fit_and_write(
     let mut report_files = Vec::new();
     let mut reports = Vec::new();
     for outcome in &outcomes {
-        let path = entry_path(fits_dir, &outcome.material);
-        let text = outcome.material.to_toml(&path)?;
+        let path = entry_path(fits_dir, outcome.material());
+        let text = outcome.material().to_toml(&path)?;
         entries.push((path, text));
-        let report = encode_fit_report(&outcome.material, &outcome.measurement, reports_dir)?;
+        let report = match outcome {
+            MaterialFit::Grey(o) => encode_fit_report(&o.material, &o.measurement, reports_dir)?,
+            MaterialFit::Spectral(o) => encode_spectral_report(o, reports_dir)?,
+        };
         reports.extend(report.files.first().map(|(path, _)| path.clone()));
         report_files.extend(report.files);
     }
@@ -75,7 +79,7 @@ fn entry_path(fits_dir: &Path, material: &Material) -> PathBuf {
 /// The index of the library as it will be once the new entries are in: the entries on disk,
 /// with the fitted ones added or replaced.
 fn index_html(
-    outcomes: &[FitOutcome],
+    outcomes: &[MaterialFit],
     fits_dir: &Path,
     reports_dir: &Path,
 ) -> Result<String, ReportError> {
@@ -85,12 +89,15 @@ fn index_html(
         Vec::new()
     };
     for outcome in outcomes {
-        let path = entry_path(fits_dir, &outcome.material);
+        let path = entry_path(fits_dir, outcome.material());
         materials.retain(|(existing, _)| *existing != path);
-        materials.push((path, outcome.material.clone()));
+        materials.push((path, outcome.material().clone()));
     }
     materials.sort_by(|a, b| a.0.cmp(&b.0));
-    let fitted: Vec<&str> = outcomes.iter().map(|o| o.material.name.as_str()).collect();
+    let fitted: Vec<&str> = outcomes
+        .iter()
+        .map(|o| o.material().name.as_str())
+        .collect();
     Ok(library_index_html(
         fits_dir,
         reports_dir,

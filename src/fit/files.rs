@@ -5,13 +5,44 @@ use super::data::MeasurementData;
 use super::options::FitOptions;
 use super::outcome::{fit_measurement, FitOutcome};
 use super::space::ModelSpace;
+use super::spectral::{fit_spectral, SpectralFitOutcome};
 use super::FitError;
+use crate::material::{Material, SAME_WAVELENGTH_UM};
 use crate::measure::{
-    collect_measurement_files, merge_repeat_measurements, read_measurement_csv, MeasurementSet,
+    collect_measurement_files, merge_repeat_measurements, read_measurement_sets, MeasurementSet,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+
+/// One material's fit: of one wavelength, or jointly of several (a spectral set, DESIGN §1.9).
+#[derive(Clone, Debug)]
+pub enum MaterialFit {
+    Grey(Box<FitOutcome>),
+    Spectral(Box<SpectralFitOutcome>),
+}
+
+impl MaterialFit {
+    /// The library entry.
+    pub fn material(&self) -> &Material {
+        match self {
+            MaterialFit::Grey(o) => &o.material,
+            MaterialFit::Spectral(o) => &o.material,
+        }
+    }
+
+    /// What the reader did that the user should know, one line each.
+    pub fn notes(&self) -> Vec<String> {
+        match self {
+            MaterialFit::Grey(o) => o.measurement.notes.clone(),
+            MaterialFit::Spectral(o) => o
+                .measurements
+                .iter()
+                .flat_map(|m| m.notes.clone())
+                .collect(),
+        }
+    }
+}
 
 /// Fits every measurement CSV among `inputs` (files, or folders of `*.csv`) and writes each
 /// chosen model to `fits_dir/<material>.toml` with [`crate::material::Material::save`].
@@ -25,39 +56,46 @@ pub fn fit_files(
     options: &FitOptions,
     fits_dir: &Path,
     progress: bool,
-) -> Result<Vec<FitOutcome>, FitError> {
+) -> Result<Vec<MaterialFit>, FitError> {
     let outcomes = fit_inputs(inputs, options, progress)?;
     for outcome in &outcomes {
-        let path = fits_dir.join(format!("{}.toml", outcome.material.name));
-        outcome.material.save(&path)?;
+        let material = outcome.material();
+        let path = fits_dir.join(format!("{}.toml", material.name));
+        material.save(&path)?;
     }
     Ok(outcomes)
 }
 
 /// [`fit_files`] without writing: every outcome, for a caller that writes the library entries
-/// together with other outputs (`irpol fit` adds reports and an index).
+/// together with other outputs (`irpol fit` adds reports and an index). A material measured at
+/// several wavelengths is fitted jointly ([`fit_spectral`]).
 pub fn fit_inputs(
     inputs: &[PathBuf],
     options: &FitOptions,
     progress: bool,
-) -> Result<Vec<FitOutcome>, FitError> {
-    let sets = read_all(inputs)?;
+) -> Result<Vec<MaterialFit>, FitError> {
+    let materials = read_all(inputs)?;
     validate_options(options)?;
 
     let bar = (progress && std::io::stderr().is_terminal()).then(|| {
-        let bar = ProgressBar::new(sets.len() as u64);
+        let bar = ProgressBar::new(materials.len() as u64);
         bar.set_style(
             ProgressStyle::with_template("fitting {bar:30} {pos}/{len} {msg}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
         bar
     });
-    let mut outcomes = Vec::with_capacity(sets.len());
-    for set in &sets {
+    let mut outcomes = Vec::with_capacity(materials.len());
+    for sets in materials {
         if let Some(bar) = &bar {
-            bar.set_message(set.material.clone());
+            bar.set_message(sets[0].material.clone());
         }
-        let outcome = fit_measurement(set, options);
+        let outcome = if sets.len() == 1 {
+            fit_measurement(&sets[0], options).map(|o| MaterialFit::Grey(Box::new(o)))
+        } else {
+            fit_spectral(sets, options, options.dispersion)
+                .map(|o| MaterialFit::Spectral(Box::new(o)))
+        };
         if let Some(bar) = &bar {
             bar.inc(1);
         }
@@ -73,21 +111,51 @@ pub fn fit_inputs(
     Ok(outcomes)
 }
 
-/// Reads every input and checks that each set can be fitted, before any fitting starts.
-fn read_all(inputs: &[PathBuf]) -> Result<Vec<MeasurementSet>, FitError> {
+/// Reads every input and checks that each set can be fitted, before any fitting starts: the
+/// sets of each material, one per wavelength, ascending.
+fn read_all(inputs: &[PathBuf]) -> Result<Vec<Vec<MeasurementSet>>, FitError> {
     if inputs.is_empty() {
         return Err(FitError::Options("no measurement file given".into()));
     }
-    let files = collect_measurement_files(inputs)?;
-    let sets = files
-        .iter()
-        .map(|file| read_measurement_csv(file))
-        .collect::<Result<Vec<_>, _>>()?;
-    let sets = merge_materials(sets)?;
-    for set in &sets {
+    let mut sets = Vec::new();
+    for input in inputs {
+        let mut read = Vec::new();
+        for file in collect_measurement_files(std::slice::from_ref(input))? {
+            read.extend(read_measurement_sets(&file)?);
+        }
+        if input.is_dir() {
+            check_folder_materials(input, &read)?;
+        }
+        sets.extend(read);
+    }
+    let materials = merge_materials(sets)?;
+    for set in materials.iter().flatten() {
         MeasurementData::new(set)?;
     }
-    Ok(sets)
+    Ok(materials)
+}
+
+/// Refuses a folder of several files where one has no `# material:` line: its material would be
+/// its file name, so files of one material measured at different wavelengths would be fitted as
+/// different materials (and files of different materials could not be told apart).
+fn check_folder_materials(folder: &Path, sets: &[MeasurementSet]) -> Result<(), FitError> {
+    let files: std::collections::BTreeSet<&Path> =
+        sets.iter().map(|s| s.source.as_path()).collect();
+    if files.len() < 2 {
+        return Ok(());
+    }
+    match sets.iter().find(|s| !s.metadata.contains_key("material")) {
+        Some(set) => Err(FitError::Measurement {
+            file: set.source.clone(),
+            message: format!(
+                "has no '# material:' line, and the folder {} holds {} measurement files: add \
+                 '# material: NAME' to each so that irpol knows which belong to one material",
+                folder.display(),
+                files.len()
+            ),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Builds the model spaces the options ask for, which checks bounds, free and fixed values.
@@ -105,19 +173,58 @@ fn validate_options(options: &FitOptions) -> Result<(), FitError> {
     Ok(())
 }
 
-/// The sets of each material, in the order the materials first appear, files of one material
-/// merged as repeat measurements (DESIGN §1.9).
-fn merge_materials(sets: Vec<MeasurementSet>) -> Result<Vec<MeasurementSet>, FitError> {
-    let mut groups: Vec<Vec<MeasurementSet>> = Vec::new();
+/// The sets of each material, in the order the materials first appear: one per wavelength,
+/// ascending, files of one material at one wavelength merged as repeat measurements (DESIGN
+/// §1.9). Files of one material must agree on what they measure (the Mueller convention and
+/// any `# distribution:` they state).
+fn merge_materials(sets: Vec<MeasurementSet>) -> Result<Vec<Vec<MeasurementSet>>, FitError> {
+    let mut materials: Vec<Vec<Vec<MeasurementSet>>> = Vec::new();
     for set in sets {
-        match groups.iter_mut().find(|g| g[0].material == set.material) {
-            Some(group) => group.push(set),
-            None => groups.push(vec![set]),
+        let Some(material) = materials
+            .iter_mut()
+            .find(|m| m[0][0].material == set.material)
+        else {
+            materials.push(vec![vec![set]]);
+            continue;
+        };
+        check_consistent(&material[0][0], &set)?;
+        match material
+            .iter_mut()
+            .find(|w| (w[0].wavelength_um - set.wavelength_um).abs() <= SAME_WAVELENGTH_UM)
+        {
+            Some(wavelength) => wavelength.push(set),
+            None => material.push(vec![set]),
         }
     }
-    let mut merged = Vec::with_capacity(groups.len());
-    for group in groups {
-        merged.extend(merge_repeat_measurements(group)?);
+    let mut merged = Vec::with_capacity(materials.len());
+    for wavelengths in materials {
+        let mut sets = Vec::with_capacity(wavelengths.len());
+        for group in wavelengths {
+            sets.extend(merge_repeat_measurements(group)?);
+        }
+        sets.sort_by(|a, b| a.wavelength_um.total_cmp(&b.wavelength_um));
+        merged.push(sets);
     }
     Ok(merged)
+}
+
+/// Refuses two files of one material that disagree on a header that says what was measured.
+fn check_consistent(first: &MeasurementSet, other: &MeasurementSet) -> Result<(), FitError> {
+    for key in ["mueller_convention", "distribution"] {
+        let (a, b) = (first.metadata.get(key), other.metadata.get(key));
+        if a.is_some() && b.is_some() && a != b {
+            return Err(FitError::Measurement {
+                file: other.source.clone(),
+                message: format!(
+                    "'# {key}: {}' disagrees with '# {key}: {}' of {}, another file of material \
+                     '{}'",
+                    crate::text::shown(b.map_or("", |v| v.as_str())),
+                    crate::text::shown(a.map_or("", |v| v.as_str())),
+                    first.source.display(),
+                    first.material
+                ),
+            });
+        }
+    }
+    Ok(())
 }

@@ -28,45 +28,69 @@ impl Default for LevenbergMarquardtSettings {
     }
 }
 
-/// Residuals (whose squares sum to the cost) at search coordinates `s`.
-pub(crate) fn residuals(objective: &Objective, s: &[f64]) -> Option<DVector<f64>> {
-    let mut r = DVector::zeros(objective.observations());
-    objective
-        .residuals_at(&objective.space().values(s), r.as_mut_slice())
-        .then_some(r)
+/// A box-constrained nonlinear least-squares problem in search coordinates: what
+/// Levenberg–Marquardt needs. One measurement's [`Objective`] is one; the joint fit of a spectral
+/// set ([`super::spectral`]) is another, whose Jacobian uses its block structure.
+pub(crate) trait LeastSquares: Sync {
+    /// Lower corner of the search box.
+    fn lower(&self) -> &[f64];
+    /// Upper corner of the search box.
+    fn upper(&self) -> &[f64];
+    /// Residuals (whose squares sum to the cost) at search coordinates `s`; `None` where the
+    /// model is invalid.
+    fn residuals(&self, s: &[f64]) -> Option<DVector<f64>>;
+    /// ∂r/∂s at `s`, where the residuals are `r`.
+    fn jacobian(&self, s: &[f64], r: &DVector<f64>) -> Option<DMatrix<f64>>;
+    /// Residual vectors one Jacobian costs (for the evaluation count).
+    fn jacobian_evaluations(&self) -> u64 {
+        self.lower().len() as u64
+    }
 }
 
-/// Forward-difference Jacobian of the residuals in search coordinates, one column per thread
-/// task; steps point into the box at a bound.
-pub(crate) fn search_jacobian(
-    objective: &Objective,
-    s: &[f64],
-    r: &DVector<f64>,
-) -> Option<DMatrix<f64>> {
-    let space = objective.space();
-    let columns: Option<Vec<DVector<f64>>> = (0..s.len())
-        .into_par_iter()
-        .map(|j| {
-            let mut shifted = s.to_vec();
-            let mut h = 1e-7 * s[j].abs().max(1.0);
-            if shifted[j] + h > space.upper()[j] {
-                h = -h;
-            }
-            shifted[j] += h;
-            residuals(objective, &shifted).map(|rh| (rh - r) / h)
-        })
-        .collect();
-    Some(DMatrix::from_columns(&columns?))
+/// The forward-difference step of coordinate `j` at `s`, pointing into the box at its upper end.
+pub(crate) fn forward_step(s: &[f64], j: usize, upper: &[f64]) -> f64 {
+    let h = 1e-7 * s[j].abs().max(1.0);
+    if s[j] + h > upper[j] {
+        -h
+    } else {
+        h
+    }
+}
+
+impl LeastSquares for Objective<'_> {
+    fn lower(&self) -> &[f64] {
+        self.space().lower()
+    }
+    fn upper(&self) -> &[f64] {
+        self.space().upper()
+    }
+    fn residuals(&self, s: &[f64]) -> Option<DVector<f64>> {
+        let mut r = DVector::zeros(self.observations());
+        self.residuals_at(&self.space().values(s), r.as_mut_slice())
+            .then_some(r)
+    }
+    /// Forward differences, one column per thread task.
+    fn jacobian(&self, s: &[f64], r: &DVector<f64>) -> Option<DMatrix<f64>> {
+        let columns: Option<Vec<DVector<f64>>> = (0..s.len())
+            .into_par_iter()
+            .map(|j| {
+                let mut shifted = s.to_vec();
+                let h = forward_step(s, j, self.upper());
+                shifted[j] += h;
+                self.residuals(&shifted).map(|rh| (rh - r) / h)
+            })
+            .collect();
+        Some(DMatrix::from_columns(&columns?))
+    }
 }
 
 /// Runs Levenberg–Marquardt from the search-box point `start`.
 pub(crate) fn levenberg_marquardt(
-    objective: &Objective,
+    problem: &impl LeastSquares,
     start: &[f64],
     settings: &LevenbergMarquardtSettings,
 ) -> (Vec<f64>, StageHistory) {
-    let space = objective.space();
-    let (lower, upper) = (space.lower(), space.upper());
+    let (lower, upper) = (problem.lower(), problem.upper());
     let mut s: Vec<f64> = start
         .iter()
         .zip(lower.iter().zip(upper))
@@ -79,12 +103,12 @@ pub(crate) fn levenberg_marquardt(
         evaluations: 0,
         termination: String::new(),
     };
-    // One residual vector per trial point, one per Jacobian column.
-    let columns = s.len() as u64;
+    // One residual vector per trial point, and those of a Jacobian.
+    let columns = problem.jacobian_evaluations();
     let finish = |history: &mut StageHistory, reason: &str| {
         history.termination = reason.to_owned();
     };
-    let Some(mut r) = residuals(objective, &s) else {
+    let Some(mut r) = problem.residuals(&s) else {
         finish(&mut history, "invalid starting point");
         return (s, history);
     };
@@ -96,7 +120,7 @@ pub(crate) fn levenberg_marquardt(
     for _ in 0..settings.max_iterations {
         history.iterations += 1;
         if jacobian.is_none() {
-            jacobian = search_jacobian(objective, &s, &r);
+            jacobian = problem.jacobian(&s, &r);
             history.evaluations += columns;
         }
         let Some(j) = &jacobian else {
@@ -137,7 +161,7 @@ pub(crate) fn levenberg_marquardt(
         let delta: DVector<f64> = DVector::from_fn(s.len(), |i, _| trial[i] - s[i]);
         // Gain ratio: actual decrease over the decrease the linear model predicts.
         let predicted = -(2.0 * g.dot(&delta) + (j * &delta).norm_squared());
-        let trial_residuals = residuals(objective, &trial);
+        let trial_residuals = problem.residuals(&trial);
         history.evaluations += 1;
         let trial_cost = trial_residuals
             .as_ref()

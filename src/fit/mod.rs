@@ -30,6 +30,7 @@ pub mod parameters;
 mod profile;
 mod robust;
 mod space;
+mod spectral;
 mod stages;
 mod uncertainty;
 
@@ -38,7 +39,7 @@ pub use data::{
     ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00,
 };
 pub use error::FitError;
-pub use files::{fit_files, fit_inputs};
+pub use files::{fit_files, fit_inputs, MaterialFit};
 pub use global::GeneticSettings;
 pub use levenberg_marquardt::LevenbergMarquardtSettings;
 pub use model_fit::ModelFit;
@@ -53,5 +54,6 @@ pub use parameters::{
 pub use profile::{CONFIDENCE, ONE_SIDED_95_DELTA_CHI2};
 pub use robust::RobustLoss;
 pub use space::ModelSpace;
+pub use spectral::{fit_spectral, Dispersion, SpectralFit, SpectralFitOutcome};
 pub use stages::{ConvergenceHistory, Optimizer, Stage, StageHistory};
 pub use uncertainty::Uncertainty;

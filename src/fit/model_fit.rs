@@ -103,7 +103,10 @@ fn starting_values(space: &ModelSpace, options: &FitOptions) -> Result<Parameter
 }
 
 /// The family `kind` with the free parameters, fixed values and bounds of `options`.
-fn model_space(kind: DistributionKind, options: &FitOptions) -> Result<ModelSpace, FitError> {
+pub(crate) fn model_space(
+    kind: DistributionKind,
+    options: &FitOptions,
+) -> Result<ModelSpace, FitError> {
     ModelSpace::new(
         kind,
         options.shadowing,

@@ -33,6 +33,8 @@ pub struct FitOptions {
     pub robust: Option<RobustLoss>,
     pub bounds: ParameterBounds,
     pub settings: OptimizerSettings,
+    /// How n, k depend on wavelength when a material was measured at several (DESIGN §1.9).
+    pub dispersion: super::Dispersion,
 }
 
 impl Default for FitOptions {
@@ -48,6 +50,7 @@ impl Default for FitOptions {
             robust: None,
             bounds: ParameterBounds::default(),
             settings: OptimizerSettings::default(),
+            dispersion: super::Dispersion::Table,
         }
     }
 }

@@ -83,7 +83,7 @@ pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<Fit
     })
 }
 
-fn names(parameters: &[Parameter]) -> Vec<String> {
+pub(super) fn names(parameters: &[Parameter]) -> Vec<String> {
     parameters.iter().map(|p| p.name().to_owned()).collect()
 }
 
@@ -156,6 +156,9 @@ fn fit_record(
             .iter()
             .map(|(p, bound)| (p.name().to_owned(), *bound))
             .collect(),
+        uncertainty_per_wavelength: BTreeMap::new(),
+        wavelengths: Vec::new(),
+        dispersion: None,
         model_choice: comparison.map(ModelComparison::summary),
         alternative: alternative.map(|other| AlternativeFit {
             model: other.model.clone(),
@@ -170,7 +173,7 @@ fn fit_record(
 }
 
 /// The settings that, with the optimizer name and seed, reproduce the fit.
-fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap<String, String> {
+pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap<String, String> {
     let mut settings = BTreeMap::new();
     let from_file = data
         .error_sources()

@@ -98,7 +98,34 @@ pub(crate) fn estimate(objective: &Objective, search: &[f64], reduced_chi2: f64)
         uncertainty.undetermined = parameters;
         return uncertainty;
     };
-    let information = jacobian.transpose() * &jacobian;
+    (uncertainty.errors, uncertainty.correlation, _) =
+        linearized_errors(&(jacobian.transpose() * &jacobian), reduced_chi2);
+    for (i, &parameter) in parameters.iter().enumerate() {
+        let degenerate = uncertainty.correlation[i]
+            .iter()
+            .enumerate()
+            .any(|(j, rho)| j != i && rho.abs() > DEGENERATE_CORRELATION);
+        let error = uncertainty.errors[i];
+        let interval = space.bounds().get(parameter);
+        let vague = error > UNDETERMINED_RELATIVE_ERROR * values.get(parameter).abs()
+            && error > UNDETERMINED_RANGE_FRACTION * (interval.upper - interval.lower);
+        if !uncertainty.errors[i].is_finite() || degenerate || vague {
+            uncertainty.undetermined.push(parameter);
+        }
+    }
+    uncertainty
+}
+
+/// 1-σ errors s √(C_ii) and correlations of C = (JᵀJ)⁺ from the information matrix JᵀJ (in the
+/// parameters' own units), s² the reduced χ²; and which parameters load on a direction the data
+/// do not constrain (error ∞, correlations 0 off the diagonal).
+pub(crate) fn linearized_errors(
+    information: &DMatrix<f64>,
+    reduced_chi2: f64,
+) -> (Vec<f64>, Vec<Vec<f64>>, Vec<bool>) {
+    let dimension = information.nrows();
+    let mut errors = vec![f64::INFINITY; dimension];
+    let mut correlation = identity(dimension);
     // Scale to unit diagonal so that the singularity test does not depend on units.
     let scale: Vec<f64> = (0..dimension)
         .map(|i| {
@@ -137,31 +164,21 @@ pub(crate) fn estimate(objective: &Objective, search: &[f64], reduced_chi2: f64)
         1.0
     };
     for i in 0..dimension {
-        if unconstrained[i] || scale[i] == 0.0 {
+        if scale[i] == 0.0 {
+            unconstrained[i] = true;
+        }
+        if unconstrained[i] {
             continue;
         }
-        uncertainty.errors[i] = (inverse[(i, i)] * variance_scale).sqrt() * scale[i];
+        errors[i] = (inverse[(i, i)] * variance_scale).sqrt() * scale[i];
         for j in 0..dimension {
             if i != j && !unconstrained[j] && scale[j] != 0.0 {
                 let rho = inverse[(i, j)] / (inverse[(i, i)] * inverse[(j, j)]).sqrt();
-                uncertainty.correlation[i][j] = rho.clamp(-1.0, 1.0);
+                correlation[i][j] = rho.clamp(-1.0, 1.0);
             }
         }
     }
-    for (i, &parameter) in parameters.iter().enumerate() {
-        let degenerate = uncertainty.correlation[i]
-            .iter()
-            .enumerate()
-            .any(|(j, rho)| j != i && rho.abs() > DEGENERATE_CORRELATION);
-        let error = uncertainty.errors[i];
-        let interval = space.bounds().get(parameter);
-        let vague = error > UNDETERMINED_RELATIVE_ERROR * values.get(parameter).abs()
-            && error > UNDETERMINED_RANGE_FRACTION * (interval.upper - interval.lower);
-        if !uncertainty.errors[i].is_finite() || degenerate || vague {
-            uncertainty.undetermined.push(parameter);
-        }
-    }
-    uncertainty
+    (errors, correlation, unconstrained)
 }
 
 fn identity(n: usize) -> Vec<Vec<f64>> {

@@ -150,6 +150,16 @@ pub struct FitRecord {
     /// side only (a linear 95 % interval reaching an end of the search interval; issue 16 item 3).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub profile_bounds: BTreeMap<String, ConfidenceBound>,
+    /// A spectral fit's 1-σ errors of the per-wavelength parameters (`n`, `k`, `rho_d`), one per
+    /// table wavelength (`uncertainty` holds the shared ones: σ, q and a law's).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub uncertainty_per_wavelength: BTreeMap<String, Vec<f64>>,
+    /// A spectral fit's quality at each wavelength.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub wavelengths: Vec<WavelengthQuality>,
+    /// A spectral fit's dispersion: which was kept and the information criteria of each fitted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dispersion: Option<DispersionChoice>,
     /// How the slope distribution was chosen when both were fitted (AIC/BIC comparison).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model_choice: Option<String>,
@@ -194,6 +204,31 @@ impl ConfidenceBound {
             (None, None) => format!("{name} not bounded in the search interval"),
         }
     }
+}
+
+/// How well a spectral fit matches one wavelength's data.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WavelengthQuality {
+    pub wavelength_um: f64,
+    pub points: usize,
+    /// χ² of this wavelength's observations over their number.
+    pub chi2_per_observation: f64,
+}
+
+/// The dispersion of a spectral fit and, when a law was fitted, the comparison with the table
+/// (DESIGN §1.9: the AIC of both).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DispersionChoice {
+    /// `table` or `lorentz:N`.
+    pub chosen: String,
+    pub table_aic: f64,
+    pub table_bic: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub law_aic: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub law_bic: Option<f64>,
 }
 
 /// A measurement file merged into a fit after [`FitRecord::source`].

@@ -28,6 +28,12 @@ const WAVELENGTH_RELATIVE_TOLERANCE: f64 = 1e-6;
 
 /// Reads and validates one measurement CSV. `path` is quoted as given in every message.
 pub fn read_measurement_csv(path: &Path) -> Result<MeasurementSet, MeasureError> {
+    let bytes = read_bytes(path)?;
+    parse_measurement_csv(path, &bytes)
+}
+
+/// The bytes of a measurement file, refused with a message if it cannot be read.
+fn read_bytes(path: &Path) -> Result<Vec<u8>, MeasureError> {
     let whole_file = |kind| Refusal::new(1, 1, kind).in_file(path);
     match std::fs::metadata(path) {
         Ok(meta) if meta.is_dir() => return Err(whole_file(MeasureErrorKind::IsDirectory)),
@@ -36,20 +42,46 @@ pub fn read_measurement_csv(path: &Path) -> Result<MeasurementSet, MeasureError>
         }
         _ => {}
     }
-    let bytes = std::fs::read(path).map_err(|e| {
+    std::fs::read(path).map_err(|e| {
         whole_file(MeasureErrorKind::Unreadable {
             reason: e.to_string(),
         })
-    })?;
-    parse_measurement_csv(path, &bytes)
+    })
 }
 
-/// Parses the bytes of a measurement CSV; `source` names it in messages and in the result.
-/// [`read_measurement_csv`] is this plus reading the file.
+/// Parses the bytes of a measurement CSV of one wavelength; `source` names it in messages and in
+/// the result. [`read_measurement_csv`] is this plus reading the file. A file whose
+/// wavelength_um column holds several wavelengths is refused at the first row of a second one
+/// ([`parse_measurement_sets`] reads it).
 pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementSet, MeasureError> {
+    let mut sets = parse_sets(source, bytes, false)?;
+    Ok(sets.remove(0))
+}
+
+/// Reads one measurement CSV as one set per wavelength, ascending (a spectral file, DESIGN
+/// §1.9, holds several in its wavelength_um column; most files hold one).
+pub fn read_measurement_sets(path: &Path) -> Result<Vec<MeasurementSet>, MeasureError> {
+    let bytes = read_bytes(path)?;
+    parse_sets(path, &bytes, true)
+}
+
+/// [`read_measurement_sets`] of bytes; `source` names them.
+pub fn parse_measurement_sets(
+    source: &Path,
+    bytes: &[u8],
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    parse_sets(source, bytes, true)
+}
+
+fn parse_sets(
+    source: &Path,
+    bytes: &[u8],
+    spectral: bool,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
     let sha256 = hex(&Sha256::digest(bytes));
     let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
-    let parsed = parse_text(text).map_err(|r| r.in_file(source))?;
+    let mut parsed = parse_text(text).map_err(|r| r.in_file(source))?;
+    let groups = wavelength_groups(&mut parsed, spectral).map_err(|r| r.in_file(source))?;
     let material = match parsed.metadata.material {
         Some(material) => material,
         None => source
@@ -57,20 +89,70 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
             .map(|stem| stem.to_string_lossy().into_owned())
             .unwrap_or_default(),
     };
-    let notes = signed_zenith_note(&source.display().to_string(), parsed.signed_rows)
+    let mut notes: Vec<String> =
+        signed_zenith_note(&source.display().to_string(), parsed.signed_rows)
+            .into_iter()
+            .collect();
+    Ok(groups
         .into_iter()
-        .collect();
-    Ok(MeasurementSet {
-        source: source.to_path_buf(),
-        sha256,
-        material,
-        wavelength_um: parsed.wavelength_um,
-        metadata: parsed.metadata.entries,
-        elements: parsed.layout.elements,
-        points: parsed.points,
-        merged: Vec::new(),
-        notes,
-    })
+        .map(|(wavelength_um, points)| MeasurementSet {
+            source: source.to_path_buf(),
+            sha256: sha256.clone(),
+            material: material.clone(),
+            wavelength_um,
+            metadata: parsed.metadata.entries.clone(),
+            elements: parsed.layout.elements.clone(),
+            points,
+            merged: Vec::new(),
+            // The file's notes go with its first set.
+            notes: std::mem::take(&mut notes),
+        })
+        .collect())
+}
+
+/// The rows of a parsed file by wavelength, ascending: all of them at the file's wavelength, or,
+/// for a wavelength_um column without a header, one group per distinct wavelength (equal within
+/// [`WAVELENGTH_RELATIVE_TOLERANCE`], the group keeping its first row's value). Unless `spectral`,
+/// a second wavelength is refused at its first row.
+fn wavelength_groups(
+    parsed: &mut ParsedText,
+    spectral: bool,
+) -> Result<Vec<(f64, Vec<MeasurementPoint>)>, Refusal> {
+    let points = std::mem::take(&mut parsed.points);
+    let Some(rows) = parsed.row_wavelengths.take() else {
+        return Ok(vec![(parsed.wavelength_um, points)]);
+    };
+    let mut groups: Vec<(HeaderWavelength, Vec<MeasurementPoint>)> = Vec::new();
+    for (point, (row, column)) in points.into_iter().zip(rows) {
+        match groups
+            .iter()
+            .position(|(w, _)| same_wavelength(w.um, row.um))
+        {
+            Some(i) => groups[i].1.push(point),
+            None if groups.is_empty() || spectral => groups.push((row, vec![point])),
+            None => {
+                let first = &groups[0].0;
+                return Err(Refusal::new(
+                    row.line,
+                    column,
+                    MeasureErrorKind::MixedWavelengths {
+                        value: shown(&row.text),
+                        first: shown(&first.text),
+                        first_line: first.line,
+                    },
+                ));
+            }
+        }
+    }
+    groups.sort_by(|a, b| a.0.um.total_cmp(&b.0.um));
+    Ok(groups
+        .into_iter()
+        .map(|(w, points)| (w.um, points))
+        .collect())
+}
+
+fn same_wavelength(a: f64, b: f64) -> bool {
+    (a - b).abs() <= WAVELENGTH_RELATIVE_TOLERANCE * a.max(b)
 }
 
 pub(crate) fn hex(bytes: &[u8]) -> String {
@@ -115,8 +197,12 @@ fn text_lines(text: &str) -> impl Iterator<Item = &str> {
 struct ParsedText {
     metadata: Metadata,
     layout: Layout,
+    /// The file's wavelength (the header's, else the first row's).
     wavelength_um: f64,
     points: Vec<MeasurementPoint>,
+    /// Each row's wavelength and the column it is in, for a wavelength_um column without a
+    /// header (which may hold several wavelengths).
+    row_wavelengths: Option<Vec<(HeaderWavelength, u64)>>,
     /// Rows whose θ_r was negative.
     signed_rows: usize,
 }
@@ -149,14 +235,20 @@ fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
     let header_fields = fields_of(header_line, header)?;
     let layout = parse_header_row(header_line, &header_fields)?;
 
-    let mut wavelength = match (&metadata.wavelength, layout.has(Quantity::Wavelength)) {
+    let wavelength = match (&metadata.wavelength, layout.has(Quantity::Wavelength)) {
         (Some(header), _) => WavelengthCheck::AgainstHeader(header.clone()),
-        (None, true) => WavelengthCheck::AgainstFirstRow(None),
+        (None, true) => WavelengthCheck::PerRow,
         (None, false) => return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength)),
     };
+    let mut row_wavelengths = Vec::new();
     let mut points = content
-        .map(|&(number, line)| parse_row(number, line, &layout, &mut wavelength))
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|&(number, line)| parse_row(number, line, &layout, &wavelength))
+        .map(|row| {
+            let (point, row_wavelength) = row?;
+            row_wavelengths.extend(row_wavelength);
+            Ok(point)
+        })
+        .collect::<Result<Vec<_>, Refusal>>()?;
     let signed_rows = fold_signed_detector_angles(&mut points);
     if points.is_empty() {
         return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
@@ -175,18 +267,23 @@ fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
             MeasureErrorKind::AllM00Zero,
         ));
     }
-    let wavelength_um = match wavelength {
-        WavelengthCheck::AgainstHeader(header) => header.um,
-        // With a wavelength column and at least one row, the first row has set it.
-        WavelengthCheck::AgainstFirstRow(first) => first
-            .map(|f| f.um)
-            .ok_or_else(|| Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows))?,
+    let (wavelength_um, row_wavelengths) = match wavelength {
+        WavelengthCheck::AgainstHeader(header) => (header.um, None),
+        // With a wavelength column and at least one row, the first row has one.
+        WavelengthCheck::PerRow => (
+            row_wavelengths
+                .first()
+                .map(|(w, _): &(HeaderWavelength, u64)| w.um)
+                .ok_or_else(|| Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows))?,
+            Some(row_wavelengths),
+        ),
     };
     Ok(ParsedText {
         metadata,
         layout,
         wavelength_um,
         points,
+        row_wavelengths,
         signed_rows,
     })
 }
@@ -207,18 +304,25 @@ fn fields_of(line_number: u64, line: &str) -> Result<Vec<Field<'_>>, Refusal> {
     split_fields(line).map_err(|(column, kind)| Refusal::new(line_number, column, kind))
 }
 
-/// How each row's wavelength_um is checked: a fit is per wavelength (DESIGN §2.1), so every row
-/// must agree with the header, or, without a header, with the first row.
+/// How each row's wavelength_um is read: with a `# wavelength_um:` header every row must agree
+/// with it (DESIGN §2.1); without one each row carries its own (a spectral file may hold
+/// several, DESIGN §1.9).
 enum WavelengthCheck {
     AgainstHeader(HeaderWavelength),
-    AgainstFirstRow(Option<HeaderWavelength>),
+    PerRow,
 }
 
 impl WavelengthCheck {
-    fn check(&mut self, line: u64, column: u64, um: f64, text: &str) -> Result<(), Refusal> {
-        let same = |a: f64, b: f64| (a - b).abs() <= WAVELENGTH_RELATIVE_TOLERANCE * a.max(b);
+    /// The row's own wavelength, for [`WavelengthCheck::PerRow`].
+    fn check(
+        &self,
+        line: u64,
+        column: u64,
+        um: f64,
+        text: &str,
+    ) -> Result<Option<(HeaderWavelength, u64)>, Refusal> {
         match self {
-            Self::AgainstHeader(header) if !same(header.um, um) => Err(Refusal::new(
+            Self::AgainstHeader(header) if !same_wavelength(header.um, um) => Err(Refusal::new(
                 line,
                 column,
                 MeasureErrorKind::WavelengthDisagrees {
@@ -227,24 +331,15 @@ impl WavelengthCheck {
                     header_line: header.line,
                 },
             )),
-            Self::AgainstFirstRow(Some(first)) if !same(first.um, um) => Err(Refusal::new(
-                line,
-                column,
-                MeasureErrorKind::MixedWavelengths {
-                    value: shown(text),
-                    first: shown(&first.text),
-                    first_line: first.line,
-                },
-            )),
-            Self::AgainstFirstRow(first @ None) => {
-                *first = Some(HeaderWavelength {
+            Self::AgainstHeader(_) => Ok(None),
+            Self::PerRow => Ok(Some((
+                HeaderWavelength {
                     um,
                     text: text.to_string(),
                     line,
-                });
-                Ok(())
-            }
-            _ => Ok(()),
+                },
+                column,
+            ))),
         }
     }
 }
@@ -253,8 +348,8 @@ fn parse_row(
     line_number: u64,
     line: &str,
     layout: &Layout,
-    wavelength: &mut WavelengthCheck,
-) -> Result<MeasurementPoint, Refusal> {
+    wavelength: &WavelengthCheck,
+) -> Result<(MeasurementPoint, Option<(HeaderWavelength, u64)>), Refusal> {
     let fields = fields_of(line_number, line)?;
     if let Some(refusal) = fields
         .iter()
@@ -289,6 +384,7 @@ fn parse_row(
         uncertainties: vec![None; layout.elements.len()],
         line: line_number,
     };
+    let mut row_wavelength = None;
     for ((field, &quantity), name) in fields.iter().zip(&layout.quantities).zip(&layout.names) {
         let refuse = |kind| Err(Refusal::new(line_number, field.column, kind));
         let text = field.text.as_ref();
@@ -323,7 +419,7 @@ fn parse_row(
                 if let Some(kind) = wavelength_refusal(value, text) {
                     return refuse(kind);
                 }
-                wavelength.check(line_number, field.column, value, text)?;
+                row_wavelength = wavelength.check(line_number, field.column, value, text)?;
             }
             Quantity::Element(index) => {
                 if index == 0 && value < 0.0 {
@@ -346,7 +442,7 @@ fn parse_row(
             }
         }
     }
-    Ok(point)
+    Ok((point, row_wavelength))
 }
 
 /// Why a wavelength_um field's (finite) value is not a wavelength irpol models, if it is not.

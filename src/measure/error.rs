@@ -115,7 +115,7 @@ pub enum MeasureErrorKind {
         header_line: u64,
     },
     #[error(
-        "column 'wavelength_um': {value} differs from {first} on line {first_line}; a fit is per wavelength, so give one file per wavelength"
+        "column 'wavelength_um': {value} differs from {first} on line {first_line}: the file holds several wavelengths, a spectral set, which `irpol fit` reads as one material but this reader of one wavelength cannot"
     )]
     MixedWavelengths {
         value: String,

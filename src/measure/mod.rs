@@ -30,7 +30,9 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 pub(crate) use csv_reader::hex;
-pub use csv_reader::{parse_measurement_csv, read_measurement_csv};
+pub use csv_reader::{
+    parse_measurement_csv, parse_measurement_sets, read_measurement_csv, read_measurement_sets,
+};
 pub use error::{Delimiter, MeasureError, MeasureErrorKind};
 pub use files::collect_measurement_files;
 pub use fingerprint::SourceData;

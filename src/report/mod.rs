@@ -5,6 +5,7 @@
 pub mod fit_report;
 pub mod index;
 pub mod paper_figures;
+pub mod spectral_report;
 
 use std::sync::Once;
 

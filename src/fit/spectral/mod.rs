@@ -1,0 +1,462 @@
+//! Joint fit of a spectral measurement set (DESIGN §1.9): every wavelength of one material at
+//! once, with σ and q shared (the surface's geometry does not depend on λ) and per wavelength
+//! either n, k, ρ_d free (`--dispersion table`, the default) or ρ_d free and n, k from a Lorentz
+//! law with shared parameters (`--dispersion lorentz:N`).
+//!
+//! How: each wavelength is first fitted alone (the grey pipeline: GA then local stages, in
+//! parallel), which finds each lobe and index without any joint search over 2 + 3K dimensions;
+//! the joint problem ([`joint`]) then starts from the per-wavelength values with σ, q at their
+//! medians and is polished by Levenberg–Marquardt, whose Jacobian costs five residual
+//! evaluations whatever K is. A Lorentz fit starts from a law fitted to the table's ε(λ)
+//! ([`lorentz_start`]). Uncertainties and correlations come from the joint Jacobian at the
+//! optimum, as for one wavelength ([`super::uncertainty`]).
+
+mod joint;
+mod lorentz_start;
+mod record;
+
+use super::comparison::{aic, bic};
+use super::data::MeasurementData;
+use super::levenberg_marquardt::{levenberg_marquardt, LeastSquares};
+use super::model_fit::{fit_model, model_space, ModelFit};
+use super::objective::Objective;
+use super::options::FitOptions;
+use super::parameters::{
+    from_search, to_search, value_per_coordinate, DistributionKind, Parameter,
+};
+use super::space::ModelSpace;
+use super::stages::StageHistory;
+use super::uncertainty::linearized_errors;
+use super::FitError;
+use crate::material::{Material, SpectralModel};
+use crate::measure::MeasurementSet;
+use crate::optics::{LorentzDispersion, Mueller};
+use joint::{Block, IndexModel, JointProblem};
+use lorentz_start::{law_bounds, lorentz_start};
+use num_complex::Complex64;
+use rayon::prelude::*;
+
+/// How n and k depend on wavelength in a spectral fit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Dispersion {
+    /// n and k free at each wavelength.
+    #[default]
+    Table,
+    /// A Lorentz law of this many oscillators (DESIGN §1.9).
+    Lorentz(usize),
+}
+
+impl Dispersion {
+    /// `table` or `lorentz:N` (N ≥ 1).
+    pub fn parse(text: &str) -> Result<Dispersion, String> {
+        let text = text.trim();
+        if text == "table" {
+            return Ok(Dispersion::Table);
+        }
+        match text.strip_prefix("lorentz:").map(str::parse::<usize>) {
+            Some(Ok(n)) if (1..=6).contains(&n) => Ok(Dispersion::Lorentz(n)),
+            _ => Err(format!(
+                "unknown dispersion '{}': use table or lorentz:N with N = 1…6 oscillators",
+                crate::text::shown(text)
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for Dispersion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Dispersion::Table => f.write_str("table"),
+            Dispersion::Lorentz(n) => write!(f, "lorentz:{n}"),
+        }
+    }
+}
+
+/// One joint fit of a spectral set.
+#[derive(Clone, Debug)]
+pub struct SpectralFit {
+    pub distribution: DistributionKind,
+    pub dispersion: Dispersion,
+    /// The fitted model (n, k of a law evaluated at the measured wavelengths).
+    pub model: SpectralModel,
+    /// Names of the free coordinates (`sigma`, `q`, `eps_inf`, `resonance_um_1`, …,
+    /// `n(8.5um)`, …) and their values, 1-σ errors and correlations, in the same order.
+    pub names: Vec<String>,
+    pub values: Vec<f64>,
+    pub errors: Vec<f64>,
+    pub correlation: Vec<Vec<f64>>,
+    /// 1-σ errors of n, k, ρ_d at each wavelength (of a law's n, k: propagated from it).
+    pub n_errors: Vec<f64>,
+    pub k_errors: Vec<f64>,
+    pub rho_d_errors: Vec<f64>,
+    pub chi2: f64,
+    pub observations: usize,
+    pub degrees_of_freedom: usize,
+    pub reduced_chi2: f64,
+    pub aic: f64,
+    pub bic: f64,
+    /// χ² and observations of each wavelength.
+    pub chi2_per_wavelength: Vec<(f64, usize)>,
+    /// The model's Mueller matrices at every point of every wavelength.
+    pub model_muellers: Vec<Vec<Mueller>>,
+    pub history: StageHistory,
+    /// Model evaluations of the joint stage (residual vectors of every wavelength).
+    pub evaluations: u64,
+}
+
+/// A fitted spectral set.
+#[derive(Clone, Debug)]
+pub struct SpectralFitOutcome {
+    /// One set per wavelength, ascending.
+    pub measurements: Vec<MeasurementSet>,
+    pub material: Material,
+    pub chosen: SpectralFit,
+    /// The table fit when a law was chosen (for the AIC comparison DESIGN §1.9 asks for).
+    pub table: Option<SpectralFit>,
+    /// The other distribution's table fit, when both were fitted.
+    pub alternative: Option<SpectralFit>,
+    /// Each wavelength's own fit (chosen distribution), where the joint fit started.
+    pub per_wavelength: Vec<ModelFit>,
+}
+
+/// Fits the sets (one material, one per wavelength, ascending) jointly.
+pub fn fit_spectral(
+    sets: Vec<MeasurementSet>,
+    options: &FitOptions,
+    dispersion: Dispersion,
+) -> Result<SpectralFitOutcome, FitError> {
+    let data = sets
+        .iter()
+        .map(MeasurementData::new)
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut fits = Vec::new();
+    for kind in options.distributions() {
+        let alone = sets
+            .par_iter()
+            .zip(&data)
+            .map(|(set, data)| fit_model(set, data, kind, options))
+            .collect::<Result<Vec<_>, _>>()?;
+        let joint = fit_table(&sets, &data, kind, options, &alone)?;
+        fits.push((joint, alone));
+    }
+    fits.sort_by(|a, b| a.0.aic.total_cmp(&b.0.aic));
+    let (table, per_wavelength) = fits.remove(0);
+    let alternative = fits.pop().map(|(fit, _)| fit);
+    let (chosen, table) = match dispersion {
+        Dispersion::Table => (table, None),
+        Dispersion::Lorentz(oscillators) => (
+            fit_lorentz(&sets, &data, options, &table, oscillators)?,
+            Some(table),
+        ),
+    };
+    let material = record::material(
+        &sets,
+        &data,
+        options,
+        &chosen,
+        table.as_ref(),
+        alternative.as_ref(),
+    );
+    Ok(SpectralFitOutcome {
+        measurements: sets,
+        material,
+        chosen,
+        table,
+        alternative,
+        per_wavelength,
+    })
+}
+
+/// The table fit of family `kind`, from the wavelengths' own fits `alone`.
+fn fit_table(
+    sets: &[MeasurementSet],
+    data: &[MeasurementData],
+    kind: DistributionKind,
+    options: &FitOptions,
+    alone: &[ModelFit],
+) -> Result<SpectralFit, FitError> {
+    let space = model_space(kind, options)?;
+    let spaces = vec![space; sets.len()];
+    let problem = joint_problem(sets, data, &spaces, options, IndexModel::Table, None);
+    let median = |p: Parameter| {
+        let mut v: Vec<f64> = alone.iter().map(|f| f.value(p)).collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut start = Vec::new();
+    for &p in &problem.shared {
+        start.push(to_search(p, median(p)));
+    }
+    for &p in &problem.families {
+        start.extend(alone.iter().map(|fit| to_search(p, fit.value(p))));
+    }
+    solve(&problem, sets, &start, options, kind, Dispersion::Table)
+}
+
+/// The Lorentz fit with `oscillators`, started from the `table` fit.
+fn fit_lorentz(
+    sets: &[MeasurementSet],
+    data: &[MeasurementData],
+    options: &FitOptions,
+    table: &SpectralFit,
+    oscillators: usize,
+) -> Result<SpectralFit, FitError> {
+    let kind = table.distribution;
+    let free: Vec<Parameter> = options
+        .free_parameters()?
+        .into_iter()
+        .filter(|p| !matches!(p, Parameter::N | Parameter::K))
+        .collect();
+    let mut law_options = options.clone();
+    law_options.free = Some(free);
+    let space = model_space(kind, &law_options)?;
+    let spaces = vec![space; sets.len()];
+    let wavelengths = &table.model.wavelength_um;
+    let eps: Vec<Complex64> = (0..wavelengths.len())
+        .map(|j| Complex64::new(table.model.n[j], table.model.k[j]).powi(2))
+        .collect();
+    let law_start = lorentz_start(oscillators, wavelengths, &eps);
+    let bounds = law_bounds(
+        oscillators,
+        wavelengths[0],
+        wavelengths[wavelengths.len() - 1],
+    );
+    let model = IndexModel::Lorentz(oscillators);
+    let problem = joint_problem(sets, data, &spaces, options, model, Some(bounds));
+    let shared_start = |p: Parameter| {
+        let i = table.names.iter().position(|n| n == p.name());
+        to_search(p, i.map_or(1.0, |i| table.values[i]))
+    };
+    let mut start: Vec<f64> = problem.shared.iter().map(|&p| shared_start(p)).collect();
+    start.extend(law_start);
+    for &p in &problem.families {
+        for j in 0..sets.len() {
+            let value = match p {
+                Parameter::RhoD => table.model.rho_d[j],
+                _ => 0.0,
+            };
+            start.push(to_search(p, value));
+        }
+    }
+    solve(
+        &problem,
+        sets,
+        &start,
+        options,
+        kind,
+        Dispersion::Lorentz(oscillators),
+    )
+}
+
+fn joint_problem<'a>(
+    sets: &[MeasurementSet],
+    data: &'a [MeasurementData],
+    spaces: &'a [ModelSpace],
+    options: &FitOptions,
+    index_model: IndexModel,
+    law_bounds: Option<(Vec<f64>, Vec<f64>)>,
+) -> JointProblem<'a> {
+    let mut end = 0;
+    let blocks = data
+        .iter()
+        .zip(spaces)
+        .zip(sets)
+        .map(|((data, space), set)| {
+            let rows = end..end + data.observations();
+            end = rows.end;
+            Block {
+                objective: Objective::new(data, space, options.robust),
+                wavelength_um: set.wavelength_um,
+                rows,
+            }
+        })
+        .collect();
+    JointProblem::new(blocks, index_model, law_bounds.unwrap_or_default())
+}
+
+/// Polishes `problem` from `start` and gathers everything about the optimum.
+fn solve(
+    problem: &JointProblem,
+    sets: &[MeasurementSet],
+    start: &[f64],
+    options: &FitOptions,
+    kind: DistributionKind,
+    dispersion: Dispersion,
+) -> Result<SpectralFit, FitError> {
+    let settings = &options.settings.levenberg_marquardt;
+    let (best, history) = levenberg_marquardt(problem, start, settings);
+    let invalid = || FitError::Optimizer {
+        file: sets[0].source.clone(),
+        stage: "joint lm".into(),
+        message: format!("the best {kind} {dispersion} model could not be evaluated"),
+    };
+    let r = problem.residuals(&best).ok_or_else(invalid)?;
+    let jacobian = problem.jacobian(&best, &r).ok_or_else(invalid)?;
+    let values: Vec<_> = (0..sets.len())
+        .map(|j| problem.block_values(&best, j))
+        .collect();
+    let mut chi2_per_wavelength = Vec::new();
+    let mut model_muellers = Vec::new();
+    for (j, block) in problem.blocks.iter().enumerate() {
+        let residuals = block
+            .objective
+            .normalized_residuals(&values[j])
+            .ok_or_else(invalid)?;
+        chi2_per_wavelength.push((residuals.iter().map(|x| x * x).sum(), residuals.len()));
+        model_muellers.push(
+            block
+                .objective
+                .model_muellers(&values[j])
+                .ok_or_else(invalid)?,
+        );
+    }
+    let chi2: f64 = chi2_per_wavelength.iter().map(|c| c.0).sum();
+    let free = best.len();
+    let observations = problem.observations;
+    let degrees_of_freedom = observations.saturating_sub(free).max(1);
+    let reduced_chi2 = chi2 / degrees_of_freedom as f64;
+    let coordinates = coordinates(problem, sets);
+    let mut physical = jacobian;
+    let mut physical_values = Vec::with_capacity(free);
+    for (c, coordinate) in coordinates.iter().enumerate() {
+        let (value, per_coordinate) = match coordinate.1 {
+            Some(p) => (from_search(p, best[c]), value_per_coordinate(p, best[c])),
+            None => (best[c], 1.0),
+        };
+        physical_values.push(value);
+        physical.column_mut(c).unscale_mut(per_coordinate);
+    }
+    let (errors, correlation, _) =
+        linearized_errors(&(physical.transpose() * &physical), reduced_chi2);
+    let law = problem.law(&best);
+    let model = SpectralModel {
+        distribution: kind.distribution(&values[0]),
+        shadowing: options.shadowing,
+        wavelength_um: sets.iter().map(|s| s.wavelength_um).collect(),
+        n: values.iter().map(|v| v.get(Parameter::N)).collect(),
+        k: values.iter().map(|v| v.get(Parameter::K)).collect(),
+        rho_d: values.iter().map(|v| v.get(Parameter::RhoD)).collect(),
+        dispersion: law.clone(),
+    };
+    let family_errors = |p: Parameter| {
+        (0..sets.len())
+            .map(|j| {
+                coordinates
+                    .iter()
+                    .position(|c| c.1 == Some(p) && c.2 == Some(j))
+                    .map_or(0.0, |c| errors[c])
+            })
+            .collect::<Vec<_>>()
+    };
+    let (n_errors, k_errors) = match &law {
+        None => (family_errors(Parameter::N), family_errors(Parameter::K)),
+        Some(law) => {
+            propagate_law_errors(law, problem, &model.wavelength_um, &errors, &correlation)
+        }
+    };
+    let rho_d_errors = family_errors(Parameter::RhoD);
+    Ok(SpectralFit {
+        distribution: kind,
+        dispersion,
+        model,
+        names: coordinates.into_iter().map(|c| c.0).collect(),
+        values: physical_values,
+        n_errors,
+        k_errors,
+        rho_d_errors,
+        errors,
+        correlation,
+        chi2,
+        observations,
+        degrees_of_freedom,
+        reduced_chi2,
+        aic: aic(chi2, free),
+        bic: bic(chi2, free, observations),
+        chi2_per_wavelength,
+        model_muellers,
+        evaluations: history.evaluations,
+        history,
+    })
+}
+
+/// Name, model parameter (None for a law coordinate) and wavelength index of each coordinate.
+fn coordinates(
+    problem: &JointProblem,
+    sets: &[MeasurementSet],
+) -> Vec<(String, Option<Parameter>, Option<usize>)> {
+    let mut out: Vec<_> = problem
+        .shared
+        .iter()
+        .map(|&p| (p.name().to_owned(), Some(p), None))
+        .collect();
+    if let IndexModel::Lorentz(oscillators) = problem.index_model {
+        out.push(("eps_inf".into(), None, None));
+        for o in 1..=oscillators {
+            for name in ["resonance_um", "strength", "damping_um"] {
+                out.push((format!("{name}_{o}"), None, None));
+            }
+        }
+    }
+    for &p in &problem.families {
+        for (j, set) in sets.iter().enumerate() {
+            let at = crate::text::number(set.wavelength_um);
+            out.push((format!("{}({at}um)", p.name()), Some(p), Some(j)));
+        }
+    }
+    out
+}
+
+/// 1-σ errors of a law's n and k at each wavelength, g·C·g with g = ∂(n, k)/∂(law) by central
+/// differences and C the law coordinates' covariance.
+fn propagate_law_errors(
+    law: &LorentzDispersion,
+    problem: &JointProblem,
+    wavelengths: &[f64],
+    errors: &[f64],
+    correlation: &[Vec<f64>],
+) -> (Vec<f64>, Vec<f64>) {
+    let at = problem.shared.len();
+    let coordinates: Vec<f64> = std::iter::once(law.eps_inf)
+        .chain(
+            law.oscillators
+                .iter()
+                .flat_map(|o| [o.resonance_um, o.strength, o.damping_um]),
+        )
+        .collect();
+    let gradient = |w: f64| {
+        (0..coordinates.len())
+            .map(|c| {
+                let h = 1e-6 * coordinates[c].abs().max(1e-3);
+                let shifted = |sign: f64| {
+                    let mut s = coordinates.clone();
+                    s[c] += sign * h;
+                    lorentz_start::law_of(&s).index(w)
+                };
+                let (plus, minus) = (shifted(1.0), shifted(-1.0));
+                (
+                    (plus.n - minus.n) / (2.0 * h),
+                    (plus.k - minus.k) / (2.0 * h),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    let variance = |g: &[f64]| {
+        let mut sum = 0.0;
+        for (a, ga) in g.iter().enumerate() {
+            for (b, gb) in g.iter().enumerate() {
+                let (ea, eb) = (errors[at + a], errors[at + b]);
+                sum += ga * gb * correlation[at + a][at + b] * ea * eb;
+            }
+        }
+        sum.max(0.0).sqrt()
+    };
+    wavelengths
+        .iter()
+        .map(|&w| {
+            let g = gradient(w);
+            let gn: Vec<f64> = g.iter().map(|x| x.0).collect();
+            let gk: Vec<f64> = g.iter().map(|x| x.1).collect();
+            (variance(&gn), variance(&gk))
+        })
+        .unzip()
+}

@@ -1,0 +1,177 @@
+//! The library entry of a spectral fit: the spectral model and its fit record (DESIGN §2.2,
+//! §2.6), with the per-wavelength errors mirroring the model's arrays.
+
+use super::super::data::MeasurementData;
+use super::super::options::FitOptions;
+use super::super::outcome::settings;
+use super::SpectralFit;
+use crate::material::{
+    DispersionChoice, FitRecord, Material, MaterialModel, MergedSource, WavelengthQuality,
+};
+use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
+use std::collections::BTreeMap;
+
+/// The material of the chosen fit, recording the table fit (when a law was chosen) and the other
+/// distribution's fit for comparison.
+pub(super) fn material(
+    sets: &[MeasurementSet],
+    data: &[MeasurementData],
+    options: &FitOptions,
+    chosen: &SpectralFit,
+    table: Option<&SpectralFit>,
+    alternative: Option<&SpectralFit>,
+) -> Material {
+    Material {
+        name: sets[0].material.clone(),
+        tool_version: format!("irpol {}", env!("CARGO_PKG_VERSION")),
+        model: MaterialModel::Spectral(chosen.model.clone()),
+        fit: Some(fit_record(sets, data, options, chosen, table, alternative)),
+    }
+}
+
+fn fit_record(
+    sets: &[MeasurementSet],
+    data: &[MeasurementData],
+    options: &FitOptions,
+    chosen: &SpectralFit,
+    table: Option<&SpectralFit>,
+    alternative: Option<&SpectralFit>,
+) -> FitRecord {
+    let first = &sets[0];
+    // Every file after the first, once each (a spectral file gives several sets).
+    let mut merged: Vec<MergedSource> = Vec::new();
+    let files = sets.iter().flat_map(|set| {
+        std::iter::once((set.source.clone(), set.sha256.clone(), set.points.len())).chain(
+            set.merged
+                .iter()
+                .map(|f| (f.path.clone(), f.sha256.clone(), f.rows)),
+        )
+    });
+    for (source, sha256, rows) in files {
+        if sha256 == first.sha256 {
+            continue;
+        }
+        match merged.iter_mut().find(|m| m.source_sha256 == sha256) {
+            Some(m) => m.points += rows,
+            None => merged.push(MergedSource {
+                source,
+                source_sha256: sha256,
+                source_data: None,
+                points: rows,
+            }),
+        }
+    }
+    let mut elements: Vec<usize> = sets.iter().flat_map(|s| s.elements.clone()).collect();
+    elements.sort_unstable();
+    elements.dedup();
+    let is_shared = |name: &String| !name.contains('(');
+    let mut settings = settings(&data[0], options);
+    settings.insert(
+        "spectral".into(),
+        "each wavelength fitted alone (the stages above), then jointly by lm from the medians of \
+         σ and q"
+            .into(),
+    );
+    let (table_fit, law) = match table {
+        Some(table) => (table, Some(chosen)),
+        None => (chosen, None),
+    };
+    FitRecord {
+        source: first.source.clone(),
+        source_sha256: first.sha256.clone(),
+        source_data: None,
+        merged_sources: merged,
+        points: sets.iter().map(|s| s.points.len()).sum(),
+        elements: elements
+            .iter()
+            .map(|&e| MUELLER_ELEMENT_NAMES[e].to_owned())
+            .collect(),
+        free_parameters: chosen.names.clone(),
+        fixed_parameters: options
+            .fixed
+            .iter()
+            .map(|(p, v)| (p.name().to_owned(), *v))
+            .collect(),
+        optimizer: format!("{} per wavelength, then joint lm", options.optimizer),
+        seed: options.seed,
+        settings,
+        iterations: chosen.history.iterations,
+        evaluations: chosen.evaluations,
+        cost: chosen.chi2,
+        reduced_chi2: chosen.reduced_chi2,
+        degrees_of_freedom: chosen.degrees_of_freedom,
+        aic: chosen.aic,
+        bic: chosen.bic,
+        termination: format!("joint lm: {}", chosen.history.termination),
+        rmse: rmse(sets, chosen),
+        uncertainty: chosen
+            .names
+            .iter()
+            .zip(&chosen.errors)
+            .filter(|(name, _)| is_shared(name))
+            .map(|(name, &e)| (name.clone(), e))
+            .collect(),
+        correlation: chosen.correlation.clone(),
+        undetermined: Vec::new(),
+        at_bound: Vec::new(),
+        profile_bounds: BTreeMap::new(),
+        uncertainty_per_wavelength: [
+            ("n", &chosen.n_errors),
+            ("k", &chosen.k_errors),
+            ("rho_d", &chosen.rho_d_errors),
+        ]
+        .into_iter()
+        .map(|(name, errors)| (name.to_owned(), errors.clone()))
+        .collect(),
+        wavelengths: sets
+            .iter()
+            .zip(&chosen.chi2_per_wavelength)
+            .map(|(set, &(chi2, observations))| WavelengthQuality {
+                wavelength_um: set.wavelength_um,
+                points: set.points.len(),
+                chi2_per_observation: chi2 / observations.max(1) as f64,
+            })
+            .collect(),
+        dispersion: Some(DispersionChoice {
+            chosen: chosen.dispersion.to_string(),
+            table_aic: table_fit.aic,
+            table_bic: table_fit.bic,
+            law_aic: law.map(|l| l.aic),
+            law_bic: law.map(|l| l.bic),
+        }),
+        model_choice: alternative.map(|other| {
+            format!(
+                "{} preferred over {} (ΔAIC = {:.1}, ΔBIC = {:.1}, table fits)",
+                table_fit.distribution,
+                other.distribution,
+                other.aic - table_fit.aic,
+                other.bic - table_fit.bic
+            )
+        }),
+        alternative: None,
+        convergence: chosen.history.best_cost.clone(),
+        global_iterations: 0,
+    }
+}
+
+/// RMS of (model − data) in sr⁻¹ per element over every wavelength that measured it.
+fn rmse(sets: &[MeasurementSet], fit: &SpectralFit) -> BTreeMap<String, f64> {
+    let mut sums: BTreeMap<usize, (f64, usize)> = BTreeMap::new();
+    for (set, muellers) in sets.iter().zip(&fit.model_muellers) {
+        for (point, m) in set.points.iter().zip(muellers) {
+            for (e, &index) in set.elements.iter().enumerate() {
+                let entry = sums.entry(index).or_default();
+                entry.0 += (m[(index / 4, index % 4)] - point.values[e]).powi(2);
+                entry.1 += 1;
+            }
+        }
+    }
+    sums.into_iter()
+        .map(|(index, (sum, count))| {
+            (
+                MUELLER_ELEMENT_NAMES[index].to_owned(),
+                (sum / count.max(1) as f64).sqrt(),
+            )
+        })
+        .collect()
+}
