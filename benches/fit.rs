@@ -9,10 +9,10 @@ mod fit_support;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fit_support::{goniometer_geometry, model, synthetic_set, LINEAR_ELEMENTS};
 use irpol::fit::{
-    fit_measurement, DistributionKind, FitOptions, MeasurementData, ModelSpace, Objective,
-    Parameter, ParameterBounds, ParameterValues,
+    fit_measurement, fit_spectral, Dispersion, DistributionKind, FitOptions, MeasurementData,
+    ModelSpace, Objective, Parameter, ParameterBounds, ParameterValues,
 };
-use irpol::measure::{read_measurement_csv, MeasurementSet};
+use irpol::measure::{read_measurement_csv, read_measurement_sets, MeasurementSet};
 use irpol::pbrdf::{Shadowing, SlopeDistribution};
 use std::path::Path;
 use std::time::Duration;
@@ -84,5 +84,63 @@ fn default_fit(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, objective, default_fit);
+/// Issue 13: the joint fit of a spectral set (table dispersion, both distributions, each
+/// wavelength fitted alone first): nine wavelengths of the silicate truth × the 472-geometry
+/// goniometer, and the shipped silicate_glass.csv (nine wavelengths, 3682 rows × 16 elements).
+/// Target: ≤ 1 s for 9 × 500 geometries.
+fn spectral_fit(c: &mut Criterion) {
+    let mut group = c.benchmark_group("spectral_fit");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    let truth = [
+        (8.0, 0.517774, 0.543731),
+        (8.5, 0.588464, 1.2793),
+        (9.0, 1.36346, 2.12223),
+        (9.5, 2.87319, 1.38554),
+        (10.0, 2.62133, 0.477271),
+        (10.6, 2.30722, 0.210027),
+        (11.5, 2.08423, 0.100204),
+        (12.5, 1.96574, 0.0596999),
+        (14.0, 1.87624, 0.0359674),
+    ];
+    let synthetic: Vec<MeasurementSet> = truth
+        .iter()
+        .enumerate()
+        .map(|(i, &(w, n, k))| {
+            let distribution = SlopeDistribution::Cauchy {
+                sigma: 0.06,
+                q: 2.8,
+            };
+            let pbrdf = model(distribution, Shadowing::Smith, n, k, 0.0);
+            let geometry = goniometer_geometry();
+            let mut set = synthetic_set(
+                "silicate",
+                &pbrdf,
+                &geometry,
+                &LINEAR_ELEMENTS,
+                1.0,
+                i as u64,
+            );
+            set.wavelength_um = w;
+            set
+        })
+        .collect();
+    let shipped = read_measurement_sets(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("measurements/silicate_glass.csv"),
+    )
+    .unwrap();
+    for (name, sets) in [
+        ("synthetic_9x472x9", synthetic),
+        ("silicate_glass_3682x16", shipped),
+    ] {
+        let options = FitOptions::default();
+        group.bench_function(name, |b| {
+            b.iter(|| fit_spectral(black_box(sets.clone()), &options, Dispersion::Table).unwrap())
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, objective, default_fit, spectral_fit);
 criterion_main!(benches);
