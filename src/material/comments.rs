@@ -69,6 +69,29 @@ const TABLES: &[(&str, &str)] = &[
     ),
     ("fit.alternative.model", "Its model (keys as in [model])."),
     (
+        "model.dispersion",
+        "The Lorentz law the spectral fit used (DESIGN §1.9): ε(ν) = eps_inf + Σ strength ν_j² /\n\
+         (ν_j² − ν² − iγ_jν), ν = 1/λ, ν_j = 1/resonance_um, γ_j = damping_um/resonance_um²;\n\
+         n and k above are this law at wavelength_um.",
+    ),
+    (
+        "model.dispersion.oscillators",
+        "One oscillator: resonance wavelength (µm), strength Δε, line width in wavelength (µm).",
+    ),
+    (
+        "fit.uncertainty_per_wavelength",
+        "1-σ errors of the per-wavelength parameters, one per wavelength_um (a law's n, k: from\n\
+         the law's covariance); [fit.uncertainty] holds the shared ones.",
+    ),
+    (
+        "fit.wavelengths",
+        "The spectral fit at one wavelength: its points and χ² per observation.",
+    ),
+    (
+        "fit.dispersion",
+        "How n, k depend on λ (table or lorentz:N) and the AIC/BIC of the table and of a law.",
+    ),
+    (
         "fit.profile_bounds.*",
         "What the data allow for a parameter whose ± would mislead (undetermined, or bounded\n\
          from one side only): one-sided profile-likelihood bounds (docs/materials.md).",
