@@ -547,9 +547,19 @@ mod tests {
         let no_header = "theta_i_deg,theta_r_deg,m00,wavelength_um\n0,0,1,10\n1,1,1,10.6\n";
         assert_eq!(
             message(no_header),
-            "mem/sample.csv:3:7: column 'wavelength_um': 10.6 differs from 10 on line 2; \
-             a fit is per wavelength, so give one file per wavelength"
+            "mem/sample.csv:3:7: column 'wavelength_um': 10.6 differs from 10 on line 2: the \
+             file holds several wavelengths, a spectral set, which `irpol fit` reads as one \
+             material but this reader of one wavelength cannot"
         );
+        // The spectral reader splits the file by wavelength, ascending, rows in file order.
+        let text = "theta_i_deg,theta_r_deg,m00,wavelength_um\n0,0,1,10.6\n1,1,1,10\n\
+                    2,2,1,10.600001\n";
+        let sets = parse_measurement_sets(Path::new("s.csv"), text.as_bytes()).unwrap();
+        let split: Vec<(f64, Vec<u64>)> = sets
+            .iter()
+            .map(|s| (s.wavelength_um, s.points.iter().map(|p| p.line).collect()))
+            .collect();
+        assert_eq!(split, [(10.0, vec![3]), (10.6, vec![2, 4])]);
     }
 
     #[test]
