@@ -449,7 +449,8 @@ fn in_plane_scan(step: usize) -> Vec<(f64, f64, f64)> {
 
 /// Issue 16 items 2 and 11: a measurement file with signed θ_r fits (with one note), two files
 /// of one material at one wavelength are merged as repeat measurements with a note, recorded in
-/// the TOML, and `irpol report` rebuilds from both; another wavelength is refused naming both.
+/// the TOML, and `irpol report` rebuilds from both; with another wavelength they are one spectral
+/// material (issue 13).
 #[test]
 fn fit_merges_repeat_files_of_one_material_and_reads_signed_angles() {
     let dir = tempfile::tempdir().unwrap();
@@ -483,15 +484,14 @@ fn fit_merges_repeat_files_of_one_material_and_reads_signed_angles() {
         irpol(&args.iter().map(String::as_str).collect::<Vec<_>>())
     };
 
-    let (ok, _, stderr) = fit(&[&a, &far]);
-    assert!(!ok && !fits.exists(), "{stderr}");
+    let (ok, stdout, stderr) = fit(&[&a, &far]);
+    assert!(ok, "{stderr}");
     assert!(
-        stderr.contains("a.csv and ")
-            && stderr.contains("far.csv both hold material 'paint'")
-            && stderr.contains("10 µm and 10.6 µm")
-            && stderr.lines().count() == 1,
-        "{stderr}"
+        stdout.contains("paint: cauchy table, 2 wavelengths 10–10.6 µm: sigma=0.2"),
+        "{stdout}"
     );
+    let spectral = irpol::material::Material::load(&fits.join("paint.toml")).unwrap();
+    assert_eq!(spectral.model.wavelengths_um(), [10.0, 10.6]);
 
     let (ok, stdout, stderr) = fit(&[&a, &b]);
     assert!(ok, "{stderr}");

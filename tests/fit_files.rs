@@ -84,21 +84,26 @@ fn a_bad_input_fails_the_run_before_anything_is_written() {
     assert!(error.to_string().contains("bad.csv:3:"), "{error}");
     assert!(!fits.exists());
 
-    // Two files of one material at different wavelengths cannot be one measurement set (same
-    // wavelength ones are merged, tests/cli.rs).
+    // Two files of one material at different wavelengths are one spectral set (same-wavelength
+    // ones are merged, tests/cli.rs), unless they disagree on what was measured.
     let copy = inputs.path().join("copy");
     std::fs::create_dir(&copy).unwrap();
     let first = write_synthetic(inputs.path(), "twin", 0.2);
     let second = write_synthetic(&copy, "twin", 0.25);
-    let text = std::fs::read_to_string(&second).unwrap();
-    std::fs::write(
-        &second,
-        text.replace("# wavelength_um: 10\n", "# wavelength_um: 10.6\n"),
-    )
-    .unwrap();
+    for (path, wavelength, distribution) in [(&first, 10.0, "gaussian"), (&second, 10.6, "cauchy")]
+    {
+        let text = std::fs::read_to_string(path).unwrap();
+        let header = format!("# wavelength_um: {wavelength}\n# distribution: {distribution}\n");
+        std::fs::write(path, text.replace("# wavelength_um: 10\n", &header)).unwrap();
+    }
     let error = fit_files(&[first, second], &options(), &fits, false).unwrap_err();
-    assert!(matches!(error, FitError::Merge { .. }), "{error}");
-    assert!(error.to_string().contains("10 µm and 10.6 µm"), "{error}");
+    assert!(matches!(error, FitError::Measurement { .. }), "{error}");
+    assert!(
+        error
+            .to_string()
+            .contains("'# distribution: cauchy' disagrees"),
+        "{error}"
+    );
     assert!(!fits.exists());
 
     // Invalid options are refused before any fitting.

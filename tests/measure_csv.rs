@@ -51,7 +51,7 @@ const BAD_FILES: &[(&str, &str)] = &[
     // Wavelength.
     ("no_wavelength.csv", "2:1: no wavelength: add a 'wavelength_um' column or a '# wavelength_um: <micrometres>' header line"),
     ("wavelength_disagrees.csv", "4:7: column 'wavelength_um': 10.6 disagrees with the header '# wavelength_um: 9.925' (line 1)"),
-    ("mixed_wavelengths.csv", "4:7: column 'wavelength_um': 10.6 differs from 9.925 on line 2; a fit is per wavelength, so give one file per wavelength"),
+    ("mixed_wavelengths.csv", "4:7: column 'wavelength_um': 10.6 differs from 9.925 on line 2: the file holds several wavelengths, a spectral set, which `irpol fit` reads as one material but this reader of one wavelength cannot"),
     ("bad_header_wavelength.csv", "1:18: header 'wavelength_um': '9,925' is not a positive number of micrometres"),
     ("nonpositive_wavelength.csv", "2:7: column 'wavelength_um': 0 is not a positive wavelength"),
     // Metadata.

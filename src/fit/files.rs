@@ -7,9 +7,10 @@ use super::outcome::{fit_measurement, FitOutcome};
 use super::space::ModelSpace;
 use super::spectral::{fit_spectral, SpectralFitOutcome};
 use super::FitError;
-use crate::material::{Material, SAME_WAVELENGTH_UM};
+use crate::material::Material;
 use crate::measure::{
     collect_measurement_files, merge_repeat_measurements, read_measurement_sets, MeasurementSet,
+    SAME_WAVELENGTH_UM,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;

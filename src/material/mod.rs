@@ -5,7 +5,7 @@ mod comments;
 mod spectral;
 
 use spectral::{check_wavelength, DistributionName};
-pub use spectral::{MaterialModel, OutsideTable, SpectralModel, SAME_WAVELENGTH_UM};
+pub use spectral::{MaterialModel, OutsideTable, SpectralModel};
 
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};

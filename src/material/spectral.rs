@@ -10,8 +10,7 @@ use crate::pbrdf::{ModelError, Shadowing, SlopeDistribution};
 use crate::text::number;
 use serde::{Deserialize, Serialize};
 
-/// Two table wavelengths closer than this (µm) are one wavelength (DESIGN §1.9).
-pub const SAME_WAVELENGTH_UM: f64 = 1e-6;
+use crate::measure::SAME_WAVELENGTH_UM;
 
 /// A material's model over wavelength.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

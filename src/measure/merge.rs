@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use super::{MeasurementSet, SourceFile, MUELLER_ELEMENT_NAMES};
 
 /// Two wavelengths closer than this (µm) are one wavelength (DESIGN §1.9).
-const SAME_WAVELENGTH_UM: f64 = 1e-6;
+pub const SAME_WAVELENGTH_UM: f64 = 1e-6;
 
 /// Why two files of one material cannot be merged into one set.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -19,7 +19,7 @@ pub struct MergeError {
     pub reason: String,
 }
 
-/// Merges `sets` (at least one, all of one material) into one set: the first file's source,
+/// Merges `sets` (at least one, all of one material and wavelength) into one set: the first file's source,
 /// hash, metadata and wavelength, every file's rows in the order given, the later files listed
 /// in [`MeasurementSet::merged`], every file's notes plus one saying what was merged. One set is
 /// returned as it is. Every file that reads is in the psps convention (the reader refuses any
@@ -69,8 +69,8 @@ fn check_mergeable(first: &MeasurementSet, other: &MeasurementSet) -> Result<(),
     };
     if (first.wavelength_um - other.wavelength_um).abs() > SAME_WAVELENGTH_UM {
         return Err(refuse(format!(
-            "their wavelengths differ ({} µm and {} µm); a spectral fit of several wavelengths is \
-             not supported yet (a later issue): fit them under different '# material:' names",
+            "their wavelengths differ ({} µm and {} µm): they are a spectral set (which `irpol \
+             fit` reads as one material), not repeat measurements",
             first.wavelength_um, other.wavelength_um
         )));
     }
@@ -159,7 +159,7 @@ mod tests {
         assert!(
             message.starts_with("a.csv and b.csv both hold material 'paint'")
                 && message.contains("10 µm and 10.5 µm")
-                && message.contains("not supported yet"),
+                && message.contains("a spectral set"),
             "{message}"
         );
         let near = set(

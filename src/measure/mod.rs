@@ -2,7 +2,8 @@
 //! [`MeasurementSet`], the input of the fit. Anything ambiguous is refused with a
 //! `file:line:column: what is wrong` [`MeasureError`]; nothing here writes.
 //!
-//! A file holds one material at one wavelength (a fit is per wavelength):
+//! A file holds one material, at one wavelength or, in a wavelength_um column without a
+//! `# wavelength_um:` header, at several (a spectral set, DESIGN §1.9; [`read_measurement_sets`]):
 //! ```text
 //! # material: gloss_paint
 //! # wavelength_um: 9.925
@@ -36,7 +37,7 @@ pub use csv_reader::{
 pub use error::{Delimiter, MeasureError, MeasureErrorKind};
 pub use files::collect_measurement_files;
 pub use fingerprint::SourceData;
-pub use merge::{merge_repeat_measurements, MergeError};
+pub use merge::{merge_repeat_measurements, MergeError, SAME_WAVELENGTH_UM};
 
 /// Column names of the 16 Mueller elements; element (r, c) has index r*4 + c (row-major).
 pub const MUELLER_ELEMENT_NAMES: [&str; 16] = [
