@@ -242,6 +242,19 @@ fn the_shipped_spectral_set_is_recovered_and_its_resonance_found() {
         .unwrap();
     assert_eq!(choice.chosen, "lorentz:1");
     assert!(choice.law_aic.unwrap() < choice.table_aic, "{choice:?}");
+
+    // `irpol report` cannot rebuild a spectral report from the entry alone, and says so.
+    let dir = tempfile::tempdir().unwrap();
+    let entry = dir.path().join("fits/silicate_glass.toml");
+    lorentz.material.save(&entry).unwrap();
+    let message = irpol::report::fit_report::rebuild_report(&entry, &dir.path().join("reports"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("a spectral material's report is written by `irpol fit`"),
+        "{message}"
+    );
+    assert!(!dir.path().join("reports").exists());
 }
 
 /// The same spectral set as a folder of one file per wavelength (each with `# material:`)

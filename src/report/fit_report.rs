@@ -239,6 +239,14 @@ pub fn rebuild_report(
     let fit = material.fit.as_ref().ok_or_else(|| ReportError::NoFit {
         material: material_path.to_owned(),
     })?;
+    // A spectral report shows the joint fit's per-wavelength state, which the entry does not
+    // hold: `irpol fit` (deterministic) writes it.
+    if material.model.spectral().is_some() {
+        return Err(ReportError::SpectralRebuild {
+            material: material_path.to_owned(),
+            csv: fit.source.clone(),
+        });
+    }
     let sets = verified_source(material_path, fit)?;
     let set = merge_repeat_measurements(sets)
         .map_err(crate::fit::FitError::from)?

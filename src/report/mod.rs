@@ -45,6 +45,11 @@ pub enum ReportError {
     Measure(#[from] crate::measure::MeasureError),
     #[error(transparent)]
     Fit(#[from] crate::fit::FitError),
+    #[error("{material}: a spectral material's report is written by `irpol fit`; run it again on its measurements ({csv}, with the same options) to rebuild it", csv = .csv.display())]
+    SpectralRebuild {
+        material: std::path::PathBuf,
+        csv: std::path::PathBuf,
+    },
     #[error("{material}: the material has no fit record, so there is no measurement to report against (fit it with `irpol fit`)")]
     NoFit { material: std::path::PathBuf },
     #[error("{material}: its source CSV {csv} is missing (looked for {tried})")]
