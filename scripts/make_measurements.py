@@ -243,12 +243,7 @@ def write_material(mat: Material, out_dir: str, rng: np.random.Generator, seed: 
         f"# material: {mat.name}",
         f"# wavelength_um: {p.wavelength_um:g}",
         "# mueller_convention: psps",
-        f"# truth_distribution: {p.distribution}",
-        f"# truth_sigma: {p.sigma:g}",
-    ]
-    if p.distribution == "cauchy":
-        header.append(f"# truth_q: {p.q:g}")
-    header += [
+        *slope_truth(p.distribution, p.sigma, p.q),
         f"# truth_n: {p.n:g}",
         f"# truth_k: {p.k:g}",
         f"# truth_rho_d: {mat.rho_d:g}",
@@ -260,6 +255,14 @@ def write_material(mat: Material, out_dir: str, rng: np.random.Generator, seed: 
     path = os.path.join(out_dir, f"{mat.name}.csv")
     write_csv(path, header, columns, rows)
     return len(g), path
+
+
+def slope_truth(distribution: str, sigma: float, q: float) -> list[str]:
+    """The header lines of the slope distribution's truth (q only for the Cauchy one)."""
+    lines = [f"# truth_distribution: {distribution}", f"# truth_sigma: {sigma:g}"]
+    if distribution == "cauchy":
+        lines.append(f"# truth_q: {q:g}")
+    return lines
 
 
 def truth_n_k(spec: SpectralMaterial) -> str:
@@ -282,12 +285,7 @@ def write_spectral_material(spec: SpectralMaterial, out_dir: str, rng: np.random
     header = [
         f"# material: {spec.name}",
         "# mueller_convention: psps",
-        f"# truth_distribution: {spec.distribution}",
-        f"# truth_sigma: {spec.sigma:g}",
-    ]
-    if spec.distribution == "cauchy":
-        header.append(f"# truth_q: {spec.q:g}")
-    header += [
+        *slope_truth(spec.distribution, spec.sigma, spec.q),
         f"# truth_dispersion: {spec.dispersion.describe()}",
         f"# truth_n_k: {truth_n_k(spec)}",
         f"# truth_rho_d: {spec.rho_d:g}",

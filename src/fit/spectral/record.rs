@@ -21,50 +21,7 @@ pub(super) fn material(
     table: Option<&SpectralFit>,
     alternative: Option<&SpectralFit>,
 ) -> Material {
-    Material {
-        name: sets[0].material.clone(),
-        tool_version: format!("irpol {}", env!("CARGO_PKG_VERSION")),
-        model: MaterialModel::Spectral(chosen.model.clone()),
-        fit: Some(fit_record(sets, data, options, chosen, table, alternative)),
-    }
-}
-
-fn fit_record(
-    sets: &[MeasurementSet],
-    data: &[MeasurementData],
-    options: &FitOptions,
-    chosen: &SpectralFit,
-    table: Option<&SpectralFit>,
-    alternative: Option<&SpectralFit>,
-) -> FitRecord {
-    let first = &sets[0];
-    // Every file after the first, once each (a spectral file gives several sets).
-    let mut merged: Vec<MergedSource> = Vec::new();
-    let files = sets.iter().flat_map(|set| {
-        std::iter::once((set.source.clone(), set.sha256.clone(), set.points.len())).chain(
-            set.merged
-                .iter()
-                .map(|f| (f.path.clone(), f.sha256.clone(), f.rows)),
-        )
-    });
-    for (source, sha256, rows) in files {
-        if sha256 == first.sha256 {
-            continue;
-        }
-        match merged.iter_mut().find(|m| m.source_sha256 == sha256) {
-            Some(m) => m.points += rows,
-            None => merged.push(MergedSource {
-                source,
-                source_sha256: sha256,
-                source_data: None,
-                points: rows,
-            }),
-        }
-    }
-    let mut elements: Vec<usize> = sets.iter().flat_map(|s| s.elements.clone()).collect();
-    elements.sort_unstable();
-    elements.dedup();
-    let is_shared = |name: &String| !name.contains('(');
+    let table_fit = table.unwrap_or(chosen);
     let mut settings = settings(&data[0], options);
     settings.insert(
         "spectral".into(),
@@ -72,20 +29,13 @@ fn fit_record(
          σ and q"
             .into(),
     );
-    let (table_fit, law) = match table {
-        Some(table) => (table, Some(chosen)),
-        None => (chosen, None),
-    };
-    FitRecord {
-        source: first.source.clone(),
-        source_sha256: first.sha256.clone(),
+    let record = FitRecord {
+        source: sets[0].source.clone(),
+        source_sha256: sets[0].sha256.clone(),
         source_data: None,
-        merged_sources: merged,
+        merged_sources: merged_sources(sets),
         points: sets.iter().map(|s| s.points.len()).sum(),
-        elements: elements
-            .iter()
-            .map(|&e| MUELLER_ELEMENT_NAMES[e].to_owned())
-            .collect(),
+        elements: element_names(sets),
         free_parameters: chosen.names.clone(),
         fixed_parameters: options
             .fixed
@@ -108,7 +58,7 @@ fn fit_record(
             .names
             .iter()
             .zip(&chosen.errors)
-            .filter(|(name, _)| is_shared(name))
+            .filter(|(name, _)| !name.contains('('))
             .map(|(name, &e)| (name.clone(), e))
             .collect(),
         correlation: chosen.correlation.clone(),
@@ -123,21 +73,13 @@ fn fit_record(
         .into_iter()
         .map(|(name, errors)| (name.to_owned(), errors.clone()))
         .collect(),
-        wavelengths: sets
-            .iter()
-            .zip(&chosen.chi2_per_wavelength)
-            .map(|(set, &(chi2, observations))| WavelengthQuality {
-                wavelength_um: set.wavelength_um,
-                points: set.points.len(),
-                chi2_per_observation: chi2 / observations.max(1) as f64,
-            })
-            .collect(),
+        wavelengths: wavelength_quality(sets, chosen),
         dispersion: Some(DispersionChoice {
             chosen: chosen.dispersion.to_string(),
             table_aic: table_fit.aic,
             table_bic: table_fit.bic,
-            law_aic: law.map(|l| l.aic),
-            law_bic: law.map(|l| l.bic),
+            law_aic: table.map(|_| chosen.aic),
+            law_bic: table.map(|_| chosen.bic),
         }),
         model_choice: alternative.map(|other| {
             format!(
@@ -151,7 +93,60 @@ fn fit_record(
         alternative: None,
         convergence: chosen.history.best_cost.clone(),
         global_iterations: 0,
+    };
+    Material {
+        name: sets[0].material.clone(),
+        tool_version: format!("irpol {}", env!("CARGO_PKG_VERSION")),
+        model: MaterialModel::Spectral(chosen.model.clone()),
+        fit: Some(record),
     }
+}
+
+/// Every file after the first, once each (a spectral file gives several sets), with its rows.
+fn merged_sources(sets: &[MeasurementSet]) -> Vec<MergedSource> {
+    let first = &sets[0].sha256;
+    let mut merged: Vec<MergedSource> = Vec::new();
+    let files = sets.iter().flat_map(|set| {
+        std::iter::once((set.source.clone(), set.sha256.clone(), set.points.len())).chain(
+            set.merged
+                .iter()
+                .map(|f| (f.path.clone(), f.sha256.clone(), f.rows)),
+        )
+    });
+    for (source, sha256, rows) in files.filter(|f| f.1 != *first) {
+        match merged.iter_mut().find(|m| m.source_sha256 == sha256) {
+            Some(m) => m.points += rows,
+            None => merged.push(MergedSource {
+                source,
+                source_sha256: sha256,
+                source_data: None,
+                points: rows,
+            }),
+        }
+    }
+    merged
+}
+
+/// The Mueller elements measured at any wavelength, in index order.
+fn element_names(sets: &[MeasurementSet]) -> Vec<String> {
+    let mut elements: Vec<usize> = sets.iter().flat_map(|s| s.elements.clone()).collect();
+    elements.sort_unstable();
+    elements.dedup();
+    elements
+        .iter()
+        .map(|&e| MUELLER_ELEMENT_NAMES[e].to_owned())
+        .collect()
+}
+
+fn wavelength_quality(sets: &[MeasurementSet], fit: &SpectralFit) -> Vec<WavelengthQuality> {
+    sets.iter()
+        .zip(&fit.chi2_per_wavelength)
+        .map(|(set, &(chi2, observations))| WavelengthQuality {
+            wavelength_um: set.wavelength_um,
+            points: set.points.len(),
+            chi2_per_observation: chi2 / observations.max(1) as f64,
+        })
+        .collect()
 }
 
 /// RMS of (model − data) in sr⁻¹ per element over every wavelength that measured it.
