@@ -12,7 +12,7 @@ mod correlation;
 mod data;
 mod diagnostics;
 mod profiles;
-mod style;
+pub(crate) mod style;
 mod table;
 #[cfg(test)]
 mod test_records;
@@ -189,6 +189,19 @@ pub fn encode_fit_report(
     Ok(EncodedReport { files })
 }
 
+/// The composite figure alone, as PNG bytes for `path` (no SVG, no panel files): for callers
+/// drawing many figures, such as the spectral report's one per wavelength.
+pub(crate) fn encode_fit_figure(
+    material: &Material,
+    set: &MeasurementSet,
+    path: &Path,
+) -> Result<Vec<u8>, ReportError> {
+    let data = ReportData::new(material, set)?;
+    encode_bitmap(path, REPORT_SIZE, |root| {
+        draw_report(root, material, set, &data, false)
+    })
+}
+
 /// The figure as SVG text.
 fn encode_svg(
     path: &Path,
@@ -207,7 +220,7 @@ fn encode_svg(
     Ok(svg_text.replace("href=\"data:png;base64,", "href=\"data:image/png;base64,"))
 }
 
-fn draw_error(path: &Path, e: &dyn std::fmt::Display) -> ReportError {
+pub(crate) fn draw_error(path: &Path, e: &dyn std::fmt::Display) -> ReportError {
     ReportError::Draw {
         path: path.to_owned(),
         message: e.to_string(),
@@ -215,7 +228,7 @@ fn draw_error(path: &Path, e: &dyn std::fmt::Display) -> ReportError {
 }
 
 /// Draws into an RGB bitmap of `size` and encodes it as PNG bytes for `path`.
-fn encode_bitmap(
+pub(crate) fn encode_bitmap(
     path: &Path,
     (width, height): (u32, u32),
     draw: impl for<'a> FnOnce(&DrawingArea<BitMapBackend<'a>, Shift>) -> DrawResult<BitMapBackend<'a>>,
@@ -345,7 +358,7 @@ fn verified_file(
 }
 
 /// The material name as a file stem: a plain name, no folders.
-fn report_stem(name: &str) -> Result<&str, ReportError> {
+pub(crate) fn report_stem(name: &str) -> Result<&str, ReportError> {
     let plain = !name.is_empty()
         && name != "."
         && name != ".."
