@@ -12,14 +12,11 @@
 use super::super::levenberg_marquardt::{forward_step, LeastSquares};
 use super::super::objective::Objective;
 use super::super::parameters::{Parameter, ParameterValues};
-use super::lorentz_start::law_of;
+use super::lorentz_start::{law_of, LAW_PER_OSCILLATOR};
 use crate::optics::LorentzDispersion;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::ops::Range;
-
-/// Lorentz law coordinates per oscillator: resonance λ_j, strength Δε_j, width w_j (µm).
-pub(crate) const LAW_PER_OSCILLATOR: usize = 3;
 
 /// What n and k are at each wavelength.
 #[derive(Clone, Debug, PartialEq)]

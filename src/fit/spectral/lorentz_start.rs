@@ -7,10 +7,12 @@
 use super::super::levenberg_marquardt::{
     forward_step, levenberg_marquardt, LeastSquares, LevenbergMarquardtSettings,
 };
-use super::joint::LAW_PER_OSCILLATOR;
 use crate::optics::{LorentzDispersion, LorentzOscillator};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
+
+/// Lorentz law coordinates per oscillator: resonance λ_j, strength Δε_j, width w_j (µm).
+pub(crate) const LAW_PER_OSCILLATOR: usize = 3;
 
 /// The box of the law's coordinates (ε_∞, then resonance, strength, width per oscillator) for
 /// tables over `first..=last` µm: resonances within half the range beyond its ends.
