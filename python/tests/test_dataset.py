@@ -175,3 +175,21 @@ def test_an_unreachable_scheduler_is_a_clear_error(sweep_folder):
     spec = _write_spec(sweep_folder, '"sun.elevation_deg" = [10.0]\n')
     with pytest.raises(SpecError, match="cannot reach the Dask scheduler at tcp://127.0.0.1:9"):
         run(spec, scheduler="tcp://127.0.0.1:9", progress=False)
+
+
+def test_a_fit_sweep_writes_one_material_per_item(tmp_path):
+    from conftest import ROOT
+
+    for name in ("rough_paint.csv", "anodized_panel.csv"):
+        shutil.copy(ROOT / "measurements" / name, tmp_path / name)
+    spec = tmp_path / "fit.toml"
+    spec.write_text('kind = "fit"\ninputs = "*.csv"\nout = "fits"\n[options]\nseed = 3\n')
+    summary = run(spec, workers=2, progress=False)
+    assert (summary.items, summary.ok, summary.failed) == (2, 2, 0)
+    rows = sorted(_rows(tmp_path / "fits"), key=lambda r: r["item"])
+    assert [r["params"]["material"] for r in rows] == ["anodized_panel", "rough_paint"]
+    assert list(rows[1]["outputs"]) == ["rough_paint.toml"]
+    bad = tmp_path / "bad.toml"
+    bad.write_text('kind = "fit"\ninputs = "*.csv"\nout = "fits"\n[options]\nsead = 3\n')
+    with pytest.raises(SpecError, match="unknown key 'sead' in \\[options\\]"):
+        run(bad, progress=False)
