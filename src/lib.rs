@@ -22,3 +22,6 @@ pub mod text;
 pub mod thermal;
 pub mod thermal_scene;
 pub mod transport;
+
+/// The version every output names (`tool_version` of a material, the `#` header of a table).
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -8,7 +8,7 @@ use cli::progress::TerminalProgress;
 use irpol::commands::evaluate::{
     read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
 };
-use irpol::commands::fit::fit_and_write;
+use irpol::commands::fit::{fit_and_write, FitFlags};
 use irpol::commands::render::{
     default_output_dir, instant_folder, render_scene, render_scene_at, Instants, TimedRender,
 };
@@ -17,15 +17,10 @@ use irpol::commands::sun::{read_times_file, write_sun_csv};
 use irpol::commands::thermal::{run_thermal, run_thermal_and_render};
 use irpol::commands::{parse_sweep, ModelArgs};
 use irpol::emitter::parse_time_utc;
-use irpol::fit::{
-    parse_parameter_list, parse_parameter_values, DistributionKind, FitOptions, Optimizer,
-    RobustLoss,
-};
-use irpol::fit::{Dispersion, MaterialFit};
+use irpol::fit::{FitOptions, MaterialFit};
 use irpol::material::MaterialModel;
 use irpol::output::staged_folder::staging_folder;
 use irpol::output::thermal::ThermalSummary;
-use irpol::pbrdf::Shadowing;
 use irpol::report::fit_report::rebuild_report;
 use irpol::report::index::write_library_index;
 use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
@@ -362,18 +357,17 @@ fn run(command: Command) -> anyhow::Result<()> {
             out,
             reports,
         } => {
-            let options = FitOptions {
-                dispersion: Dispersion::parse(&dispersion).map_err(anyhow::Error::msg)?,
-                ..fit_options(
-                    distribution,
-                    &shadowing,
-                    free,
-                    fix,
-                    &optimizer,
-                    seed,
-                    robust,
-                )?
-            };
+            let options = FitFlags {
+                distribution,
+                shadowing,
+                free,
+                fix,
+                optimizer,
+                seed,
+                robust,
+                dispersion,
+            }
+            .options()?;
             fit_and_summarize(&inputs, &options, &out, &reports)?;
         }
         Command::Report { material, reports } => {
@@ -437,40 +431,6 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Demo => demo()?,
     }
     Ok(())
-}
-
-fn fit_options(
-    distribution: Option<String>,
-    shadowing: &str,
-    free: Option<String>,
-    fix: Option<String>,
-    optimizer: &str,
-    seed: u64,
-    robust: Option<String>,
-) -> anyhow::Result<FitOptions> {
-    let mut options = FitOptions {
-        shadowing: Shadowing::parse(shadowing).ok_or_else(|| {
-            anyhow::anyhow!("unknown shadowing '{shadowing}': use none, torrance-sparrow or smith")
-        })?,
-        optimizer: Optimizer::parse(optimizer).map_err(anyhow::Error::msg)?,
-        seed,
-        ..FitOptions::default()
-    };
-    if let Some(name) = distribution {
-        options.distribution = Some(DistributionKind::parse(&name).ok_or_else(|| {
-            anyhow::anyhow!("unknown distribution '{name}': use cauchy or gaussian")
-        })?);
-    }
-    if let Some(list) = free {
-        options.free = Some(parse_parameter_list(&list).map_err(anyhow::Error::msg)?);
-    }
-    if let Some(values) = fix {
-        options.fixed = parse_parameter_values(&values).map_err(anyhow::Error::msg)?;
-    }
-    if let Some(loss) = robust {
-        options.robust = Some(RobustLoss::parse(&loss).map_err(anyhow::Error::msg)?);
-    }
-    Ok(options)
 }
 
 /// Fits, writes the library entries, reports and index (all or nothing) and prints one line per

@@ -4,14 +4,88 @@
 //! reports exactly as they were; the library entries are renamed into place last.
 
 use super::output_set::OutputSet;
-use crate::fit::{fit_inputs, FitOptions, MaterialFit};
+use crate::fit::{
+    fit_inputs, parse_parameter_list, parse_parameter_values, Dispersion, DistributionKind,
+    FitOptions, MaterialFit, Optimizer, RobustLoss,
+};
 use crate::material::{list_library, Material};
+use crate::pbrdf::Shadowing;
 use crate::report::fit_report::encode_fit_report;
 use crate::report::index::library_index_html;
 use crate::report::spectral_report::encode_spectral_report;
 use crate::report::ReportError;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
+
+/// The options of `irpol fit` as its flags give them, as text: parsed into [`FitOptions`] by one
+/// function for the command line and the Python bindings alike, so both refuse the same input
+/// with the same message.
+#[derive(Clone, Debug)]
+pub struct FitFlags {
+    /// `cauchy` or `gaussian`; `None` fits both and keeps the preferred.
+    pub distribution: Option<String>,
+    pub shadowing: String,
+    /// e.g. `sigma,q,n,k,rho`.
+    pub free: Option<String>,
+    /// e.g. `k=0.1,rho=0`.
+    pub fix: Option<String>,
+    /// Stages joined by `+`: ga, nm, lm.
+    pub optimizer: String,
+    pub seed: u64,
+    /// `huber` or `cauchy`, optionally with a scale (`huber:2`).
+    pub robust: Option<String>,
+    /// `table` or `lorentz:N`.
+    pub dispersion: String,
+}
+
+impl Default for FitFlags {
+    /// The command line's defaults.
+    fn default() -> FitFlags {
+        FitFlags {
+            distribution: None,
+            shadowing: "smith".into(),
+            free: None,
+            fix: None,
+            optimizer: "ga+lm".into(),
+            seed: FitOptions::default().seed,
+            robust: None,
+            dispersion: "table".into(),
+        }
+    }
+}
+
+impl FitFlags {
+    /// The fit options, or the message naming the flag that is wrong.
+    pub fn options(&self) -> anyhow::Result<FitOptions> {
+        let shadowing = &self.shadowing;
+        let mut options = FitOptions {
+            dispersion: Dispersion::parse(&self.dispersion).map_err(anyhow::Error::msg)?,
+            shadowing: Shadowing::parse(shadowing).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "unknown shadowing '{shadowing}': use none, torrance-sparrow or smith"
+                )
+            })?,
+            optimizer: Optimizer::parse(&self.optimizer).map_err(anyhow::Error::msg)?,
+            seed: self.seed,
+            ..FitOptions::default()
+        };
+        if let Some(name) = &self.distribution {
+            options.distribution = Some(DistributionKind::parse(name).ok_or_else(|| {
+                anyhow::anyhow!("unknown distribution '{name}': use cauchy or gaussian")
+            })?);
+        }
+        if let Some(list) = &self.free {
+            options.free = Some(parse_parameter_list(list).map_err(anyhow::Error::msg)?);
+        }
+        if let Some(values) = &self.fix {
+            options.fixed = parse_parameter_values(values).map_err(anyhow::Error::msg)?;
+        }
+        if let Some(loss) = &self.robust {
+            options.robust = Some(RobustLoss::parse(loss).map_err(anyhow::Error::msg)?);
+        }
+        Ok(options)
+    }
+}
 
 /// What a fit wrote.
 pub struct FitWritten {

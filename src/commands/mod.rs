@@ -60,23 +60,7 @@ impl ModelArgs {
                 );
             }
             let material = Material::load(path)?;
-            let mut spec = match (self.wavelength_um, material.model.spectral()) {
-                (Some(wavelength), _) => material.at(wavelength)?,
-                (None, None) => material.grey_model()?.clone(),
-                (None, Some(table)) => {
-                    let (first, last) = table.range_um();
-                    anyhow::bail!(
-                        "material '{}' is spectral ({}–{} µm): give --wavelength UM",
-                        material.name,
-                        crate::text::number(first),
-                        crate::text::number(last)
-                    )
-                }
-            };
-            if let Some(shadowing) = shadowing {
-                spec.shadowing = shadowing;
-            }
-            return Ok(spec.pbrdf()?);
+            return material_pbrdf(&material, self.wavelength_um, shadowing);
         }
         if self.wavelength_um.is_some() {
             anyhow::bail!(
@@ -112,6 +96,33 @@ impl ModelArgs {
             self.rho.unwrap_or(0.0),
         )?)
     }
+}
+
+/// The pBRDF of a loaded material as `eval` and `emissivity` use it: at `wavelength_um` (required
+/// for a spectral material, interpolated in its table), with `shadowing` overriding the
+/// material's own when given.
+pub fn material_pbrdf(
+    material: &Material,
+    wavelength_um: Option<f64>,
+    shadowing: Option<Shadowing>,
+) -> anyhow::Result<Pbrdf> {
+    let mut spec = match (wavelength_um, material.model.spectral()) {
+        (Some(wavelength), _) => material.at(wavelength)?,
+        (None, None) => material.grey_model()?.clone(),
+        (None, Some(table)) => {
+            let (first, last) = table.range_um();
+            anyhow::bail!(
+                "material '{}' is spectral ({}–{} µm): give --wavelength UM",
+                material.name,
+                crate::text::number(first),
+                crate::text::number(last)
+            )
+        }
+    };
+    if let Some(shadowing) = shadowing {
+        spec.shadowing = shadowing;
+    }
+    Ok(spec.pbrdf()?)
 }
 
 /// `#` lines stating the model a table was computed with (`eval`, `emissivity` output): the

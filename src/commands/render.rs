@@ -5,7 +5,7 @@ use crate::material::write_atomically;
 use crate::output::{write_outputs, RenderSummary};
 use crate::progress::Progress;
 use crate::render::{render, RenderError};
-use crate::scene::{load_scene, Scene, SceneError};
+use crate::scene::{load_scene, load_scene_text, Scene, SceneError};
 use crate::thermal_scene::{scene_at, solve_scene, ThermalSolution};
 use anyhow::Context;
 use image::codecs::gif::{GifEncoder, Repeat};
@@ -32,12 +32,7 @@ pub fn render_scene(
     let start = Instant::now();
     let scene = load_scene(scene_path)?;
     if scene.thermal.is_some() {
-        return Err(SceneError::new(
-            scene_path,
-            "has a [thermal] section: say when to render it with --time SECONDS, \
-             --time-utc INSTANT or --times START:STOP:STEP (seconds from thermal.start_utc)",
-        )
-        .into());
+        return Err(thermal_needs_instant(scene_path));
     }
     render_loaded(&scene, out_dir, progress, start)
 }
@@ -80,13 +75,10 @@ pub fn render_scene_at(
     progress: &dyn Progress,
 ) -> anyhow::Result<Vec<TimedRender>> {
     let scene = load_scene(scene_path)?;
-    let setup = scene.thermal.as_deref().ok_or_else(|| {
-        anyhow::anyhow!(
-            "{}: --time/--times need temperatures from the thermal model, but the scene has no \
-             [thermal] section",
-            scene_path.display()
-        )
-    })?;
+    let setup = scene
+        .thermal
+        .as_deref()
+        .ok_or_else(|| instant_needs_thermal(scene_path))?;
     let times = match instants {
         Instants::Seconds(times) => times.clone(),
         Instants::Utc(text) => {
@@ -113,14 +105,7 @@ pub fn render_solution_at(
     let mut renders = Vec::with_capacity(times.len());
     for (i, &time_s) in times.iter().enumerate() {
         let start = Instant::now();
-        let index = solution
-            .times_s
-            .iter()
-            .position(|&t| (t - time_s).abs() < 1e-6)
-            .ok_or_else(|| {
-                anyhow::anyhow!("t = {time_s} s is not an instant of the thermal run")
-            })?;
-        let at = scene_at(scene, solution, index).map_err(|e| SceneError::new(&scene.path, e))?;
+        let at = solution_instant(scene, solution, time_s)?;
         let folder = instant_folder(out_dir, i, time_s, series);
         let summary = render_loaded(&at, &folder, progress, start)?;
         renders.push(TimedRender {
@@ -135,6 +120,60 @@ pub fn render_solution_at(
             .with_context(|| format!("{}: cannot write", out_dir.display()))?;
     }
     Ok(renders)
+}
+
+/// The thermal scene with the temperatures of `solution` at `time_s` (an instant of the run).
+fn solution_instant(
+    scene: &Scene,
+    solution: &ThermalSolution,
+    time_s: f64,
+) -> anyhow::Result<Scene> {
+    let index = solution
+        .times_s
+        .iter()
+        .position(|&t| (t - time_s).abs() < 1e-6)
+        .ok_or_else(|| anyhow::anyhow!("t = {time_s} s is not an instant of the thermal run"))?;
+    Ok(scene_at(scene, solution, index).map_err(|e| SceneError::new(&scene.path, e))?)
+}
+
+/// The scene of `path` read from `text` (the file's own, or changed by a caller such as the
+/// Python bindings), as it is rendered: itself, or for a scene with `[thermal]` its thermal
+/// solution at `time_s` seconds from `thermal.start_utc`. Refused as `irpol render` refuses a
+/// thermal scene without an instant, or an instant without `[thermal]`.
+pub fn scene_to_render(
+    path: &Path,
+    text: &str,
+    time_s: Option<f64>,
+    progress: &dyn Progress,
+) -> anyhow::Result<Scene> {
+    let scene = load_scene_text(path, text)?;
+    match (time_s, scene.thermal.is_some()) {
+        (None, false) => Ok(scene),
+        (None, true) => Err(thermal_needs_instant(path).into()),
+        (Some(_), false) => Err(instant_needs_thermal(path)),
+        (Some(time_s), true) => {
+            let solution = solve_scene(&scene, &[time_s], progress)
+                .with_context(|| format!("{}: thermal run", path.display()))?;
+            solution_instant(&scene, &solution, time_s)
+        }
+    }
+}
+
+fn thermal_needs_instant(path: &Path) -> RenderError {
+    SceneError::new(
+        path,
+        "has a [thermal] section: say when to render it with --time SECONDS, \
+         --time-utc INSTANT or --times START:STOP:STEP (seconds from thermal.start_utc)",
+    )
+    .into()
+}
+
+fn instant_needs_thermal(path: &Path) -> anyhow::Error {
+    anyhow::anyhow!(
+        "{}: --time/--times need temperatures from the thermal model, but the scene has no \
+         [thermal] section",
+        path.display()
+    )
 }
 
 /// Where instant `i` at `time_s` is written: `out_dir` itself, or `out_dir/NNN_<t>s/` in a series.

@@ -170,7 +170,13 @@ impl Scene {
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| SceneError::new(path, format!("cannot read the scene: {e}")))?;
-    let config: SceneConfig = toml::from_str(&text).map_err(|e| {
+    load_scene_text(path, &text)
+}
+
+/// [`load_scene`] of a scene's text (e.g. a file's text with some values changed, as the Python
+/// bindings' sweeps do); `path` names it in messages and relative paths resolve from its folder.
+pub fn load_scene_text(path: &Path, text: &str) -> Result<Scene, SceneError> {
+    let config: SceneConfig = toml::from_str(text).map_err(|e| {
         let at = e.span().map_or(String::new(), |span| {
             let before = &text[..span.start.min(text.len())];
             let line = before.matches('\n').count() + 1;

@@ -1,0 +1,158 @@
+"""irpol — infrared polarimetry in Python: the irpol Rust library with numpy arrays in and out.
+
+Every number comes from the Rust library (the one implementation, bit for bit the same as the
+``irpol`` command line); this package only broadcasts arrays and wraps results.
+
+Units: angles in degrees, wavelengths in µm, temperatures in K, BRDF values in sr⁻¹, radiances
+in W·m⁻²·sr⁻¹. Mueller matrices are in SCATMECH's psps frames (DESIGN §1.3), row-major.
+
+>>> import irpol
+>>> paint = irpol.Material.load("fits/paper_paint.toml")
+>>> irpol.mueller(paint, 60.0, 0.0, [-30.0, 0.0, 30.0], 180.0).shape
+(3, 4, 4)
+
+Errors raise ``ValueError`` (bad input) or ``OSError`` (a file), with the command line's message.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _irpol
+from ._irpol import Material
+
+__version__ = _irpol.__version__
+__all__ = [
+    "Material",
+    "mueller",
+    "emissivity",
+    "band_radiance",
+    "brightness_temperature",
+    "read_measurements",
+    "Measurements",
+    "fit",
+    "FitResult",
+    "render",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+LWIR_BAND_UM = (8.0, 14.0)
+
+
+def _material(material: Union[Material, PathLike]) -> Material:
+    """A Material, or the material file at a path."""
+    return material if isinstance(material, Material) else Material.load(os.fspath(material))
+
+
+def _real(name: str, values: Any) -> np.ndarray:
+    """`values` as a float64 array; refuses complex, boolean and non-numeric input."""
+    array = np.asarray(values)
+    if array.dtype.kind not in "iuf":
+        raise ValueError(f"{name} must be real numbers (got dtype {array.dtype})")
+    return array.astype(np.float64, copy=False)
+
+
+def _flat(*arrays: np.ndarray) -> Tuple[Tuple[int, ...], List[np.ndarray]]:
+    """The broadcast shape and each array broadcast to it, flat and contiguous."""
+    broadcast = np.broadcast_arrays(*arrays)
+    shape = broadcast[0].shape
+    return shape, [np.ascontiguousarray(a.reshape(-1)) for a in broadcast]
+
+
+def mueller(
+    material: Union[Material, PathLike],
+    theta_i: Any,
+    phi_i: Any,
+    theta_r: Any,
+    phi_r: Any,
+    wavelength_um: Optional[float] = None,
+) -> np.ndarray:
+    """Mueller BRDF of `material` (sr⁻¹, psps frames) at the given geometries.
+
+    The four angle arguments (degrees) are broadcast together (numpy rules); the result has
+    shape ``broadcast_shape + (4, 4)``, float64, ``[..., row, column]`` = m_row,column. θ_i must lie
+    in [0°, 90°); θ_r in (−90°, 90°), a negative θ_r being the detector across the normal,
+    (|θ_r|, φ_r + 180°), as ``irpol eval`` reads it. `wavelength_um` (µm) selects where a
+    spectral material is evaluated (required for one). Raises ValueError on an invalid angle.
+    """
+    model = _material(material)
+    shape, flat = _flat(*(_real(n, v) for n, v in
+                          (("theta_i", theta_i), ("phi_i", phi_i),
+                           ("theta_r", theta_r), ("phi_r", phi_r))))
+    values = _irpol.mueller_flat(model, wavelength_um, *flat)
+    return values.reshape(shape + (4, 4))
+
+
+def emissivity(
+    material: Union[Material, PathLike], theta: Any, wavelength_um: Optional[float] = None
+) -> np.ndarray:
+    """Polarized emissivity (ε0, ε1, ε2, ε3), dimensionless, at emission zeniths `theta` (degrees,
+    in [0°, 90°)), as ``irpol emissivity`` computes it (Kirchhoff: 1 minus the hemispherical
+    reflectance, DESIGN §1.4). Shape ``theta.shape + (4,)``, float64."""
+    model = _material(material)
+    angles = _real("theta", theta)
+    values = _irpol.emissivity_flat(model, wavelength_um, np.ascontiguousarray(angles.reshape(-1)))
+    return values.reshape(angles.shape + (4,))
+
+
+def band_radiance(temperature_k: Any, band_um: Tuple[float, float] = LWIR_BAND_UM) -> Any:
+    """Blackbody band radiance ∫ B_λ(T) dλ over `band_um` (µm, flat response), W·m⁻²·sr⁻¹, at
+    each temperature (K, finite, in [0, 1e4]); the shape of `temperature_k`."""
+    t = _real("temperature_k", temperature_k)
+    values = _irpol.band_radiance_flat(np.ascontiguousarray(t.reshape(-1)), tuple(band_um))
+    return values.reshape(t.shape)[()]
+
+
+def brightness_temperature(radiance: Any, band_um: Tuple[float, float] = LWIR_BAND_UM) -> Any:
+    """The inverse of :func:`band_radiance`: the temperature (K) whose blackbody band radiance is
+    `radiance` (W·m⁻²·sr⁻¹, finite, ≥ 0); the shape of `radiance`."""
+    r = _real("radiance", radiance)
+    values = _irpol.brightness_temperature_flat(np.ascontiguousarray(r.reshape(-1)), tuple(band_um))
+    return values.reshape(r.shape)[()]
+
+
+@dataclass
+class Measurements:
+    """One wavelength of a measurement file (DESIGN §2.1), validated by irpol's reader.
+
+    Angles in degrees (θ_r < 0 in the file already read as (|θ_r|, φ_r + 180°)); `values` and
+    `uncertainties` have shape (points, len(elements)) in sr⁻¹, NaN where the file gives no
+    uncertainty for an element."""
+
+    material: str
+    wavelength_um: float
+    source: str
+    sha256: str
+    metadata: Dict[str, str]
+    elements: List[str]
+    theta_i_deg: np.ndarray
+    phi_i_deg: np.ndarray
+    theta_r_deg: np.ndarray
+    phi_r_deg: np.ndarray
+    values: np.ndarray
+    uncertainties: np.ndarray
+    line: np.ndarray
+    merged: List[str]
+    notes: List[str]
+
+    @classmethod
+    def _from_dict(cls, d: Dict[str, Any]) -> "Measurements":
+        d = dict(d)
+        d["source"] = os.fspath(d["source"])
+        d["merged"] = [os.fspath(p) for p in d["merged"]]
+        return cls(**d)
+
+
+def read_measurements(path: PathLike) -> List[Measurements]:
+    """Reads a measurement CSV: one :class:`Measurements` per wavelength, ascending. Raises
+    OSError (unreadable) or ValueError (``file:line:column: what is wrong``)."""
+    return [Measurements._from_dict(d) for d in _irpol.read_measurement_sets(os.fspath(path))]
+
+
+from ._fit import FitResult, fit  # noqa: E402  (needs Measurements)
+from ._render import render  # noqa: E402

@@ -1,0 +1,117 @@
+//! `irpol fit` without writing: the library's fit of each material among the inputs, returned
+//! with its library entry, the uncertainties and correlations, χ² and the per-point residuals.
+
+use crate::errors::raised;
+use crate::material::PyMaterial;
+use crate::measurements::set_dict;
+use irpol::commands::fit::FitFlags;
+use irpol::fit::{fit_inputs, MaterialFit};
+use irpol::optics::Mueller;
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::{Path, PathBuf};
+
+/// Fits every material among `inputs` (CSV files or folders) with the options `irpol fit` takes
+/// as flags (same names, same defaults, same messages); one dict per material, in the order
+/// `irpol fit` reports them.
+#[pyfunction]
+#[pyo3(signature = (inputs, *, distribution = None, shadowing = "smith".to_owned(), free = None,
+    fix = None, optimizer = "ga+lm".to_owned(), seed = None, robust = None,
+    dispersion = "table".to_owned()))]
+#[allow(clippy::too_many_arguments)]
+pub fn fit_materials(
+    py: Python<'_>,
+    inputs: Vec<PathBuf>,
+    distribution: Option<String>,
+    shadowing: String,
+    free: Option<String>,
+    fix: Option<String>,
+    optimizer: String,
+    seed: Option<u64>,
+    robust: Option<String>,
+    dispersion: String,
+) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    let flags = FitFlags {
+        distribution,
+        shadowing,
+        free,
+        fix,
+        optimizer,
+        seed: seed.unwrap_or(FitFlags::default().seed),
+        robust,
+        dispersion,
+    };
+    let paths: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    let options = flags.options().map_err(|e| raised(e, &[]))?;
+    let outcomes = py
+        .detach(|| fit_inputs(&inputs, &options, false))
+        .map_err(|e| raised(e.into(), &paths))?;
+    outcomes.iter().map(|o| outcome_dict(py, o)).collect()
+}
+
+/// Mueller matrices as rows of 16 (row-major m00…m33).
+fn mueller_rows<'py>(py: Python<'py>, muellers: &[Mueller]) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let rows: Vec<Vec<f64>> = muellers
+        .iter()
+        .map(|m| m.transpose().iter().copied().collect())
+        .collect();
+    Ok(PyArray2::from_vec2(py, &rows)?)
+}
+
+fn outcome_dict<'py>(py: Python<'py>, outcome: &MaterialFit) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let material = outcome.material();
+    d.set_item("name", &material.name)?;
+    d.set_item(
+        "material",
+        PyMaterial {
+            inner: material.clone(),
+        },
+    )?;
+    let entry = PathBuf::from(format!("{}.toml", material.name));
+    let toml = material
+        .to_toml(&entry)
+        .map_err(|e| raised(e.into(), &[]))?;
+    d.set_item("toml", toml)?;
+    d.set_item("notes", outcome.notes())?;
+    match outcome {
+        MaterialFit::Grey(o) => {
+            let fit = &o.chosen;
+            d.set_item("kind", "grey")?;
+            d.set_item("chi2", fit.chi2)?;
+            d.set_item("observations", fit.observations)?;
+            d.set_item("measurements", vec![set_dict(py, &o.measurement)?])?;
+            d.set_item(
+                "model_mueller",
+                vec![mueller_rows(py, &fit.model_muellers)?],
+            )?;
+            let columns = o.measurement.elements.len();
+            let rows: Vec<Vec<f64>> = fit
+                .normalized_residuals
+                .chunks(columns)
+                .map(<[f64]>::to_vec)
+                .collect();
+            d.set_item("normalized_residuals", PyArray2::from_vec2(py, &rows)?)?;
+        }
+        MaterialFit::Spectral(o) => {
+            let fit = &o.chosen;
+            d.set_item("kind", "spectral")?;
+            d.set_item("chi2", fit.chi2)?;
+            d.set_item("observations", fit.observations)?;
+            let sets: PyResult<Vec<_>> = o.measurements.iter().map(|s| set_dict(py, s)).collect();
+            d.set_item("measurements", sets?)?;
+            let models: PyResult<Vec<_>> = fit
+                .model_muellers
+                .iter()
+                .map(|m| mueller_rows(py, m))
+                .collect();
+            d.set_item("model_mueller", models?)?;
+            d.set_item("normalized_residuals", py.None())?;
+            d.set_item("n_errors", PyArray1::from_slice(py, &fit.n_errors))?;
+            d.set_item("k_errors", PyArray1::from_slice(py, &fit.k_errors))?;
+            d.set_item("rho_d_errors", PyArray1::from_slice(py, &fit.rho_d_errors))?;
+        }
+    }
+    Ok(d)
+}

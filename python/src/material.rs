@@ -1,0 +1,259 @@
+//! `irpol.Material`: one entry of the material library (DESIGN §2.2), grey or spectral, read,
+//! built from parameters or written exactly as the library does it.
+
+use crate::errors::{bad_argument, raised};
+use irpol::material::{Material, MaterialModel};
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use std::path::PathBuf;
+
+/// A pBRDF material: slope distribution and σ, q (shared across wavelengths), shadowing, and
+/// N = n + ik and ρ_d, one value (grey) or one per table wavelength (spectral, µm, ascending).
+#[pyclass(name = "Material", module = "irpol", frozen)]
+#[derive(Clone)]
+pub struct PyMaterial {
+    pub inner: Material,
+}
+
+/// A number or a list of numbers as a TOML value of `[model]`.
+fn one_or_many(value: &Bound<'_, PyAny>, name: &str) -> PyResult<toml::Value> {
+    if let Ok(x) = value.extract::<f64>() {
+        return Ok(toml::Value::Float(x));
+    }
+    let many: Vec<f64> = value
+        .extract()
+        .map_err(|_| bad_argument(format!("{name} must be a number or a sequence of numbers")))?;
+    Ok(toml::Value::Array(
+        many.into_iter().map(toml::Value::Float).collect(),
+    ))
+}
+
+fn floats<'py>(py: Python<'py>, values: &[f64]) -> Bound<'py, PyAny> {
+    PyArray1::from_slice(py, values).into_any()
+}
+
+#[pymethods]
+impl PyMaterial {
+    /// Builds a material from its parameters, checked as a material file's `[model]` is.
+    /// σ and q are dimensionless; n, k, ρ_d numbers (grey) or arrays over `wavelength_um` (µm).
+    #[new]
+    #[pyo3(signature = (*, sigma, n, k, distribution = "cauchy", q = None, shadowing = "smith",
+        rho_d = None, wavelength_um = None, name = "material"))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        sigma: f64,
+        n: &Bound<'_, PyAny>,
+        k: &Bound<'_, PyAny>,
+        distribution: &str,
+        q: Option<f64>,
+        shadowing: &str,
+        rho_d: Option<&Bound<'_, PyAny>>,
+        wavelength_um: Option<&Bound<'_, PyAny>>,
+        name: &str,
+    ) -> PyResult<PyMaterial> {
+        let mut table = toml::map::Map::new();
+        table.insert("distribution".into(), distribution.into());
+        table.insert("sigma".into(), sigma.into());
+        if let Some(q) = q {
+            table.insert("q".into(), q.into());
+        }
+        table.insert("shadowing".into(), shadowing.into());
+        table.insert("n".into(), one_or_many(n, "n")?);
+        table.insert("k".into(), one_or_many(k, "k")?);
+        if let Some(rho_d) = rho_d {
+            table.insert("rho_d".into(), one_or_many(rho_d, "rho_d")?);
+        }
+        let wavelength = match wavelength_um {
+            Some(w) => one_or_many(w, "wavelength_um")?,
+            None if table["n"].is_array() => {
+                return Err(bad_argument(
+                    "a spectral material (n, k arrays) needs wavelength_um, one per value",
+                ))
+            }
+            // A grey material is the same at every wavelength; this only records one.
+            None => toml::Value::Float(DEFAULT_GREY_WAVELENGTH_UM),
+        };
+        table.insert("wavelength_um".into(), wavelength);
+        let model: MaterialModel =
+            toml::Value::Table(table)
+                .try_into()
+                .map_err(|e: toml::de::Error| {
+                    bad_argument(format!("invalid material: {}", e.message()))
+                })?;
+        model
+            .validate()
+            .map_err(|e| bad_argument(format!("the model is invalid: {e}")))?;
+        Ok(PyMaterial {
+            inner: Material {
+                name: name.to_owned(),
+                tool_version: format!("irpol {}", irpol::VERSION),
+                model,
+                fit: None,
+            },
+        })
+    }
+
+    /// Reads a material TOML (as `irpol fit` writes them). Raises OSError or ValueError.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<PyMaterial> {
+        Material::load(&path)
+            .map(|inner| PyMaterial { inner })
+            .map_err(|e| raised(e.into(), &[&path]))
+    }
+
+    /// A material from the text of a material TOML.
+    #[staticmethod]
+    fn from_toml(text: &str) -> PyResult<PyMaterial> {
+        Material::from_toml(text, std::path::Path::new("<text>"))
+            .map(|inner| PyMaterial { inner })
+            .map_err(|e| raised(e.into(), &[]))
+    }
+
+    /// The material TOML text, with its explanatory comments, as `save` writes it.
+    fn to_toml(&self) -> PyResult<String> {
+        let path = PathBuf::from(format!("{}.toml", self.inner.name));
+        self.inner.to_toml(&path).map_err(|e| raised(e.into(), &[]))
+    }
+
+    /// Writes the material TOML atomically (temporary file + rename).
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        self.inner.save(&path).map_err(|e| raised(e.into(), &[]))
+    }
+
+    /// The grey material at `wavelength_um` (µm): a spectral table interpolated linearly, a grey
+    /// material itself. Raises ValueError outside a spectral table.
+    fn at(&self, wavelength_um: f64) -> PyResult<PyMaterial> {
+        let spec = self
+            .inner
+            .at(wavelength_um)
+            .map_err(|e| raised(e.into(), &[]))?;
+        Ok(PyMaterial {
+            inner: Material {
+                model: MaterialModel::Grey(spec),
+                fit: None,
+                ..self.inner.clone()
+            },
+        })
+    }
+
+    #[getter]
+    fn name(&self) -> &str {
+        &self.inner.name
+    }
+
+    #[getter]
+    fn distribution(&self) -> &'static str {
+        self.inner.model.distribution().name()
+    }
+
+    #[getter]
+    fn shadowing(&self) -> &'static str {
+        self.inner.model.shadowing().name()
+    }
+
+    /// Slope parameter σ (dimensionless).
+    #[getter]
+    fn sigma(&self) -> f64 {
+        self.inner.model.distribution().sigma()
+    }
+
+    /// Cauchy exponent q, or None for the Gaussian distribution.
+    #[getter]
+    fn q(&self) -> Option<f64> {
+        match self.inner.model.distribution() {
+            irpol::pbrdf::SlopeDistribution::Cauchy { q, .. } => Some(q),
+            irpol::pbrdf::SlopeDistribution::Gaussian { .. } => None,
+        }
+    }
+
+    #[getter]
+    fn is_spectral(&self) -> bool {
+        self.inner.model.spectral().is_some()
+    }
+
+    /// Real part of the refractive index: a float (grey) or an array over `wavelength_um`.
+    #[getter]
+    fn n<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        self.per_wavelength(py, |m| m.n, |s| &s.n)
+    }
+
+    /// Extinction coefficient k: a float (grey) or an array over `wavelength_um`.
+    #[getter]
+    fn k<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        self.per_wavelength(py, |m| m.k, |s| &s.k)
+    }
+
+    /// Diffuse reflectance ρ_d: a float (grey) or an array over `wavelength_um`.
+    #[getter]
+    fn rho_d<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        self.per_wavelength(py, |m| m.rho_d, |s| &s.rho_d)
+    }
+
+    /// µm: where a grey material was measured, or a spectral material's table wavelengths.
+    #[getter]
+    fn wavelength_um<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        self.per_wavelength(py, |m| m.wavelength_um, |s| &s.wavelength_um)
+    }
+
+    /// The fit record (`[fit]` of the TOML) as JSON text, or None for a material not fitted.
+    #[getter]
+    fn fit_json(&self) -> PyResult<Option<String>> {
+        self.inner
+            .fit
+            .as_ref()
+            .map(serde_json::to_string)
+            .transpose()
+            .map_err(|e| bad_argument(e.to_string()))
+    }
+
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let rebuild = py.get_type::<PyMaterial>().getattr("from_toml")?;
+        Ok((rebuild, PyTuple::new(py, [self.to_toml()?])?))
+    }
+
+    fn __repr__(&self) -> String {
+        let m = &self.inner.model;
+        let q = self.q().map_or(String::new(), |q| format!(", q={q}"));
+        let spectral = match m.spectral() {
+            Some(s) => {
+                let (a, b) = s.range_um();
+                format!(
+                    ", spectral {}–{} µm ({} wavelengths)",
+                    a,
+                    b,
+                    s.wavelength_um.len()
+                )
+            }
+            None => String::new(),
+        };
+        format!(
+            "Material(name={:?}, distribution={:?}, sigma={}{q}, shadowing={:?}{spectral})",
+            self.inner.name,
+            m.distribution().name(),
+            m.distribution().sigma(),
+            m.shadowing().name()
+        )
+    }
+}
+
+/// Where a grey material built from parameters says it was measured (µm): the middle of the LWIR
+/// band. It changes no value: a grey material is the same at every wavelength.
+const DEFAULT_GREY_WAVELENGTH_UM: f64 = 10.0;
+
+impl PyMaterial {
+    fn per_wavelength<'py>(
+        &self,
+        py: Python<'py>,
+        grey: impl Fn(&irpol::material::ModelSpec) -> f64,
+        spectral: impl Fn(&irpol::material::SpectralModel) -> &Vec<f64>,
+    ) -> Bound<'py, PyAny> {
+        match &self.inner.model {
+            MaterialModel::Grey(m) => grey(m).into_pyobject(py).expect("a float").into_any(),
+            MaterialModel::Spectral(s) => floats(py, spectral(s)),
+        }
+    }
+}

@@ -1,0 +1,60 @@
+//! Measurement CSVs (DESIGN §2.1) read and validated by the library's reader, as numpy arrays.
+
+use crate::errors::raised;
+use irpol::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+
+/// Every set of one measurement file, one per wavelength (ascending), each as a dict of arrays
+/// (angles in degrees, Mueller elements and their 1-σ uncertainties in sr⁻¹, NaN where the file
+/// gives no uncertainty) and metadata.
+#[pyfunction]
+pub fn read_measurement_sets(py: Python<'_>, path: PathBuf) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    let sets = py
+        .detach(|| irpol::measure::read_measurement_sets(&path))
+        .map_err(|e| raised(e.into(), &[&path]))?;
+    sets.iter().map(|set| set_dict(py, set)).collect()
+}
+
+pub fn set_dict<'py>(py: Python<'py>, set: &MeasurementSet) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let column = |f: fn(&irpol::measure::MeasurementPoint) -> f64| {
+        PyArray1::from_vec(py, set.points.iter().map(f).collect())
+    };
+    d.set_item("material", &set.material)?;
+    d.set_item("wavelength_um", set.wavelength_um)?;
+    d.set_item("source", &set.source)?;
+    d.set_item("sha256", &set.sha256)?;
+    d.set_item("metadata", set.metadata.clone())?;
+    let names: Vec<&str> = set
+        .elements
+        .iter()
+        .map(|&e| MUELLER_ELEMENT_NAMES[e])
+        .collect();
+    d.set_item("elements", names)?;
+    d.set_item("theta_i_deg", column(|p| p.theta_i_deg))?;
+    d.set_item("phi_i_deg", column(|p| p.phi_i_deg))?;
+    d.set_item("theta_r_deg", column(|p| p.theta_r_deg))?;
+    d.set_item("phi_r_deg", column(|p| p.phi_r_deg))?;
+    let values: Vec<Vec<f64>> = set.points.iter().map(|p| p.values.clone()).collect();
+    let uncertainties: Vec<Vec<f64>> = set
+        .points
+        .iter()
+        .map(|p| {
+            p.uncertainties
+                .iter()
+                .map(|u| u.unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    d.set_item("values", PyArray2::from_vec2(py, &values)?)?;
+    d.set_item("uncertainties", PyArray2::from_vec2(py, &uncertainties)?)?;
+    let lines: Vec<u64> = set.points.iter().map(|p| p.line).collect();
+    d.set_item("line", PyArray1::from_vec(py, lines))?;
+    let merged: Vec<PathBuf> = set.merged.iter().map(|m| m.path.clone()).collect();
+    d.set_item("merged", merged)?;
+    d.set_item("notes", set.notes.clone())?;
+    Ok(d)
+}

@@ -1,0 +1,190 @@
+//! A scene TOML with some values replaced: each key a dotted path into the file (array indices
+//! as numbers, `objects.0.parts.hood.temperature_k`), as the sweep spec's grid keys are
+//! (DESIGN §2.7). Every part of the path must already exist in the scene: a misspelt key is an
+//! error, never a new, silently ignored entry. The edit keeps the rest of the text as it was.
+
+use crate::errors::{bad_argument, raised};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyString};
+use std::path::{Path, PathBuf};
+use toml_edit::{DocumentMut, Item, TableLike, Value};
+
+/// A Python value as a TOML value: bool, int, float, str, and lists and dicts of them.
+pub fn toml_value(object: &Bound<'_, PyAny>) -> PyResult<Value> {
+    if let Ok(b) = object.cast::<PyBool>() {
+        return Ok(Value::from(b.is_true()));
+    }
+    if object.is_instance_of::<PyFloat>() {
+        return Ok(Value::from(object.extract::<f64>()?));
+    }
+    if let Ok(i) = object.extract::<i64>() {
+        return Ok(Value::from(i));
+    }
+    if let Ok(x) = object.extract::<f64>() {
+        return Ok(Value::from(x));
+    }
+    if let Ok(s) = object.cast::<PyString>() {
+        return Ok(Value::from(s.to_str()?));
+    }
+    if let Ok(d) = object.cast::<PyDict>() {
+        let mut table = toml_edit::InlineTable::new();
+        for (k, v) in d.iter() {
+            table.insert(&k.extract::<String>()?, toml_value(&v)?);
+        }
+        return Ok(Value::InlineTable(table));
+    }
+    if let Ok(items) = object.extract::<Vec<Bound<'_, PyAny>>>() {
+        let values: PyResult<Vec<Value>> = items.iter().map(toml_value).collect();
+        return Ok(Value::Array(values?.into_iter().collect()));
+    }
+    Err(bad_argument(format!(
+        "cannot write {} into a scene TOML: use numbers, strings, booleans, lists or dicts",
+        object.repr()?
+    )))
+}
+
+/// Where a walk down a key is, for messages: `'sun'`, `'objects.0'`, or the file's top level.
+fn place(parts: &[&str], depth: usize) -> String {
+    if depth == 0 {
+        "the top level".into()
+    } else {
+        format!("'{}'", parts[..depth].join("."))
+    }
+}
+
+fn index(parts: &[&str], depth: usize, len: usize) -> Result<usize, String> {
+    parts[depth]
+        .parse::<usize>()
+        .ok()
+        .filter(|&i| i < len)
+        .ok_or_else(|| {
+            format!(
+                "'{}' is not an index of the array {} ({len} entries)",
+                parts[depth],
+                place(parts, depth)
+            )
+        })
+}
+
+/// How a walk treats a missing last key: an error (a sweep's grid keys), or a new entry (the
+/// render overrides, whose keys a scene may leave to their defaults).
+#[derive(Clone, Copy, PartialEq)]
+pub enum Missing {
+    Refuse,
+    Create,
+}
+
+fn set_in_table(
+    t: &mut dyn TableLike,
+    parts: &[&str],
+    depth: usize,
+    v: Value,
+    missing: Missing,
+) -> Result<(), String> {
+    if missing == Missing::Create && depth + 1 == parts.len() && t.get(parts[depth]).is_none() {
+        t.insert(parts[depth], Item::Value(v));
+        return Ok(());
+    }
+    let child = t
+        .get_mut(parts[depth])
+        .ok_or_else(|| format!("no '{}' in {}", parts[depth], place(parts, depth)))?;
+    set_in_item(child, parts, depth + 1, v, missing)
+}
+
+fn set_in_item(
+    item: &mut Item,
+    parts: &[&str],
+    depth: usize,
+    v: Value,
+    missing: Missing,
+) -> Result<(), String> {
+    if depth == parts.len() {
+        if !item.is_value() {
+            return Err(format!(
+                "{} is a table: set its keys one by one",
+                place(parts, depth)
+            ));
+        }
+        *item = Item::Value(v);
+        return Ok(());
+    }
+    match item {
+        Item::Table(t) => set_in_table(t, parts, depth, v, missing),
+        Item::ArrayOfTables(a) => {
+            let i = index(parts, depth, a.len())?;
+            let table = a.get_mut(i).expect("index checked");
+            if depth + 1 == parts.len() {
+                return Err(format!(
+                    "{} is a table: set its keys one by one",
+                    place(parts, depth + 1)
+                ));
+            }
+            set_in_table(table, parts, depth + 1, v, missing)
+        }
+        Item::Value(value) => set_in_value(value, parts, depth, v, missing),
+        Item::None => Err(format!("no {}", place(parts, depth))),
+    }
+}
+
+fn set_in_value(
+    value: &mut Value,
+    parts: &[&str],
+    depth: usize,
+    v: Value,
+    missing: Missing,
+) -> Result<(), String> {
+    if depth == parts.len() {
+        *value = v;
+        return Ok(());
+    }
+    match value {
+        Value::Array(a) => {
+            let i = index(parts, depth, a.len())?;
+            let element = a.get_mut(i).expect("index checked");
+            set_in_value(element, parts, depth + 1, v, missing)
+        }
+        Value::InlineTable(t) => set_in_table(t, parts, depth, v, missing),
+        _ => Err(format!(
+            "{} is a single value, not a table or an array",
+            place(parts, depth)
+        )),
+    }
+}
+
+/// `text` with each `(key, value)` set; a key that does not name an existing entry is refused
+/// with the scene's path and the key (unless `missing` says to create a missing last key).
+pub fn patched(
+    path: &Path,
+    text: &str,
+    patch: &[(String, Value)],
+    missing: Missing,
+) -> Result<String, String> {
+    let mut doc: DocumentMut = text
+        .parse()
+        .map_err(|e| format!("{}: not a valid scene: {e}", path.display()))?;
+    for (key, value) in patch {
+        let parts: Vec<&str> = key.split('.').collect();
+        set_in_item(doc.as_item_mut(), &parts, 0, value.clone(), missing)
+            .map_err(|e| format!("{}: scene key '{key}': {e}", path.display()))?;
+    }
+    Ok(doc.to_string())
+}
+
+/// A scene file's text, refused as `irpol render` refuses an unreadable scene.
+pub fn scene_text(path: &Path) -> PyResult<String> {
+    std::fs::read_to_string(path).map_err(|e| {
+        let error = irpol::scene::SceneError::new(path, format!("cannot read the scene: {e}"));
+        raised(anyhow::Error::new(error), &[path])
+    })
+}
+
+/// Checks that every dotted key names an entry of the scene file (a sweep does this before
+/// any work starts); raises ValueError naming the first that does not.
+#[pyfunction]
+pub fn check_scene_keys(scene: PathBuf, keys: Vec<String>) -> PyResult<()> {
+    let text = scene_text(&scene)?;
+    let patch: Vec<(String, Value)> = keys.into_iter().map(|k| (k, Value::from(0))).collect();
+    patched(&scene, &text, &patch, Missing::Refuse)
+        .map(drop)
+        .map_err(bad_argument)
+}

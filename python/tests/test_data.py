@@ -1,0 +1,161 @@
+"""band_radiance / brightness_temperature, read_measurements, fit (against `irpol fit`'s TOML)
+and render (against `irpol render`'s TIFFs), bit for bit; bad input with the CLI's messages."""
+
+from __future__ import annotations
+
+import csv
+import shutil
+
+import numpy as np
+import pytest
+import tifffile
+
+import irpol
+from conftest import ROOT, cli_error, cli_output, run_cli
+
+MEASUREMENTS = ROOT / "measurements"
+
+
+def test_band_radiance_and_its_inverse():
+    t = np.array([[250.0, 300.0], [350.0, 1000.0]])
+    radiance = irpol.band_radiance(t)
+    assert radiance.shape == (2, 2) and radiance.dtype == np.float64
+    assert np.all(np.diff(radiance.ravel()) > 0)
+    assert abs(irpol.band_radiance(300.0) - 54.93) < 0.01      # 8–14 µm at 300 K, W m⁻² sr⁻¹
+    assert np.allclose(irpol.brightness_temperature(radiance), t, rtol=1e-12, atol=0)
+    wide = irpol.band_radiance(300, band_um=(3.0, 5.0))
+    assert 0 < wide < irpol.band_radiance(300)
+    assert isinstance(irpol.band_radiance(300), float)
+    assert irpol.band_radiance([300]).shape == (1,)
+    with pytest.raises(ValueError, match="sensor band 14–8 µm is invalid"):
+        irpol.band_radiance(300, band_um=(14, 8))
+    with pytest.raises(ValueError, match="temperature -1"):
+        irpol.band_radiance(-1.0)
+    with pytest.raises(ValueError, match="radiance -1 W"):
+        irpol.brightness_temperature(-1.0)
+
+
+def test_read_measurements_holds_the_file():
+    path = MEASUREMENTS / "rough_paint.csv"
+    [sets] = irpol.read_measurements(path)
+    rows = list(csv.DictReader(l for l in open(path) if not l.startswith("#")))
+    assert sets.material == "rough_paint" and len(rows) == sets.values.shape[0]
+    assert sets.values.shape == (len(rows), len(sets.elements))
+    for j, name in enumerate(sets.elements):
+        assert np.array_equal(sets.values[:, j], [float(r[name]) for r in rows])
+    assert np.array_equal(sets.theta_i_deg, [float(r["theta_i_deg"]) for r in rows])
+    spectral = irpol.read_measurements(MEASUREMENTS / "silicate_glass.csv")
+    wavelengths = [s.wavelength_um for s in spectral]
+    assert len(spectral) > 1 and wavelengths == sorted(wavelengths)
+
+
+def test_bad_measurement_files_raise_the_cli_message(tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("theta_i_deg,theta_r_deg,m00\n10,20,abc\n")
+    message = cli_error("fit", bad, "--out", tmp_path / "f", "--reports", tmp_path / "r")
+    with pytest.raises(ValueError) as raised:
+        irpol.read_measurements(bad)
+    assert str(raised.value) == message
+    with pytest.raises(ValueError) as raised:
+        irpol.fit(bad)
+    assert str(raised.value) == message
+    missing = tmp_path / "missing.csv"
+    message = cli_error("fit", missing, "--out", tmp_path / "f", "--reports", tmp_path / "r")
+    with pytest.raises(OSError) as raised:
+        irpol.fit(missing)
+    assert str(raised.value) == message
+
+
+def test_fit_equals_irpol_fit(tmp_path):
+    source = MEASUREMENTS / "rough_paint.csv"
+    options = ["--optimizer", "ga+lm", "--seed", "7", "--fix", "rho=0.03"]
+    cli_output("fit", source, *options, "--out", tmp_path / "fits", "--reports", tmp_path / "r")
+    [result] = irpol.fit(source, optimizer="ga+lm", seed=7, fix={"rho": 0.03})
+    assert result.toml == (tmp_path / "fits" / "rough_paint.toml").read_text()
+    assert result.name == "rough_paint" and result.kind == "grey"
+    free = result.free_parameters
+    assert "rho" not in free and result.correlation.shape == (len(free), len(free))
+    assert np.allclose(np.diag(result.correlation), 1.0)
+    assert set(result.uncertainty) == set(free)
+    residuals = result.normalized_residuals
+    assert residuals.shape == result.measurements[0].values.shape
+    assert np.isclose(np.sum(residuals ** 2), result.chi2, rtol=1e-12)
+    assert result.reduced_chi2 == pytest.approx(result.chi2 / result.degrees_of_freedom, rel=1e-6)
+    assert result.model_mueller[0].shape == (residuals.shape[0], 4, 4)
+
+
+def test_spectral_fit_equals_irpol_fit(tmp_path):
+    source = MEASUREMENTS / "silicate_glass.csv"
+    cli_output("fit", source, "--out", tmp_path / "fits", "--reports", tmp_path / "r")
+    [result] = irpol.fit(source)
+    assert result.kind == "spectral" and result.material.is_spectral
+    assert result.toml == (tmp_path / "fits" / "silicate_glass.toml").read_text()
+    assert len(result.model_mueller) == len(result.measurements) > 1
+
+
+def test_fit_options_are_refused_with_the_cli_message(tmp_path):
+    source = MEASUREMENTS / "rough_paint.csv"
+    for flags, kwargs in [(["--optimizer", "ga+xx"], {"optimizer": "ga+xx"}),
+                          (["--shadowing", "smyth"], {"shadowing": "smyth"}),
+                          (["--free", "sigma,zz"], {"free": ["sigma", "zz"]}),
+                          (["--dispersion", "lorentz:x"], {"dispersion": "lorentz:x"})]:
+        message = cli_error("fit", source, *flags, "--out", tmp_path, "--reports", tmp_path)
+        with pytest.raises(ValueError) as raised:
+            irpol.fit(source, **kwargs)
+        assert str(raised.value) == message
+
+
+CHANNELS = ["S0", "S1", "S2", "S3", "DoLP", "AoP", "I0", "I45", "I90", "I135", "stderr_S0"]
+
+
+@pytest.fixture(scope="module")
+def small_scene(tmp_path_factory):
+    """`irpol scene init`'s starter scene at 48×36 pixels, 4 samples per pixel."""
+    folder = tmp_path_factory.mktemp("scene")
+    cli_output("scene", "init", "--out", folder / "scene.toml")
+    text = (folder / "scene.toml").read_text()
+    text = text.replace("resolution = [640, 480]", "resolution = [48, 36]")
+    text = text.replace("samples = 16 ", "samples = 4 ")
+    (folder / "scene.toml").write_text(text)
+    return folder / "scene.toml"
+
+
+def test_render_equals_irpol_render(small_scene, tmp_path):
+    cli_output("render", small_scene, "--out", tmp_path / "cli")
+    images = irpol.render(small_scene, out=tmp_path / "py")
+    for name in CHANNELS:
+        tiff = tifffile.imread(tmp_path / "cli" / f"{name}.tif")
+        assert images[name].dtype == np.float32 and images[name].shape == (36, 48)
+        assert np.array_equal(images[name], tiff, equal_nan=True), name
+        assert (tmp_path / "py" / f"{name}.tif").read_bytes() == (tmp_path / "cli" / f"{name}.tif").read_bytes()
+    assert images["summary"]["width"] == 48
+
+
+def test_render_overrides_equal_an_edited_scene(small_scene, tmp_path):
+    text = small_scene.read_text().replace("resolution = [48, 36]", "resolution = [32, 24]")
+    text = text.replace("elevation_deg = 35.0", "elevation_deg = 20.0")
+    edited = small_scene.parent / "edited.toml"
+    edited.write_text(text)
+    cli_output("render", edited, "--out", tmp_path / "cli")
+    images = irpol.render(small_scene, resolution=(32, 24), patch={"sun.elevation_deg": 20.0})
+    for name in CHANNELS:
+        assert np.array_equal(images[name], tifffile.imread(tmp_path / "cli" / f"{name}.tif"),
+                              equal_nan=True), name
+
+
+def test_bad_scenes_raise_the_cli_message(small_scene, tmp_path):
+    message = cli_error("render", tmp_path / "missing.toml", "--out", tmp_path / "o")
+    with pytest.raises(OSError) as raised:
+        irpol.render(tmp_path / "missing.toml")
+    assert str(raised.value) == message
+    broken = tmp_path / "broken.toml"
+    broken.write_text(small_scene.read_text().replace("fov_deg = 30.0", "fov_deg = 300.0"))
+    shutil.copy(small_scene, tmp_path / "ok.toml")
+    message = cli_error("render", broken, "--out", tmp_path / "o")
+    with pytest.raises(ValueError) as raised:
+        irpol.render(broken)
+    assert str(raised.value) == message
+    with pytest.raises(ValueError, match="scene key 'sun.elevation_dg': no 'elevation_dg' in 'sun'"):
+        irpol.render(small_scene, patch={"sun.elevation_dg": 20.0})
+    with pytest.raises(ValueError, match="'7' is not an index of the array 'objects' \\(2 entries\\)"):
+        irpol.render(small_scene, patch={"objects.7.temperature_k": 300.0})
