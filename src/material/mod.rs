@@ -5,7 +5,10 @@ mod comments;
 mod spectral;
 
 use spectral::{check_wavelength, DistributionName};
-pub use spectral::{MaterialModel, OutsideTable, SpectralModel, SAME_WAVELENGTH_UM};
+pub use spectral::{
+    BandModelError, MaterialModel, OutsideTable, SpectralModel, SAME_WAVELENGTH_UM,
+    THERMAL_EMISSIVITY_REFERENCE_K,
+};
 
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};
