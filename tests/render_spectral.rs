@@ -422,3 +422,50 @@ fn the_monte_carlo_spectral_approximation_is_small() {
     assert!(largest_correction > 0.1, "{largest_correction}");
     assert!(worst < 5e-3, "{worst}");
 }
+
+/// The thermal model (DESIGN §1.8) takes a spectral material's default emissivity as its
+/// hemispherical emissivity Planck-weighted at 300 K over its table (README "Band rendering").
+#[test]
+fn a_spectral_material_has_a_planck_weighted_thermal_emissivity() {
+    let dir = tempfile::tempdir().unwrap();
+    write_silicate(&dir.path().join("lib"), "silicate");
+    let text = format!(
+        "material_library = \"lib\"\n{}{AUTUMN_ENVIRONMENT}\
+         [thermal]\nweather = {{ clear_day = {{ air_min_k = 287.0, air_max_k = 301.0, wind_m_s = 2.0 }} }}\n\
+         start_utc = \"2026-06-21T00:00:00Z\"\nlatitude_deg = 48.14\nlongitude_deg = 11.58\n\
+         [thermal.layers.glass]\nconductivity_w_mk = 1.0\ndensity_kg_m3 = 2500.0\nheat_capacity_j_kgk = 800.0\n\
+         [[objects]]\nname = \"pane\"\nshape = {{ kind = \"plane\", size = [1.0, 1.0], divisions = [1, 1] }}\n\
+         material = \"silicate\"\n[objects.thermal]\nstack = [[\"glass\", 0.004]]\nsolar_absorptance = 0.1\n",
+        camera_toml(8)
+    );
+    let scene = load_scene(&write_scene(dir.path(), &text)).unwrap();
+    let thermal = scene.thermal.as_ref().unwrap();
+    let emissivity = thermal.surfaces[0].as_ref().unwrap().emissivity;
+    // Σ f_m(300 K) ε_h(λ_m) over the table's own range, 8–14 µm.
+    let material = Material::load(&dir.path().join("lib/silicate.toml")).unwrap();
+    let MaterialModel::Spectral(model) = &material.model else {
+        panic!("a spectral material")
+    };
+    let nodes =
+        irpol::optics::WavelengthNodes::for_table(&irpol::optics::Band::lwir(), &SILICATE_UM)
+            .unwrap();
+    let expected: f64 = nodes
+        .wavelengths_um()
+        .iter()
+        .zip(nodes.planck_fractions(300.0))
+        .map(|(&l, f)| {
+            f * model
+                .at(l)
+                .unwrap()
+                .pbrdf()
+                .unwrap()
+                .hemispherical_emissivity()
+        })
+        .sum();
+    assert!(
+        (emissivity - expected).abs() < 1e-12,
+        "{emissivity} vs {expected}"
+    );
+    // Between the reststrahlen band's 0.51 and the window's 0.86.
+    assert!((0.74..0.76).contains(&emissivity), "{emissivity}");
+}
