@@ -469,3 +469,45 @@ fn a_spectral_material_has_a_planck_weighted_thermal_emissivity() {
     // Between the reststrahlen band's 0.51 and the window's 0.86.
     assert!((0.74..0.76).contains(&emissivity), "{emissivity}");
 }
+
+/// Spectral materials of one scene share one set of wavelength nodes: the band split at the
+/// table wavelengths of all of them, so that light passed between them keeps its spectrum.
+#[test]
+fn spectral_materials_of_a_scene_share_their_wavelength_nodes() {
+    let dir = tempfile::tempdir().unwrap();
+    let lib = dir.path().join("lib");
+    write_silicate(&lib, "silicate");
+    let table = [7.5, 9.25, 14.5];
+    write_material(
+        &lib,
+        "paint",
+        0.2,
+        2.0,
+        [
+            &table,
+            &[1.5, 1.7, 1.6],
+            &[0.1, 0.3, 0.2],
+            &[0.02, 0.03, 0.02],
+        ],
+    );
+    let text = format!(
+        "material_library = \"lib\"\n{}{AUTUMN_ENVIRONMENT}\
+         [[objects]]\nname = \"ball\"\nshape = {{ kind = \"sphere\", radius = 1.0, subdivisions = 2 }}\n\
+         material = \"silicate\"\ntemperature_k = 300.0\n\
+         [[objects]]\nname = \"pebble\"\nshape = {{ kind = \"sphere\", radius = 0.2, subdivisions = 1 }}\n\
+         translate = [1.2, 0.0, 0.0]\nmaterial = \"paint\"\ntemperature_k = 300.0\n",
+        camera_toml(16)
+    );
+    let scene = load_scene(&write_scene(dir.path(), &text)).unwrap();
+    let nodes: Vec<_> = scene
+        .materials
+        .iter()
+        .map(|m| m.optics.band().unwrap().nodes().clone())
+        .collect();
+    assert_eq!(nodes[0], nodes[1]);
+    // Breaks at the silicate's seven inner wavelengths and 9.25 µm: nine pieces, the last
+    // (12.5–14 µm) in two.
+    assert_eq!(nodes[0].len(), 10 * 4);
+    let image = render(&scene, &Silent).unwrap().image;
+    assert!(image.stokes.iter().all(|s| s.iter().all(|v| v.is_finite())));
+}
