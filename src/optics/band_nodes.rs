@@ -166,7 +166,7 @@ impl WavelengthNodes {
 }
 
 /// Weights over a material's wavelength nodes, e.g. the Planck fractions of a source, possibly
-/// interpolated between two tabulated rows: weight(m) = (1 − t) lower[m] + t upper[m].
+/// interpolated between two tabulated rows: `weight(m) = (1 − t) lower[m] + t upper[m]`.
 #[derive(Clone, Copy, Debug)]
 pub struct SpectralMix<'a> {
     lower: &'a [f64],

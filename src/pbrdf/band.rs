@@ -86,7 +86,7 @@ impl BandPbrdf {
         &self.models
     }
 
-    /// [`Pbrdf::visit_specular_nodes`] of every model at once: `visit(ω_i, K)` with K[m] the
+    /// [`Pbrdf::visit_specular_nodes`] of every model at once: `visit(ω_i, K)` with `K[m]` the
     /// Stokes weight of node ω_i for the model at wavelength node m. The nodes are those of each
     /// model's own quadrature (they depend on σ, q and the shadowing alone).
     pub fn visit_specular_nodes(

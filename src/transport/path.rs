@@ -22,12 +22,12 @@
 //! counted twice.
 //!
 //! A band material (DESIGN §1.9) scatters each source with its band-weighted Mueller matrix
-//! Σ_m f_m F(λ_m), f the Planck fractions of that source's spectrum over the material's
-//! wavelength nodes: the sun's as a 5772 K blackbody through the band; a surface hit's and the
-//! environment's as grey at their brightness temperatures (the light leaving a surface is not
-//! grey, nor is the sky: the approximation is measured in the README). In the correction the
-//! hit's S_in and the environment's L_env e₀ each get their own fractions, so a ray that escapes
-//! still adds exactly zero.
+//! Σ_m f_m F(λ_m), f the shares of that source's spectrum over the wavelength nodes: the sun's
+//! as a 5772 K blackbody through the band; the environment a correction replaces, grey at its
+//! brightness temperature; the light of a surface hit as its emission, node by node, plus what
+//! it reflects, modelled as a uniform grey source reflected by the hit (`band_scattering`).
+//! Only the hit's emission is exact: the approximation is measured in the README ("Band
+//! rendering"). A ray that escapes still adds exactly zero (no hit, no correction).
 
 use super::accel::Accelerator;
 use super::open_world::OpenWorld;
