@@ -121,6 +121,14 @@ impl BandEnvironment {
         }
     }
 
+    /// The wavelength node with the largest mean share of the environment's radiance.
+    pub fn brightest_node(&self) -> usize {
+        (0..self.mean_shares.len())
+            .rev()
+            .max_by(|&a, &b| self.mean_shares[a].total_cmp(&self.mean_shares[b]))
+            .unwrap_or(0)
+    }
+
     /// The coefficients of a quantity Q_m given per wavelength node on each component:
     /// [Σ_m f̄_m Q_m, Σ_m U_m1 Q_m, …] (a kernel weight, ρ_d).
     pub fn project(&self, per_node: impl Fn(usize) -> f64) -> Vec<f64> {

@@ -121,13 +121,15 @@ pub fn specular_kernel(
 
 /// The specular kernels of every wavelength node of a band material at once (DESIGN §1.9): the
 /// nodes of each model's quadrature are the same directions ([`BandPbrdf::visit_specular_nodes`]),
-/// merged once. Cells merge at the mean direction weighted by Σ_m s_m |K0_m| for the shares s
-/// `mass_shares` (Σ s = 1: a model that does not change with λ merges as its grey kernel).
+/// merged once, each cell at its mean direction weighted by |K0| of the wavelength node
+/// `merge_node` (the one carrying most of the environment's light). A material that does not
+/// change with λ then merges exactly as its grey kernel (the same directions to the bit: a node
+/// on the horizon must not change sides).
 pub fn band_specular_kernel(
     band: &BandPbrdf,
     theta_r: f64,
     quadrature: &KernelQuadrature,
-    mass_shares: &[f64],
+    merge_node: usize,
 ) -> BandKernel {
     let models = band.models().len();
     let scattered = Direction::from_angles(theta_r, 0.0);
@@ -140,12 +142,10 @@ pub fn band_specular_kernel(
     let mut nodes = NodeMerger::new(&band.models()[0], theta_r, quadrature, models);
     let mut weights = vec![[0.0; 3]; models];
     band.visit_specular_nodes(&scattered, &quadrature.hemisphere(), |w_i, k| {
-        let mut mass = 0.0;
-        for ((slot, stokes), share) in weights.iter_mut().zip(k).zip(mass_shares) {
+        for (slot, stokes) in weights.iter_mut().zip(k) {
             *slot = [stokes[0], stokes[1], stokes[2]];
-            mass += share * stokes[0].abs();
         }
-        nodes.add(*w_i, mass, &weights)
+        nodes.add(*w_i, k[merge_node][0].abs(), &weights)
     });
     let (directions, weights) = nodes.finish();
     BandKernel {

@@ -309,12 +309,12 @@ impl MaterialTables {
         let quadrature = merged_quadrature(&resolution, quadrature);
         let sky = environment.sine_table(1024);
         let split = BandEnvironment::new(&sky, band, material.nodes());
+        let merge_node = split.brightest_node();
         let kernels: Vec<(ComponentKernel, Vec<[f64; 3]>)> = (0..theta.len())
             .into_par_iter()
             .map(|i| {
                 let theta_r = theta_of_coordinate(theta.value(i));
-                let kernel =
-                    band_specular_kernel(material, theta_r, &quadrature, &split.mean_shares);
+                let kernel = band_specular_kernel(material, theta_r, &quadrature, merge_node);
                 let per_component: Vec<Vec<[f64; 3]>> = std::iter::once(&split.mean_shares)
                     .chain(split.components.iter().map(|c| &c.shares))
                     .map(|shares| kernel.combined(shares))
@@ -764,7 +764,7 @@ mod tests {
         let (theta, tilt, phi) = table_grids(&resolution);
         let quadrature = merged_quadrature(&resolution, &KernelQuadrature::default());
         let sky = environment.sine_table(1024);
-        let mass_shares = BandEnvironment::new(&sky, band, material.nodes()).mean_shares;
+        let merge_node = BandEnvironment::new(&sky, band, material.nodes()).brightest_node();
         let nodes = material.nodes().len();
         let split = |l: f64| {
             let f = material
@@ -788,7 +788,7 @@ mod tests {
                     material,
                     theta_of_coordinate(theta.value(i)),
                     &quadrature,
-                    &mass_shares,
+                    merge_node,
                 );
                 let unit = |m: usize| {
                     (0..nodes)
@@ -843,6 +843,57 @@ mod tests {
             worst / largest
         );
         assert!(worst < 1e-5 * largest, "{worst} vs {largest}");
+    }
+
+    #[test]
+    fn a_band_material_that_does_not_change_with_wavelength_has_its_grey_tables() {
+        let band = Band::lwir();
+        let grey = Pbrdf::new(
+            SlopeDistribution::Cauchy { sigma: 0.1, q: 2.5 },
+            Shadowing::Smith,
+            RefractiveIndex::new(1.6, 0.4),
+            0.05,
+        )
+        .unwrap();
+        let nodes =
+            crate::optics::WavelengthNodes::for_table(&band, &[7.0, 9.0, 12.0, 15.0]).unwrap();
+        let flat = BandPbrdf::new(nodes.clone(), vec![grey.clone(); nodes.len()]).unwrap();
+        let environment = window_sky(&band);
+        let resolution = TableResolution {
+            tilt: 9,
+            theta: 16,
+            phi: 9,
+            merge_cell_deg: 2.0,
+        };
+        let quadrature = KernelQuadrature::default();
+        let a = MaterialTables::build(&grey, &environment, resolution, &quadrature).unwrap();
+        let b = MaterialTables::build_band(
+            &flat,
+            &environment,
+            &band,
+            (280.0, 300.0),
+            resolution,
+            &quadrature,
+        )
+        .unwrap();
+        for cos_theta in [1.0, 0.7, 0.2, 0.01] {
+            let (e_grey, e_band) = (a.emissivity(cos_theta), b.emissivity_at(cos_theta, 291.3));
+            for j in 0..2 {
+                assert!((e_grey[j] - e_band[j]).abs() < 1e-15, "{cos_theta} ε{j}");
+            }
+        }
+        for (x, y) in a.diffuse.iter().zip(&b.diffuse) {
+            assert!((x - y).abs() <= 1e-14 * x.abs(), "{x} vs {y}");
+        }
+        // The f32 entries agree but where the f64 sums, equal to ~1e-16, round differently.
+        for (x, y) in a.reflection.iter().zip(&b.reflection) {
+            for j in 0..3 {
+                assert!(
+                    (x[j] - y[j]).abs() <= f32::EPSILON * x[0].abs(),
+                    "{x:?} vs {y:?}"
+                );
+            }
+        }
     }
 
     #[test]
