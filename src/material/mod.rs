@@ -5,7 +5,9 @@ mod comments;
 mod spectral;
 
 use spectral::{check_wavelength, DistributionName};
-pub use spectral::{MaterialModel, OutsideTable, SpectralModel};
+pub use spectral::{
+    BandModelError, MaterialModel, OutsideTable, SpectralModel, THERMAL_EMISSIVITY_REFERENCE_K,
+};
 
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};

@@ -5,8 +5,10 @@
 //! A grey model is the same at every wavelength.
 
 use super::ModelSpec;
-use crate::optics::{LorentzDispersion, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
-use crate::pbrdf::{ModelError, Shadowing, SlopeDistribution};
+use crate::optics::{
+    Band, LorentzDispersion, TableMissesBand, WavelengthNodes, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM,
+};
+use crate::pbrdf::{BandPbrdf, ModelError, Shadowing, SlopeDistribution};
 use crate::text::number;
 use serde::{Deserialize, Serialize};
 
@@ -48,7 +50,62 @@ pub struct OutsideTable {
     pub last_um: f64,
 }
 
+/// Why a spectral model cannot be integrated over a band.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum BandModelError {
+    #[error(transparent)]
+    Table(#[from] TableMissesBand),
+    #[error(transparent)]
+    Outside(#[from] OutsideTable),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+}
+
+/// The temperature (K) at which a spectral material's thermal emissivity is Planck-weighted
+/// ([`SpectralModel::thermal_emissivity`]).
+pub const THERMAL_EMISSIVITY_REFERENCE_K: f64 = 300.0;
+
 impl SpectralModel {
+    /// The model at each wavelength node of `band` (DESIGN §1.9, [`crate::optics::band_nodes`]),
+    /// refused when the table does not span the band.
+    pub fn band_pbrdf(&self, band: &Band) -> Result<BandPbrdf, BandModelError> {
+        self.band_pbrdf_on(WavelengthNodes::for_table(band, &self.wavelength_um)?)
+    }
+
+    /// The model at each of `nodes` (which must lie inside the table: nodes of a band it spans,
+    /// e.g. shared with other materials, [`WavelengthNodes::for_tables`]).
+    pub fn band_pbrdf_on(&self, nodes: WavelengthNodes) -> Result<BandPbrdf, BandModelError> {
+        let models = nodes
+            .wavelengths_um()
+            .iter()
+            .map(|&lambda| Ok(self.at(lambda)?.pbrdf()?))
+            .collect::<Result<Vec<_>, BandModelError>>()?;
+        Ok(BandPbrdf::new(nodes, models)?)
+    }
+
+    /// The thermal hemispherical emissivity of DESIGN §1.8 for a spectral material: the
+    /// hemispherical ε_h(λ) of each model, Planck-weighted at
+    /// [`THERMAL_EMISSIVITY_REFERENCE_K`] over the table's own range (flat response), the
+    /// wavelengths the material is known at: Σ_m f_m ε_h(λ_m). A heat balance is broadband and
+    /// the table is not, so this takes the table's Planck-weighted mean to hold outside it.
+    pub fn thermal_emissivity(&self) -> Result<f64, BandModelError> {
+        let (first, last) = self.range_um();
+        let table = Band::new(first, last, None).map_err(|_| TableMissesBand {
+            table_um: (first, last),
+            band_um: (first, last),
+        })?;
+        let band = self.band_pbrdf(&table)?;
+        let shares = band
+            .nodes()
+            .planck_fractions(THERMAL_EMISSIVITY_REFERENCE_K);
+        Ok(band
+            .models()
+            .iter()
+            .zip(&shares)
+            .map(|(model, f)| f * model.hemispherical_emissivity())
+            .sum())
+    }
+
     /// The model at `wavelength_um`: n, k, ρ_d interpolated linearly between the two nearest
     /// table nodes (exactly the node's values at a node).
     pub fn at(&self, wavelength_um: f64) -> Result<ModelSpec, OutsideTable> {
@@ -344,6 +401,29 @@ mod tests {
         let outside = model.at(7.9).unwrap_err().to_string();
         assert_eq!(outside, "7.9 µm is outside its table, 8–11.5 µm");
         assert!(model.at(f64::NAN).is_err());
+    }
+
+    #[test]
+    fn a_flat_table_has_its_grey_thermal_emissivity() {
+        let flat = SpectralModel {
+            n: vec![1.4; 3],
+            k: vec![0.3; 3],
+            rho_d: vec![0.02; 3],
+            ..glass()
+        };
+        let grey = flat.at(9.0).unwrap().pbrdf().unwrap();
+        let thermal = flat.thermal_emissivity().unwrap();
+        assert!((thermal - grey.hemispherical_emissivity()).abs() < 1e-12);
+        // A table that does not change with λ integrates over any band to its grey self.
+        let band = flat
+            .band_pbrdf(&Band::new(8.5, 11.0, None).unwrap())
+            .unwrap();
+        assert!(band.models().iter().all(|m| m.index() == grey.index()));
+        let err = flat.band_pbrdf(&Band::lwir()).unwrap_err().to_string();
+        assert!(
+            err.contains("8–11.5 µm") && err.contains("8–14 µm"),
+            "{err}"
+        );
     }
 
     #[test]

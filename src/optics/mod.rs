@@ -1,17 +1,20 @@
 //! Optics primitives: Fresnel coefficients of an absorbing medium, Jones/Mueller/Stokes algebra in
 //! the SCATMECH "psps" convention, and Planck band radiance. Nothing here knows about microfacets.
 
+pub mod band_nodes;
 mod dispersion;
 pub mod frame;
 mod fresnel;
 mod planck;
 mod polarization;
 
+pub use band_nodes::{SpectralMix, TableMissesBand, WavelengthNodes};
 pub use dispersion::{LorentzDispersion, LorentzOscillator};
 pub use frame::{rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame};
 pub use fresnel::{fresnel_amplitudes, FresnelFractions, RefractiveIndex};
 pub use planck::{
-    valid_temperature, Band, OpticsError, MAX_TEMPERATURE_K, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM,
+    ln_spectral_radiance, spectral_radiance, valid_temperature, Band, OpticsError,
+    MAX_TEMPERATURE_K, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM,
 };
 pub use polarization::{
     fresnel_mueller, jones_to_mueller, rotate_stokes, stokes_rotator, Mueller, Stokes,

@@ -54,6 +54,8 @@ pub struct Band {
     hi_um: f64,
     /// Quadrature nodes (wavelength in m) and weights (dλ in m, times R(λ)).
     nodes: Vec<(f64, f64)>,
+    /// The response table (µm, R), `None` for R ≡ 1.
+    response: Option<Vec<(f64, f64)>>,
 }
 
 impl Band {
@@ -115,11 +117,35 @@ impl Band {
             lo_um,
             hi_um,
             nodes,
+            response,
         })
     }
 
     pub fn limits_um(&self) -> (f64, f64) {
         (self.lo_um, self.hi_um)
+    }
+
+    /// The spectral response R(λ) at `wavelength_um`: 1 without a table, else linear between
+    /// its rows and 0 outside them (and outside the band).
+    pub fn response_at(&self, wavelength_um: f64) -> f64 {
+        if !(self.lo_um..=self.hi_um).contains(&wavelength_um) {
+            return 0.0;
+        }
+        self.response
+            .as_ref()
+            .map_or(1.0, |table| interpolate_response(table, wavelength_um))
+    }
+
+    /// Where R(λ) has a kink inside the band (its table's rows, µm, ascending): a quadrature
+    /// over the band must break its panels there.
+    pub fn response_knots_um(&self) -> Vec<f64> {
+        self.response.as_ref().map_or(Vec::new(), |table| {
+            table
+                .iter()
+                .map(|&(w, _)| w)
+                .filter(|&w| w > self.lo_um && w < self.hi_um)
+                .collect()
+        })
     }
 
     /// Band radiance L_bb(T) = ∫ R(λ) 2hc²/λ⁵ / (exp(hc/(λkT)) − 1) dλ in W·m⁻²·sr⁻¹; 0 at T ≤ 0.
@@ -200,8 +226,22 @@ impl Band {
 }
 
 /// Spectral radiance B_λ(T) in W·m⁻²·sr⁻¹·m⁻¹ at wavelength λ in metres.
-fn spectral_radiance(lambda_m: f64, temperature_k: f64) -> f64 {
+pub fn spectral_radiance(lambda_m: f64, temperature_k: f64) -> f64 {
     C1L / lambda_m.powi(5) / (C2 / (lambda_m * temperature_k)).exp_m1()
+}
+
+/// ln B_λ(T) (B_λ in W·m⁻²·sr⁻¹·m⁻¹, λ in metres), finite for any T > 0: where B_λ itself
+/// underflows (x = hc/(λkT) beyond ~700, a few kelvin in the infrared) its logarithm is still
+/// −x + …, which ratios of spectral radiances at one temperature need.
+pub fn ln_spectral_radiance(lambda_m: f64, temperature_k: f64) -> f64 {
+    let x = C2 / (lambda_m * temperature_k);
+    // ln(eˣ − 1) = x + ln(1 − e⁻ˣ) without overflow; below x = 1 the direct form is exact.
+    let ln_expm1 = if x > 1.0 {
+        x + (-(-x).exp()).ln_1p()
+    } else {
+        x.exp_m1().ln()
+    };
+    C1L.ln() - 5.0 * lambda_m.ln() - ln_expm1
 }
 
 fn validate_response(table: &[(f64, f64)]) -> Result<(), OpticsError> {
@@ -306,6 +346,21 @@ mod tests {
             tri.radiance(300.0) < full.radiance(300.0)
                 && tri.radiance(300.0) > 0.3 * full.radiance(300.0)
         );
+    }
+
+    #[test]
+    fn log_spectral_radiance_matches_and_stays_finite() {
+        for (lambda, t) in [(10e-6, 300.0), (8e-6, 5772.0), (14e-6, 50.0), (12e-6, 4.0)] {
+            let direct = spectral_radiance(lambda, t).ln();
+            let log = ln_spectral_radiance(lambda, t);
+            assert!(
+                (log - direct).abs() < 1e-12 * direct.abs().max(1.0),
+                "{lambda} {t}"
+            );
+        }
+        // B_λ underflows to 0 at 0.01 K; its logarithm does not.
+        assert_eq!(spectral_radiance(10e-6, 0.01), 0.0);
+        assert!(ln_spectral_radiance(10e-6, 0.01).is_finite());
     }
 
     #[test]

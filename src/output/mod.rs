@@ -211,6 +211,9 @@ pub struct MaterialSummary {
     pub name: String,
     pub origin: String,
     pub table: TableResolution,
+    /// A spectral material is band-integrated (DESIGN §1.9) on this many wavelength nodes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub band_nodes: Option<usize>,
 }
 
 /// `summary.json`, also returned to the caller.
@@ -394,6 +397,7 @@ pub fn write_outputs(
                 name: m.name.clone(),
                 origin: m.origin.clone(),
                 table,
+                band_nodes: m.optics.band().map(|b| b.nodes().len()),
             })
             .collect(),
         timings_s: timings,

@@ -24,4 +24,11 @@ pub enum ModelError {
     Azimuth { name: &'static str, value: f64 },
     #[error("the directional-hemispherical reflectance at θ = {theta_deg:.2}° is {reflectance:.6} > 1: this model is not energy conserving there (no shadowing at grazing angles?); use shadowing = smith")]
     ReflectanceAboveOne { theta_deg: f64, reflectance: f64 },
+    #[error("at {} µm: {source}", number(*.wavelength_um))]
+    AtWavelength {
+        wavelength_um: f64,
+        source: Box<ModelError>,
+    },
+    #[error("a band material needs one model per wavelength node, all with the same slope distribution and shadowing")]
+    BandModels,
 }

@@ -21,6 +21,7 @@ use crate::optics::frame::{double_angle, facet_axis_in_scattered_frame, Directio
 use crate::optics::{FresnelFractions, Stokes};
 use gauss_quad::legendre::GaussLegendre;
 use nalgebra::Vector3;
+use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -132,6 +133,33 @@ fn radial_panel_edges(first: f64, growth: f64, split: f64, end: f64) -> Vec<f64>
     edges
 }
 
+/// One node of the specular reflection quadrature without its Fresnel factor
+/// ([`Pbrdf::visit_specular_facets`]): cos β of the facet, the node's weight times
+/// G cosβ secθ_h / cosθ_r, and (cos 2η_r, sin 2η_r) of the facet frame against ω_r's.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SpecularFacet {
+    pub cos_beta: f64,
+    pub scale: f64,
+    pub cos2: f64,
+    pub sin2: f64,
+}
+
+impl SpecularFacet {
+    /// The node's Stokes weight (first column of the facet Mueller matrix) for permittivity ε.
+    #[inline]
+    pub fn stokes(&self, permittivity: Complex64) -> Stokes {
+        let (rs2, rp2, _) =
+            FresnelFractions::new(self.cos_beta, permittivity).reflectances_and_cross();
+        let half_diff = 0.5 * (rs2 - rp2) * self.scale;
+        Stokes::new(
+            0.5 * (rs2 + rp2) * self.scale,
+            self.cos2 * half_diff,
+            self.sin2 * half_diff,
+            0.0,
+        )
+    }
+}
+
 impl Pbrdf {
     /// ∫ F_j0(ω_i→ω_r) L(ω_i) cosθ_i dΩ_i for an unpolarized environment radiance L given in the
     /// local frame, as a Stokes vector in the psps frame of ω_r (DESIGN §1.5). Zero for ω_r at or
@@ -182,6 +210,22 @@ impl Pbrdf {
         quadrature: &HemisphereQuadrature,
         mut visit: impl FnMut(&Vector3<f64>, Stokes),
     ) {
+        let permittivity = self.index().permittivity();
+        self.visit_specular_facets(scattered, quadrature, |w_i, facet| {
+            visit(w_i, facet.stokes(permittivity))
+        });
+    }
+
+    /// The node placement of [`Pbrdf::visit_specular_nodes`] without the Fresnel factor: calls
+    /// `visit(ω_i, facet)` for each node, whose weight for an index of permittivity ε is
+    /// `facet.stokes(ε)`. It depends on the slope distribution and shadowing alone, so that
+    /// models differing only in N (one material over wavelength, DESIGN §1.9) share it.
+    pub(crate) fn visit_specular_facets(
+        &self,
+        scattered: &Direction,
+        quadrature: &HemisphereQuadrature,
+        mut visit: impl FnMut(&Vector3<f64>, SpecularFacet),
+    ) {
         let w_r = scattered.vector;
         let cos_r = w_r.z;
         if cos_r <= 0.0 {
@@ -191,7 +235,6 @@ impl Pbrdf {
         let tangential = scattered.azimuthal_axis;
         let radial = tangential.cross(&Vector3::z());
         let distribution = self.prepared_distribution();
-        let permittivity = self.index().permittivity();
 
         // The facet tilted by slope u toward azimuth Δ (from ω_r's azimuth) mirrors ω_r above the
         // horizon iff cosΔ > κ(u) = cosθ_r (u² − 1) / (2u sinθ_r). Hence every azimuth is kept for
@@ -225,20 +268,17 @@ impl Pbrdf {
                 cos_beta * cos_beta,
                 [self.quadrature_masking(cos_i), masking_r],
             );
-            let (rs2, rp2, _) =
-                FresnelFractions::new(cos_beta, permittivity).reflectances_and_cross();
             // Facet s axis against the psps frame of ω_r (η_r of DESIGN §1.3).
             let (cos2, sin2) = double_angle(facet_axis_in_scattered_frame(&w_i, scattered));
-            let f = weight * g * cos_beta * sec_h / cos_r;
-            let half_diff = 0.5 * (rs2 - rp2) * f;
+            let scale = weight * g * cos_beta * sec_h / cos_r;
             visit(
                 &w_i,
-                Stokes::new(
-                    0.5 * (rs2 + rp2) * f,
-                    cos2 * half_diff,
-                    sin2 * half_diff,
-                    0.0,
-                ),
+                SpecularFacet {
+                    cos_beta,
+                    scale,
+                    cos2,
+                    sin2,
+                },
             );
         };
 

@@ -3,6 +3,7 @@
 //! (eqs. 8–9) and the hemispherical reflection integrals that both the emissivity and the scene
 //! renderer use.
 
+mod band;
 mod distribution;
 mod error;
 mod exponential;
@@ -14,6 +15,7 @@ mod sample;
 mod shadowing;
 
 pub use crate::optics::Direction;
+pub use band::{BandPbrdf, MaterialOptics};
 pub use distribution::SlopeDistribution;
 pub use error::ModelError;
 pub use geometry::{fold_signed_zenith, signed_zenith_note};

@@ -52,20 +52,39 @@ impl FacetReflection {
     }
 }
 
+/// The N-independent factors of a facet reflection: e^E of the facet density D = c e^E and
+/// c G/(4 cosθ_i cosθ_r), so that [`FacetReflection::scale`] = e^E (that × the Fresnel terms'
+/// common inverse denominator).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct FacetShape {
+    density: f64,
+    factor: f64,
+}
+
+impl FacetShape {
+    /// The facet scale for the Fresnel terms' inverse denominator `fresnel_inverse`.
+    #[inline(always)]
+    pub(super) fn scale(&self, fresnel_inverse: f64) -> f64 {
+        // Two long chains, the density's log and exp and the Fresnel square roots and division,
+        // meet in the last multiplications; every other factor is ready before them.
+        self.density * (self.factor * fresnel_inverse)
+    }
+}
+
 /// A direction pair and its facet as the model needs them: cos θ_i, cos θ_r, tan²θ of the facet
 /// tilt and cos²β of the local incidence — squares, so that none costs a square root.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct FacetGeometry {
-    cos_i: f64,
-    cos_r: f64,
-    tan2_theta: f64,
-    cos2_beta: f64,
+pub(super) struct FacetGeometry {
+    pub(super) cos_i: f64,
+    pub(super) cos_r: f64,
+    pub(super) tan2_theta: f64,
+    pub(super) cos2_beta: f64,
 }
 
 impl FacetGeometry {
     /// `None` when either direction is at or below the horizon.
     #[inline]
-    fn new(incident: &Direction, scattered: &Direction) -> Option<FacetGeometry> {
+    pub(super) fn new(incident: &Direction, scattered: &Direction) -> Option<FacetGeometry> {
         let (w_i, w_r) = (&incident.vector, &scattered.vector);
         let (cos_i, cos_r) = (w_i.z, w_r.z);
         if cos_i <= 0.0 || cos_r <= 0.0 {
@@ -111,6 +130,39 @@ impl ScatteringGeometry {
                 scattered,
             )),
         })
+    }
+
+    /// The facet geometry (cos θ_i, cos θ_r, tan²θ, cos²β).
+    pub(super) fn facet(&self) -> &FacetGeometry {
+        &self.facet
+    }
+
+    /// L(−η_r) F_fres L(η_i) + `diffuse` in m00 (DESIGN §1.3) from F_fres's elements
+    /// [A, B, C, S] with the facet scale folded in.
+    #[inline(always)]
+    pub(super) fn assemble_mueller(&self, fresnel: [f64; 4], diffuse: f64) -> Mueller {
+        let [a, b, c, s] = fresnel;
+        let (ci, si) = self.incident_rotation;
+        let (cr, sr) = self.scattered_rotation;
+        // L(−η_r) F_fres L(η_i) multiplied out.
+        Mueller::new(
+            a + diffuse,
+            b * ci,
+            b * si,
+            0.0,
+            cr * b,
+            cr * a * ci + sr * c * si,
+            cr * a * si - sr * c * ci,
+            sr * s,
+            sr * b,
+            sr * a * ci - cr * c * si,
+            sr * a * si + cr * c * ci,
+            -cr * s,
+            0.0,
+            -s * si,
+            s * ci,
+            c,
+        )
     }
 
     /// cos θ_i, the argument of the incident direction's [`Pbrdf::masking`].
@@ -206,6 +258,26 @@ impl Pbrdf {
         geometry: &FacetGeometry,
         masking: Option<[f64; 2]>,
     ) -> FacetReflection {
+        let shape = self.facet_shape(geometry, masking);
+        let (rs2, rp2, cross, fresnel_inverse) =
+            FresnelFractions::from_cos2(geometry.cos2_beta, self.permittivity)
+                .reflectances_and_cross_unnormalized();
+        FacetReflection {
+            scale: shape.scale(fresnel_inverse),
+            rs2,
+            rp2,
+            cross,
+        }
+    }
+
+    /// The part of [`Pbrdf::facet_reflection`] that does not depend on N: the facet density and
+    /// the shadowing (shared by a material's models over wavelength, DESIGN §1.9).
+    #[inline(always)]
+    pub(super) fn facet_shape(
+        &self,
+        geometry: &FacetGeometry,
+        masking: Option<[f64; 2]>,
+    ) -> FacetShape {
         let FacetGeometry {
             cos_i,
             cos_r,
@@ -224,19 +296,15 @@ impl Pbrdf {
         let (density_exponent, density_factor) = self
             .prepared
             .normal_distribution_exponent_and_factor(tan2_theta);
-        let (rs2, rp2, cross, fresnel_inverse) =
-            FresnelFractions::from_cos2(cos2_beta, self.permittivity)
-                .reflectances_and_cross_unnormalized();
-        // Two long chains, the density's log and exp and the Fresnel square roots and division,
-        // meet in the last multiplications; every other factor is ready before them.
-        let scale = inline_exp(density_exponent)
-            * (density_factor * g / (4.0 * cos_i * cos_r) * fresnel_inverse);
-        FacetReflection {
-            scale,
-            rs2,
-            rp2,
-            cross,
+        FacetShape {
+            density: inline_exp(density_exponent),
+            factor: density_factor * g / (4.0 * cos_i * cos_r),
         }
+    }
+
+    /// ε = N², the Fresnel coefficients' parameter.
+    pub(super) fn permittivity(&self) -> Complex64 {
+        self.permittivity
     }
 
     /// The full 4×4 Mueller BRDF (sr⁻¹) from `incident` (ω_i, toward the source) to `scattered`
@@ -278,32 +346,12 @@ impl Pbrdf {
     #[inline]
     fn mueller_at(&self, geometry: &ScatteringGeometry, masking: Option<[f64; 2]>) -> Mueller {
         let facet = self.facet_reflection(&geometry.facet, masking);
-        let (ci, si) = geometry.incident_rotation;
-        let (cr, sr) = geometry.scattered_rotation;
         // F_fres = [[A, B, 0, 0], [B, A, 0, 0], [0, 0, C, S], [0, 0, −S, C]] with the facet scale
         // folded in: A, B = (|r_s|² ± |r_p|²)/2, C + iS = r_s* r_p.
         let (a, b) = facet.scaled_a_and_b();
         let c = facet.cross.re * facet.scale;
         let s = facet.cross.im * facet.scale;
-        // L(−η_r) F_fres L(η_i) multiplied out (DESIGN §1.3).
-        Mueller::new(
-            a + self.rho_d * FRAC_1_PI,
-            b * ci,
-            b * si,
-            0.0,
-            cr * b,
-            cr * a * ci + sr * c * si,
-            cr * a * si - sr * c * ci,
-            sr * s,
-            sr * b,
-            sr * a * ci - cr * c * si,
-            sr * a * si + cr * c * ci,
-            -cr * s,
-            0.0,
-            -s * si,
-            s * ci,
-            c,
-        )
+        geometry.assemble_mueller([a, b, c, s], self.rho_d * FRAC_1_PI)
     }
 
     /// First column F_j0 (sr⁻¹): the Stokes BRDF for unpolarized illumination, the only part that

@@ -9,7 +9,7 @@ pub mod film;
 pub mod raster;
 pub mod sensor;
 
-use crate::pbrdf::ModelError;
+use crate::pbrdf::{MaterialOptics, ModelError};
 use crate::progress::Progress;
 use crate::scene::config::Shading;
 use crate::scene::mesh::bounding_diagonal;
@@ -72,7 +72,6 @@ pub struct Rendered {
 pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, RenderError> {
     let mut timings = Timings::default();
     let start = Instant::now();
-    let (tables, resolutions) = material_tables(scene)?;
     let mesh = &scene.mesh;
     let (t_lo, t_hi) = mesh
         .temperatures
@@ -80,7 +79,9 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
             (lo.min(t), hi.max(t))
         });
-    let radiance = RadianceTable::new(&scene.sensor.band, t_lo.min(t_hi), t_hi.max(t_lo));
+    let temperatures = (t_lo.min(t_hi), t_hi.max(t_lo));
+    let (tables, resolutions) = material_tables(scene, temperatures)?;
+    let radiance = RadianceTable::new(&scene.sensor.band, temperatures.0, temperatures.1);
     timings.tables = start.elapsed().as_secs_f64();
 
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
@@ -118,29 +119,43 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
     })
 }
 
-/// The open-world tables of every material, at resolutions suited to each lobe.
+/// The open-world tables of every material, at resolutions suited to each lobe; band materials'
+/// emissivity over the scene's surface temperatures `temperatures_k` (min, max).
 fn material_tables(
     scene: &Scene,
+    temperatures_k: (f64, f64),
 ) -> Result<(Vec<MaterialTables>, Vec<TableResolution>), RenderError> {
     let quadrature = KernelQuadrature::default();
     let resolutions: Vec<TableResolution> = scene
         .materials
         .iter()
-        .map(|m| TableResolution::for_material(&m.pbrdf))
+        .map(|m| TableResolution::for_material(m.optics.sampling_pbrdf()))
         .collect();
     let tables = scene
         .materials
         .iter()
         .zip(&resolutions)
         .map(|(m, &resolution)| {
-            MaterialTables::build(&m.pbrdf, &scene.environment, resolution, &quadrature).map_err(
-                |source| RenderError::Material {
-                    scene: scene.path.clone(),
-                    material: m.name.clone(),
-                    origin: m.origin.clone(),
-                    source,
-                },
-            )
+            let environment = &scene.environment;
+            match &m.optics {
+                MaterialOptics::Grey(pbrdf) => {
+                    MaterialTables::build(pbrdf, environment, resolution, &quadrature)
+                }
+                MaterialOptics::Band(band) => MaterialTables::build_band(
+                    band,
+                    environment,
+                    &scene.sensor.band,
+                    temperatures_k,
+                    resolution,
+                    &quadrature,
+                ),
+            }
+            .map_err(|source| RenderError::Material {
+                scene: scene.path.clone(),
+                material: m.name.clone(),
+                origin: m.origin.clone(),
+                source,
+            })
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok((tables, resolutions))

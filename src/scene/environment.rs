@@ -96,12 +96,28 @@ impl Environment {
 /// [`Environment::sine_table`]: per cell, the radiance at its left end and its increase across
 /// the cell. Lookups take the cell coordinate x = (u + 1)·cells_per_unit, so that callers can fold
 /// the scaling into precomputed coefficients.
+#[derive(Clone, Debug)]
 pub struct SineTable {
     pub cells_per_unit: f64,
     pieces: Vec<[f64; 2]>,
 }
 
 impl SineTable {
+    /// A table of `cells` (radiance at each cell's left end, its increase across the cell) over
+    /// u ∈ [−1, 1], for another function of u on the same cells (e.g. one spectral component of
+    /// the environment, `transport::band_environment`).
+    pub fn from_cells(cells: Vec<[f64; 2]>) -> SineTable {
+        SineTable {
+            cells_per_unit: cells.len() as f64 / 2.0,
+            pieces: cells,
+        }
+    }
+
+    /// Each cell's (radiance at its left end, increase across it).
+    pub fn cells(&self) -> &[[f64; 2]] {
+        &self.pieces
+    }
+
     /// Radiance at cell coordinate x (clamped to the table).
     #[inline]
     pub fn at_cell(&self, x: f64) -> f64 {

@@ -19,9 +19,9 @@ use crate::emitter::{
     default_band_irradiance, parse_time_utc, sun_direction, sun_position, validate_irradiance,
     validate_sun_angles, validate_transmittance, Sun,
 };
-use crate::material::Material;
+use crate::material::{Material, MaterialModel, SpectralModel};
 use crate::optics::{Band, RefractiveIndex};
-use crate::pbrdf::{Pbrdf, SlopeDistribution};
+use crate::pbrdf::{MaterialOptics, Pbrdf, SlopeDistribution};
 use crate::text::number;
 use camera::Camera;
 use config::{InlineMaterialConfig, ObjectConfig, SceneConfig, Shading, ShapeConfig};
@@ -55,16 +55,34 @@ impl SceneError {
     }
 }
 
-/// A material used by the scene, with its validated pBRDF.
+/// A material used by the scene, with its validated pBRDF over the sensor band.
 #[derive(Clone, Debug)]
 pub struct SceneMaterial {
     /// The name given in the scene.
     pub name: String,
     /// Where it came from: the material file, or "inline".
     pub origin: String,
-    pub pbrdf: Pbrdf,
-    /// The wavelength a library material was measured at (inline materials have none).
+    /// Grey (one pBRDF), or for a spectral material its pBRDF at each wavelength node of the
+    /// sensor band (DESIGN §1.9).
+    pub optics: MaterialOptics,
+    /// The wavelength a grey library material was measured at (inline and spectral materials
+    /// have none).
     pub wavelength_um: Option<f64>,
+    /// A spectral material's table (the thermal emissivity needs wavelengths beyond the band).
+    pub spectral_model: Option<SpectralModel>,
+}
+
+impl SceneMaterial {
+    /// The thermal hemispherical emissivity of DESIGN §1.8's default: the grey pBRDF's ε_h, or a
+    /// spectral table's Planck-weighted one ([`SpectralModel::thermal_emissivity`]).
+    pub fn thermal_emissivity(&self) -> Result<f64, String> {
+        match (&self.optics, &self.spectral_model) {
+            (_, Some(model)) => model
+                .thermal_emissivity()
+                .map_err(|e| format!("material '{}' ({}): {e}", self.name, self.origin)),
+            (optics, None) => Ok(optics.sampling_pbrdf().hemispherical_emissivity()),
+        }
+    }
 }
 
 /// One part of one object: what `ShadedMesh::triangle_surface` indexes.
@@ -283,6 +301,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
     let library = dir.join(config.material_library.as_deref().unwrap_or("fits"));
     let mut materials = MaterialResolver {
         scene: path,
+        band: &band,
         dir,
         library,
         inline: &config.materials,
@@ -316,22 +335,23 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         object_names.push(name);
         mesh.append(object_mesh);
     }
+    share_wavelength_nodes(&mut materials.resolved, &band).map_err(&fail)?;
     warnings.extend(likely_mistakes(&config, &materials.resolved, &band));
     let thermal = match (thermal_run, &config.thermal) {
         (Some(mut run), Some(thermal_config)) => {
-            let pbrdfs: Vec<&Pbrdf> = materials.resolved.iter().map(|m| &m.pbrdf).collect();
             run.surfaces = thermal::resolve_surfaces(
                 &config,
                 thermal_config,
                 &surfaces,
                 &object_names,
-                &pbrdfs,
+                &materials.resolved,
             )
             .map_err(&fail)?;
             Some(std::sync::Arc::new(run))
         }
         _ => None,
     };
+    let materials = materials.resolved;
 
     Ok(Scene {
         path: path.to_owned(),
@@ -351,7 +371,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         preview: checked_preview(&config.render.preview).map_err(&fail)?,
         transport,
         sun,
-        materials: materials.resolved,
+        materials,
         object_names,
         surfaces,
         mesh,
@@ -359,6 +379,31 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         thermal_instant: None,
         warnings,
     })
+}
+
+/// Puts every spectral material of a scene on one set of wavelength nodes (DESIGN §1.9,
+/// [`crate::optics::WavelengthNodes::for_tables`]): the band split at the table wavelengths of
+/// all of them, so that light passed from one to another keeps its spectrum node by node.
+fn share_wavelength_nodes(materials: &mut [SceneMaterial], band: &Band) -> Result<(), String> {
+    let tables: Vec<&[f64]> = materials
+        .iter()
+        .filter_map(|m| m.spectral_model.as_ref())
+        .map(|model| model.wavelength_um.as_slice())
+        .collect();
+    if tables.len() < 2 {
+        return Ok(());
+    }
+    let nodes =
+        crate::optics::WavelengthNodes::for_tables(band, &tables).map_err(|e| e.to_string())?;
+    for material in materials.iter_mut() {
+        if let Some(model) = &material.spectral_model {
+            let band_pbrdf = model
+                .band_pbrdf_on(nodes.clone())
+                .map_err(|e| format!("material '{}' ({}): {e}", material.name, material.origin))?;
+            material.optics = MaterialOptics::Band(band_pbrdf);
+        }
+    }
+    Ok(())
 }
 
 /// Below this a temperature is probably in °C (the coldest natural surface, Antarctic snow at
@@ -775,6 +820,8 @@ fn procedural_shape(shape: &ShapeConfig) -> Result<RawMesh, String> {
 /// library name (`<library>/<name>.toml`). Each distinct material is loaded once.
 struct MaterialResolver<'a> {
     scene: &'a Path,
+    /// The sensor band spectral materials are integrated over.
+    band: &'a Band,
     dir: &'a Path,
     library: PathBuf,
     inline: &'a std::collections::BTreeMap<String, InlineMaterialConfig>,
@@ -796,8 +843,9 @@ impl MaterialResolver<'_> {
                 SceneMaterial {
                     name: reference.to_owned(),
                     origin: "inline".into(),
-                    pbrdf,
+                    optics: MaterialOptics::Grey(pbrdf),
                     wavelength_um: None,
+                    spectral_model: None,
                 },
             )
         } else {
@@ -817,27 +865,45 @@ impl MaterialResolver<'_> {
                 return Ok(i);
             }
             let loaded = Material::load(&path).map_err(|e| e.to_string())?;
-            // Band integration over a spectral table is not wired into the renderer yet: refuse
-            // rather than render one wavelength's index as if it held across the band.
-            let model = loaded
-                .grey_model()
-                .map_err(|e| format!("{}: {e}", path.display()))?;
-            let pbrdf = model
-                .pbrdf()
-                .map_err(|e| format!("{}: {e}", path.display()))?;
-            (
-                key,
-                SceneMaterial {
-                    name: reference.to_owned(),
-                    origin: path.display().to_string(),
-                    pbrdf,
-                    wavelength_um: Some(model.wavelength_um),
-                },
-            )
+            let material = self
+                .library_material(reference, &path, &loaded)
+                .map_err(|e| format!("material '{reference}' ({}): {e}", path.display()))?;
+            (key, material)
         };
         self.resolved.push(material);
         self.index_of.insert(key, self.resolved.len() - 1);
         Ok(self.resolved.len() - 1)
+    }
+}
+
+impl MaterialResolver<'_> {
+    /// A material from the library or a file: grey, or spectral and integrated over the band's
+    /// wavelength nodes (refused when its table does not span the band).
+    fn library_material(
+        &self,
+        reference: &str,
+        path: &Path,
+        loaded: &Material,
+    ) -> Result<SceneMaterial, String> {
+        let (optics, wavelength_um, spectral_model) = match &loaded.model {
+            MaterialModel::Grey(model) => (
+                MaterialOptics::Grey(model.pbrdf().map_err(|e| e.to_string())?),
+                Some(model.wavelength_um),
+                None,
+            ),
+            MaterialModel::Spectral(model) => (
+                MaterialOptics::Band(model.band_pbrdf(self.band).map_err(|e| e.to_string())?),
+                None,
+                Some(model.clone()),
+            ),
+        };
+        Ok(SceneMaterial {
+            name: reference.to_owned(),
+            origin: path.display().to_string(),
+            optics,
+            wavelength_um,
+            spectral_model,
+        })
     }
 }
 

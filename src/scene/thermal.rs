@@ -6,9 +6,8 @@ use super::config::{
     BackConfig, EnvironmentConfig, InternalHeatConfig, LayerMaterialConfig, ObjectConfig,
     PartThermalConfig, SceneConfig, ThermalConfig, WeatherConfig,
 };
-use super::{valid_temperature, Surface, MAX_TEMPERATURE_K};
+use super::{valid_temperature, SceneMaterial, Surface, MAX_TEMPERATURE_K};
 use crate::emitter::parse_time_utc;
-use crate::pbrdf::Pbrdf;
 use crate::text::number;
 use crate::thermal::{Back, Layer, LayerMaterial, LayerStack, Site, Weather};
 use std::collections::BTreeMap;
@@ -203,13 +202,14 @@ pub fn part_thermal<'a>(object: &'a ObjectConfig, part: &str) -> Option<&'a Part
         .or(object.thermal.as_ref())
 }
 
-/// Each surface's thermal model. `pbrdfs[i]` is material i's pBRDF (for the default emissivity).
+/// Each surface's thermal model. `materials[i]` is material i (its
+/// [`SceneMaterial::thermal_emissivity`] is the default emissivity).
 pub fn resolve_surfaces(
     config: &SceneConfig,
     thermal: &ThermalConfig,
     surfaces: &[Surface],
     object_names: &[String],
-    pbrdfs: &[&Pbrdf],
+    materials: &[SceneMaterial],
 ) -> Result<Vec<Option<SurfaceThermal>>, String> {
     let mut resolved = Vec::with_capacity(surfaces.len());
     let mut emissivity_of = BTreeMap::new();
@@ -224,9 +224,16 @@ pub fn resolve_surfaces(
         );
         let emissivity = match part.emissivity {
             Some(e) => e,
-            None => *emissivity_of
-                .entry(surface.material)
-                .or_insert_with(|| pbrdfs[surface.material].hemispherical_emissivity()),
+            None => match emissivity_of.get(&surface.material) {
+                Some(&e) => e,
+                None => {
+                    let e = materials[surface.material]
+                        .thermal_emissivity()
+                        .map_err(|e| format!("{label}: {e}"))?;
+                    emissivity_of.insert(surface.material, e);
+                    e
+                }
+            },
         };
         let model =
             resolve_part(part, &thermal.layers, emissivity).map_err(|e| format!("{label}.{e}"))?;

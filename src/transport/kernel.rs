@@ -19,7 +19,7 @@
 //! narrow specular lobe from ~1000 nodes to a few dozen.
 
 use crate::optics::Stokes;
-use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
+use crate::pbrdf::{BandPbrdf, Direction, HemisphereQuadrature, Pbrdf};
 use nalgebra::Vector3;
 use std::collections::HashMap;
 
@@ -108,42 +108,138 @@ pub fn specular_kernel(
     if scattered.cos_theta() <= 0.0 {
         return SpecularKernel::default();
     }
-    let (sin_r, cos_r) = theta_r.sin_cos();
-    let specular = Vector3::new(-sin_r, 0.0, cos_r);
-    let core_slope = pbrdf.distribution().slope_quantile(quadrature.merge_core);
-    let core = (2.0 * core_slope.atan()).max(4.0 * quadrature.merge_cell);
-    let mut nodes = NodeMerger::new(quadrature.merge_cell, specular, core);
+    let mut nodes = NodeMerger::new(pbrdf, theta_r, quadrature, 1);
     pbrdf.visit_specular_nodes(&scattered, &quadrature.hemisphere(), |w_i, k| {
-        nodes.add(*w_i, [k[0], k[1], k[2]])
+        nodes.add(*w_i, k[0].abs(), &[[k[0], k[1], k[2]]])
     });
-    nodes.finish()
+    let (directions, weights) = nodes.finish();
+    SpecularKernel {
+        directions,
+        weights,
+    }
+}
+
+/// The specular kernels of every wavelength node of a band material at once (DESIGN §1.9): the
+/// nodes of each model's quadrature are the same directions ([`BandPbrdf::visit_specular_nodes`]),
+/// merged once, each cell at its mean direction weighted by |K0| of the wavelength node
+/// `merge_node` (the one carrying most of the environment's light). A material that does not
+/// change with λ then merges exactly as its grey kernel (the same directions to the bit: a node
+/// on the horizon must not change sides).
+pub fn band_specular_kernel(
+    band: &BandPbrdf,
+    theta_r: f64,
+    quadrature: &KernelQuadrature,
+    merge_node: usize,
+) -> BandKernel {
+    let models = band.models().len();
+    let scattered = Direction::from_angles(theta_r, 0.0);
+    if scattered.cos_theta() <= 0.0 {
+        return BandKernel {
+            kernel: SpecularKernel::default(),
+            models,
+        };
+    }
+    let mut nodes = NodeMerger::new(&band.models()[0], theta_r, quadrature, models);
+    let mut weights = vec![[0.0; 3]; models];
+    band.visit_specular_nodes(&scattered, &quadrature.hemisphere(), |w_i, k| {
+        for (slot, stokes) in weights.iter_mut().zip(k) {
+            *slot = [stokes[0], stokes[1], stokes[2]];
+        }
+        nodes.add(*w_i, k[merge_node][0].abs(), &weights)
+    });
+    let (directions, weights) = nodes.finish();
+    BandKernel {
+        kernel: SpecularKernel {
+            directions,
+            weights,
+        },
+        models,
+    }
+}
+
+/// The merged specular nodes of a band material at one θ_r: shared directions, a Stokes weight
+/// per direction and wavelength node (`kernel.weights[k · models + m]`).
+#[derive(Clone, Debug)]
+pub struct BandKernel {
+    kernel: SpecularKernel,
+    models: usize,
+}
+
+impl BandKernel {
+    pub fn directions(&self) -> &[Vector3<f64>] {
+        &self.kernel.directions
+    }
+
+    /// Σ_k K_mk for each wavelength node m: the specular directional-hemispherical reflectance.
+    pub fn totals(&self) -> Vec<[f64; 3]> {
+        let mut totals = vec![[0.0; 3]; self.models];
+        for node in self.kernel.weights.chunks(self.models) {
+            for (total, k) in totals.iter_mut().zip(node) {
+                for j in 0..3 {
+                    total[j] += k[j];
+                }
+            }
+        }
+        totals
+    }
+
+    /// The weights Σ_m c_m K_mk of each direction for coefficients `c` over the wavelength nodes.
+    pub fn combined(&self, coefficients: &[f64]) -> Vec<[f64; 3]> {
+        self.kernel
+            .weights
+            .chunks(self.models)
+            .map(|node| {
+                let mut sum = [0.0; 3];
+                for (k, c) in node.iter().zip(coefficients) {
+                    for j in 0..3 {
+                        sum[j] += c * k[j];
+                    }
+                }
+                sum
+            })
+            .collect()
+    }
 }
 
 /// Sums nodes falling in the same cube cell of the unit sphere. Within `core` radians of the
 /// specular direction the cells are `cell` wide; beyond, level ℓ = ⌈log₂(α/core)⌉ cells are
 /// 4^ℓ times wider: each doubling of the distance holds a few cells, whose weights fall off
-/// with the slope density's tail.
+/// with the slope density's tail. Each node carries `channels` Stokes weights (one per
+/// wavelength node of a band material) and a mass that weights its direction.
 struct NodeMerger {
     cell: f64,
     specular: Vector3<f64>,
     core: f64,
+    channels: usize,
     index_of: HashMap<[i32; 4], usize>,
-    /// Σ|K0|-weighted direction, Σ|K0|, and Σ K per merged node.
-    sums: Vec<(Vector3<f64>, f64, [f64; 3])>,
+    /// Σ mass-weighted direction and Σ mass per merged node.
+    sums: Vec<(Vector3<f64>, f64)>,
+    /// Σ K per merged node and channel (`[node · channels + channel]`).
+    weights: Vec<[f64; 3]>,
 }
 
 impl NodeMerger {
-    fn new(cell: f64, specular: Vector3<f64>, core: f64) -> NodeMerger {
+    /// The merger for ω_r at `theta_r` of a model with `pbrdf`'s slope distribution.
+    fn new(
+        pbrdf: &Pbrdf,
+        theta_r: f64,
+        quadrature: &KernelQuadrature,
+        channels: usize,
+    ) -> NodeMerger {
+        let (sin_r, cos_r) = theta_r.sin_cos();
+        let core_slope = pbrdf.distribution().slope_quantile(quadrature.merge_core);
         NodeMerger {
-            cell,
-            specular,
-            core,
+            cell: quadrature.merge_cell,
+            specular: Vector3::new(-sin_r, 0.0, cos_r),
+            core: (2.0 * core_slope.atan()).max(4.0 * quadrature.merge_cell),
+            channels,
             index_of: HashMap::new(),
             sums: Vec::new(),
+            weights: Vec::new(),
         }
     }
 
-    fn add(&mut self, direction: Vector3<f64>, weight: [f64; 3]) {
+    fn add(&mut self, direction: Vector3<f64>, mass: f64, weights: &[[f64; 3]]) {
         let angle = direction.dot(&self.specular).clamp(-1.0, 1.0).acos();
         let level = if angle <= self.core {
             0
@@ -153,28 +249,35 @@ impl NodeMerger {
         let cell = self.cell * f64::powi(4.0, level);
         let key = direction.map(|c| (c / cell).floor() as i32);
         let key = [level, key.x, key.y, key.z];
+        let channels = self.channels;
         let i = *self.index_of.entry(key).or_insert_with(|| {
-            self.sums.push((Vector3::zeros(), 0.0, [0.0; 3]));
+            self.sums.push((Vector3::zeros(), 0.0));
+            self.weights.extend(std::iter::repeat_n([0.0; 3], channels));
             self.sums.len() - 1
         });
         let entry = &mut self.sums[i];
-        // |K0| + tiny keeps zero-weight nodes (fully shadowed) from producing a 0/0 direction.
-        let mass = weight[0].abs() + 1e-300;
+        // mass + tiny keeps zero-weight nodes (fully shadowed) from producing a 0/0 direction.
+        let mass = mass + 1e-300;
         entry.0 += direction * mass;
         entry.1 += mass;
-        for (sum, w) in entry.2.iter_mut().zip(weight) {
-            *sum += w;
+        for (sum, w) in self.weights[i * channels..(i + 1) * channels]
+            .iter_mut()
+            .zip(weights)
+        {
+            for (s, v) in sum.iter_mut().zip(w) {
+                *s += v;
+            }
         }
     }
 
-    fn finish(self) -> SpecularKernel {
-        let mut kernel = SpecularKernel::default();
-        for (direction, mass, weight) in self.sums {
-            let mean = direction / mass;
-            kernel.directions.push(mean.normalize());
-            kernel.weights.push(weight);
-        }
-        kernel
+    /// The merged directions (mass-weighted means) and weights.
+    fn finish(self) -> (Vec<Vector3<f64>>, Vec<[f64; 3]>) {
+        let directions = self
+            .sums
+            .into_iter()
+            .map(|(direction, mass)| (direction / mass).normalize())
+            .collect();
+        (directions, self.weights)
     }
 }
 

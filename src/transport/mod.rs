@@ -6,6 +6,7 @@
 //!   the open-world value (its control variate), with rays through [`accel`].
 
 pub mod accel;
+pub mod band_environment;
 pub mod kernel;
 pub mod open_world;
 pub mod path;

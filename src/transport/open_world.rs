@@ -28,7 +28,7 @@ impl OpenWorld<'_> {
     pub fn leaving(&self, material: usize, frame: &OutgoingFrame, temperature: f64) -> Stokes {
         let tables = &self.tables[material];
         let cos_table = frame.cos_theta.max(THETA_MAX.cos());
-        let e = tables.emissivity(cos_table);
+        let e = tables.emissivity_at(cos_table, temperature);
         let r = tables.reflected(frame.cos_tilt.acos(), cos_table, frame.phi);
         let l = self.radiance.radiance(temperature);
         Stokes::new(e[0] * l + r[0], e[1] * l + r[1], r[2], 0.0)

@@ -20,15 +20,25 @@
 //! integral of F times a shadow-ray visibility. It is not part of the control variate (the
 //! open-world tables hold no sun), and escaped correction rays never count it, so it is not
 //! counted twice.
+//!
+//! A band material (DESIGN §1.9) scatters each source with its band-weighted Mueller matrix
+//! Σ_m f_m F(λ_m), f the shares of that source's spectrum over the wavelength nodes: the sun's
+//! as a 5772 K blackbody through the band; the environment a correction replaces, grey at its
+//! brightness temperature; the light of a surface hit as its emission, node by node, plus what
+//! it reflects, modelled as a uniform grey source reflected by the hit (`band_scattering`).
+//! Only the hit's emission is exact: the approximation is measured in the README ("Band
+//! rendering"). A ray that escapes still adds exactly zero (no hit, no correction).
 
 use super::accel::Accelerator;
 use super::open_world::OpenWorld;
-use crate::emitter::{DiscQuadrature, Sun};
+use super::tables::THETA_MAX;
+use crate::emitter::{DiscQuadrature, Sun, SUN_TEMPERATURE_K};
+use crate::optics::band_nodes::{BrightnessGrid, FractionsByRadiance};
 use crate::optics::{
-    rotate_stokes, rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame,
-    Stokes,
+    rotate_stokes, rotation_between_frames, stokes_to_camera_frame, Direction, Mueller,
+    OutgoingFrame, SpectralMix, Stokes,
 };
-use crate::pbrdf::Pbrdf;
+use crate::pbrdf::{BandPbrdf, MaterialOptics, Pbrdf};
 use crate::scene::mesh::SurfaceHit;
 use crate::scene::{PathSettings, Scene};
 use nalgebra::Vector3;
@@ -80,6 +90,107 @@ pub struct PathTracer<'a> {
     pub settings: PathSettings,
     /// The sun and its disc quadrature per material.
     pub sun: Option<(Sun, Vec<DiscQuadrature>)>,
+    /// Per material, the source spectra a band material weights its models with (`None`: grey).
+    band_sources: Vec<Option<BandSources>>,
+}
+
+/// The spectral shares of the sources a band material scatters (DESIGN §1.9, module docs).
+struct BandSources {
+    /// Planck fractions of a grey source by its band radiance (a surface hit, the environment).
+    by_radiance: FractionsByRadiance,
+    /// Planck fractions of the sun: a 5772 K blackbody through the band.
+    sun: Vec<f64>,
+}
+
+/// Light emitted by a surface hit, in the receiver's incident frame ([`PathTracer::emitted_toward`]).
+struct EmittedLight {
+    /// L_bb(T) of the hit.
+    radiance: f64,
+    /// Its (ε0, ε1) toward the receiver (band-integrated for a band material).
+    emissivity: [f64; 2],
+    /// (ε0, ε1) of a band material at each wavelength node; `None` for a grey one.
+    per_node: Option<Vec<[f64; 2]>>,
+    /// The unit linear polarization (0, 1, 0, 0) of the hit's outgoing frame, rotated into the
+    /// receiver's incident frame: the hit emits L (ε0 e₀ + ε1 u).
+    polarization: Stokes,
+}
+
+/// Where a band material scatters: the incident and scattered directions (local frame) and the
+/// shadowing factors of both.
+struct BandScattering<'a> {
+    incident: &'a Direction,
+    scattered: &'a Direction,
+    masking: [f64; 2],
+}
+
+/// One sample of F (S_in − L_env e₀) at a band material (DESIGN §1.9), S_in the light from a
+/// surface hit, each part with its own spectrum over the wavelength nodes m:
+/// - what the hit emits, L_bb(T) (ε0 e₀ + ε1 u) with u its polarization: node by node
+///   p_m(T) (ε0_m e₀ + ε1_m u), p the Planck shares at the hit's temperature and ε_m its
+///   emissivity at λ_m (constant for a grey hit);
+/// - what it reflects, S_in less its emission, taken as a uniform grey source at the
+///   brightness temperature T_s of (that light / the hit's mean reflectance) reflected by the
+///   hit (Kirchhoff: a uniform source L_s is reflected as L_s ((1 − ε0_m) e₀ − ε1_m u)), with
+///   L_s such that its S0 is exact; the polarization the model misses keeps the shares f(T_s);
+/// - the environment it replaces, grey at its brightness temperature.
+fn band_scattering(
+    band: &BandPbrdf,
+    sources: &BandSources,
+    at: &BandScattering,
+    s_in: &Stokes,
+    emitted: &EmittedLight,
+    environment: f64,
+) -> Stokes {
+    let nodes = band.nodes().len();
+    let per_node = emitted.per_node.as_ref().filter(|e| e.len() == nodes);
+    let emissivity = |m: usize| per_node.map_or(emitted.emissivity, |e| e[m]);
+    let [e0, e1] = emitted.emissivity;
+    let hit = emitted.radiance;
+    let unpolarized = Stokes::new(1.0, 0.0, 0.0, 0.0);
+    let reflected = s_in - (unpolarized * e0 + emitted.polarization * e1) * hit;
+    let source = sources.by_radiance.at(reflected[0] / (1.0 - e0).max(1e-9));
+    let reflectance: f64 = (0..nodes)
+        .map(|m| source.weight(m) * (1.0 - emissivity(m)[0]))
+        .sum();
+    let source_radiance = if reflectance > 1e-12 {
+        reflected[0] / reflectance
+    } else {
+        0.0
+    };
+    let planck = sources.by_radiance.at(hit);
+    let (mut along_e0, mut along_u) = (vec![0.0; nodes], vec![0.0; nodes]);
+    let mut modelled_u = 0.0;
+    for m in 0..nodes {
+        let [em0, em1] = emissivity(m);
+        let (p, f) = (planck.weight(m), source.weight(m));
+        along_e0[m] = p * em0 * hit + f * (1.0 - em0) * source_radiance;
+        along_u[m] = p * em1 * hit - f * em1 * source_radiance;
+        modelled_u -= f * em1 * source_radiance;
+    }
+    // What the uniform-source model leaves out of the reflected light (its S0 is exact).
+    let unmodelled = reflected - unpolarized * reflected[0] - emitted.polarization * modelled_u;
+    let [mueller_e0, mueller_u, mueller_rest, mueller_environment] = band.mueller_mixtures(
+        at.incident,
+        at.scattered,
+        at.masking,
+        [
+            SpectralMix::fixed(&along_e0),
+            SpectralMix::fixed(&along_u),
+            source,
+            sources.by_radiance.at(environment),
+        ],
+    );
+    mueller_e0.column(0).into_owned() + mueller_u * emitted.polarization + mueller_rest * unmodelled
+        - mueller_environment.column(0) * environment
+}
+
+impl BandSources {
+    fn new(band: &BandPbrdf, grid: &BrightnessGrid) -> BandSources {
+        BandSources {
+            by_radiance: FractionsByRadiance::new(band.nodes(), grid),
+            sun: band.nodes().planck_fractions(SUN_TEMPERATURE_K),
+        }
+    }
 }
 
 impl PathTracer<'_> {
@@ -93,16 +204,24 @@ impl PathTracer<'_> {
             let rules = scene
                 .materials
                 .iter()
-                .map(|m| sun.quadrature(&m.pbrdf))
+                .map(|m| sun.quadrature(m.optics.sampling_pbrdf()))
                 .collect();
             (sun, rules)
         });
+        let any_band = scene.materials.iter().any(|m| m.optics.band().is_some());
+        let grid = any_band.then(|| BrightnessGrid::new(&scene.sensor.band));
+        let band_sources = scene
+            .materials
+            .iter()
+            .map(|m| Some(BandSources::new(m.optics.band()?, grid.as_ref()?)))
+            .collect();
         PathTracer {
             scene,
             open_world,
             accel,
             settings,
             sun,
+            band_sources,
         }
     }
 
@@ -201,7 +320,8 @@ impl PathTracer<'_> {
         stratum: f64,
         rng: &mut ChaCha8Rng,
     ) -> Stokes {
-        let pbrdf = &self.scene.materials[material].pbrdf;
+        let optics = &self.scene.materials[material].optics;
+        let pbrdf = optics.sampling_pbrdf();
         let w_o = frame.to_local(&frame.omega);
         if w_o.z <= 0.0 {
             return Stokes::zeros();
@@ -227,16 +347,48 @@ impl PathTracer<'_> {
         let s_incident = -frame.to_world(&incident.azimuthal_axis);
         let eta = rotation_between_frames(&s_from, &s_incident, &toward_x);
         let mut s_in = rotate_stokes(&leaving, eta);
-        s_in[0] -= self.scene.environment.radiance(&direction);
+        let environment = self.scene.environment.radiance(&direction);
         let scattered = Direction::from_unit_vector(w_o);
-        let mueller = pbrdf.mueller_with_masking(
-            &incident,
-            &scattered,
+        let masking = [
             pbrdf.quadrature_masking(w_i.z),
             pbrdf.quadrature_masking(w_o.z),
-        );
-        let local = mueller * s_in * (w_i.z / pdf);
+        ];
+        let local = match (optics, &self.band_sources[material]) {
+            (MaterialOptics::Band(band), Some(sources)) => {
+                let emitted = self.emitted_toward(&next, &toward_x, eta);
+                let geometry = BandScattering {
+                    incident: &incident,
+                    scattered: &scattered,
+                    masking,
+                };
+                band_scattering(band, sources, &geometry, &s_in, &emitted, environment)
+                    * (w_i.z / pdf)
+            }
+            _ => {
+                s_in[0] -= environment;
+                let mueller =
+                    pbrdf.mueller_with_masking(&incident, &scattered, masking[0], masking[1]);
+                mueller * s_in * (w_i.z / pdf)
+            }
+        };
         self.to_outgoing_frame(&local, &scattered, frame)
+    }
+
+    /// What the hit `vertex` emits toward the receiver along `toward_x` (its open-world emission,
+    /// rotated by `eta` into the receiver's incident frame) and its spectrum: the hit's
+    /// emissivity at each wavelength node (a band material; `None`: grey) and temperature.
+    fn emitted_toward(&self, vertex: &Vertex, toward_x: &Vector3<f64>, eta: f64) -> EmittedLight {
+        let frame = OutgoingFrame::new(&vertex.normal, toward_x);
+        let material = self.scene.triangle_material(vertex.hit.triangle);
+        let temperature = vertex.hit.temperature;
+        let tables = &self.open_world.tables[material];
+        let cos_theta = frame.cos_theta.max(THETA_MAX.cos());
+        EmittedLight {
+            radiance: self.open_world.radiance.radiance(temperature),
+            emissivity: tables.emissivity_at(cos_theta, temperature),
+            per_node: tables.node_emissivities(cos_theta),
+            polarization: rotate_stokes(&Stokes::new(0.0, 1.0, 0.0, 0.0), eta),
+        }
     }
 
     /// A Stokes vector in the psps frame of local `scattered` re-expressed with `frame.s_axis`.
@@ -270,7 +422,8 @@ impl PathTracer<'_> {
         if w_o.z <= 0.0 {
             return None;
         }
-        let pbrdf: &Pbrdf = &self.scene.materials[material].pbrdf;
+        let optics = &self.scene.materials[material].optics;
+        let pbrdf: &Pbrdf = optics.sampling_pbrdf();
         let scattered = Direction::from_unit_vector(w_o);
         let masking_o = pbrdf.quadrature_masking(w_o.z);
         let mut sum = Stokes::zeros();
@@ -282,12 +435,19 @@ impl PathTracer<'_> {
             }
             any = true;
             let incident = Direction::from_unit_vector(w_i);
-            let mueller = pbrdf.mueller_with_masking(
-                &incident,
-                &scattered,
-                pbrdf.quadrature_masking(w_i.z),
-                masking_o,
-            );
+            let masking = [pbrdf.quadrature_masking(w_i.z), masking_o];
+            let mueller: Mueller = match (optics, &self.band_sources[material]) {
+                (MaterialOptics::Band(band), Some(sources)) => {
+                    let [mixed] = band.mueller_mixtures(
+                        &incident,
+                        &scattered,
+                        masking,
+                        [SpectralMix::fixed(&sources.sun)],
+                    );
+                    mixed
+                }
+                _ => pbrdf.mueller_with_masking(&incident, &scattered, masking[0], masking[1]),
+            };
             sum += mueller.column(0) * (weight * w_i.z);
         }
         any.then(|| self.to_outgoing_frame(&(sum * sun.irradiance), &scattered, frame))
