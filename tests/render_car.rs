@@ -97,8 +97,9 @@ fn shipped_scene_renders_with_the_shipped_library() {
         vec![
             "paper_paint",
             "rough_paint",
-            "smooth_glass",
+            "silicate_glass",
             "anodized_panel",
+            "smooth_glass",
             "asphalt"
         ]
     );

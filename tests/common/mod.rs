@@ -71,6 +71,38 @@ pub fn write_truth_library(dir: &Path) {
         };
         material.save(&dir.join(format!("{name}.toml"))).unwrap();
     }
+    silicate_truth()
+        .save(&dir.join("silicate_glass.toml"))
+        .unwrap();
+}
+
+/// The spectral truth of measurements/silicate_glass.csv (scripts/make_measurements.py: one
+/// Lorentz oscillator, n and k at its nine wavelengths to 6 digits), the car's windows.
+pub fn silicate_truth() -> Material {
+    let wavelength_um = vec![8.0, 8.5, 9.0, 9.5, 10.0, 10.6, 11.5, 12.5, 14.0];
+    let n = vec![
+        0.517774, 0.588464, 1.36346, 2.87319, 2.62133, 2.30722, 2.08423, 1.96574, 1.87624,
+    ];
+    let k = vec![
+        0.543731, 1.2793, 2.12223, 1.38554, 0.477271, 0.210027, 0.100204, 0.0596999, 0.0359674,
+    ];
+    Material {
+        name: "silicate_glass".into(),
+        tool_version: "test".into(),
+        model: MaterialModel::Spectral(irpol::material::SpectralModel {
+            distribution: SlopeDistribution::Cauchy {
+                sigma: 0.06,
+                q: 2.8,
+            },
+            shadowing: Shadowing::Smith,
+            rho_d: vec![0.0; wavelength_um.len()],
+            wavelength_um,
+            n,
+            k,
+            dispersion: None,
+        }),
+        fit: None,
+    }
 }
 
 /// A copy of the shipped car scene in `dir/scenes`, with the truth library in `dir/fits`, at the
@@ -93,6 +125,7 @@ pub fn car_scene_with_shipped_fits(
         "paper_paint",
         "rough_paint",
         "smooth_glass",
+        "silicate_glass",
         "anodized_panel",
     ] {
         let file = format!("{name}.toml");
