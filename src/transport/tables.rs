@@ -185,6 +185,20 @@ struct ComponentKernel {
     weights: Vec<[f64; 3]>,
 }
 
+impl ComponentKernel {
+    /// The kernel of `directions` with `per_component[c][k]` the weight of direction k against
+    /// component c.
+    fn interleaved(directions: &[Vector3<f64>], per_component: &[Vec<[f64; 3]>]) -> Self {
+        let weights = (0..directions.len())
+            .flat_map(|k| per_component.iter().map(move |w| w[k]))
+            .collect();
+        ComponentKernel {
+            directions: directions.to_vec(),
+            weights,
+        }
+    }
+}
+
 /// Environment components c = 0… as functions of u = sin(elevation) on the same cells, each
 /// cell's pieces side by side (`cells[i · components + c]`, as in [`SineTable::cells`]) so that a
 /// lookup locates the cell once for all of them.
@@ -319,15 +333,8 @@ impl MaterialTables {
                     .chain(split.components.iter().map(|c| &c.shares))
                     .map(|shares| kernel.combined(shares))
                     .collect();
-                let directions = kernel.directions().to_vec();
-                let weights = (0..directions.len())
-                    .flat_map(|k| per_component.iter().map(move |w| w[k]))
-                    .collect();
                 (
-                    ComponentKernel {
-                        directions,
-                        weights,
-                    },
+                    ComponentKernel::interleaved(kernel.directions(), &per_component),
                     kernel.totals(),
                 )
             })
@@ -796,14 +803,7 @@ mod tests {
                         .collect::<Vec<_>>()
                 };
                 let per_node: Vec<_> = (0..nodes).map(|m| kernel.combined(&unit(m))).collect();
-                let directions = kernel.directions().to_vec();
-                let weights = (0..directions.len())
-                    .flat_map(|k| per_node.iter().map(move |w| w[k]))
-                    .collect();
-                ComponentKernel {
-                    directions,
-                    weights,
-                }
+                ComponentKernel::interleaved(kernel.directions(), &per_node)
             })
             .collect();
         let skies: Vec<&SineTable> = skies.iter().collect();
