@@ -681,10 +681,11 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
     let span = |values: &[f64], digits: usize| {
         let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let (lo, hi) = (format!("{lo:.digits$}"), format!("{hi:.digits$}"));
         if lo == hi {
-            format!("{lo:.digits$}")
+            lo
         } else {
-            format!("{lo:.digits$}–{hi:.digits$}")
+            format!("{lo}–{hi}")
         }
     };
     for (_, m) in materials {
@@ -710,7 +711,7 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
             m.name,
             m.model.distribution().name(),
             m.model.shadowing().name(),
-            span(&wavelengths, 3),
+            span(&wavelengths, if wavelengths.len() > 1 { 1 } else { 3 }),
             m.model.distribution().sigma(),
             q,
             span(&n, 3),
