@@ -129,16 +129,21 @@ pub fn fit_spectral(
         .iter()
         .map(MeasurementData::new)
         .collect::<Result<Vec<_>, _>>()?;
-    let mut fits = Vec::new();
-    for kind in options.distributions() {
-        let alone = sets
-            .par_iter()
-            .zip(&data)
-            .map(|(set, data)| fit_model(set, data, kind, options))
-            .collect::<Result<Vec<_>, _>>()?;
-        let joint = fit_table(&sets, &data, kind, options, &alone)?;
-        fits.push((joint, alone));
-    }
+    // Both distributions at once: their 2 × K wavelength fits share the cores instead of each
+    // distribution's K waiting for its slowest (each fit is seeded, so the result is the same).
+    let mut fits = options
+        .distributions()
+        .into_par_iter()
+        .map(|kind| {
+            let alone = sets
+                .par_iter()
+                .zip(&data)
+                .map(|(set, data)| fit_model(set, data, kind, options))
+                .collect::<Result<Vec<_>, _>>()?;
+            let joint = fit_table(&sets, &data, kind, options, &alone)?;
+            Ok((joint, alone))
+        })
+        .collect::<Result<Vec<_>, FitError>>()?;
     fits.sort_by(|a, b| a.0.aic.total_cmp(&b.0.aic));
     let (table, per_wavelength) = fits.remove(0);
     let alternative = fits.pop().map(|(fit, _)| fit);
