@@ -6,6 +6,7 @@
 //! [`pbrdf`]; everything else calls it.
 
 pub mod commands;
+pub mod elementary;
 pub mod emitter;
 pub mod fit;
 pub mod interrupt;

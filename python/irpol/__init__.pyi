@@ -53,7 +53,7 @@ class FitResult:
     reduced_chi2: float
     observations: int
     degrees_of_freedom: int
-    normalized_residuals: Optional[npt.NDArray[np.float64]]
+    normalized_residuals: List[npt.NDArray[np.float64]]
     model_mueller: List[npt.NDArray[np.float64]]
     measurements: List[Measurements]
     notes: List[str]

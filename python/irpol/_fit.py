@@ -20,9 +20,9 @@ class FitResult:
     `toml` is that file's text exactly. `uncertainty` holds the 1-σ errors of the free
     parameters (scaled by the reduced χ²), `correlation` their correlation matrix in
     `free_parameters` order; `chi2` is Σ r² of the normalized residuals (model − data)/σ, which
-    `normalized_residuals` holds per point and element (grey fits; None for a spectral fit).
+    `normalized_residuals` holds, one (points, measured elements) array per wavelength.
     `model_mueller` is the fitted model at each measured geometry, one (points, 4, 4) array per
-    wavelength (sr⁻¹), beside `measurements`."""
+    wavelength (sr⁻¹). Both lists run beside `measurements` (one item for a grey fit)."""
 
     name: str
     kind: str
@@ -36,7 +36,7 @@ class FitResult:
     reduced_chi2: float
     observations: int
     degrees_of_freedom: int
-    normalized_residuals: Optional[np.ndarray]
+    normalized_residuals: List[np.ndarray]
     model_mueller: List[np.ndarray]
     measurements: list
     notes: List[str]
@@ -63,7 +63,7 @@ def _result(d: Dict[str, Any]) -> FitResult:
         reduced_chi2=record["reduced_chi2"],
         observations=d["observations"],
         degrees_of_freedom=record["degrees_of_freedom"],
-        normalized_residuals=d["normalized_residuals"],
+        normalized_residuals=list(d["normalized_residuals"]),
         model_mueller=[m.reshape(-1, 4, 4) for m in d["model_mueller"]],
         measurements=[Measurements._from_dict(s) for s in d["measurements"]],
         notes=list(d["notes"]),

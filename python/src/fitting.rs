@@ -6,6 +6,7 @@ use crate::material::PyMaterial;
 use crate::measurements::set_dict;
 use irpol::commands::fit::FitFlags;
 use irpol::fit::{fit_inputs, MaterialFit};
+use irpol::measure::MeasurementSet;
 use irpol::optics::Mueller;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -59,6 +60,19 @@ fn mueller_rows<'py>(py: Python<'py>, muellers: &[Mueller]) -> PyResult<Bound<'p
     Ok(PyArray2::from_vec2(py, &rows)?)
 }
 
+/// Normalized residuals as a (points, measured elements) array in the set's column order.
+fn residual_rows<'py>(
+    py: Python<'py>,
+    residuals: &[f64],
+    set: &MeasurementSet,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let rows: Vec<Vec<f64>> = residuals
+        .chunks(set.elements.len())
+        .map(<[f64]>::to_vec)
+        .collect();
+    Ok(PyArray2::from_vec2(py, &rows)?)
+}
+
 fn outcome_dict<'py>(py: Python<'py>, outcome: &MaterialFit) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let material = outcome.material();
@@ -86,13 +100,14 @@ fn outcome_dict<'py>(py: Python<'py>, outcome: &MaterialFit) -> PyResult<Bound<'
                 "model_mueller",
                 vec![mueller_rows(py, &fit.model_muellers)?],
             )?;
-            let columns = o.measurement.elements.len();
-            let rows: Vec<Vec<f64>> = fit
-                .normalized_residuals
-                .chunks(columns)
-                .map(<[f64]>::to_vec)
-                .collect();
-            d.set_item("normalized_residuals", PyArray2::from_vec2(py, &rows)?)?;
+            d.set_item(
+                "normalized_residuals",
+                vec![residual_rows(
+                    py,
+                    &fit.normalized_residuals,
+                    &o.measurement,
+                )?],
+            )?;
         }
         MaterialFit::Spectral(o) => {
             let fit = &o.chosen;
@@ -107,7 +122,13 @@ fn outcome_dict<'py>(py: Python<'py>, outcome: &MaterialFit) -> PyResult<Bound<'
                 .map(|m| mueller_rows(py, m))
                 .collect();
             d.set_item("model_mueller", models?)?;
-            d.set_item("normalized_residuals", py.None())?;
+            let residuals: PyResult<Vec<_>> = fit
+                .normalized_residuals
+                .iter()
+                .zip(&o.measurements)
+                .map(|(r, set)| residual_rows(py, r, set))
+                .collect();
+            d.set_item("normalized_residuals", residuals?)?;
             d.set_item("n_errors", PyArray1::from_slice(py, &fit.n_errors))?;
             d.set_item("k_errors", PyArray1::from_slice(py, &fit.k_errors))?;
             d.set_item("rho_d_errors", PyArray1::from_slice(py, &fit.rho_d_errors))?;

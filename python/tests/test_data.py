@@ -77,7 +77,7 @@ def test_fit_equals_irpol_fit(tmp_path):
     assert "rho" not in free and result.correlation.shape == (len(free), len(free))
     assert np.allclose(np.diag(result.correlation), 1.0)
     assert set(result.uncertainty) == set(free)
-    residuals = result.normalized_residuals
+    [residuals] = result.normalized_residuals
     assert residuals.shape == result.measurements[0].values.shape
     assert np.isclose(np.sum(residuals ** 2), result.chi2, rtol=1e-12)
     assert result.reduced_chi2 == pytest.approx(result.chi2 / result.degrees_of_freedom, rel=1e-6)
@@ -91,6 +91,11 @@ def test_spectral_fit_equals_irpol_fit(tmp_path):
     assert result.kind == "spectral" and result.material.is_spectral
     assert result.toml == (tmp_path / "fits" / "silicate_glass.toml").read_text()
     assert len(result.model_mueller) == len(result.measurements) > 1
+    assert len(result.normalized_residuals) == len(result.measurements)
+    for residuals, measured in zip(result.normalized_residuals, result.measurements):
+        assert residuals.shape == measured.values.shape
+    chi2 = sum(np.sum(r ** 2) for r in result.normalized_residuals)
+    assert np.isclose(chi2, result.chi2, rtol=1e-12)
 
 
 def test_fit_options_are_refused_with_the_cli_message(tmp_path):

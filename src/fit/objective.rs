@@ -63,7 +63,7 @@ impl<'a> Objective<'a> {
             .data
             .zenith_cosines
             .iter()
-            .map(|&c| pbrdf.masking(c))
+            .map(|&c| pbrdf.masking_without_table(c))
             .collect();
         let width = self.data.elements.len();
         for (point, g) in self.data.geometry.iter().enumerate() {
@@ -139,8 +139,8 @@ impl<'a> Objective<'a> {
                 .map(|g| {
                     let s = &g.scattering;
                     let masking = [
-                        pbrdf.masking(s.cos_incident()),
-                        pbrdf.masking(s.cos_scattered()),
+                        pbrdf.masking_without_table(s.cos_incident()),
+                        pbrdf.masking_without_table(s.cos_scattered()),
                     ];
                     pbrdf.mueller_for_geometry(s, masking[0], masking[1])
                 })

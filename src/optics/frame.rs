@@ -11,6 +11,7 @@
 //! [`LocalFrame`] (tangent, bitangent, normal) and [`rotation_between_frames`].
 
 use super::polarization::{rotate_stokes, Stokes};
+use crate::elementary::sin_cos_degrees;
 use nalgebra::Vector3;
 
 /// A unit direction pointing away from the surface, with the horizontal axis ê_φ = unit(ẑ × ω) =
@@ -29,8 +30,18 @@ impl Direction {
     /// From zenith θ and azimuth φ in radians.
     #[inline]
     pub fn from_angles(theta: f64, phi: f64) -> Direction {
-        let (sin_t, cos_t) = theta.sin_cos();
-        let (sin_p, cos_p) = phi.sin_cos();
+        Direction::from_sines_and_cosines(theta.sin_cos(), phi.sin_cos())
+    }
+
+    /// From zenith θ and azimuth φ in degrees (exact at multiples of 90°; see
+    /// [`sin_cos_degrees`]).
+    #[inline]
+    pub fn from_degrees(theta_deg: f64, phi_deg: f64) -> Direction {
+        Direction::from_sines_and_cosines(sin_cos_degrees(theta_deg), sin_cos_degrees(phi_deg))
+    }
+
+    #[inline(always)]
+    fn from_sines_and_cosines((sin_t, cos_t): (f64, f64), (sin_p, cos_p): (f64, f64)) -> Direction {
         Direction {
             vector: Vector3::new(sin_t * cos_p, sin_t * sin_p, cos_t),
             azimuthal_axis: Vector3::new(-sin_p, cos_p, 0.0),

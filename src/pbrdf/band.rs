@@ -121,7 +121,7 @@ impl BandPbrdf {
             return [Mueller::zeros(); N];
         };
         let facet = geometry.facet();
-        let shape = self.models[0].facet_shape(facet, Some(masking));
+        let shape = self.models[0].facet_shape(facet, masking);
         let mut fresnel = [[0.0f64; 4]; N];
         let mut diffuse = [0.0f64; N];
         for (m, model) in self.models.iter().enumerate() {

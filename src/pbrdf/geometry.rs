@@ -23,10 +23,7 @@ impl Direction {
                 value: phi_deg,
             });
         }
-        Ok(Direction::from_angles(
-            theta_deg.to_radians(),
-            phi_deg.to_radians(),
-        ))
+        Ok(Direction::from_degrees(theta_deg, phi_deg))
     }
 
     /// A detector direction from a signed zenith angle (in-plane scans are written −80…80°):

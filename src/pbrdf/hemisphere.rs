@@ -251,7 +251,7 @@ impl Pbrdf {
         );
 
         // The scattered direction's shadowing factor is the same for every facet.
-        let masking_r = self.quadrature_masking(cos_r);
+        let masking_r = self.masking(cos_r);
         let mut add_facet = |u: f64, delta: f64, weight: f64| {
             let (sin_d, cos_d) = delta.sin_cos();
             let sec_h = (1.0 + u * u).sqrt();
@@ -266,7 +266,7 @@ impl Pbrdf {
                 cos_i,
                 cos_r,
                 cos_beta * cos_beta,
-                [self.quadrature_masking(cos_i), masking_r],
+                [self.masking(cos_i), masking_r],
             );
             // Facet s axis against the psps frame of ω_r (η_r of DESIGN §1.3).
             let (cos2, sin2) = double_angle(facet_axis_in_scattered_frame(&w_i, scattered));

@@ -6,7 +6,6 @@
 mod band;
 mod distribution;
 mod error;
-mod exponential;
 mod geometry;
 mod hemisphere;
 pub mod limits;

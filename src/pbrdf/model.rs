@@ -3,9 +3,9 @@
 //! M = L(−η_r) F_fres(β) L(η_i).
 
 use super::distribution::{CauchySmithTable, PreparedDistribution};
-use super::exponential::inline_exp;
 use super::limits::{within, MAX_K, MAX_N, MIN_N};
 use super::{ModelError, Shadowing, SlopeDistribution};
+use crate::elementary::inline_exp;
 use crate::optics::frame::{
     double_angle, facet_axis_in_incident_frame, facet_axis_in_scattered_frame, Direction,
 };
@@ -24,9 +24,9 @@ pub struct Pbrdf {
     rho_d: f64,
     prepared: PreparedDistribution,
     permittivity: Complex64,
-    /// Built on the first hemispherical quadrature with Smith–Cauchy (see
-    /// [`Pbrdf::quadrature_masking`]); `None` inside for the other models.
-    quadrature_lambda: OnceLock<Option<CauchySmithTable>>,
+    /// Smith–Cauchy Λ, built on the first [`Pbrdf::masking`]; `None` inside for the other
+    /// distributions.
+    lambda_table: OnceLock<Option<CauchySmithTable>>,
 }
 
 /// What one facet reflection contributes: P G/(4 cosθ cosθ_i cosθ_r) (|r_s|², |r_p|², r_s* r_p)
@@ -205,7 +205,7 @@ impl Pbrdf {
             rho_d,
             prepared: distribution.prepare(),
             permittivity: index.permittivity(),
-            quadrature_lambda: OnceLock::new(),
+            lambda_table: OnceLock::new(),
         })
     }
 
@@ -226,38 +226,42 @@ impl Pbrdf {
     }
 
     /// The factor of the shadowing G that depends on one direction only, for a direction with
-    /// cos θ = `cos_theta`: Smith's G1(θ) = 1/(1+Λ(θ)) (DESIGN §1.3); 1 for `none` and
-    /// `torrance-sparrow`. The Cauchy Λ needs an incomplete beta function (~0.2 µs), so a caller
-    /// that evaluates many direction pairs sharing few zenith angles (a fit) computes it once per
-    /// angle and passes it to [`Pbrdf::mueller_with_masking`].
+    /// cos θ = `cos_theta`: Smith's G1(θ) = 1/(1+Λ(θ)); 1 for `none` and `torrance-sparrow`
+    /// (DESIGN §1.3). The Cauchy Λ comes from a table built on the model's first call (~0.1 ms,
+    /// then ~20 ns per direction; within 2e-15 of the incomplete-beta form for q ≤ 4, see
+    /// [`CauchySmithTable`]), so every evaluation of one model — `irpol eval`, renders,
+    /// quadratures, the Python `mueller` — uses the same numbers.
     pub fn masking(&self, cos_theta: f64) -> f64 {
-        self.shadowing.masking(&self.prepared, cos_theta)
-    }
-
-    /// [`Pbrdf::masking`] for quadratures and renderers that need it at thousands of directions: Smith's Cauchy
-    /// Λ comes from a table built on first use (~0.1 ms; G1 within 2e-9 of the exact one, far
-    /// below the quadrature's 1e-5), everything else is exact.
-    pub fn quadrature_masking(&self, cos_theta: f64) -> f64 {
         if self.shadowing != Shadowing::Smith {
             return 1.0;
         }
         let table = self
-            .quadrature_lambda
+            .lambda_table
             .get_or_init(|| self.prepared.smith_lambda_table());
         match table {
             Some(table) => 1.0 / (1.0 + table.lambda(cos_theta)),
-            None => self.masking(cos_theta),
+            None => self.masking_without_table(cos_theta),
         }
     }
 
+    /// The [`Pbrdf::masking`] factors of ω_i and ω_r.
+    #[inline]
+    fn masking_of(&self, geometry: &FacetGeometry) -> [f64; 2] {
+        [self.masking(geometry.cos_i), self.masking(geometry.cos_r)]
+    }
+
+    /// [`Pbrdf::masking`] from the incomplete beta function itself (~0.2 µs per call), for a
+    /// caller that evaluates each new model at a few dozen angles only (a fit's objective, where
+    /// building the table would cost more than it saves) and passes the factors to
+    /// [`Pbrdf::mueller_with_masking`].
+    pub fn masking_without_table(&self, cos_theta: f64) -> f64 {
+        self.shadowing.masking(&self.prepared, cos_theta)
+    }
+
     /// Distribution, shadowing and Fresnel part shared by the full and fast paths. `masking`
-    /// holds the [`Pbrdf::masking`] factors of ω_i and ω_r, or `None` to compute them here.
+    /// holds the [`Pbrdf::masking`] factors of ω_i and ω_r.
     #[inline(always)]
-    fn facet_reflection(
-        &self,
-        geometry: &FacetGeometry,
-        masking: Option<[f64; 2]>,
-    ) -> FacetReflection {
+    fn facet_reflection(&self, geometry: &FacetGeometry, masking: [f64; 2]) -> FacetReflection {
         let shape = self.facet_shape(geometry, masking);
         let (rs2, rp2, cross, fresnel_inverse) =
             FresnelFractions::from_cos2(geometry.cos2_beta, self.permittivity)
@@ -273,25 +277,16 @@ impl Pbrdf {
     /// The part of [`Pbrdf::facet_reflection`] that does not depend on N: the facet density and
     /// the shadowing (shared by a material's models over wavelength, DESIGN §1.9).
     #[inline(always)]
-    pub(super) fn facet_shape(
-        &self,
-        geometry: &FacetGeometry,
-        masking: Option<[f64; 2]>,
-    ) -> FacetShape {
+    pub(super) fn facet_shape(&self, geometry: &FacetGeometry, masking: [f64; 2]) -> FacetShape {
         let FacetGeometry {
             cos_i,
             cos_r,
             tan2_theta,
             cos2_beta,
         } = *geometry;
-        let g = match masking {
-            Some(masking) => self
-                .shadowing
-                .factor_with_masking(cos_i, cos_r, cos2_beta, masking),
-            None => self
-                .shadowing
-                .factor(&self.prepared, cos_i, cos_r, cos2_beta),
-        };
+        let g = self
+            .shadowing
+            .factor_with_masking(cos_i, cos_r, cos2_beta, masking);
         // P(θ)/(4 cosθ cosθ_i cosθ_r) = D(θ)/(4 cosθ_i cosθ_r) with D = P/cosθ = c e^E.
         let (density_exponent, density_factor) = self
             .prepared
@@ -312,7 +307,10 @@ impl Pbrdf {
     #[inline]
     pub fn mueller(&self, incident: &Direction, scattered: &Direction) -> Mueller {
         match ScatteringGeometry::new(incident, scattered) {
-            Some(geometry) => self.mueller_at(&geometry, None),
+            Some(geometry) => {
+                let masking = self.masking_of(&geometry.facet);
+                self.mueller_at(&geometry, masking)
+            }
             None => Mueller::zeros(),
         }
     }
@@ -327,7 +325,7 @@ impl Pbrdf {
         masking_r: f64,
     ) -> Mueller {
         match ScatteringGeometry::new(incident, scattered) {
-            Some(geometry) => self.mueller_at(&geometry, Some([masking_i, masking_r])),
+            Some(geometry) => self.mueller_at(&geometry, [masking_i, masking_r]),
             None => Mueller::zeros(),
         }
     }
@@ -340,11 +338,11 @@ impl Pbrdf {
         masking_i: f64,
         masking_r: f64,
     ) -> Mueller {
-        self.mueller_at(geometry, Some([masking_i, masking_r]))
+        self.mueller_at(geometry, [masking_i, masking_r])
     }
 
     #[inline]
-    fn mueller_at(&self, geometry: &ScatteringGeometry, masking: Option<[f64; 2]>) -> Mueller {
+    fn mueller_at(&self, geometry: &ScatteringGeometry, masking: [f64; 2]) -> Mueller {
         let facet = self.facet_reflection(&geometry.facet, masking);
         // F_fres = [[A, B, 0, 0], [B, A, 0, 0], [0, 0, C, S], [0, 0, −S, C]] with the facet scale
         // folded in: A, B = (|r_s|² ± |r_p|²)/2, C + iS = r_s* r_p.
@@ -361,7 +359,7 @@ impl Pbrdf {
         let Some(geometry) = FacetGeometry::new(incident, scattered) else {
             return Stokes::zeros();
         };
-        let facet = self.facet_reflection(&geometry, None);
+        let facet = self.facet_reflection(&geometry, self.masking_of(&geometry));
         let (cr, sr) = double_angle(facet_axis_in_scattered_frame(&incident.vector, scattered));
         let (a, b) = facet.scaled_a_and_b();
         Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)

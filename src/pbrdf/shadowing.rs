@@ -33,24 +33,6 @@ impl Shadowing {
         }
     }
 
-    /// G for incidence θ_i and reflection θ_r (as cosines) off the facet that mirrors one into the
-    /// other, at local incidence β. The facet enters only through cos²β: V-grooves need
-    /// 2cosθ/cosβ = (cosθ_i + cosθ_r)/cos²β, as ω_i + ω_r = 2cosβ h.
-    #[inline]
-    pub(crate) fn factor(
-        &self,
-        distribution: &PreparedDistribution,
-        cos_i: f64,
-        cos_r: f64,
-        cos2_beta: f64,
-    ) -> f64 {
-        let masking = [
-            self.masking(distribution, cos_i),
-            self.masking(distribution, cos_r),
-        ];
-        self.factor_with_masking(cos_i, cos_r, cos2_beta, masking)
-    }
-
     /// The part of G that depends on one direction only: Smith's G1(θ) = 1/(1+Λ(θ)); 1 for the
     /// other kinds, whose G couples both directions through the facet.
     #[inline]
@@ -61,8 +43,10 @@ impl Shadowing {
         }
     }
 
-    /// G given the per-direction factors [`Shadowing::masking`] of ω_i and ω_r (precomputed by a
-    /// caller that evaluates many direction pairs sharing zenith angles).
+    /// G for incidence θ_i and reflection θ_r (as cosines) off the facet that mirrors one into the
+    /// other, at local incidence β, given the per-direction factors [`Shadowing::masking`] of ω_i
+    /// and ω_r. The facet enters only through cos²β: V-grooves need 2cosθ/cosβ =
+    /// (cosθ_i + cosθ_r)/cos²β, as ω_i + ω_r = 2cosβ h.
     #[inline]
     pub(crate) fn factor_with_masking(
         &self,

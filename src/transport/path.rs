@@ -349,10 +349,7 @@ impl PathTracer<'_> {
         let mut s_in = rotate_stokes(&leaving, eta);
         let environment = self.scene.environment.radiance(&direction);
         let scattered = Direction::from_unit_vector(w_o);
-        let masking = [
-            pbrdf.quadrature_masking(w_i.z),
-            pbrdf.quadrature_masking(w_o.z),
-        ];
+        let masking = [pbrdf.masking(w_i.z), pbrdf.masking(w_o.z)];
         let local = match (optics, &self.band_sources[material]) {
             (MaterialOptics::Band(band), Some(sources)) => {
                 let emitted = self.emitted_toward(&next, &toward_x, eta);
@@ -425,7 +422,7 @@ impl PathTracer<'_> {
         let optics = &self.scene.materials[material].optics;
         let pbrdf: &Pbrdf = optics.sampling_pbrdf();
         let scattered = Direction::from_unit_vector(w_o);
-        let masking_o = pbrdf.quadrature_masking(w_o.z);
+        let masking_o = pbrdf.masking(w_o.z);
         let mut sum = Stokes::zeros();
         let mut any = false;
         for (node, weight) in &rules[material].nodes {
@@ -435,7 +432,7 @@ impl PathTracer<'_> {
             }
             any = true;
             let incident = Direction::from_unit_vector(w_i);
-            let masking = [pbrdf.quadrature_masking(w_i.z), masking_o];
+            let masking = [pbrdf.masking(w_i.z), masking_o];
             let mueller: Mueller = match (optics, &self.band_sources[material]) {
                 (MaterialOptics::Band(band), Some(sources)) => {
                     let [mixed] = band.mueller_mixtures(

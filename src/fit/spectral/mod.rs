@@ -99,6 +99,9 @@ pub struct SpectralFit {
     pub chi2_per_wavelength: Vec<(f64, usize)>,
     /// The model's Mueller matrices at every point of every wavelength.
     pub model_muellers: Vec<Vec<Mueller>>,
+    /// The normalized residuals (model − data)/σ of every wavelength, point by point with the
+    /// measured elements in their set's column order (as [`ModelFit::normalized_residuals`]).
+    pub normalized_residuals: Vec<Vec<f64>>,
     pub history: StageHistory,
     /// Model evaluations of the joint stage (residual vectors of every wavelength).
     pub evaluations: u64,
@@ -302,12 +305,14 @@ fn solve(
         .collect();
     let mut chi2_per_wavelength = Vec::new();
     let mut model_muellers = Vec::new();
+    let mut normalized_residuals = Vec::new();
     for (j, block) in problem.blocks.iter().enumerate() {
         let residuals = block
             .objective
             .normalized_residuals(&values[j])
             .ok_or_else(invalid)?;
         chi2_per_wavelength.push((residuals.iter().map(|x| x * x).sum(), residuals.len()));
+        normalized_residuals.push(residuals);
         model_muellers.push(
             block
                 .objective
@@ -379,6 +384,7 @@ fn solve(
         bic: bic(chi2, free, observations),
         chi2_per_wavelength,
         model_muellers,
+        normalized_residuals,
         evaluations: history.evaluations,
         history,
     })

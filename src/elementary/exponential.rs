@@ -4,11 +4,13 @@
 //! use it too): e^y = 2^(k/64) e^r with k = round(64y/ln 2) and |r| ≤ ln 2/128, a 64-entry table
 //! of 2^(j/64) and a degree-5 polynomial. With fused multiply–adds it is about 15 instructions
 //! (`.cargo/config.toml` builds for the host CPU, which has FMA on any x86-64 since 2013–2015;
-//! see [`multiply_add`] for targets without it). The first-column BRDF takes 29 ns with it,
+//! see [`super::multiply_add`] for targets without it). The first-column BRDF takes 29 ns with it,
 //! 34 ns unfused on baseline x86-64, and took 36 ns with glibc's exp. It stays within 1 ulp of
 //! glibc's exp; the tests check that over two million arguments. No maintained crate offers an
 //! inlinable double-precision exp: the `libm` crate's is an out-of-line call (95 ns per BRDF
 //! evaluation).
+
+use super::multiply_add;
 
 /// 2^(j/64), j = 0..63, correctly rounded (from exact decimal arithmetic:
 /// `float(Decimal(2) ** (Decimal(j) / 64))` at 60 digits), as IEEE-754 bits.
@@ -109,22 +111,6 @@ pub(crate) fn inline_exp(y: f64) -> f64 {
     let expm1 = multiply_add(r2, multiply_add(r, 1.0 / 6.0, 0.5), r)
         + (r2 * r2) * multiply_add(r, 1.0 / 120.0, 1.0 / 24.0);
     multiply_add(scale, expm1, scale)
-}
-
-/// a·b + c, fused where the target has the instruction (x86-64 with FMA, as `.cargo/config.toml`
-/// builds on any recent CPU; aarch64 always). On x86 without it, `mul_add` would be a libm call
-/// (43 ns per first-column BRDF); unfused it is 34 ns, and the 1-ulp bound holds either way (the
-/// reduction's k·HI is exact; the test passes in both builds).
-#[inline(always)]
-fn multiply_add(a: f64, b: f64, c: f64) -> f64 {
-    if cfg!(all(
-        any(target_arch = "x86", target_arch = "x86_64"),
-        not(target_feature = "fma")
-    )) {
-        a * b + c
-    } else {
-        a.mul_add(b, c)
-    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,26 @@
+//! Elementary functions inlined into the physics' hot paths, where the system libm's opaque
+//! calls dominated the cost: e^y for the slope density and the Smith Λ table, and sin/cos of
+//! angles in degrees for the direction tables built from measurement and evaluation columns.
+//! Each file says why no crate serves and how its accuracy is tested.
+
+mod degrees;
+mod exponential;
+
+pub use degrees::sin_cos_degrees;
+pub(crate) use exponential::inline_exp;
+
+/// a·b + c, fused where the target has the instruction (x86-64 with FMA, as `.cargo/config.toml`
+/// builds on any recent CPU; aarch64 always). On x86 without it, `mul_add` would be a libm call
+/// (43 ns per first-column BRDF); unfused it is 34 ns, and the 1-ulp bound holds either way (the
+/// reduction's k·HI is exact; the test passes in both builds).
+#[inline(always)]
+pub(crate) fn multiply_add(a: f64, b: f64, c: f64) -> f64 {
+    if cfg!(all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        not(target_feature = "fma")
+    )) {
+        a * b + c
+    } else {
+        a.mul_add(b, c)
+    }
+}
