@@ -398,7 +398,7 @@ def rough_conductor(material):
             "eta": material["n"], "k": material["k"]}
 
 
-def mitsuba_scene(mi, work, width, height, bounces, spp):
+def mitsuba_scene(mi, work, width, height, bounces, spp, sampler="independent"):
     T = mi.ScalarTransform4f
     s, p, c = SCENE["sphere"], SCENE["plane"], SCENE["camera"]
     ply = work / "icosphere.ply"
@@ -415,7 +415,7 @@ def mitsuba_scene(mi, work, width, height, bounces, spp):
             "to_world": T().look_at(origin=c["position"], target=c["look_at"], up=c["up"]),
             "film": {"type": "hdrfilm", "width": width, "height": height,
                      "rfilter": {"type": "box"}, "pixel_format": "luminance"},
-            "sampler": {"type": "independent", "sample_count": spp},
+            "sampler": {"type": sampler, "sample_count": spp},
         },
         "sky": {"type": "envmap", "bitmap": envmap_bitmap(mi),
                 "to_world": T().rotate([1.0, 0.0, 0.0], 90.0)},
@@ -489,7 +489,8 @@ def brdf_check(mi, irpol, work):
             [irpol, "eval", "--distribution", "gaussian", "--sigma", str(material["sigma"]),
              "--n", str(material["n"]), "--k", str(material["k"]), "--shadowing", "smith",
              "--geometry", str(csv)], check=True, capture_output=True, text=True).stdout
-        lines = out.strip().splitlines()
+        # `irpol eval` starts with `#` lines naming the model (CSV comments).
+        lines = [l for l in out.strip().splitlines() if not l.startswith("#")]
         header = lines[0].split(",")
         for line, (ti, pi, tr, pr) in zip(lines[1:], geometries):
             row = dict(zip(header, map(float, line.split(","))))
@@ -721,6 +722,9 @@ def main():
     parser.add_argument("--passes", type=int, default=8, help="independent passes per renderer")
     parser.add_argument("--irpol-samples", type=int, default=1024, help="irpol samples per pass")
     parser.add_argument("--mitsuba-spp", type=int, default=2048, help="Mitsuba spp per pass")
+    parser.add_argument("--mitsuba-sampler", default="independent",
+                        help="Mitsuba sampler plugin: independent (its default), stratified, "
+                             "multijitter, orthogonal or ldsampler")
     parser.add_argument("--irpol-supersample", type=int, default=1, metavar="N",
                         help="diagnostic: render irpol at N× the resolution (samples/N² each) and "
                              "average N×N blocks, i.e. a box-filtered pixel like Mitsuba's")
@@ -783,14 +787,15 @@ def main():
 
     # Mitsuba passes.
     t0 = time.perf_counter()
-    scene = mitsuba_scene(mi, work, width, height, args.bounces, args.mitsuba_spp)
+    scene = mitsuba_scene(mi, work, width, height, args.bounces, args.mitsuba_spp,
+                          args.mitsuba_sampler)
     t_load = time.perf_counter() - t0
     mi_passes, mi_times = [], []
     for seed in range(1, args.passes + 1):
         s, t = mitsuba_stokes(mi, scene, args.mitsuba_spp, seed)
         mi_passes.append(s)
         mi_times.append(t)
-    print(f"Mitsuba: {args.passes} passes × {args.mitsuba_spp} spp, path max_depth "
+    print(f"Mitsuba: {args.passes} passes × {args.mitsuba_spp} spp ({args.mitsuba_sampler} sampler), path max_depth "
           f"{args.bounces + 2}: {sum(t for t, _ in mi_times):.2f} s wall, "
           f"{sum(c for _, c in mi_times):.2f} s CPU (mi.render; first pass {mi_times[0][0]:.2f} s "
           f"incl. JIT, others {np.mean([t for t, _ in mi_times[1:]]) if len(mi_times) > 1 else float('nan'):.2f} s;"

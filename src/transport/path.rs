@@ -31,6 +31,7 @@
 
 use super::accel::Accelerator;
 use super::open_world::OpenWorld;
+use super::sampler::PixelSampler;
 use super::tables::THETA_MAX;
 use crate::emitter::{DiscQuadrature, Sun, SUN_TEMPERATURE_K};
 use crate::optics::band_nodes::{BrightnessGrid, FractionsByRadiance};
@@ -44,6 +45,9 @@ use crate::scene::{PathSettings, Scene};
 use nalgebra::Vector3;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
+
+/// A pixel's sample points and random stream.
+type Sampler<'a> = PixelSampler<'a, ChaCha8Rng>;
 
 /// Shadow rays toward the sun per visible point (stratified over the disc's area).
 const SHADOW_RAYS_PER_PIXEL: u32 = 4;
@@ -254,14 +258,15 @@ impl PathTracer<'_> {
         if sun.is_some() {
             for (s, v) in visibility.iter_mut().take(shadow_rays).enumerate() {
                 let stratum = (s as f64 + rng.random::<f64>()) / shadow_rays as f64;
-                *v = self.sun_visibility(vertex, stratum, rng);
+                *v = self.sun_visibility(vertex, [stratum, rng.random::<f64>()]);
             }
         }
-        for s in 0..n {
-            let stratum = (s as f64 + rng.random::<f64>()) / n as f64;
-            let mut x = self.correction(vertex, &frame, material, 0, stratum, rng);
+        let mut sampler = PixelSampler::new(n as usize, rng);
+        for s in 0..sampler.paths() {
+            sampler.start_path(s);
+            let mut x = self.correction(vertex, &frame, material, 0, &mut sampler);
             if let Some(integral) = sun {
-                x += integral * visibility[s as usize % shadow_rays];
+                x += integral * visibility[s % shadow_rays];
             }
             let x = to_pixel(&x);
             let d = x - *first.get_or_insert(x);
@@ -290,7 +295,7 @@ impl PathTracer<'_> {
         vertex: &Vertex,
         omega: &Vector3<f64>,
         depth: u32,
-        rng: &mut ChaCha8Rng,
+        sampler: &mut Sampler,
     ) -> (Stokes, Vector3<f64>) {
         let frame = OutgoingFrame::new(&vertex.normal, omega);
         let material = self.scene.triangle_material(vertex.hit.triangle);
@@ -298,27 +303,25 @@ impl PathTracer<'_> {
             .open_world
             .leaving(material, &frame, vertex.hit.temperature);
         if let Some(integral) = self.sun_integral(vertex, &frame, material) {
-            let stratum = rng.random::<f64>();
-            s += integral * self.sun_visibility(vertex, stratum, rng);
+            let disc_point = [sampler.uniform(), sampler.uniform()];
+            s += integral * self.sun_visibility(vertex, disc_point);
         }
         if depth <= self.settings.bounces {
-            let stratum = rng.random::<f64>();
-            s += self.correction(vertex, &frame, material, depth, stratum, rng);
+            s += self.correction(vertex, &frame, material, depth, sampler);
         }
         (s, frame.s_axis)
     }
 
     /// One sample of ∫ F (S_in − L_env e₀) cosθ_i dΩ_i at `vertex` (depth `depth`), in the psps
-    /// frame of `frame`; `stratum` ∈ [0, 1) chooses the lobe and its radial coordinate
-    /// ([`Pbrdf::sample_incident`]), stratified over a pixel's samples.
+    /// frame of `frame`, the pBRDF sampled at the path's point for this depth
+    /// ([`PixelSampler::bounce_point`], stratified over the pixel's paths).
     fn correction(
         &self,
         vertex: &Vertex,
         frame: &OutgoingFrame,
         material: usize,
         depth: u32,
-        stratum: f64,
-        rng: &mut ChaCha8Rng,
+        sampler: &mut Sampler,
     ) -> Stokes {
         let optics = &self.scene.materials[material].optics;
         let pbrdf = optics.sampling_pbrdf();
@@ -326,8 +329,7 @@ impl PathTracer<'_> {
         if w_o.z <= 0.0 {
             return Stokes::zeros();
         }
-        let u = [stratum, rng.random::<f64>()];
-        let Some((w_i, pdf)) = pbrdf.sample_incident(&w_o, u) else {
+        let Some((w_i, pdf)) = pbrdf.sample_incident(&w_o, sampler.bounce_point(depth)) else {
             return Stokes::zeros();
         };
         let direction = frame.to_world(&w_i);
@@ -341,7 +343,7 @@ impl PathTracer<'_> {
         };
         let toward_x = -direction;
         let next = Vertex::seen_from(hit, &toward_x);
-        let (leaving, s_from) = self.leaving(&next, &toward_x, depth + 1, rng);
+        let (leaving, s_from) = self.leaving(&next, &toward_x, depth + 1, sampler);
         // Incident frame at x: k = −ω_i, s = −ê_φ(ω_i) in the local frame (DESIGN §1.3).
         let incident = Direction::from_unit_vector(w_i);
         let s_incident = -frame.to_world(&incident.azimuthal_axis);
@@ -450,12 +452,13 @@ impl PathTracer<'_> {
         any.then(|| self.to_outgoing_frame(&(sum * sun.irradiance), &scattered, frame))
     }
 
-    /// 1 if a shadow ray from `vertex` to the disc point of area fraction `stratum` escapes.
-    fn sun_visibility(&self, vertex: &Vertex, stratum: f64, rng: &mut ChaCha8Rng) -> f64 {
+    /// 1 if a shadow ray from `vertex` to the disc point `[area fraction, angle fraction]`
+    /// ([`Sun::disc_point`]) escapes.
+    fn sun_visibility(&self, vertex: &Vertex, [stratum, angle]: [f64; 2]) -> f64 {
         let Some((sun, _)) = self.sun.as_ref() else {
             return 0.0;
         };
-        let direction = sun.disc_point(stratum, rng.random::<f64>());
+        let direction = sun.disc_point(stratum, angle);
         if direction.dot(&vertex.geometric_normal) <= 0.0 {
             return 0.0;
         }
