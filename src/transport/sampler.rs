@@ -4,7 +4,8 @@
 //! ([`crate::pbrdf::Pbrdf::sample_incident`]: u₀ picks the lobe and its radial coordinate, u₁
 //! the azimuth). Independent points leave clumps and holes; the correction's integrand has
 //! edges (a silhouette of the geometry it hits), where stratified points converge faster. So the
-//! n paths of a pixel take, at each depth, the n points of one multi-jittered pattern (Chiu,
+//! n paths of a pixel take, at each of their first [`STRATIFIED_DEPTHS`] depths, the n points of
+//! one multi-jittered pattern (Chiu,
 //! Shirley and Wang, "Multi-jittered sampling", Graphics Gems IV, 1994): with n = m k, each cell
 //! of an m × k grid holds one point, and each of the n strata of either coordinate holds one too.
 //! The n strata of u₀ keep what the integrator relied on before: the two lobes get their exact
