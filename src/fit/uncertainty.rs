@@ -39,7 +39,7 @@ pub struct Uncertainty {
     pub undetermined: Vec<Parameter>,
     /// Parameters resting on a bound of their search interval.
     pub at_bound: Vec<Parameter>,
-    /// One-sided profile-likelihood bounds of each undetermined parameter ([`super::profile`]).
+    /// One-sided profile-likelihood bounds of each undetermined parameter (`super::profile`).
     pub profile_bounds: Vec<(Parameter, ConfidenceBound)>,
 }
 

@@ -37,7 +37,7 @@ pub struct SourceData {
 impl MeasurementSet {
     /// The fingerprint of the data of the set's own file (`source`: all rows unless files were
     /// merged into it), its rows grouped `rows_per_digest` to a digest (0: as few per group as
-    /// keep the digests within [`MAX_DIGESTS`]).
+    /// keep the digests within `MAX_DIGESTS`).
     pub fn source_data(&self, rows_per_digest: usize) -> SourceData {
         let merged_rows: usize = self.merged.iter().map(|file| file.rows).sum();
         let own = self.points.len().saturating_sub(merged_rows);

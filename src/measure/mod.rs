@@ -63,7 +63,7 @@ pub struct MeasurementPoint {
     pub theta_r_deg: f64,
     /// Receiver azimuth, degrees (180, the specular side, when the file has no phi_r_deg column).
     pub phi_r_deg: f64,
-    /// Mueller-matrix BRDF elements, sr⁻¹, aligned with [`MeasurementSet::elements`]; values[0]
+    /// Mueller-matrix BRDF elements, sr⁻¹, aligned with [`MeasurementSet::elements`]; `values[0]`
     /// is m00 ≥ 0.
     pub values: Vec<f64>,
     /// Absolute 1-σ uncertainties, sr⁻¹ (> 0), aligned with [`MeasurementSet::elements`]:

@@ -8,7 +8,8 @@
 //!
 //! Local directions ([`Direction`]) carry their own axes so that θ = 0 takes the limit θ → 0⁺
 //! along the given azimuth (SCATMECH's choice). World-space frames of the renderer use
-//! [`LocalFrame`] (tangent, bitangent, normal) and [`rotation_between_frames`].
+//! [`OutgoingFrame`] (the psps frame of a direction leaving a surface) and
+//! [`rotation_between_frames`].
 
 use super::polarization::{rotate_stokes, Stokes};
 use crate::elementary::sin_cos_degrees;

@@ -49,7 +49,7 @@ impl FresnelFractions {
     /// would cost a square root.
     ///
     /// The fractions are multiplied through by s > 0, where s√z = (|z| + Re z, Im z) or
-    /// (|Im z|, ±(|z| − Re z)) (see [`scaled_principal_sqrt`]): s·w needs no division,
+    /// (|Im z|, ±(|z| − Re z)) (see `scaled_principal_sqrt`): s·w needs no division,
     /// s cosβ = √(s² cos²β) one square root, and the ratios are unchanged. This is the hot path of
     /// every BRDF evaluation, so the chain from cos²β to the fractions is kept short: z is formed
     /// with one addition from ε − 1, which does not wait for cos²β.

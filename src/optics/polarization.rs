@@ -12,7 +12,7 @@ pub type Stokes = Vector4<f64>;
 
 /// Mueller matrix of a Jones matrix J acting on (E_s, E_p): M_ij = ½ Re tr(σ_i J σ_j J†), with the
 /// Pauli basis ordered to the psps Stokes definition above (σ0 = I, σ1 = diag(1,−1),
-/// σ2 = [[0,1],[1,0]], σ3 = [[0,−i],[i,0]]), so that S_i = tr(σ_i E E†).
+/// σ2 = `[[0,1],[1,0]]`, σ3 = `[[0,−i],[i,0]]`), so that S_i = tr(σ_i E E†).
 pub fn jones_to_mueller(jones: &Matrix2<Complex64>) -> Mueller {
     let zero = Complex64::new(0.0, 0.0);
     let one = Complex64::new(1.0, 0.0);
@@ -28,7 +28,7 @@ pub fn jones_to_mueller(jones: &Matrix2<Complex64>) -> Mueller {
 }
 
 /// Mueller matrix of a reflection with amplitude coefficients (r_s, r_p) in its own s/p frame:
-/// [[A,B,0,0],[B,A,0,0],[0,0,C,−S],[0,0,S,C]] with A = (|r_s|²+|r_p|²)/2, B = (|r_s|²−|r_p|²)/2,
+/// `[[A,B,0,0],[B,A,0,0],[0,0,C,−S],[0,0,S,C]]` with A = (|r_s|²+|r_p|²)/2, B = (|r_s|²−|r_p|²)/2,
 /// C = Re(r_s* r_p), S = Im(r_s* r_p) (DESIGN §1.3; `jones_to_mueller` of diag(r_s, r_p)).
 #[inline]
 pub fn fresnel_mueller(r_s: Complex64, r_p: Complex64) -> Mueller {
@@ -44,7 +44,7 @@ pub fn fresnel_mueller(r_s: Complex64, r_p: Complex64) -> Mueller {
     )
 }
 
-/// The frame rotator L(η) = [[1,0,0,0],[0,c,s,0],[0,−s,c,0],[0,0,0,1]], c = cos2η, s = sin2η: the
+/// The frame rotator L(η) = `[[1,0,0,0],[0,c,s,0],[0,−s,c,0],[0,0,0,1]]`, c = cos2η, s = sin2η: the
 /// Mueller matrix of re-expressing a Stokes vector in s/p axes rotated by η (Jones [[cosη, sinη],
 /// [−sinη, cosη]]).
 pub fn stokes_rotator(eta: f64) -> Mueller {

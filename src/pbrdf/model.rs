@@ -229,7 +229,7 @@ impl Pbrdf {
     /// cos θ = `cos_theta`: Smith's G1(θ) = 1/(1+Λ(θ)); 1 for `none` and `torrance-sparrow`
     /// (DESIGN §1.3). The Cauchy Λ comes from a table built on the model's first call (~0.1 ms,
     /// then ~20 ns per direction; within 2e-15 of the incomplete-beta form for q ≤ 4, see
-    /// [`CauchySmithTable`]), so every evaluation of one model — `irpol eval`, renders,
+    /// `CauchySmithTable`), so every evaluation of one model — `irpol eval`, renders,
     /// quadratures, the Python `mueller` — uses the same numbers.
     pub fn masking(&self, cos_theta: f64) -> f64 {
         if self.shadowing != Shadowing::Smith {

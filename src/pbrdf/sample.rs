@@ -18,9 +18,9 @@ impl Pbrdf {
     }
 
     /// Draws ω_i (local frame, macro normal ẑ) for light scattered along unit `scattered` from
-    /// the mixture of the facet-lobe and cosine densities, with uniforms `u` ∈ [0, 1)². u[0] both
+    /// the mixture of the facet-lobe and cosine densities, with uniforms `u` ∈ [0, 1)². `u[0]` both
     /// chooses the lobe (below the lobe's weight w) and, rescaled to [0, 1), gives the radial
-    /// coordinate within it; u[1] gives the azimuth. Stratifying u[0] over a pixel's samples
+    /// coordinate within it; `u[1]` gives the azimuth. Stratifying `u[0]` over a pixel's samples
     /// therefore allocates the two lobes in proportion (Veach's multi-sample estimator with the
     /// balance heuristic is then exactly f/pdf_mixture per sample) and stratifies each lobe
     /// radially. Returns ω_i and its mixture pdf (sr⁻¹), or `None` for a direction below the

@@ -3,7 +3,7 @@
 //! part, resolved into one world-space [`ShadedMesh`] ready for `render`.
 //!
 //! Paths in a scene are relative to the scene file. Every error names the file and the item
-//! ("scenes/car.toml: objects[0] 'car', part 'hood': …", "scenes/car.obj: line 12: …").
+//! ("scenes/car.toml: objects\[0\] 'car', part 'hood': …", "scenes/car.obj: line 12: …").
 
 pub mod camera;
 pub mod car;

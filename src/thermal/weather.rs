@@ -21,7 +21,7 @@
 //! - DNI and DHI from the simplified Solis clear-sky model ([`solis`]; Ineichen 2008) at the
 //!   apparent solar elevation, with [`SolisAtmosphere::DEFAULT`] (aod700 = 0.1, 1 cm of
 //!   precipitable water, 101325 Pa); zero with the sun below the horizon;
-//! - the air temperature of a diurnal cycle ([`clear_day`] module): its minimum `air_min_k` at each
+//! - the air temperature of a diurnal cycle (`clear_day` module): its minimum `air_min_k` at each
 //!   sunrise and its maximum `air_max_k` at 15:00 local apparent solar time (solar transit + 3 h),
 //!   joined by half cosines; without a sunrise (polar day or night) the minimum is at 03:00
 //!   apparent solar time;

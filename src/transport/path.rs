@@ -16,7 +16,7 @@
 //! polarization appears after two conductor bounces). Vertex k (the camera's visible point is
 //! k = 0) traces its correction while k ≤ `bounces`; deeper hits take the open-world value.
 //!
-//! The sun (see [`super::sun`]) is added at every vertex as next-event estimation: the disc
+//! The sun (see [`crate::emitter`]) is added at every vertex as next-event estimation: the disc
 //! integral of F times a shadow-ray visibility. It is not part of the control variate (the
 //! open-world tables hold no sun), and escaped correction rays never count it, so it is not
 //! counted twice.

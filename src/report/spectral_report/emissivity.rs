@@ -21,7 +21,7 @@ pub const MAX_ANGLE_DEG: f64 = 85.0;
 pub struct EmissivityGrid {
     /// Ascending, µm: evenly spread over the table, with every table node among them.
     pub wavelength_um: Vec<f64>,
-    /// Ascending, degrees, 0…[`MAX_ANGLE_DEG`].
+    /// Ascending, degrees, 0…`MAX_ANGLE_DEG`.
     pub theta_deg: Vec<f64>,
     /// ε0 at `[wavelength][angle]`.
     pub e0: Vec<Vec<f64>>,
