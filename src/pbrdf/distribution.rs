@@ -216,10 +216,7 @@ impl PreparedDistribution {
 /// x = 1 − s² = a/(a + μ²), DESIGN §1.3's Λ = Γ(q−½)√a/(Γ(q−1)√π (2q−3) μ) (1 + μ²/a)^(3/2−q)
 /// − ½ I_x(q−1, ½) is, since (1 + μ²/a)^(3/2−q) = x^(q−1)/√x and √a/(μ√x) = 1/s,
 ///     Λ = x^(q−1) [K/s − φ(s)/2],  K = Γ(q−½)/(Γ(q−1)√π (2q−3)),  φ(s) = I_x(q−1, ½)/x^(q−1).
-/// φ is analytic on [0, 1]: the incomplete beta's x^(q−1) behaviour at x → 0 is divided out and
-/// its (1−x)^½ = s behaviour at x → 1 is analytic in s. So φ is tabulated on a uniform grid in s
-/// (from statrs' incomplete beta) and interpolated by 6-point Lagrange polynomials; G1 = 1/(1+Λ)
-/// then agrees with the incomplete-beta form to its own rounding error: within 2e-15 relative
+/// φ is [`HalfBetaRatio`] with p = q − 1; G1 = 1/(1+Λ) then agrees with the incomplete-beta form to its own rounding error: within 2e-15 relative
 /// for q ≤ 4, 1e-13 up to q = 100 (test below; 4-point interpolation on the same grid was
 /// 3e-13 at q = 1.8 and 2e-9 at q = 60).
 #[derive(Clone, Debug)]
@@ -227,32 +224,17 @@ pub(crate) struct CauchySmithTable {
     a: f64,
     q: f64,
     k: f64,
-    /// φ(j/N) for j = 0..=N.
-    phi: Vec<f64>,
+    phi: HalfBetaRatio,
 }
 
 impl CauchySmithTable {
     fn new(a: f64, q: f64, smith_prefactor: f64) -> CauchySmithTable {
-        // φ varies faster as q grows (the lobe nears a Gaussian); 512 intervals keep the
-        // interpolation error at rounding level up to q = 32, beyond that the grid grows with q.
-        let intervals = 512.max((16.0 * q).ceil() as usize);
-        let phi = (0..=intervals)
-            .map(|j| {
-                let s = j as f64 / intervals as f64;
-                let x = 1.0 - s * s;
-                if j == intervals {
-                    // lim x→0 I_x(q−1, ½)/x^(q−1) = 1/((q−1) B(q−1, ½)) = Γ(q−½)/(Γ(q−1)√π (q−1)).
-                    smith_prefactor / (q - 1.0)
-                } else {
-                    beta_reg(q - 1.0, 0.5, x) / x.powf(q - 1.0)
-                }
-            })
-            .collect();
         CauchySmithTable {
             a,
             q,
             k: smith_prefactor / (2.0 * q - 3.0),
-            phi,
+            // lim x→0 I_x(q−1, ½)/x^(q−1) = 1/((q−1) B(q−1, ½)) = Γ(q−½)/(Γ(q−1)√π (q−1)).
+            phi: HalfBetaRatio::new(q - 1.0, smith_prefactor / (q - 1.0)),
         }
     }
 
@@ -268,12 +250,45 @@ impl CauchySmithTable {
         // x^(q−1) as e^((q−1) ln x), as in the slope density: glibc's correctly rounded pow was
         // the largest single cost of a bulk evaluation (~14 %); the relative error, ~(q−1)|ln x|
         // 1e-16, matters only where Λ ≈ x^(q−1) K/s is itself negligible against 1.
-        inline_exp((self.q - 1.0) * x.ln()) * (self.k / s - 0.5 * self.interpolated_phi(s))
+        inline_exp((self.q - 1.0) * x.ln()) * (self.k / s - 0.5 * self.phi.at(s))
+    }
+}
+
+/// φ_p(s) = I_x(p, ½)/x^p with x = 1 − s², s ∈ [0, 1]: the regularized incomplete beta function
+/// that Student-t tails need (the Cauchy Smith Λ with p = q − 1, the visible-slope sampler's
+/// conditional slope with p = q − ½), with its x^p behaviour at x → 0 divided out. What is left is
+/// analytic in s on [0, 1] (the (1 − x)^½ = s behaviour at x → 1 is analytic in s), so it is
+/// tabulated on a uniform grid in s (from statrs' incomplete beta, ~0.2 µs a call) and
+/// interpolated by 6-point Lagrange polynomials (~10 ns).
+#[derive(Clone, Debug)]
+pub(crate) struct HalfBetaRatio {
+    /// φ_p(j/N) for j = 0..=N.
+    phi: Vec<f64>,
+}
+
+impl HalfBetaRatio {
+    /// The table for exponent `p`; `limit_at_one` = 1/(p B(p, ½)), φ_p's value at s = 1 (x = 0).
+    pub(crate) fn new(p: f64, limit_at_one: f64) -> HalfBetaRatio {
+        // φ varies faster as p grows (the lobe nears a Gaussian); 512 intervals keep the
+        // interpolation error at rounding level up to p ≈ 31, beyond that the grid grows with p.
+        let intervals = 512.max((16.0 * (p + 1.0)).ceil() as usize);
+        let phi = (0..=intervals)
+            .map(|j| {
+                let s = j as f64 / intervals as f64;
+                let x = 1.0 - s * s;
+                if j == intervals {
+                    limit_at_one
+                } else {
+                    beta_reg(p, 0.5, x) / x.powf(p)
+                }
+            })
+            .collect();
+        HalfBetaRatio { phi }
     }
 
-    /// φ(s) from the 6 grid points around s (one-sided at the ends of [0, 1]).
+    /// φ_p(s) from the 6 grid points around s (one-sided at the ends of [0, 1]).
     #[inline]
-    fn interpolated_phi(&self, s: f64) -> f64 {
+    pub(crate) fn at(&self, s: f64) -> f64 {
         let intervals = self.phi.len() - 1;
         let u = s * intervals as f64;
         let first = (u as usize).saturating_sub(2).min(intervals - 5);

@@ -12,6 +12,7 @@ pub mod limits;
 mod model;
 mod sample;
 mod shadowing;
+mod visible_slopes;
 
 pub use crate::optics::Direction;
 pub use band::{BandPbrdf, MaterialOptics};

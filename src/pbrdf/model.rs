@@ -4,6 +4,7 @@
 
 use super::distribution::{CauchySmithTable, PreparedDistribution};
 use super::limits::{within, MAX_K, MAX_N, MIN_N};
+use super::visible_slopes::VisibleSlopes;
 use super::{ModelError, Shadowing, SlopeDistribution};
 use crate::elementary::inline_exp;
 use crate::optics::frame::{
@@ -27,6 +28,9 @@ pub struct Pbrdf {
     /// Smith–Cauchy Λ, built on the first [`Pbrdf::masking`]; `None` inside for the other
     /// distributions.
     lambda_table: OnceLock<Option<CauchySmithTable>>,
+    /// The importance sampler of visible slopes, built on the first sampled direction; `None`
+    /// inside where no visible-normal density exists (Cauchy q ≤ 3/2).
+    visible_slopes: OnceLock<Option<VisibleSlopes>>,
 }
 
 /// What one facet reflection contributes: P G/(4 cosθ cosθ_i cosθ_r) (|r_s|², |r_p|², r_s* r_p)
@@ -206,6 +210,7 @@ impl Pbrdf {
             prepared: distribution.prepare(),
             permittivity: index.permittivity(),
             lambda_table: OnceLock::new(),
+            visible_slopes: OnceLock::new(),
         })
     }
 
@@ -223,6 +228,11 @@ impl Pbrdf {
     }
     pub(crate) fn prepared_distribution(&self) -> &PreparedDistribution {
         &self.prepared
+    }
+    pub(super) fn visible_slopes(&self) -> Option<&VisibleSlopes> {
+        self.visible_slopes
+            .get_or_init(|| VisibleSlopes::new(&self.prepared))
+            .as_ref()
     }
 
     /// The factor of the shadowing G that depends on one direction only, for a direction with

@@ -1,8 +1,8 @@
 //! Where a pixel's paths go: the 2-D sample points of their bounces.
 //!
 //! A path's bounce at depth d needs one point u ∈ [0, 1)² for the pBRDF sample
-//! ([`crate::pbrdf::Pbrdf::sample_incident`]: u₀ picks the lobe and its radial coordinate, u₁
-//! the azimuth). Independent points leave clumps and holes; the correction's integrand has
+//! ([`crate::pbrdf::Pbrdf::sample_incident`]: u₀ picks the lobe and the first coordinate of the
+//! visible facet slope, u₁ the second; both maps are monotone, so strata stay strata). Independent points leave clumps and holes; the correction's integrand has
 //! edges (a silhouette of the geometry it hits), where stratified points converge faster. So the
 //! n paths of a pixel take, at each of their first [`STRATIFIED_DEPTHS`] depths, the n points of
 //! one multi-jittered pattern (Chiu,
