@@ -30,7 +30,8 @@ pub struct Pbrdf {
     lambda_table: OnceLock<Option<CauchySmithTable>>,
     /// The importance sampler of visible slopes, built on the first sampled direction; `None`
     /// inside where no visible-normal density exists (Cauchy q ≤ 3/2).
-    visible_slopes: OnceLock<Option<VisibleSlopes>>,
+    /// (Boxed: it is large, and most models are never sampled.)
+    visible_slopes: OnceLock<Option<Box<VisibleSlopes>>>,
 }
 
 /// What one facet reflection contributes: P G/(4 cosθ cosθ_i cosθ_r) (|r_s|², |r_p|², r_s* r_p)
@@ -231,8 +232,8 @@ impl Pbrdf {
     }
     pub(super) fn visible_slopes(&self) -> Option<&VisibleSlopes> {
         self.visible_slopes
-            .get_or_init(|| VisibleSlopes::new(&self.prepared))
-            .as_ref()
+            .get_or_init(|| VisibleSlopes::new(&self.prepared).map(Box::new))
+            .as_deref()
     }
 
     /// The factor of the shadowing G that depends on one direction only, for a direction with

@@ -79,9 +79,7 @@ impl<'a> Accelerator<'a> {
             if slab.entry(&node.mins(), &node.maxs()) == f64::MAX {
                 TraversalAction::Prune
             } else if let Some(triangle) = node.leaf_data() {
-                hit = bvh
-                    .triangle(triangle)
-                    .intersects_local_ray(&ray, f64::MAX);
+                hit = bvh.triangle(triangle).intersects_local_ray(&ray, f64::MAX);
                 if hit {
                     TraversalAction::EarlyExit
                 } else {
@@ -227,12 +225,20 @@ mod tests {
             let origin = Vector3::new(
                 rng.random_range(-3.0..3.0),
                 rng.random_range(-3.0..3.0),
-                if i % 3 == 0 { 0.0 } else { rng.random_range(-0.5..3.0) },
+                if i % 3 == 0 {
+                    0.0
+                } else {
+                    rng.random_range(-0.5..3.0)
+                },
             );
             let direction = Vector3::new(
                 rng.random_range(-1.0..1.0),
                 rng.random_range(-1.0..1.0),
-                if i % 5 == 0 { 0.0 } else { rng.random_range(-1.0..1.0) },
+                if i % 5 == 0 {
+                    0.0
+                } else {
+                    rng.random_range(-1.0..1.0)
+                },
             )
             .normalize();
             let ray = Ray::new(to_parry(&origin), to_parry(&direction));
@@ -250,7 +256,11 @@ mod tests {
                 (None, None) => misses += 1,
                 (expected, ours) => panic!("ray {i}: parry {expected:?}, ours {ours:?}"),
             }
-            assert_eq!(accel.occluded(&origin, &direction), expected.is_some(), "ray {i}");
+            assert_eq!(
+                accel.occluded(&origin, &direction),
+                expected.is_some(),
+                "ray {i}"
+            );
         }
         assert!(hits > 5000 && misses > 5000, "{hits} hits, {misses} misses");
     }
