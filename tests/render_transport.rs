@@ -353,7 +353,7 @@ fn the_open_world_car_is_unchanged() {
     let path = car_scene_with_shipped_fits(dir.path(), 160, 120, "pixel");
     let text = std::fs::read_to_string(&path)
         .unwrap()
-        .replace("samples = 16 ", "open_world = true\nsamples = 16 ")
+        .replace("samples = 12 ", "open_world = true\nsamples = 12 ")
         .replace("\"silicate_glass\"", "\"smooth_glass\"");
     assert!(text.contains("open_world = true"));
     std::fs::write(&path, text).unwrap();

@@ -315,9 +315,13 @@ impl HalfBetaRatio {
             d01 * d23 * d[5],
             d01 * d23 * d[4],
         ];
-        (0..6)
-            .map(|j| products[j] * INVERSE_DENOMINATORS[j] * f[j])
-            .sum()
+        // Written out: as an iterator sum the closure stayed a call, a fifth of a car render.
+        products[0] * INVERSE_DENOMINATORS[0] * f[0]
+            + products[1] * INVERSE_DENOMINATORS[1] * f[1]
+            + products[2] * INVERSE_DENOMINATORS[2] * f[2]
+            + products[3] * INVERSE_DENOMINATORS[3] * f[3]
+            + products[4] * INVERSE_DENOMINATORS[4] * f[4]
+            + products[5] * INVERSE_DENOMINATORS[5] * f[5]
     }
 }
 

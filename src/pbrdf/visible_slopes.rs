@@ -200,15 +200,30 @@ impl SlopeLaw {
     /// The solver variable v (x/σ, or s) at which [`SlopeLaw::visible_cdf`] reaches `target`.
     fn marginal_root(&self, nu: f64, target: f64, start: f64) -> f64 {
         solve_increasing(self.bottom(), self.top(nu), start, |v| {
-            let [density, slope] = self.visible_density(nu, v);
-            (self.visible_cdf(nu, v) - target, density, slope)
+            let (cdf, density, slope) = self.visible_cdf_and_derivatives(nu, v);
+            (cdf - target, density, slope)
         })
     }
 
     /// ∫ (ν − t)⁺ p_x(t) dt up to the solver variable `v` (x/σ, or s for the Cauchy law).
     fn visible_cdf(&self, nu: f64, v: f64) -> f64 {
+        self.visible_cdf_and_derivatives(nu, v).0
+    }
+
+    /// [`SlopeLaw::visible_cdf`] and its first two derivatives in `v`, sharing their
+    /// exponentials: (ν − t) φ(t) and −φ(t) (1 + t(ν − t)) (Gaussian); in s = X/√(1+X²), with
+    /// x = 1 − s² and dX/ds = x^(−3/2), (ν − X) c x^(q−2) and
+    /// −c x^(q−2) (x^(−3/2) + 2s(q−2)(ν − X)/x) (Cauchy).
+    fn visible_cdf_and_derivatives(&self, nu: f64, v: f64) -> (f64, f64, f64) {
         match *self {
-            SlopeLaw::Gaussian { .. } => nu * 0.5 * erfc(-v / SQRT_2) + standard_normal_density(v),
+            SlopeLaw::Gaussian { .. } => {
+                let density = standard_normal_density(v);
+                (
+                    nu * 0.5 * erfc(-v / SQRT_2) + density,
+                    (nu - v) * density,
+                    -density * (1.0 + v * (nu - v)),
+                )
+            }
             SlopeLaw::Cauchy {
                 q,
                 marginal_norm,
@@ -216,36 +231,20 @@ impl SlopeLaw {
                 ..
             } => {
                 let x = (1.0 - v) * (1.0 + v);
+                if x <= 0.0 {
+                    // The ends s = ±1 (X = ±∞), where the density vanishes (q > 3/2).
+                    return (if v < 0.0 { 0.0 } else { nu }, 0.0, 0.0);
+                }
                 let x_q1 = power(x, q - 1.0);
                 let tail = 0.5 * marginal_tail.at(v.abs()) * x_q1;
                 let below = if v < 0.0 { tail } else { 1.0 - tail };
-                // (1 + X²)^(3/2−q) = x^(q−3/2) = x^(q−1)/√x (→ 0 as x → 0, as q > 3/2).
-                let steep = if x > 0.0 { x_q1 / x.sqrt() } else { 0.0 };
-                nu * below + marginal_norm * steep / (2.0 * q - 3.0)
-            }
-        }
-    }
-
-    /// The first two derivatives of [`SlopeLaw::visible_cdf`] in `v`: (ν − t) φ(t) and
-    /// −φ(t) (1 + t(ν − t)) (Gaussian); in s = X/√(1+X²), with x = 1 − s² and
-    /// dX/ds = x^(−3/2), (ν − X) c x^(q−2) and −c x^(q−2) (x^(−3/2) + 2s(q−2)(ν − X)/x) (Cauchy).
-    fn visible_density(&self, nu: f64, v: f64) -> [f64; 2] {
-        match *self {
-            SlopeLaw::Gaussian { .. } => {
-                let density = standard_normal_density(v);
-                [(nu - v) * density, -density * (1.0 + v * (nu - v))]
-            }
-            SlopeLaw::Cauchy {
-                q, marginal_norm, ..
-            } => {
-                let x = (1.0 - v) * (1.0 + v);
                 let root_x = x.sqrt();
-                let lead = marginal_norm * power(x, q - 2.0);
+                // (1 + X²)^(3/2−q) = x^(q−3/2) = x^(q−1)/√x.
+                let cdf = nu * below + marginal_norm * x_q1 / root_x / (2.0 * q - 3.0);
+                let lead = marginal_norm * x_q1 / x;
                 let gap = nu - v / root_x;
-                [
-                    gap * lead,
-                    -lead * (1.0 / (x * root_x) + 2.0 * v * (q - 2.0) * gap / x),
-                ]
+                let second = -lead * (1.0 / (x * root_x) + 2.0 * v * (q - 2.0) * gap / x);
+                (cdf, gap * lead, second)
             }
         }
     }
@@ -265,9 +264,10 @@ impl SlopeLaw {
         };
         solve_increasing(-1.0, 1.0, start, |s| {
             let x = (1.0 - s) * (1.0 + s);
-            let tail = 0.5 * conditional_tail.at(s.abs()) * power(x, q - 0.5);
+            let x_q = power(x, q - 0.5);
+            let tail = 0.5 * conditional_tail.at(s.abs()) * x_q;
             let cdf = if s < 0.0 { tail } else { 1.0 - tail };
-            let density = conditional_norm * power(x, q - 1.5);
+            let density = conditional_norm * x_q / x;
             (cdf - u, density, -2.0 * s * (q - 1.5) * density / x)
         })
     }
