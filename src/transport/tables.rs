@@ -221,7 +221,7 @@ impl ComponentSkies {
         }
     }
 
-    /// Σ_c weights[c] · L_c(x) at cell coordinate x (clamped to the table), as
+    /// Σ_c weights\[c\] · L_c(x) at cell coordinate x (clamped to the table), as
     /// [`SineTable::at_cell`] computes each L_c.
     #[inline]
     fn weighted_at_cell(&self, x: f64, weights: &[[f64; 3]], sum: &mut [f64; 3]) {

@@ -8,7 +8,7 @@
 //! the joint problem ([`joint`]) then starts from the per-wavelength values with σ, q at their
 //! medians and is polished by Levenberg–Marquardt, whose Jacobian costs five residual
 //! evaluations whatever K is. A Lorentz fit starts from a law fitted to the table's ε(λ)
-//! ([`lorentz_start`]). Uncertainties and correlations come from the joint Jacobian at the
+//! ([`lorentz_start`](mod@lorentz_start)). Uncertainties and correlations come from the joint Jacobian at the
 //! optimum, as for one wavelength ([`super::uncertainty`]).
 
 mod joint;
