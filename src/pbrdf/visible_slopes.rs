@@ -38,8 +38,8 @@ const NORMAL_VIEW_MU: f64 = 1e7;
 #[derive(Clone, Debug)]
 pub(crate) struct VisibleSlopes {
     law: SlopeLaw,
-    /// The x-marginal's inverse at grid points of (s(ν), u): where Newton starts (from there it
-    /// needs two or three CDF evaluations instead of six to eleven).
+    /// The x-marginal's inverse at grid points of (s(ν), u): where Halley starts (from there it
+    /// needs about two CDF evaluations instead of six to eleven).
     marginal_starts: StartTable,
 }
 
@@ -53,14 +53,61 @@ enum SlopeLaw {
         q: f64,
         /// c of the marginal p_x = c (1 + X²)^(½−q).
         marginal_norm: f64,
-        /// 1/B(½, q−½), the normalization of (1 + Z²)^(−q).
-        conditional_norm: f64,
-        /// φ_{q−1} (the marginal's tail) and φ_{q−½} (the conditional's).
+        /// φ_{q−1}: the marginal's tail.
         marginal_tail: HalfBetaRatio,
-        conditional_tail: HalfBetaRatio,
-        /// The conditional's inverse (in s) at u = j/N, where its Newton starts.
-        conditional_starts: Vec<f64>,
+        conditional: CauchyConditional,
     },
+}
+
+/// The Cauchy law's y given x, scaled: Z ∝ (1 + Z²)^(−q), inverted in s = Z/√(1+Z²), where its
+/// CDF is ½ φ_{q−½}(|s|) (1 − s²)^(q−½) below 0 and the complement above, and
+/// dF/ds = (1 − s²)^(q−3/2)/B(½, q−½).
+#[derive(Clone, Debug)]
+struct CauchyConditional {
+    q: f64,
+    /// 1/B(½, q−½), the normalization of (1 + Z²)^(−q).
+    norm: f64,
+    /// φ_{q−½}: its tail.
+    tail: HalfBetaRatio,
+    /// Its inverse at u = j/N, where Halley starts.
+    starts: Vec<f64>,
+}
+
+impl CauchyConditional {
+    fn new(q: f64) -> CauchyConditional {
+        let p = q - 0.5;
+        // 1/B(½, q−½) = Γ(q)/(√π Γ(q−½)); φ_p(1) = 1/(p B(p, ½)) = Γ(p+½)/(√π Γ(p) p).
+        let norm = (ln_gamma(q) - ln_gamma(p)).exp() / PI.sqrt();
+        let mut conditional = CauchyConditional {
+            q,
+            norm,
+            tail: HalfBetaRatio::new(p, norm / p),
+            starts: Vec::new(),
+        };
+        conditional.starts = (0..=START_COLUMNS)
+            .map(|j| conditional.root(j as f64 / START_COLUMNS as f64, 0.0))
+            .collect();
+        conditional
+    }
+
+    /// s at which the CDF reaches `u`, from `start`.
+    fn root(&self, u: f64, start: f64) -> f64 {
+        let q = self.q;
+        solve_increasing(-1.0, 1.0, start, |s| {
+            let x = (1.0 - s) * (1.0 + s);
+            let x_q = power(x, q - 0.5);
+            let tail = 0.5 * self.tail.at(s.abs()) * x_q;
+            let cdf = if s < 0.0 { tail } else { 1.0 - tail };
+            let density = self.norm * x_q / x;
+            (cdf - u, density, -2.0 * s * (q - 1.5) * density / x)
+        })
+    }
+
+    /// Z at CDF `u`.
+    fn quantile(&self, u: f64) -> f64 {
+        let s = self.root(u, interpolate(&self.starts, u));
+        s / ((1.0 - s) * (1.0 + s)).sqrt()
+    }
 }
 
 /// Grid intervals of the start tables: in s(ν) = ν/√(1+ν²) and in u. A bilinear start is then
@@ -81,30 +128,14 @@ impl VisibleSlopes {
                 q,
                 smith_prefactor,
                 ..
-            } if q > 1.5 => {
-                let p = q - 0.5;
-                // 1/(p B(p, ½)) = Γ(p+½)/(√π Γ(p) p) and 1/B(½, q−½) = Γ(q)/(√π Γ(q−½)).
-                let conditional_norm = (ln_gamma(q) - ln_gamma(p)).exp() / PI.sqrt();
-                let mut law = SlopeLaw::Cauchy {
-                    sqrt_a: a.sqrt(),
-                    q,
-                    marginal_norm: smith_prefactor,
-                    conditional_norm,
-                    marginal_tail: HalfBetaRatio::new(q - 1.0, smith_prefactor / (q - 1.0)),
-                    conditional_tail: HalfBetaRatio::new(p, conditional_norm / p),
-                    conditional_starts: Vec::new(),
-                };
-                let starts = (0..=START_COLUMNS)
-                    .map(|j| law.conditional_root(j as f64 / START_COLUMNS as f64, 0.0))
-                    .collect();
-                if let SlopeLaw::Cauchy {
-                    conditional_starts, ..
-                } = &mut law
-                {
-                    *conditional_starts = starts;
-                }
-                law
-            }
+            } if q > 1.5 => SlopeLaw::Cauchy {
+                sqrt_a: a.sqrt(),
+                q,
+                marginal_norm: smith_prefactor,
+                // φ_{q−1}(1) = 1/((q−1) B(q−1, ½)) = Γ(q−½)/(√π Γ(q−1) (q−1)).
+                marginal_tail: HalfBetaRatio::new(q - 1.0, smith_prefactor / (q - 1.0)),
+                conditional: CauchyConditional::new(q),
+            },
             PreparedDistribution::Cauchy { .. } => return None,
         };
         let marginal_starts = StartTable::new(|w, u| {
@@ -144,12 +175,10 @@ impl VisibleSlopes {
         let [x, y] = match law {
             SlopeLaw::Gaussian { .. } => [x, standard_normal_quantile(u[1])],
             SlopeLaw::Cauchy {
-                conditional_starts, ..
+                ref conditional, ..
             } => {
                 let big_x = x / ((1.0 - x) * (1.0 + x)).sqrt();
-                let start = interpolate(conditional_starts, u[1]);
-                let z = law.conditional_root(u[1], start);
-                let big_z = z / ((1.0 - z) * (1.0 + z)).sqrt();
+                let big_z = conditional.quantile(u[1]);
                 [big_x, (1.0 + big_x * big_x).sqrt() * big_z]
             }
         };
@@ -247,29 +276,6 @@ impl SlopeLaw {
                 (cdf, gap * lead, second)
             }
         }
-    }
-
-    /// The Cauchy conditional Z ∝ (1 + Z²)^(−q) at CDF `u`, in s = Z/√(1+Z²): its CDF is
-    /// ½ φ_{q−½}(|s|) (1 − s²)^(q−½) below 0 and the complement above; dF/ds = (1 − s²)^(q−3/2)
-    /// /B(½, q−½).
-    fn conditional_root(&self, u: f64, start: f64) -> f64 {
-        let SlopeLaw::Cauchy {
-            q,
-            conditional_norm,
-            ref conditional_tail,
-            ..
-        } = *self
-        else {
-            unreachable!("only the Cauchy law has a tabulated conditional");
-        };
-        solve_increasing(-1.0, 1.0, start, |s| {
-            let x = (1.0 - s) * (1.0 + s);
-            let x_q = power(x, q - 0.5);
-            let tail = 0.5 * conditional_tail.at(s.abs()) * x_q;
-            let cdf = if s < 0.0 { tail } else { 1.0 - tail };
-            let density = conditional_norm * x_q / x;
-            (cdf - u, density, -2.0 * s * (q - 1.5) * density / x)
-        })
     }
 }
 
