@@ -216,9 +216,9 @@ impl PreparedDistribution {
 /// x = 1 − s² = a/(a + μ²), DESIGN §1.3's Λ = Γ(q−½)√a/(Γ(q−1)√π (2q−3) μ) (1 + μ²/a)^(3/2−q)
 /// − ½ I_x(q−1, ½) is, since (1 + μ²/a)^(3/2−q) = x^(q−1)/√x and √a/(μ√x) = 1/s,
 ///     Λ = x^(q−1) [K/s − φ(s)/2],  K = Γ(q−½)/(Γ(q−1)√π (2q−3)),  φ(s) = I_x(q−1, ½)/x^(q−1).
-/// φ is [`HalfBetaRatio`] with p = q − 1; G1 = 1/(1+Λ) then agrees with the incomplete-beta form to its own rounding error: within 2e-15 relative
-/// for q ≤ 4, 1e-13 up to q = 100 (test below; 4-point interpolation on the same grid was
-/// 3e-13 at q = 1.8 and 2e-9 at q = 60).
+/// φ is [`HalfBetaRatio`] with p = q − 1; G1 = 1/(1+Λ) then agrees with the incomplete-beta
+/// form to its own rounding error: within 2e-15 relative for q ≤ 4, 1e-13 up to q = 100 (test
+/// below; 4-point interpolation on the same grid was 3e-13 at q = 1.8 and 2e-9 at q = 60).
 #[derive(Clone, Debug)]
 pub(crate) struct CauchySmithTable {
     a: f64,
@@ -251,6 +251,12 @@ impl CauchySmithTable {
         // the largest single cost of a bulk evaluation (~14 %); the relative error, ~(q−1)|ln x|
         // 1e-16, matters only where Λ ≈ x^(q−1) K/s is itself negligible against 1.
         inline_exp((self.q - 1.0) * x.ln()) * (self.k / s - 0.5 * self.phi.at(s))
+    }
+
+    /// φ(s) = I_x(q−1, ½)/x^(q−1) at x = 1 − s²: also the tail of the Cauchy law's slope
+    /// marginal, ½ φ x^(q−1) beyond |X| = s/√x (the visible-slope sampler's x).
+    pub(crate) fn tail_ratio(&self, s: f64) -> f64 {
+        self.phi.at(s)
     }
 }
 

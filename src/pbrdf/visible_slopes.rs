@@ -23,7 +23,7 @@
 //! sampling the facet density alone leaves a factor (ω_o·h)/(cosθ_o cosθ_h) that grows without
 //! bound at grazing views and spends samples on facets ω_o cannot see.
 
-use super::distribution::{HalfBetaRatio, PreparedDistribution};
+use super::distribution::{CauchySmithTable, HalfBetaRatio, PreparedDistribution};
 use crate::elementary::inline_exp;
 use statrs::function::erf::{erfc, erfc_inv};
 use statrs::function::gamma::ln_gamma;
@@ -53,8 +53,8 @@ enum SlopeLaw {
         q: f64,
         /// c of the marginal p_x = c (1 + X²)^(½−q).
         marginal_norm: f64,
-        /// φ_{q−1}: the marginal's tail.
-        marginal_tail: HalfBetaRatio,
+        /// The Smith Λ table, whose φ_{q−1} is also the marginal's tail.
+        marginal_tail: CauchySmithTable,
         conditional: CauchyConditional,
     },
 }
@@ -105,8 +105,7 @@ impl CauchyConditional {
 
     /// Z at CDF `u`.
     fn quantile(&self, u: f64) -> f64 {
-        let s = self.root(u, interpolate(&self.starts, u));
-        s / ((1.0 - s) * (1.0 + s)).sqrt()
+        unbounded(self.root(u, interpolate(&self.starts, u)))
     }
 }
 
@@ -128,18 +127,17 @@ impl VisibleSlopes {
                 q,
                 smith_prefactor,
                 ..
-            } if q > 1.5 => SlopeLaw::Cauchy {
+            } => SlopeLaw::Cauchy {
                 sqrt_a: a.sqrt(),
                 q,
                 marginal_norm: smith_prefactor,
-                // φ_{q−1}(1) = 1/((q−1) B(q−1, ½)) = Γ(q−½)/(√π Γ(q−1) (q−1)).
-                marginal_tail: HalfBetaRatio::new(q - 1.0, smith_prefactor / (q - 1.0)),
+                // None for q ≤ 3/2, where Λ (the visible area of the tail) is infinite.
+                marginal_tail: distribution.smith_lambda_table()?,
                 conditional: CauchyConditional::new(q),
             },
-            PreparedDistribution::Cauchy { .. } => return None,
         };
         let marginal_starts = StartTable::new(|w, u| {
-            let nu = (w / ((1.0 - w) * (1.0 + w)).sqrt()).min(NORMAL_VIEW_MU);
+            let nu = unbounded(w).min(NORMAL_VIEW_MU);
             let total = law.visible_cdf(nu, law.top(nu));
             law.marginal_root(nu, u * total, law.plain_start(nu, u))
         });
@@ -177,7 +175,7 @@ impl VisibleSlopes {
             SlopeLaw::Cauchy {
                 ref conditional, ..
             } => {
-                let big_x = x / ((1.0 - x) * (1.0 + x)).sqrt();
+                let big_x = unbounded(x);
                 let big_z = conditional.quantile(u[1]);
                 [big_x, (1.0 + big_x * big_x).sqrt() * big_z]
             }
@@ -265,7 +263,7 @@ impl SlopeLaw {
                     return (if v < 0.0 { 0.0 } else { nu }, 0.0, 0.0);
                 }
                 let x_q1 = power(x, q - 1.0);
-                let tail = 0.5 * marginal_tail.at(v.abs()) * x_q1;
+                let tail = 0.5 * marginal_tail.tail_ratio(v.abs()) * x_q1;
                 let below = if v < 0.0 { tail } else { 1.0 - tail };
                 let root_x = x.sqrt();
                 // (1 + X²)^(3/2−q) = x^(q−3/2) = x^(q−1)/√x.
@@ -320,6 +318,11 @@ fn interpolate(values: &[f64], u: f64) -> f64 {
     let j = (x as usize).min(n - 1);
     let t = x - j as f64;
     (1.0 - t) * values[j] + t * values[j + 1]
+}
+
+/// X from s = X/√(1+X²) ∈ (−1, 1), the bounded variable the solvers and tables use.
+fn unbounded(s: f64) -> f64 {
+    s / ((1.0 - s) * (1.0 + s)).sqrt()
 }
 
 /// Where the Gaussian solver's bracket starts: Φ(−37) ≈ 6e-300, so no u above that lies below.
