@@ -1,6 +1,6 @@
 //! Rendering benchmarks: the shipped car scene with the shipped material library (`fits/`),
 //! per-pixel shading, at 640×480 and 1920×1080, with occlusion, inter-reflection and the sun (the
-//! scene as shipped, its windows the spectral silicate glass band-integrated over 8–14 µm, DESIGN
+//! scene as shipped, its windows the spectral silicate glass band-integrated over 8–14 µm, docs/design.md
 //! §1.9) and in the open world (`open_world = true`, the paper's model); and at 640×480 with
 //! grey windows (`smooth_glass`, one wavelength), the cost of the spectral ones. Each iteration is
 //! a whole render in memory: per-material tables, ray-tracing hierarchy, rasterization, shading,

@@ -38,7 +38,7 @@ How the two are made to describe the same thing:
   handedness, so S_irpol = L(ψ) S_mitsuba with ψ the signed angle from x_m to x_pix about −d
   (S1' = cos2ψ S1 + sin2ψ S2, S2' = −sin2ψ S1 + cos2ψ S2), S0 unchanged.
 - S3. Mitsuba's fresnel_polarized conjugates N = n + ik to n − ik (the exp(+iωt) convention), so its
-  r_s, r_p are the complex conjugates of irpol's (DESIGN §1.3, exp(−iωt)): every Mueller matrix has the
+  r_s, r_p are the complex conjugates of irpol's (docs/design.md §1.3, exp(−iωt)): every Mueller matrix has the
   signs of its S3 row and column flipped, M_mitsuba = D M_irpol D with D = diag(1, 1, 1, −1), and
   S3_irpol = −S3_mitsuba. The script checks this at the BRDF level before it compares images: it
   evaluates both BRDFs (`irpol eval` and Mitsuba's bsdf.eval, rotated into the psps frames) at a few
@@ -443,7 +443,7 @@ def mitsuba_stokes(mi, scene, spp, seed):
 
 
 def mueller_brdf_mitsuba(mi, material, w_i, w_r):
-    """Mitsuba's roughconductor as a Mueller BRDF (sr⁻¹) in irpol's psps frames (DESIGN §1.3)."""
+    """Mitsuba's roughconductor as a Mueller BRDF (sr⁻¹) in irpol's psps frames (docs/design.md §1.3)."""
     vec = lambda v: mi.Vector3f(*[float(x) for x in v])
     w_i, w_r = np.asarray(w_i, float), np.asarray(w_r, float)
     bsdf = mi.load_dict(rough_conductor(material))

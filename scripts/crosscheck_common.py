@@ -1,14 +1,14 @@
 """Shared parts of the fit cross-checks (`crosscheck_nlopt.py`, `crosscheck_emcee.py`).
 
-* reading a measurement CSV (DESIGN §2.1) with its u_ columns into arrays;
+* reading a measurement CSV (docs/design.md §2.1) with its u_ columns into arrays;
 * the weighted least-squares objective of issue 3, chi2 = sum(((model - data) / u)^2) over every
   Mueller element present, on a fast form of the numpy port (`pbrdf_numpy.py`) that is vectorized
   over parameter sets as well as geometries;
 * irpol's free parameters, bounds and search coordinates (src/fit/parameters.rs on branch `fit`);
-* running `irpol fit` on one file and reading the material TOML it writes (DESIGN §2.2).
+* running `irpol fit` on one file and reading the material TOML it writes (docs/design.md §2.2).
 
 Fast form of the model.  For fixed geometry the Jones matrix is J = P_out diag(r_s, r_p) P_in
-(DESIGN §1.3), so every Mueller element is a fixed real linear combination of the four real numbers
+(docs/design.md §1.3), so every Mueller element is a fixed real linear combination of the four real numbers
 |r_s|^2, |r_p|^2, Re(r_s r_p*), Im(r_s r_p*).  The four coefficient matrices per geometry are
 computed once from the port's own frames and Jones -> Mueller map; a parameter set then costs one
 Fresnel evaluation per point, one Smith G1 per distinct zenith angle and a small matrix product.
@@ -64,7 +64,7 @@ class SetupError(RuntimeError):
 PARAMETERS = ("sigma", "q", "n", "k", "rho_d")
 BOUNDS = {
     "sigma": (0.005, 1.5),
-    "q": (1.51, 50.0),  # 1.05 without Smith; Smith's Cauchy Lambda needs q > 3/2 (DESIGN §1.3)
+    "q": (1.51, 50.0),  # 1.05 without Smith; Smith's Cauchy Lambda needs q > 3/2 (docs/design.md §1.3)
     "n": (0.05, 10.0),
     "k": (0.0, 50.0),
     "rho_d": (0.0, 1.0),
@@ -105,7 +105,7 @@ def from_search(name: str, coord):
 
 
 # ---------------------------------------------------------------------------------------------
-# Measurement files (DESIGN §2.1)
+# Measurement files (docs/design.md §2.1)
 # ---------------------------------------------------------------------------------------------
 
 ELEMENTS = [f"m{i}{j}" for i in range(4) for j in range(4)]
@@ -128,7 +128,7 @@ class Measurement:
 
 
 def read_measurement(path: str) -> Measurement:
-    """The subset of DESIGN §2.1 the shipped files use; every element must have its u_ column
+    """The subset of docs/design.md §2.1 the shipped files use; every element must have its u_ column
     (the cross-checks weight by the file's own uncertainties, not irpol's defaults)."""
     meta: dict[str, str] = {}
     lines = []
@@ -193,7 +193,7 @@ def read_measurement(path: str) -> Measurement:
 
 
 def _smith_lambda_batch(theta: np.ndarray, distribution: str, sigma: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """DESIGN §1.3 closed-form Lambda for W parameter sets (sigma, q of shape (W,)) and U zenith
+    """docs/design.md §1.3 closed-form Lambda for W parameter sets (sigma, q of shape (W,)) and U zenith
     angles (U,) -> (W, U); theta = 0 gives 0.  Same formulas as pbrdf_numpy.smith_lambda, with
     the parameters as arrays (checked against it in verify_against_port)."""
     lam = np.zeros((len(sigma), len(theta)))
@@ -213,7 +213,7 @@ def _smith_lambda_batch(theta: np.ndarray, distribution: str, sigma: np.ndarray,
 
 
 class FastModel:
-    """The pBRDF of DESIGN §1.3 on one file's geometries, with Smith shadowing (irpol's default)
+    """The pBRDF of docs/design.md §1.3 on one file's geometries, with Smith shadowing (irpol's default)
     or none/torrance-sparrow, vectorized over parameter sets."""
 
     def __init__(self, m: Measurement, distribution: str, shadowing: str = "smith"):
@@ -431,7 +431,7 @@ def normalize_name(name: str) -> str:
 
 
 def _fit_takes_reports(irpol: str) -> bool:
-    """Whether this irpol build has `fit --reports` (DESIGN §4); earlier builds write no reports."""
+    """Whether this irpol build has `fit --reports` (docs/design.md §4); earlier builds write no reports."""
     try:
         help_text = subprocess.run([irpol, "fit", "--help"], capture_output=True, text=True, timeout=60).stdout
     except (OSError, subprocess.TimeoutExpired) as e:

@@ -1,4 +1,4 @@
-"""Cross-check of `irpol sun` against pvlib's NREL SPA (DESIGN §1.7, "Sun" and "World frame").
+"""Cross-check of `irpol sun` against pvlib's NREL SPA (docs/design.md §1.7, "Sun" and "World frame").
 
     .venv/bin/python scripts/crosscheck_sun.py [--irpol PATH] [--year 2026] [--delta-t pvlib|SECONDS]
 

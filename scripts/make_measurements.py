@@ -1,9 +1,9 @@
-"""Synthetic Mueller-matrix BRDF "measurements" (DESIGN §2.1) generated with NIST SCATMECH plus seeded noise.
+"""Synthetic Mueller-matrix BRDF "measurements" (docs/design.md §2.1) generated with NIST SCATMECH plus seeded noise.
 
     python scripts/make_measurements.py [--out measurements] [--seed 20240611]
 
 Each material's noise-free Mueller BRDF is SCATMECH's `Shadowed_Facet_BRDF_Model` (see
-scatmech_backend.py for the mapping of DESIGN §1.3 onto it) plus SCATMECH's `Lambertian_BRDF_Model`
+scatmech_backend.py for the mapping of docs/design.md §1.3 onto it) plus SCATMECH's `Lambertian_BRDF_Model`
 with reflectance rho_d (rho_d/pi on m00 only).  Not the numpy port: the files must not share code
 with any model that is later fitted to them.
 
@@ -23,9 +23,9 @@ Noise (seeded): m00 * (1 + 0.03 N(0,1)) (gaussian, multiplicative); other elemen
 deviations (0.03 m00 and 0.01 m00 of the noise-free m00), so a weighted fit of the true model
 gives reduced chi^2 ~ 1.
 
-Spectral materials (DESIGN §1.9) share sigma, q, shadowing and rho_d over wavelength and take
+Spectral materials (docs/design.md §1.9) share sigma, q, shadowing and rho_d over wavelength and take
 N = n + ik at each wavelength from a dispersion law evaluated here in Python (`Lorentz`, written
-from DESIGN §1.9, not from the Rust code).  SCATMECH is called once per wavelength with that
+from docs/design.md §1.9, not from the Rust code).  SCATMECH is called once per wavelength with that
 wavelength's n, k (full double precision) and `lambda`.  The rows of all wavelengths go into one file
 with a `wavelength_um` column, one block per wavelength (ascending), and their noise comes from one
 seeded stream drawn in that order.  Seeds: --seed + index, MATERIALS first, then SPECTRAL_MATERIALS,
@@ -220,7 +220,7 @@ def provenance_header(seed: int, note: str) -> list[str]:
         "# generator: scripts/make_measurements.py with NIST SCATMECH (pyscatmech 0.1.10)"
         " Shadowed_Facet_BRDF_Model + Lambertian_BRDF_Model",
         f"# {note}",
-        "# synthetic data (phi_r = 180 is the specular side, DESIGN §1.1). Absent points are those within",
+        "# synthetic data (phi_r = 180 is the specular side, docs/design.md §1.1). Absent points are those within",
         "# 3 deg of retro-reflection (detector shadows the source), with theta_r >= 88 deg, or with",
         "# noise-free m00 < 1e-4 per sr (noise floor)",
     ]
@@ -293,7 +293,7 @@ def write_spectral_material(spec: SpectralMaterial, out_dir: str, rng: np.random
     ]
     header += provenance_header(seed, spec.note)
     header += [
-        "# spectral (DESIGN §1.9) with one block of rows per wavelength_um, ascending. n and k at each",
+        "# spectral (docs/design.md §1.9) with one block of rows per wavelength_um, ascending. n and k at each",
         "# wavelength come from the truth_dispersion law (evaluated in make_measurements.py, full double",
         "# precision; truth_n_k rounds them), sigma, q and rho_d are shared",
     ]

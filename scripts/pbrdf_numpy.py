@@ -1,8 +1,8 @@
-"""Independent numpy port of the irpol polarized BRDF (DESIGN §1.1–1.3), vectorized over geometries.
+"""Independent numpy port of the irpol polarized BRDF (docs/design.md §1.1–1.3), vectorized over geometries.
 
 F(w_i -> w_r) = P(theta) G M(beta, eta_i, eta_r) / (4 cos(theta) cos(theta_i) cos(theta_r)) + rho_d/pi diag(1,0,0,0)
 
-Written from DESIGN.md, not from the Rust code; the SCATMECH side (scatmech_backend.py) is the
+Written from docs/design.md, not from the Rust code; the SCATMECH side (scatmech_backend.py) is the
 external reference.  Used by the nlopt/emcee cross-checks as a fast model.
 
     python scripts/pbrdf_numpy.py --self-test [--count N] [--seed S]
@@ -27,7 +27,7 @@ SHADOWINGS = ("none", "torrance-sparrow", "smith")
 
 
 # ---------------------------------------------------------------------------------------------
-# Geometry (DESIGN §1.1) and frames (§1.3)
+# Geometry (docs/design.md §1.1) and frames (§1.3)
 # ---------------------------------------------------------------------------------------------
 
 
@@ -46,7 +46,7 @@ def _dot(a, b):
 
 
 def global_frames(theta_i, phi_i, theta_r, phi_r):
-    """psps frames of DESIGN §1.3: s = unit(z x k), p = k x s for k_in = -w_i and k_out = w_r.
+    """psps frames of docs/design.md §1.3: s = unit(z x k), p = k x s for k_in = -w_i and k_out = w_r.
 
     z x k is written out from the azimuth, which is the theta -> 0+ limit along phi at normal
     incidence/viewing and needs no special case: for w = (sin t cos f, sin t sin f, cos t),
@@ -63,7 +63,7 @@ def global_frames(theta_i, phi_i, theta_r, phi_r):
 
 
 # ---------------------------------------------------------------------------------------------
-# Fresnel (DESIGN §1.3), exp(-i w t) convention, N = n + i k
+# Fresnel (docs/design.md §1.3), exp(-i w t) convention, N = n + i k
 # ---------------------------------------------------------------------------------------------
 
 
@@ -77,7 +77,7 @@ def fresnel(cos_beta, n, k):
 
 
 # ---------------------------------------------------------------------------------------------
-# Slope distributions (DESIGN §1.2) and shadowing (§1.3)
+# Slope distributions (docs/design.md §1.2) and shadowing (§1.3)
 # ---------------------------------------------------------------------------------------------
 
 
@@ -91,7 +91,7 @@ def slope_density(tan2, distribution, sigma, q):
 
 
 def smith_lambda(theta, distribution, sigma, q):
-    """Closed forms of DESIGN §1.3. theta = 0 gives Lambda = 0."""
+    """Closed forms of docs/design.md §1.3. theta = 0 gives Lambda = 0."""
     theta = np.asarray(theta, dtype=float)
     lam = np.zeros_like(theta)
     pos = theta > 0.0
@@ -125,7 +125,7 @@ def shadowing_factor(shadowing, cos_t, cos_b, theta_i, theta_r, distribution, si
 
 
 # ---------------------------------------------------------------------------------------------
-# Jones -> Mueller in the DESIGN §1.3 Stokes convention
+# Jones -> Mueller in the docs/design.md §1.3 Stokes convention
 # ---------------------------------------------------------------------------------------------
 
 
@@ -158,7 +158,7 @@ def mueller_brdf(
     shadowing="none",
     rho_d=0.0,
 ):
-    """Mueller BRDF (N, 4, 4) in sr^-1, psps frames of the global geometry (DESIGN §1.3)."""
+    """Mueller BRDF (N, 4, 4) in sr^-1, psps frames of the global geometry (docs/design.md §1.3)."""
     if distribution not in DISTRIBUTIONS:
         raise ValueError(f"unknown distribution {distribution!r}")
     ti, pi_, tr, pr = (
@@ -243,7 +243,7 @@ def _self_test(count: int, seed: int) -> int:
 
     failures = []
 
-    # 1. DESIGN §1.3 known values (Gaussian s = 0.3 -> sigma = 0.3/sqrt 2, N = 1.5+0.1i, G = 1).
+    # 1. docs/design.md §1.3 known values (Gaussian s = 0.3 -> sigma = 0.3/sqrt 2, N = 1.5+0.1i, G = 1).
     sig = 0.3 / math.sqrt(2.0)
     M = mueller_brdf(30, 0, 30, 180, distribution="gaussian", sigma=sig, n=1.5, k=0.1)[0]
     known = {(0, 0): 5.08136012e-02, (0, 1): 1.98022899e-02, (1, 0): 1.98022899e-02,
@@ -262,7 +262,7 @@ def _self_test(count: int, seed: int) -> int:
     if abs(M[0, 0] - 5.77611334e-04) > 5e-9 * 5.77611334e-04:
         failures.append(f"known value TS m00: {M[0, 0]:.9e}")
 
-    # 2. Smith closed forms (DESIGN §1.3) vs quadrature of Smith's definition; the Cauchy marginal
+    # 2. Smith closed forms (docs/design.md §1.3) vs quadrature of Smith's definition; the Cauchy marginal
     #    used by that quadrature vs a 2-D integral of the slope density; q = 2 closed form.
     for dist, s, qq in [("gaussian", 0.1, 0.0), ("gaussian", 0.4, 0.0), ("cauchy", 0.1, 1.6),
                         ("cauchy", 0.3, 2.0), ("cauchy", 0.2, 2.5), ("cauchy", 0.5, 4.0)]:

@@ -1,25 +1,25 @@
 """NIST SCATMECH (PyPI `pyscatmech`) as the independent reference for the irpol pBRDF model.
 
-Maps the irpol model of DESIGN §1.3 onto SCATMECH's `Shadowed_Facet_BRDF_Model`:
+Maps the irpol model of docs/design.md §1.3 onto SCATMECH's `Shadowed_Facet_BRDF_Model`:
 
 * geometry: irpol uses global spherical angles with directions pointing away from the surface
   (specular at phi_r = phi_i + 180°).  SCATMECH puts the source in the x-z plane and measures the
   viewer azimuth from the specular direction, in radians, so
-  thetai = theta_i, thetas = theta_r, phis = phi_r - phi_i - 180° (DESIGN §1.3).  Mueller matrices are
+  thetai = theta_i, thetas = theta_r, phis = phi_r - phi_i - 180° (docs/design.md §1.3).  Mueller matrices are
   requested in SCATMECH's "psps" frames, which are rotation invariant about z, so the irpol value at
   any phi_i equals SCATMECH's at the relative azimuth.
 * slope distribution: Cauchy/Student-t as a `Table_Slope_Distribution_Function` whose table is the
-  slope-space density of DESIGN §1.2 written as a SCATMECH formula string; Gaussian as SCATMECH's
+  slope-space density of docs/design.md §1.2 written as a SCATMECH formula string; Gaussian as SCATMECH's
   native `Gaussian_Slope_Distribution_Function` with s = sqrt(2) sigma (its density is
   exp(-(m/s)^2)/(pi s^2)).
 * shadowing: none -> `Unit_Shadow_Function`; torrance-sparrow -> `Torrance_Sparrow_Shadow_Function`;
   smith -> `Table_Shadow_Function`, which SCATMECH evaluates as T(theta_i) T(theta_s), with T a
   two-column table file of (theta [rad], G1).  SCATMECH's own `Smith_Shadow_Function` is NOT used: it
   is Smith's 1967 form with an extra factor (1 - erfc(mu/(sqrt2 w))/2) and only for the Gaussian; it is
-  not the G1 = 1/(1+Lambda) of DESIGN §1.3.
+  not the G1 = 1/(1+Lambda) of docs/design.md §1.3.
   G1 is computed here by quadrature of Smith's definition
   Lambda(mu) = (1/mu) int_mu^inf (m - mu) p1(m) dm with p1 the one-dimensional marginal slope density
-  (not with the closed forms of DESIGN §1.3, which the numpy port uses), and the table holds the exact
+  (not with the closed forms of docs/design.md §1.3, which the numpy port uses), and the table holds the exact
   evaluation angles as nodes, so SCATMECH's linear table interpolation returns node values and adds no
   error (`scatmech_reference.py --measure-table-interpolation` shows what a plain grid would cost).
 """
@@ -55,7 +55,7 @@ def fmt(x: float) -> str:
 
 @dataclass(frozen=True)
 class SurfaceParams:
-    """One irpol surface model (DESIGN §1.3) without the diffuse term."""
+    """One irpol surface model (docs/design.md §1.3) without the diffuse term."""
 
     distribution: str
     sigma: float
@@ -80,7 +80,7 @@ class SurfaceParams:
 
 
 def cauchy_slope_formula(sigma: float, q: float) -> str:
-    """SCATMECH formula string for p(m) = (q-1) a^(q-1) / (pi (m^2+a)^q), a = 2 sigma^2 (DESIGN §1.2).
+    """SCATMECH formula string for p(m) = (q-1) a^(q-1) / (pi (m^2+a)^q), a = 2 sigma^2 (docs/design.md §1.2).
 
     SCATMECH's evaluator has no `pi` and evaluates ^ left to right, so everything is parenthesized
     and the numbers are substituted with 17 significant digits."""
@@ -92,7 +92,7 @@ def cauchy_slope_formula(sigma: float, q: float) -> str:
 
 
 # ---------------------------------------------------------------------------------------------
-# Smith G1 by quadrature of the definition (independent of the closed forms in DESIGN §1.3)
+# Smith G1 by quadrature of the definition (independent of the closed forms in docs/design.md §1.3)
 # ---------------------------------------------------------------------------------------------
 
 

@@ -1,4 +1,4 @@
-"""SCATMECH golden data for the irpol pBRDF model (DESIGN §1.3), and a parity check of the irpol CLI.
+"""SCATMECH golden data for the irpol pBRDF model (docs/design.md §1.3), and a parity check of the irpol CLI.
 
     python scripts/scatmech_reference.py [--out tests/data/scatmech_golden.csv] [--seed S]
         Writes the golden CSV (deterministic for a given seed).
@@ -22,9 +22,9 @@ Rows are dropped when SCATMECH's value is not trustworthy or not comparable:
 * m00 = 0, non-finite, or below 1e-280 (subnormal results lose relative precision);
 * 0 < beta < 0.5 deg (near retro-reflection): SCATMECH's facet Jones matrix divides by
   sin^2(2 iota) with iota = acos(...), so it loses ~eps/beta^2 relative accuracy (measured: 2e-8 at
-  beta = 0.005 deg, 2e-4 at 5e-5 deg, while the vector form of DESIGN §1.3 is smooth there);
+  beta = 0.005 deg, 2e-4 at 5e-5 deg, while the vector form of docs/design.md §1.3 is smooth there);
 * theta_i = theta_r = 0 with phi_r - phi_i not a multiple of 180 deg: SCATMECH's exact-retro branch
-  ignores the viewer azimuth there, while DESIGN §1.3 takes the theta -> 0+ limit along each azimuth.
+  ignores the viewer azimuth there, while docs/design.md §1.3 takes the theta -> 0+ limit along each azimuth.
   (theta_i = theta_r = 0 with phi_r = phi_i + 180 is kept: both conventions agree.)
 """
 
@@ -53,7 +53,7 @@ THETA_MAX_DEG = 89.0
 RETRO_MIN_BETA_DEG = 0.5
 M00_MIN = 1e-280
 
-# Paints/dielectrics of DESIGN §1.3 and the task, a metal, a glass, and a non-absorbing dielectric.
+# Paints/dielectrics of docs/design.md §1.3 and the task, a metal, a glass, and a non-absorbing dielectric.
 INDICES = [(1.2, 0.2), (1.5, 0.1), (2.4, 0.05), (10.0, 30.0), (2.2, 0.6), (1.55, 0.05), (1.8, 0.0)]
 WAVELENGTHS = [9.925, 10.0, 10.6]
 CAUCHY_FIXED = [(0.05, 1.6), (0.1, 1.8), (0.2, 2.0), (0.3, 2.5), (0.5, 4.0)]
@@ -136,7 +136,7 @@ def draw_geometries(rng: np.random.Generator, count: int) -> np.ndarray:
 
 
 def half_angle_beta_deg(g: np.ndarray) -> np.ndarray:
-    """Local incidence angle beta (DESIGN §1.1) from cos 2beta = w_i . w_r."""
+    """Local incidence angle beta (docs/design.md §1.1) from cos 2beta = w_i . w_r."""
     ti, pi_, tr, pr = np.radians(g.T)
     c2b = np.cos(ti) * np.cos(tr) + np.sin(ti) * np.sin(tr) * np.cos(pr - pi_)
     return np.degrees(0.5 * np.arccos(np.clip(c2b, -1.0, 1.0)))

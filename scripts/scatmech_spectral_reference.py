@@ -1,4 +1,4 @@
-"""SCATMECH reference for the per-wavelength pBRDF of a spectral material (DESIGN §1.3, §1.9).
+"""SCATMECH reference for the per-wavelength pBRDF of a spectral material (docs/design.md §1.3, §1.9).
 
     python scripts/scatmech_spectral_reference.py [--out tests/data/scatmech_spectral.csv]
 

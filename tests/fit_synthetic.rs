@@ -96,7 +96,7 @@ fn noise_free_data_are_recovered_exactly_for_every_shadowing() {
     });
 }
 
-/// Near an absorption band n falls below 1 (silicate glass at 8–8.5 µm, DESIGN §1.9): a surface
+/// Near an absorption band n falls below 1 (silicate glass at 8–8.5 µm, docs/design.md §1.9): a surface
 /// with N = 0.6 + 0.4i is recovered, which the old n ∈ [1, 6] search interval could not hold.
 #[test]
 fn an_index_below_one_is_recovered() {

@@ -1,4 +1,4 @@
-//! Integration tests of measurement ingestion (DESIGN §2.1): a corpus of malformed files, each
+//! Integration tests of measurement ingestion (docs/design.md §2.1): a corpus of malformed files, each
 //! refused with an exact `file:line:column: what is wrong` message; good files parsed to known
 //! values; and random or truncated input that must give Ok or Err, never a panic.
 

@@ -1,5 +1,5 @@
 //! Physics checks of the pBRDF core against closed forms, invariants and the reference values of
-//! DESIGN §1.3–1.4 (which come from NIST SCATMECH and high-resolution integration).
+//! docs/design.md §1.3–1.4 (which come from NIST SCATMECH and high-resolution integration).
 
 use irpol::optics::{fresnel_amplitudes, RefractiveIndex};
 use irpol::pbrdf::{Direction, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
@@ -25,7 +25,7 @@ fn assert_rel(got: f64, want: f64, tol: f64, what: &str) {
     );
 }
 
-/// DESIGN §1.3 SCATMECH values: Gaussian s = 0.3 (σ = s/√2), N = 1.5 + 0.1i, G = 1.
+/// docs/design.md §1.3 SCATMECH values: Gaussian s = 0.3 (σ = s/√2), N = 1.5 + 0.1i, G = 1.
 /// SCATMECH's φ_s = φ_r − φ_i − 180°.
 #[test]
 fn matches_scatmech_reference_values() {
@@ -50,7 +50,7 @@ fn matches_scatmech_reference_values() {
     assert_rel(ts.mueller(&i, &r)[(0, 0)], 5.77611334e-04, 1e-8, "TS m00");
 }
 
-/// Smooth limit (σ → 0): ε0 = 1 − (R_s+R_p)/2, ε1 = (R_p − R_s)/2 (DESIGN §1.4).
+/// Smooth limit (σ → 0): ε0 = 1 − (R_s+R_p)/2, ε1 = (R_p − R_s)/2 (docs/design.md §1.4).
 #[test]
 fn emissivity_reaches_the_smooth_surface_fresnel_limit() {
     let quad = HemisphereQuadrature::default();
@@ -79,7 +79,7 @@ fn emissivity_reaches_the_smooth_surface_fresnel_limit() {
             );
         }
     }
-    // DESIGN §1.4 smooth reference at 60°.
+    // docs/design.md §1.4 smooth reference at 60°.
     let m = model(
         SlopeDistribution::Gaussian { sigma: 1e-4 },
         Shadowing::Smith,
@@ -94,7 +94,7 @@ fn emissivity_reaches_the_smooth_surface_fresnel_limit() {
     );
 }
 
-/// DESIGN §1.4 rough-surface emissivity references (N = 1.5 + 0.1i).
+/// docs/design.md §1.4 rough-surface emissivity references (N = 1.5 + 0.1i).
 #[test]
 fn emissivity_matches_reference_values() {
     let quad = HemisphereQuadrature::default();
@@ -331,7 +331,7 @@ fn smith_conserves_energy_and_excess_reflectance_is_reported() {
             }
         }
     }
-    // ρ_d lowers ε0 by exactly ρ_d (DESIGN §1.4), and ρ(θ) = 1 − ε0(θ).
+    // ρ_d lowers ε0 by exactly ρ_d (docs/design.md §1.4), and ρ(θ) = 1 − ε0(θ).
     let smooth = model(
         SlopeDistribution::Gaussian { sigma: 0.1 },
         Shadowing::Smith,
@@ -368,7 +368,7 @@ fn smith_conserves_energy_and_excess_reflectance_is_reported() {
     assert!(err.to_string().contains("> 1"), "{err}");
 }
 
-/// Isothermal enclosure (DESIGN §1.5): reflected uniform radiance plus emission is (L, 0, 0, 0).
+/// Isothermal enclosure (docs/design.md §1.5): reflected uniform radiance plus emission is (L, 0, 0, 0).
 #[test]
 fn isothermal_enclosure_is_unpolarized_blackbody() {
     let quad = HemisphereQuadrature::default();
@@ -434,7 +434,7 @@ fn bad_parameters_are_refused_with_a_clear_error() {
     }
 }
 
-/// Hemispherical emissivity (the thermal model's default ε, DESIGN §1.8): in the smooth limit it
+/// Hemispherical emissivity (the thermal model's default ε, docs/design.md §1.8): in the smooth limit it
 /// is 1 − 2∫ R(θ) cosθ sinθ dθ with R the unpolarized Fresnel reflectance, integrated here by a
 /// 20 000-point midpoint rule in θ; ρ_d lowers it by exactly ρ_d; a rough surface agrees with a
 /// brute-force midpoint integral of its own ε0(θ).

@@ -1,5 +1,5 @@
 //! Bad scenes are refused with one clear message naming the file and the item, and nothing is
-//! written (DESIGN §4: errors are one line, never a panic).
+//! written (docs/design.md §4: errors are one line, never a panic).
 
 mod common;
 

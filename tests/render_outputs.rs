@@ -1,7 +1,7 @@
 //! What `irpol render` writes and how the sensor side behaves: float TIFFs and the EXR hold the
 //! rendered values, the channels are consistent, previews and summary are complete; per-vertex
 //! PLY temperatures are interpolated perspective-correctly; the atmosphere and the NETD noise
-//! follow DESIGN §1.5 and are reproducible.
+//! follow docs/design.md §1.5 and are reproducible.
 
 mod common;
 
@@ -47,7 +47,7 @@ fn files_hold_the_rendered_channels() {
         assert_eq!(data, image.channel(channel), "{}", channel.name());
         stacks.push(data);
     }
-    // Channel identities (DESIGN §1.6): I0 + I90 = I45 + I135 = S0, I0 − I90 = S1, DoLP, AoP.
+    // Channel identities (docs/design.md §1.6): I0 + I90 = I45 + I135 = S0, I0 − I90 = S1, DoLP, AoP.
     for i in 0..64 * 48 {
         let pixel: Vec<f64> = stacks.iter().map(|channel| channel[i] as f64).collect();
         let [s0, s1, s2, s3, dolp, aop, i0, i45, i90, i135] = pixel[..] else {

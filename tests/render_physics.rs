@@ -1,4 +1,4 @@
-//! Physics acceptance tests of the renderer on small procedural scenes (DESIGN §1.5–1.6):
+//! Physics acceptance tests of the renderer on small procedural scenes (docs/design.md §1.5–1.6):
 //! an isothermal enclosure shows no contrast and no polarization; emission alone is polarized
 //! along the projected normal with DoLP = |ε1|/ε0; reflection alone across it; Gouraud and
 //! per-pixel shading agree on a finely tessellated sphere.
@@ -52,7 +52,7 @@ fn orientation_gap(a: f64, b: f64) -> f64 {
 }
 
 /// Orientation of a world vector projected on the image plane at ray ω_r: angle from image
-/// right, counter-clockwise (DESIGN §1.6 pixel frame).
+/// right, counter-clockwise (docs/design.md §1.6 pixel frame).
 fn projected_angle(scene: &Scene, v: &Vector3<f64>, w_r: &Vector3<f64>) -> f64 {
     let right = scene.camera.right;
     let x_pix = (right - w_r * right.dot(w_r)).normalize();
@@ -70,7 +70,7 @@ fn isothermal_enclosure_has_no_contrast_and_no_polarization() {
     let l = band.radiance(300.0);
     for shading in ["pixel", "gouraud"] {
         // A rough sphere and a glossy tilted plate in a 300 K enclosure, through a 300 K
-        // atmosphere: everything must read L_bb(300 K), unpolarized (DESIGN §1.5).
+        // atmosphere: everything must read L_bb(300 K), unpolarized (docs/design.md §1.5).
         let text = format!(
             "{}{}[render]\nshading = \"{shading}\"\n[atmosphere]\nextinction_per_km = 50.0\n\
              temperature_k = 300.0\n{}{}\

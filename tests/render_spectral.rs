@@ -1,4 +1,4 @@
-//! Band rendering of spectral materials (DESIGN §1.9; issue 13): a material whose n, k, ρ_d are
+//! Band rendering of spectral materials (docs/design.md §1.9; issue 13): a material whose n, k, ρ_d are
 //! tables over wavelength is integrated over the sensor band, S_j = ∫ R(λ) [∫ F_j0(λ) L_env,λ
 //! cosθ_i dΩ_i + ε_j(λ) B_λ(T)] dλ, against grey materials, a dense wavelength integral and a
 //! wavelength-by-wavelength render.
@@ -336,7 +336,7 @@ fn the_summary_names_band_integrated_materials() {
     assert!(band_nodes("m").is_null());
 }
 
-/// The Monte Carlo parts' spectral approximation (DESIGN §1.7, §1.9; README "Band rendering").
+/// The Monte Carlo parts' spectral approximation (docs/design.md §1.7, §1.9; README "Band rendering").
 /// The correction at a band material takes the light of a surface hit as its emission, exact
 /// node by node, plus what it reflects, modelled as a uniform grey source reflected by the hit;
 /// the environment grey at its brightness temperature; the sun a 5772 K blackbody. Checked
@@ -423,7 +423,7 @@ fn the_monte_carlo_spectral_approximation_is_small() {
     assert!(worst < 5e-3, "{worst}");
 }
 
-/// The thermal model (DESIGN §1.8) takes a spectral material's default emissivity as its
+/// The thermal model (docs/design.md §1.8) takes a spectral material's default emissivity as its
 /// hemispherical emissivity Planck-weighted at 300 K over its table (README "Band rendering").
 #[test]
 fn a_spectral_material_has_a_planck_weighted_thermal_emissivity() {

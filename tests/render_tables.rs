@@ -1,9 +1,9 @@
 //! The renderer's reflection integral and tables against an independent brute-force quadrature
-//! of 10⁵ directions (DESIGN §1.5): ∫ F_j0(ω_i→ω_r) L_env(ω_i) cosθ_i dΩ_i with the car scene's
+//! of 10⁵ directions (docs/design.md §1.5): ∫ F_j0(ω_i→ω_r) L_env(ω_i) cosθ_i dΩ_i with the car scene's
 //! sky (window model) and ground (with its jump at the horizon), for σ from 0.03 to 0.5.
 //!
 //! The brute force is stratified importance sampling: 300 × 300 half vectors drawn from the
-//! slope distribution (DESIGN §1.2 inverse CDFs) plus 100 × 100 cosine-weighted directions for
+//! slope distribution (docs/design.md §1.2 inverse CDFs) plus 100 × 100 cosine-weighted directions for
 //! the diffuse term, combined with the balance heuristic; the pBRDF only enters through
 //! `Pbrdf::first_column`.
 
@@ -32,7 +32,7 @@ fn autumn() -> Environment {
     Environment::new(&config, &Band::lwir()).unwrap()
 }
 
-/// Facet density per solid angle of the half vector, P(θ) (DESIGN §1.2), and its sampler.
+/// Facet density per solid angle of the half vector, P(θ) (docs/design.md §1.2), and its sampler.
 fn facet_pdf(d: SlopeDistribution, cos_h: f64) -> f64 {
     let tan2 = (1.0 - cos_h * cos_h) / (cos_h * cos_h);
     match d {

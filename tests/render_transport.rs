@@ -1,4 +1,4 @@
-//! Acceptance tests of the path integrator (DESIGN §1.7; issue 11): occlusion, inter-reflection
+//! Acceptance tests of the path integrator (docs/design.md §1.7; issue 11): occlusion, inter-reflection
 //! and the sun against closed forms and independent computations.
 
 mod common;
@@ -383,7 +383,7 @@ fn the_open_world_car_is_unchanged() {
     }
 }
 
-/// DESIGN §1.7: a fixed seed gives bit-identical images whatever the number of threads (one
+/// docs/design.md §1.7: a fixed seed gives bit-identical images whatever the number of threads (one
 /// random stream per pixel), and another seed gives other noise.
 #[test]
 fn a_fixed_seed_renders_the_same_bits_on_any_thread_count() {

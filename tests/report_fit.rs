@@ -1,6 +1,6 @@
 //! Fit reports end to end: a synthetic measurement of a known pBRDF (seeded noise) written as a
 //! CSV, a material with a hand-filled fit record, and the report's files, plus `irpol report`'s
-//! refusals (DESIGN §2.2, §4).
+//! refusals (docs/design.md §2.2, §4).
 
 mod report_support;
 

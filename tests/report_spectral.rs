@@ -1,4 +1,4 @@
-//! The spectral fit report end to end (DESIGN §1.9): the shipped silicate glass set fitted jointly,
+//! The spectral fit report end to end (docs/design.md §1.9): the shipped silicate glass set fitted jointly,
 //! its report encoded in memory, the figure decoded and checked for ink in every panel, one grey
 //! fit report per wavelength, and the emissivity map checked against the model's own ε0.
 

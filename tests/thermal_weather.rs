@@ -1,4 +1,4 @@
-//! The thermal model's weather (DESIGN §1.8, §2.5): the weather CSV read and refused with
+//! The thermal model's weather (docs/design.md §1.8, §2.5): the weather CSV read and refused with
 //! file:line:column, interpolation in time, and the built-in clear day.
 
 use irpol::emitter::{parse_time_utc, sun_direction, sun_position};

@@ -4,7 +4,7 @@ Every number comes from the Rust library (the one implementation, bit for bit th
 ``irpol`` command line); this package only broadcasts arrays and wraps results.
 
 Units: angles in degrees, wavelengths in µm, temperatures in K, BRDF values in sr⁻¹, radiances
-in W·m⁻²·sr⁻¹. Mueller matrices are in SCATMECH's psps frames (DESIGN §1.3), row-major.
+in W·m⁻²·sr⁻¹. Mueller matrices are in SCATMECH's psps frames (docs/design.md §1.3), row-major.
 
 >>> import irpol
 >>> paint = irpol.Material.load("fits/paper_paint.toml")
@@ -93,7 +93,7 @@ def emissivity(
 ) -> np.ndarray:
     """Polarized emissivity (ε0, ε1, ε2, ε3), dimensionless, at emission zeniths `theta` (degrees,
     in [0°, 90°)), as ``irpol emissivity`` computes it (Kirchhoff: 1 minus the hemispherical
-    reflectance, DESIGN §1.4). Shape ``theta.shape + (4,)``, float64."""
+    reflectance, docs/design.md §1.4). Shape ``theta.shape + (4,)``, float64."""
     model = _material(material)
     angles = _real("theta", theta)
     values = _irpol.emissivity_flat(model, wavelength_um, np.ascontiguousarray(angles.reshape(-1)))
@@ -118,7 +118,7 @@ def brightness_temperature(radiance: Any, band_um: Tuple[float, float] = LWIR_BA
 
 @dataclass
 class Measurements:
-    """One wavelength of a measurement file (DESIGN §2.1), validated by irpol's reader.
+    """One wavelength of a measurement file (docs/design.md §2.1), validated by irpol's reader.
 
     Angles in degrees (θ_r < 0 in the file already read as (|θ_r|, φ_r + 180°)); `values` and
     `uncertainties` have shape (points, len(elements)) in sr⁻¹, NaN where the file gives no

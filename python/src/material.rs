@@ -1,4 +1,4 @@
-//! `irpol.Material`: one entry of the material library (DESIGN §2.2), grey or spectral, read,
+//! `irpol.Material`: one entry of the material library (docs/design.md §2.2), grey or spectral, read,
 //! built from parameters or written exactly as the library does it.
 
 use crate::errors::{bad_argument, raised};

@@ -1,4 +1,4 @@
-//! Measurement CSVs (DESIGN §2.1) read and validated by the library's reader, as numpy arrays.
+//! Measurement CSVs (docs/design.md §2.1) read and validated by the library's reader, as numpy arrays.
 
 use crate::errors::raised;
 use irpol::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};

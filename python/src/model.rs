@@ -1,4 +1,4 @@
-//! The pBRDF of a material evaluated at arrays of geometries: `mueller` (DESIGN §1.3) and
+//! The pBRDF of a material evaluated at arrays of geometries: `mueller` (docs/design.md §1.3) and
 //! `emissivity` (§1.4). The Python side broadcasts the angle arrays and hands over flat,
 //! contiguous float64 arrays of one length; results come back flat (16 or 4 values per entry).
 

@@ -1,4 +1,4 @@
-//! Band radiance of a blackbody and its inverse, the brightness temperature (DESIGN §1.5), over
+//! Band radiance of a blackbody and its inverse, the brightness temperature (docs/design.md §1.5), over
 //! a sensor band with a flat response.
 
 use crate::errors::bad_argument;

@@ -1,6 +1,6 @@
 //! A scene TOML with some values replaced: each key a dotted path into the file (array indices
 //! as numbers, `objects.0.parts.hood.temperature_k`), as the sweep spec's grid keys are
-//! (DESIGN §2.7). Every part of the path must already exist in the scene: a misspelt key is an
+//! (docs/design.md §2.7). Every part of the path must already exist in the scene: a misspelt key is an
 //! error, never a new, silently ignored entry. The edit keeps the rest of the text as it was.
 
 use crate::errors::{bad_argument, raised};

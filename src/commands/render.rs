@@ -1,5 +1,5 @@
 //! `irpol render`: scene file in, output files out; for a scene with `[thermal]`, at instants of
-//! its thermal run (DESIGN §2.6).
+//! its thermal run (docs/design.md §2.6).
 
 use crate::material::write_atomically;
 use crate::output::{write_outputs, RenderSummary};
@@ -13,7 +13,7 @@ use image::{Delay, Frame, RgbaImage};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// The default output folder `out/<scene stem>/` (DESIGN §4).
+/// The default output folder `out/<scene stem>/` (docs/design.md §4).
 pub fn default_output_dir(scene_path: &Path) -> PathBuf {
     let stem = scene_path
         .file_stem()

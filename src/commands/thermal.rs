@@ -1,4 +1,4 @@
-//! `irpol thermal`: a scene's temperatures over its `[thermal]` run (DESIGN §1.8, §2.6).
+//! `irpol thermal`: a scene's temperatures over its `[thermal]` run (docs/design.md §1.8, §2.6).
 
 use super::render::{render_solution_at, TimedRender};
 use crate::output::thermal::{write_thermal_outputs, ThermalSummary};

@@ -1,4 +1,4 @@
-//! The sun as the renderer sees it (DESIGN §1.7): a disc of angular diameter 0.533° and uniform,
+//! The sun as the renderer sees it (docs/design.md §1.7): a disc of angular diameter 0.533° and uniform,
 //! unpolarized radiance L_sun = E_sun/Ω, where E_sun is its band irradiance on a surface facing it
 //! (its position and brightness: [`super::sun`]).
 //!

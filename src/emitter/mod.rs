@@ -1,8 +1,8 @@
-//! Light sources that are not scene surfaces (DESIGN §1.7): the sun, its position, its disc
-//! radiance and the disc quadrature the renderer integrates reflected sunlight with. (Today's sky and ground environment still lives in `scene::environment`; DESIGN §3 plans
+//! Light sources that are not scene surfaces (docs/design.md §1.7): the sun, its position, its disc
+//! radiance and the disc quadrature the renderer integrates reflected sunlight with. (Today's sky and ground environment still lives in `scene::environment`; docs/design.md §3 plans
 //! it here as `sky.rs`.)
 //!
-//! World frame everywhere in this module (DESIGN §1.7): z up, north +y, east +x; azimuth clockwise
+//! World frame everywhere in this module (docs/design.md §1.7): z up, north +y, east +x; azimuth clockwise
 //! from north (+y) toward east (+x), elevation above the xy-plane. Angles are in degrees and say so
 //! in their names, because they come straight from scene files, weather files and the CLI.
 

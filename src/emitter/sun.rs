@@ -1,4 +1,4 @@
-//! The sun (DESIGN §1.7): where it is, which way its light comes from, and how bright its disc is in
+//! The sun (docs/design.md §1.7): where it is, which way its light comes from, and how bright its disc is in
 //! a sensor band.
 //!
 //! **Position.** NREL's Solar Position Algorithm (Reda & Andreas, Solar Energy 76:577, 2004; ±0.0003°
@@ -19,7 +19,7 @@
 //! time, against which the sun's geocentric position moves ~1.1e-5° per second (0.9856°/day), so a
 //! ΔT off by seconds moves the position by ~1e-4° (more in azimuth near the zenith).
 //!
-//! **Frame and angles** (DESIGN §1.7, and SPA's own convention): azimuth clockwise from north (+y)
+//! **Frame and angles** (docs/design.md §1.7, and SPA's own convention): azimuth clockwise from north (+y)
 //! toward east (+x), 0…360°; elevation above the horizontal xy-plane; z up.
 //!
 //! **Radiance.** A uniform unpolarized disc of angular diameter 0.533°, solid angle
@@ -31,7 +31,7 @@ use chrono::{DateTime, SecondsFormat, Utc};
 use nalgebra::Vector3;
 use solar_positioning::{delta_t, Location, RefractionCorrection, SolarPositions};
 
-/// Mean angular diameter of the solar disc seen from Earth (degrees): DESIGN §1.7.
+/// Mean angular diameter of the solar disc seen from Earth (degrees): docs/design.md §1.7.
 pub const SUN_ANGULAR_DIAMETER_DEG: f64 = 0.533;
 /// Angular radius of the disc (degrees), half of [`SUN_ANGULAR_DIAMETER_DEG`].
 pub const SUN_HALF_ANGLE_DEG: f64 = 0.5 * SUN_ANGULAR_DIAMETER_DEG;
@@ -67,7 +67,7 @@ pub enum SunError {
 }
 
 /// Where the sun is: elevation above the horizon and azimuth clockwise from north, in degrees, in
-/// the world frame of DESIGN §1.7.
+/// the world frame of docs/design.md §1.7.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunPosition {
     pub elevation_deg: f64,
@@ -193,7 +193,7 @@ pub fn sun_position_with(
     })
 }
 
-/// Unit vector toward the sun in the world frame (DESIGN §1.7: z up, north +y, east +x, azimuth
+/// Unit vector toward the sun in the world frame (docs/design.md §1.7: z up, north +y, east +x, azimuth
 /// clockwise from north toward east): d = (cos e sin a, cos e cos a, sin e).
 pub fn sun_direction(elevation_deg: f64, azimuth_deg: f64) -> Vector3<f64> {
     let (sin_e, cos_e) = elevation_deg.to_radians().sin_cos();
@@ -231,7 +231,7 @@ pub fn validate_irradiance(irradiance_w_m2: f64) -> Result<(), SunError> {
     }
 }
 
-/// Default band irradiance of the sun on a surface facing it (W·m⁻², DESIGN §1.7):
+/// Default band irradiance of the sun on a surface facing it (W·m⁻², docs/design.md §1.7):
 /// E_sun = τ Ω L_bb(5772 K), L_bb the band radiance over the band and its spectral response. The
 /// band's Gauss–Legendre panels (≤ 0.5 µm) integrate Planck's law at 5772 K as well as at 300 K
 /// (tested against a direct integral to 1e-6 for 3–5 and 8–14 µm). τ is taken as given: check it
@@ -260,7 +260,7 @@ mod tests {
 
     #[test]
     fn direction_follows_the_world_frame() {
-        // DESIGN §1.7: azimuth 0° is north (+y), 90° east (+x), clockwise seen from above (+z).
+        // docs/design.md §1.7: azimuth 0° is north (+y), 90° east (+x), clockwise seen from above (+z).
         assert_close(sun_direction(0.0, 0.0), [0.0, 1.0, 0.0]);
         assert_close(sun_direction(0.0, 90.0), [1.0, 0.0, 0.0]);
         assert_close(sun_direction(0.0, 180.0), [0.0, -1.0, 0.0]);
@@ -281,7 +281,7 @@ mod tests {
     fn solid_angle_is_the_cone_of_the_half_angle() {
         let half = SUN_HALF_ANGLE_DEG.to_radians();
         assert_eq!(SUN_HALF_ANGLE_DEG, 0.2665);
-        // 2π(1 − cos θ) as written in DESIGN §1.7 (cancellation costs ~1e-12 here) …
+        // 2π(1 − cos θ) as written in docs/design.md §1.7 (cancellation costs ~1e-12 here) …
         let cone = 2.0 * std::f64::consts::PI * (1.0 - half.cos());
         assert!((SUN_SOLID_ANGLE_SR / cone - 1.0).abs() < 1e-6);
         // … and without cancellation, 4π sin²(θ/2), and the small-cap series πθ²(1 − θ²/12 + θ⁴/360).
@@ -290,7 +290,7 @@ mod tests {
         let series =
             std::f64::consts::PI * half * half * (1.0 - half * half / 12.0 + half.powi(4) / 360.0);
         assert!((SUN_SOLID_ANGLE_SR / series - 1.0).abs() < 1e-14);
-        // The 6.80e-5 sr quoted in DESIGN §1.7.
+        // The 6.80e-5 sr quoted in docs/design.md §1.7.
         assert!((SUN_SOLID_ANGLE_SR - 6.80e-5).abs() < 0.005e-5);
         assert_eq!(disc_radiance(SUN_SOLID_ANGLE_SR), 1.0);
     }
@@ -326,7 +326,7 @@ mod tests {
             assert!((e / (0.8 * SUN_SOLID_ANGLE_SR * direct) - 1.0).abs() < 1e-6);
         }
         // Magnitudes: 1.50872 W·m⁻² in 8–14 µm and 21.8252 W·m⁻² in 3–5 µm at τ = 1 (a separate
-        // Simpson integral in Python with the same constants); DESIGN §2.4's example gives 1.6.
+        // Simpson integral in Python with the same constants); docs/design.md §2.4's example gives 1.6.
         let lwir = default_band_irradiance(&Band::lwir(), 1.0);
         assert!((lwir / 1.508_720 - 1.0).abs() < 1e-6, "{lwir}");
         let mwir = default_band_irradiance(&Band::new(3.0, 5.0, None).unwrap(), 1.0);

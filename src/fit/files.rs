@@ -16,7 +16,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-/// One material's fit: of one wavelength, or jointly of several (a spectral set, DESIGN §1.9).
+/// One material's fit: of one wavelength, or jointly of several (a spectral set, docs/design.md §1.9).
 #[derive(Clone, Debug)]
 pub enum MaterialFit {
     Grey(Box<FitOutcome>),
@@ -175,7 +175,7 @@ fn validate_options(options: &FitOptions) -> Result<(), FitError> {
 }
 
 /// The sets of each material, in the order the materials first appear: one per wavelength,
-/// ascending, files of one material at one wavelength merged as repeat measurements (DESIGN
+/// ascending, files of one material at one wavelength merged as repeat measurements (docs/design.md
 /// §1.9). Files of one material must agree on what they measure (the Mueller convention and
 /// any `# distribution:` they state).
 fn merge_materials(sets: Vec<MeasurementSet>) -> Result<Vec<Vec<MeasurementSet>>, FitError> {

@@ -1,5 +1,5 @@
 //! Real-coded genetic algorithm as an argmin [`Solver`]: the global stage of a fit, before the
-//! Nelder–Mead polish (DESIGN §3, `src/fit/`: "genetic optimizer (an argmin Solver)").
+//! Nelder–Mead polish (docs/design.md §3, `src/fit/`: "genetic optimizer (an argmin Solver)").
 //!
 //! The algorithm is a generational GA on real vectors inside a box `[lower, upper]`:
 //! tournament selection, simulated binary crossover (SBX), polynomial mutation and elitism. It runs

@@ -1,4 +1,4 @@
-//! What a fit is asked to do (the options of `irpol fit`, DESIGN §4).
+//! What a fit is asked to do (the options of `irpol fit`, docs/design.md §4).
 
 use super::optimize::OptimizerSettings;
 use super::parameters::{DistributionKind, Parameter, ParameterBounds, ParameterValues};
@@ -33,7 +33,7 @@ pub struct FitOptions {
     pub robust: Option<RobustLoss>,
     pub bounds: ParameterBounds,
     pub settings: OptimizerSettings,
-    /// How n, k depend on wavelength when a material was measured at several (DESIGN §1.9).
+    /// How n, k depend on wavelength when a material was measured at several (docs/design.md §1.9).
     pub dispersion: super::Dispersion,
 }
 

@@ -1,5 +1,5 @@
 //! The result of fitting one measurement: the chosen model as a library [`Material`] with its
-//! fit record (DESIGN §2.2), the competing distribution's fit, and the comparison between them.
+//! fit record (docs/design.md §2.2), the competing distribution's fit, and the comparison between them.
 
 use super::comparison::ModelComparison;
 use super::data::{ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR};
@@ -97,7 +97,7 @@ fn fixed_values(chosen: &ModelFit) -> BTreeMap<String, f64> {
         .collect()
 }
 
-/// The provenance and quality record of DESIGN §2.2.
+/// The provenance and quality record of docs/design.md §2.2.
 fn fit_record(
     set: &MeasurementSet,
     data: &MeasurementData,

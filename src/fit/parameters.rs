@@ -1,4 +1,4 @@
-//! The fitted pBRDF parameters (σ, q, n, k, ρ_d of DESIGN §1.2–1.3), their bounds, and the search
+//! The fitted pBRDF parameters (σ, q, n, k, ρ_d of docs/design.md §1.2–1.3), their bounds, and the search
 //! coordinates the optimizers work in.
 //!
 //! Every optimizer sees a parameter through a smooth, monotone map from the physical value to a
@@ -14,7 +14,7 @@
 //!
 //! The genetic stage samples the search box; the local stages add a sine map on top of it
 //! (MINUIT's bounded transform) so that Nelder–Mead runs unconstrained and can settle exactly on
-//! a bound. The Smith Λ of the Cauchy distribution diverges for q ≤ 3/2 (DESIGN §1.3), hence the
+//! a bound. The Smith Λ of the Cauchy distribution diverges for q ≤ 3/2 (docs/design.md §1.3), hence the
 //! raised lower bound of q with Smith shadowing.
 
 use crate::pbrdf::{limits, Shadowing, SlopeDistribution};
@@ -26,7 +26,7 @@ use std::fmt;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Parameter {
-    /// Slope parameter σ of either distribution (DESIGN §1.2).
+    /// Slope parameter σ of either distribution (docs/design.md §1.2).
     Sigma,
     /// Cauchy exponent q (not a parameter of the Gaussian).
     Q,
@@ -59,7 +59,7 @@ impl Parameter {
         }
     }
 
-    /// Parses a name of [`Parameter::name`]; `rho` is accepted for ρ_d (DESIGN §4).
+    /// Parses a name of [`Parameter::name`]; `rho` is accepted for ρ_d (docs/design.md §4).
     pub fn parse(text: &str) -> Option<Parameter> {
         match text.trim() {
             "sigma" => Some(Parameter::Sigma),
@@ -221,7 +221,7 @@ impl Interval {
     }
 }
 
-/// Bounds of the physical parameters (DESIGN issue 3). The q interval's lower end is raised to
+/// Bounds of the physical parameters (docs/design.md §1.3). The q interval's lower end is raised to
 /// [`SMITH_MIN_Q`] when Smith shadowing is used (see [`ParameterBounds::effective`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ParameterBounds {

@@ -9,7 +9,7 @@ use crate::material::ModelSpec;
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{ModelError, Pbrdf, Shadowing};
 
-/// A family of pBRDF models with some parameters free (DESIGN §1.3).
+/// A family of pBRDF models with some parameters free (docs/design.md §1.3).
 #[derive(Clone, Debug)]
 pub struct ModelSpace {
     kind: DistributionKind,

@@ -8,7 +8,7 @@ use toml_edit::{DocumentMut, Item, Table};
 
 /// Above the first key of the file.
 const HEADER: &str =
-    "irpol material library entry: the pBRDF model (DESIGN §1.3) and how it was fitted.\n\
+    "irpol material library entry: the pBRDF model (docs/design.md §1.3) and how it was fitted.\n\
 Every field is explained in docs/materials.md; values are as the fit wrote them.";
 
 const TOP: &[(&str, &str)] = &[
@@ -70,7 +70,7 @@ const TABLES: &[(&str, &str)] = &[
     ("fit.alternative.model", "Its model (keys as in [model])."),
     (
         "model.dispersion",
-        "The Lorentz law the spectral fit used (DESIGN §1.9): ε(ν) = eps_inf + Σ strength ν_j² /\n\
+        "The Lorentz law the spectral fit used (docs/design.md §1.9): ε(ν) = eps_inf + Σ strength ν_j² /\n\
          (ν_j² − ν² − iγ_jν), ν = 1/λ, ν_j = 1/resonance_um, γ_j = damping_um/resonance_um²;\n\
          n and k above are this law at wavelength_um.",
     ),

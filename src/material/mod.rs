@@ -1,4 +1,4 @@
-//! The material library: one TOML file per material (DESIGN §2.2) holding the pBRDF model, how it
+//! The material library: one TOML file per material (docs/design.md §2.2) holding the pBRDF model, how it
 //! was fitted, and its uncertainties. Written atomically; read by `render` and `report`.
 
 mod comments;
@@ -42,7 +42,7 @@ pub enum MaterialError {
     },
 }
 
-/// The pBRDF parameters of a material (DESIGN §1.3) at one wavelength. Read through
+/// The pBRDF parameters of a material (docs/design.md §1.3) at one wavelength. Read through
 /// `RawModelSpec`, which refuses unknown keys: serde cannot deny them on a struct with a
 /// flattened field, and a typo such as `rho = 0.5` must not silently give ρ_d = 0.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -101,7 +101,7 @@ impl ModelSpec {
     }
 }
 
-/// How a material was fitted (DESIGN §2.2): provenance, optimizer, quality and uncertainties.
+/// How a material was fitted (docs/design.md §2.2): provenance, optimizer, quality and uncertainties.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FitRecord {
@@ -219,7 +219,7 @@ pub struct WavelengthQuality {
 }
 
 /// The dispersion of a spectral fit and, when a law was fitted, the comparison with the table
-/// (DESIGN §1.9: the AIC of both).
+/// (docs/design.md §1.9: the AIC of both).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DispersionChoice {

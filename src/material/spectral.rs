@@ -1,5 +1,5 @@
 //! The `[model]` of a material file: grey (one wavelength, as fitted from one measurement) or
-//! spectral (DESIGN §1.9, §2.6): n, k and ρ_d as tables over ascending wavelengths, σ, q and the
+//! spectral (docs/design.md §1.9, §2.6): n, k and ρ_d as tables over ascending wavelengths, σ, q and the
 //! shadowing shared (the surface's geometry does not depend on λ). Between table nodes n, k and ρ_d
 //! are linear in λ; outside the table the model is not defined and [`MaterialModel::at`] refuses.
 //! A grey model is the same at every wavelength.
@@ -66,7 +66,7 @@ pub enum BandModelError {
 pub const THERMAL_EMISSIVITY_REFERENCE_K: f64 = 300.0;
 
 impl SpectralModel {
-    /// The model at each wavelength node of `band` (DESIGN §1.9, [`crate::optics::band_nodes`]),
+    /// The model at each wavelength node of `band` (docs/design.md §1.9, [`crate::optics::band_nodes`]),
     /// refused when the table does not span the band.
     pub fn band_pbrdf(&self, band: &Band) -> Result<BandPbrdf, BandModelError> {
         self.band_pbrdf_on(WavelengthNodes::for_table(band, &self.wavelength_um)?)
@@ -83,7 +83,7 @@ impl SpectralModel {
         Ok(BandPbrdf::new(nodes, models)?)
     }
 
-    /// The thermal hemispherical emissivity of DESIGN §1.8 for a spectral material: the
+    /// The thermal hemispherical emissivity of docs/design.md §1.8 for a spectral material: the
     /// hemispherical ε_h(λ) of each model, Planck-weighted at
     /// [`THERMAL_EMISSIVITY_REFERENCE_K`] over the table's own range (flat response), the
     /// wavelengths the material is known at: Σ_m f_m ε_h(λ_m). A heat balance is broadband and

@@ -1,4 +1,4 @@
-//! The header row of a measurement CSV: which quantity each column holds (DESIGN §2.1).
+//! The header row of a measurement CSV: which quantity each column holds (docs/design.md §2.1).
 //! Required: theta_i_deg, theta_r_deg, m00. Optional: phi_i_deg, phi_r_deg, wavelength_um, any of
 //! m01…m33 and their uncertainties u_m00…u_m33. Names are case-sensitive.
 

@@ -1,4 +1,4 @@
-//! Reading a measurement CSV into a [`MeasurementSet`] (DESIGN §2.1), refusing anything that is
+//! Reading a measurement CSV into a [`MeasurementSet`] (docs/design.md §2.1), refusing anything that is
 //! not unambiguous with a `file:line:column` message. The reader never writes.
 //!
 //! Order of checks: UTF-8, then all `# key: value` metadata (wherever it stands), then the
@@ -18,7 +18,7 @@ use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
 use crate::text::shown;
 
 /// Default azimuths when the columns are absent: the plane of incidence, with the receiver on
-/// the specular side (φ_r = φ_i + 180°, DESIGN §1.1).
+/// the specular side (φ_r = φ_i + 180°, docs/design.md §1.1).
 const DEFAULT_PHI_I_DEG: f64 = 0.0;
 const DEFAULT_PHI_R_DEG: f64 = 180.0;
 
@@ -58,7 +58,7 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
     Ok(sets.remove(0))
 }
 
-/// Reads one measurement CSV as one set per wavelength, ascending (a spectral file, DESIGN
+/// Reads one measurement CSV as one set per wavelength, ascending (a spectral file, docs/design.md
 /// §1.9, holds several in its wavelength_um column; most files hold one).
 pub fn read_measurement_sets(path: &Path) -> Result<Vec<MeasurementSet>, MeasureError> {
     let bytes = read_bytes(path)?;
@@ -305,8 +305,8 @@ fn fields_of(line_number: u64, line: &str) -> Result<Vec<Field<'_>>, Refusal> {
 }
 
 /// How each row's wavelength_um is read: with a `# wavelength_um:` header every row must agree
-/// with it (DESIGN §2.1); without one each row carries its own (a spectral file may hold
-/// several, DESIGN §1.9).
+/// with it (docs/design.md §2.1); without one each row carries its own (a spectral file may hold
+/// several, docs/design.md §1.9).
 enum WavelengthCheck {
     AgainstHeader(HeaderWavelength),
     PerRow,
@@ -394,7 +394,7 @@ fn parse_row(
         };
         match quantity {
             // Zenith angles of directions above the surface; 90° is grazing and leaves the
-            // BRDF's 1/cosθ undefined (DESIGN §1.3). The detector's may be signed (in-plane
+            // BRDF's 1/cosθ undefined (docs/design.md §1.3). The detector's may be signed (in-plane
             // scans are written −80…80°); parse_text folds the negative ones.
             Quantity::ThetaI => {
                 if !(0.0..90.0).contains(&value) {

@@ -1,4 +1,4 @@
-//! Errors of measurement ingestion (DESIGN §2.1): every refusal names the file, the 1-based line
+//! Errors of measurement ingestion (docs/design.md §2.1): every refusal names the file, the 1-based line
 //! and the 1-based character column of the offending field, then says what is wrong, so that
 //! `irpol fit` can print it as one line (`file:line:column: what is wrong`).
 

@@ -1,5 +1,5 @@
 //! Splitting one CSV line into trimmed fields that remember their character column, so every
-//! refusal can point at `line:column` (DESIGN §2.1).
+//! refusal can point at `line:column` (docs/design.md §2.1).
 //!
 //! Written by hand rather than with the `csv` crate because the crate reports positions per
 //! record, not per field. Fields are separated by ','; surrounding whitespace is trimmed; a field

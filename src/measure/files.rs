@@ -1,4 +1,4 @@
-//! Expanding the command line's CSV-or-folder arguments (DESIGN §4, `irpol fit <CSV or
+//! Expanding the command line's CSV-or-folder arguments (docs/design.md §4, `irpol fit <CSV or
 //! folder>...`) into the list of measurement files.
 
 use std::path::{Path, PathBuf};

@@ -1,12 +1,12 @@
 //! Several files of one material at one wavelength as one measurement set: repeat measurements
-//! (DESIGN §1.9), concatenated in the order given, with a note saying so. Files that cannot be one
+//! (docs/design.md §1.9), concatenated in the order given, with a note saying so. Files that cannot be one
 //! set (another wavelength, other columns) are refused with a message naming both.
 
 use std::path::PathBuf;
 
 use super::{MeasurementSet, SourceFile, MUELLER_ELEMENT_NAMES};
 
-/// Two wavelengths closer than this (µm) are one wavelength (DESIGN §1.9).
+/// Two wavelengths closer than this (µm) are one wavelength (docs/design.md §1.9).
 pub const SAME_WAVELENGTH_UM: f64 = 1e-6;
 
 /// Why two files of one material cannot be merged into one set.

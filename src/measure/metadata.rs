@@ -1,4 +1,4 @@
-//! `# key: value` header lines of a measurement CSV (DESIGN §2.1). Every such line is metadata;
+//! `# key: value` header lines of a measurement CSV (docs/design.md §2.1). Every such line is metadata;
 //! any other `#` line is a comment. Three keys have a meaning for irpol and are validated:
 //! `material`, `wavelength_um` and `mueller_convention`.
 
@@ -109,7 +109,7 @@ impl Metadata {
                     });
                 }
             },
-            // Only SCATMECH's psps Stokes convention is modelled (DESIGN §1.3); the spelling's
+            // Only SCATMECH's psps Stokes convention is modelled (docs/design.md §1.3); the spelling's
             // case carries no meaning, so `PSPS` is the same convention.
             CONVENTION if !value.eq_ignore_ascii_case("psps") => {
                 return refuse(MeasureErrorKind::UnsupportedConvention {
@@ -129,7 +129,7 @@ pub(crate) fn wavelength_in_range(um: f64) -> bool {
     (MIN_WAVELENGTH_UM..=MAX_WAVELENGTH_UM).contains(&um)
 }
 
-/// Why a material name cannot become `fits/<material>.toml` (DESIGN §2.2), if it cannot: a
+/// Why a material name cannot become `fits/<material>.toml` (docs/design.md §2.2), if it cannot: a
 /// name from a file header must not reach outside the output folder.
 fn unusable_file_name(name: &str) -> Option<String> {
     if let Some(c) = name

@@ -1,9 +1,9 @@
-//! Measurement ingestion (DESIGN §2.1): SOC-style Mueller-matrix BRDF CSV files into a validated
+//! Measurement ingestion (docs/design.md §2.1): SOC-style Mueller-matrix BRDF CSV files into a validated
 //! [`MeasurementSet`], the input of the fit. Anything ambiguous is refused with a
 //! `file:line:column: what is wrong` [`MeasureError`]; nothing here writes.
 //!
 //! A file holds one material, at one wavelength or, in a wavelength_um column without a
-//! `# wavelength_um:` header, at several (a spectral set, DESIGN §1.9; [`read_measurement_sets`]):
+//! `# wavelength_um:` header, at several (a spectral set, docs/design.md §1.9; [`read_measurement_sets`]):
 //! ```text
 //! # material: gloss_paint
 //! # wavelength_um: 9.925
@@ -15,7 +15,7 @@
 //! with a note), m00. Optional: phi_i_deg (default 0°),
 //! phi_r_deg (default 180°), wavelength_um (else the `# wavelength_um:` header; both must agree),
 //! any of m01…m33, and absolute 1-σ uncertainties u_m00…u_m33 for any subset of the elements
-//! present. Mueller elements are BRDF values in sr⁻¹ in SCATMECH's psps convention (DESIGN §1.3),
+//! present. Mueller elements are BRDF values in sr⁻¹ in SCATMECH's psps convention (docs/design.md §1.3),
 //! not normalized by m00.
 
 mod columns;
@@ -51,7 +51,7 @@ pub fn mueller_index(name: &str) -> Option<usize> {
 }
 
 /// One measured geometry: the Mueller elements of [`MeasurementSet::elements`] at (θ_i, φ_i) →
-/// (θ_r, φ_r), directions pointing away from the surface (DESIGN §1.1).
+/// (θ_r, φ_r), directions pointing away from the surface (docs/design.md §1.1).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasurementPoint {
     /// Incidence zenith angle, degrees, in [0, 90).
@@ -79,7 +79,7 @@ pub struct MeasurementPoint {
 pub struct MeasurementSet {
     /// The path as given by the caller.
     pub source: PathBuf,
-    /// Lower-case hex SHA-256 of the file's bytes (fit provenance, DESIGN §2.2).
+    /// Lower-case hex SHA-256 of the file's bytes (fit provenance, docs/design.md §2.2).
     pub sha256: String,
     /// The `# material:` header, else the file stem.
     pub material: String,

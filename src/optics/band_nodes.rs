@@ -1,4 +1,4 @@
-//! Wavelength nodes for band rendering (DESIGN §1.9): the sensor signal of a material whose n, k
+//! Wavelength nodes for band rendering (docs/design.md §1.9): the sensor signal of a material whose n, k
 //! and ρ_d are tables over wavelength is S_j = ∫ R(λ) [reflected + ε_j(λ) B_λ(T)] dλ, and this
 //! module chooses the λ_m and weights w_m of Σ_m w_m (…)(λ_m) that stand for the integral.
 //!
@@ -13,7 +13,7 @@
 //! ≤ 3.3e-8, 2 by 8e-5, 1 by 4.5e-3; narrower pieces change nothing there (the table's own pieces
 //! are ≤ 1.5 µm). Four points keep a 300-fold margin on the 1e-5 the renderer promises.
 //!
-//! **Planck fractions.** A grey source (a blackbody's spectrum scaled to a band radiance, DESIGN
+//! **Planck fractions.** A grey source (a blackbody's spectrum scaled to a band radiance, docs/design.md
 //! §1.9's stand-in for an environment known only by its band radiance) at brightness temperature
 //! T puts the fraction f_m(T) = w_m B_λm(T) / Σ_m' w_m' B_λm'(T) of its band radiance at node m;
 //! Σ_m f_m = 1 to rounding, so a material whose pBRDF does not change with λ is band-integrated
@@ -30,7 +30,7 @@ use std::num::NonZeroUsize;
 pub const POINTS_PER_PIECE: usize = 4;
 /// The widest piece (µm): a two-row table 8–14 µm is still integrated on 1 µm pieces.
 pub const MAX_PIECE_UM: f64 = 1.0;
-/// Piece breaks closer than this (µm) are one (the tables' own resolution, DESIGN §1.9).
+/// Piece breaks closer than this (µm) are one (the tables' own resolution, docs/design.md §1.9).
 const SAME_BREAK_UM: f64 = 1e-6;
 /// Below this temperature (K) the fractions are those of the limit T → 0.
 const COLDEST_K: f64 = 1e-3;
@@ -243,7 +243,7 @@ impl BrightnessGrid {
 }
 
 /// The Planck fractions of a grey source as a function of its band radiance, for the Monte Carlo
-/// parts (DESIGN §1.7, §1.9): the rows f(T_b) at the nodes of a [`BrightnessGrid`], interpolated
+/// parts (docs/design.md §1.7, §1.9): the rows f(T_b) at the nodes of a [`BrightnessGrid`], interpolated
 /// linearly (so the weights still sum to 1).
 #[derive(Clone, Debug)]
 pub struct FractionsByRadiance {

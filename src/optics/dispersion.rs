@@ -1,4 +1,4 @@
-//! A parametric dispersion law for the complex index over wavelength (DESIGN §1.9): a sum of
+//! A parametric dispersion law for the complex index over wavelength (docs/design.md §1.9): a sum of
 //! Lorentz oscillators on a constant background,
 //!
 //!   ε(ν) = ε_∞ + Σ_j Δε_j ν_j² / (ν_j² − ν² − i γ_j ν),

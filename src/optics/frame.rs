@@ -1,4 +1,4 @@
-//! Polarization frames — the ONE place they live (DESIGN §1.1, §1.3, §1.6, §1.7).
+//! Polarization frames — the ONE place they live (docs/design.md §1.1, §1.3, §1.6, §1.7).
 //!
 //! Convention (SCATMECH "psps"): light propagating along k at a surface with normal n has
 //! s = unit(n × k) and p = k × s; the Stokes vector (S0, S1, S2, S3) is referred to (s, p) with
@@ -209,7 +209,7 @@ pub fn rotation_between_frames(
 }
 
 /// A Stokes vector leaving along `toward_camera` with psps s axis `s_axis`, in the pixel frame of
-/// DESIGN §1.6: x = image right made perpendicular to the ray, y = x_pix-completing image up
+/// docs/design.md §1.6: x = image right made perpendicular to the ray, y = x_pix-completing image up
 /// (y = ω × x, propagation toward the camera). With ψ = atan2(s·y_pix, s·x_pix) the rotation is
 /// `rotate_stokes`(S, −ψ).
 #[inline]

@@ -1,4 +1,4 @@
-//! Fresnel amplitude reflection coefficients for a complex refractive index (DESIGN §1.3).
+//! Fresnel amplitude reflection coefficients for a complex refractive index (docs/design.md §1.3).
 
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
@@ -24,7 +24,7 @@ impl RefractiveIndex {
 }
 
 /// The numerators and denominators of the Fresnel amplitude coefficients at local incidence angle
-/// β, for permittivity ε (DESIGN §1.3), with w = √(ε − sin²β):
+/// β, for permittivity ε (docs/design.md §1.3), with w = √(ε − sin²β):
 /// r_s = (cosβ − w)/(cosβ + w), r_p = (ε cosβ − w)/(ε cosβ + w).
 ///
 /// With k ≥ 0, Im(ε − sin²β) = 2nk ≥ 0, so the principal square root has Re ≥ 0 and Im ≥ 0: the

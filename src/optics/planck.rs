@@ -1,5 +1,5 @@
 //! Planck band radiance over a sensor band with an optional spectral response, and its inverse
-//! (apparent / brightness temperature). CODATA 2018 exact constants (DESIGN §1.5).
+//! (apparent / brightness temperature). CODATA 2018 exact constants (docs/design.md §1.5).
 
 use crate::text::number;
 use gauss_quad::legendre::GaussLegendre;

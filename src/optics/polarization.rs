@@ -1,5 +1,5 @@
 //! Jones → Mueller conversion, Mueller/Stokes rotations and the Fresnel Mueller matrix, all in the
-//! SCATMECH "psps" Stokes convention (DESIGN §1.3): S0 = |E_s|²+|E_p|², S1 = |E_s|²−|E_p|²,
+//! SCATMECH "psps" Stokes convention (docs/design.md §1.3): S0 = |E_s|²+|E_p|², S1 = |E_s|²−|E_p|²,
 //! S2 = 2 Re(E_s* E_p) (+45° from s toward p), S3 = 2 Im(E_s* E_p).
 
 use nalgebra::{Matrix2, Matrix4, Vector4};
@@ -29,7 +29,7 @@ pub fn jones_to_mueller(jones: &Matrix2<Complex64>) -> Mueller {
 
 /// Mueller matrix of a reflection with amplitude coefficients (r_s, r_p) in its own s/p frame:
 /// `[[A,B,0,0],[B,A,0,0],[0,0,C,−S],[0,0,S,C]]` with A = (|r_s|²+|r_p|²)/2, B = (|r_s|²−|r_p|²)/2,
-/// C = Re(r_s* r_p), S = Im(r_s* r_p) (DESIGN §1.3; `jones_to_mueller` of diag(r_s, r_p)).
+/// C = Re(r_s* r_p), S = Im(r_s* r_p) (docs/design.md §1.3; `jones_to_mueller` of diag(r_s, r_p)).
 #[inline]
 pub fn fresnel_mueller(r_s: Complex64, r_p: Complex64) -> Mueller {
     let (rs2, rp2) = (r_s.norm_sqr(), r_p.norm_sqr());
@@ -58,7 +58,7 @@ pub fn stokes_rotator(eta: f64) -> Mueller {
 }
 
 /// Applies L(η) to a Stokes vector: S1' = cos2η S1 + sin2η S2, S2' = −sin2η S1 + cos2η S2.
-/// (DESIGN §1.6's rotation into the pixel frame by ψ is `rotate_stokes(s, −ψ)`.)
+/// (docs/design.md §1.6's rotation into the pixel frame by ψ is `rotate_stokes(s, −ψ)`.)
 #[inline]
 pub fn rotate_stokes(stokes: &Stokes, eta: f64) -> Stokes {
     let (s, c) = (2.0 * eta).sin_cos();

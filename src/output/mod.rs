@@ -1,4 +1,4 @@
-//! Render outputs (DESIGN §4 `irpol render`): one 32-bit float single-channel TIFF per channel,
+//! Render outputs (docs/design.md §4 `irpol render`): one 32-bit float single-channel TIFF per channel,
 //! `stokes.exr` with every channel, PNG previews with colour bars, `composite.png` (the paper's
 //! Fig. 5 layout) and `summary.json`. Every file is encoded in memory first; the set is then
 //! written into a staging folder and swapped with the output folder in one step
@@ -28,7 +28,7 @@ use std::io::Cursor;
 use std::path::Path;
 use std::time::Instant;
 
-/// The image channels written (DESIGN §1.6).
+/// The image channels written (docs/design.md §1.6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Channel {
     S0,
@@ -176,7 +176,7 @@ pub struct ErrorSummary {
     pub p99: f64,
 }
 
-/// How light was transported (DESIGN §1.7, §2.6).
+/// How light was transported (docs/design.md §1.7, §2.6).
 #[derive(Clone, Debug, Serialize)]
 pub struct TransportSummary {
     pub open_world: bool,
@@ -211,7 +211,7 @@ pub struct MaterialSummary {
     pub name: String,
     pub origin: String,
     pub table: TableResolution,
-    /// A spectral material is band-integrated (DESIGN §1.9) on this many wavelength nodes.
+    /// A spectral material is band-integrated (docs/design.md §1.9) on this many wavelength nodes.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub band_nodes: Option<usize>,
 }

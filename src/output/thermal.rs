@@ -1,4 +1,4 @@
-//! Outputs of `irpol thermal` (DESIGN §2.6): the per-part temperature table, per-vertex PLY meshes
+//! Outputs of `irpol thermal` (docs/design.md §2.6): the per-part temperature table, per-vertex PLY meshes
 //! at each recorded instant, the temperature plot and a JSON summary, swapped into the output
 //! folder as one set (see `staged_folder`).
 

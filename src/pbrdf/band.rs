@@ -1,4 +1,4 @@
-//! A material over a sensor band (DESIGN §1.9): its pBRDF at each wavelength node of the band
+//! A material over a sensor band (docs/design.md §1.9): its pBRDF at each wavelength node of the band
 //! ([`crate::optics::band_nodes`]), all sharing the slope distribution and shadowing (σ, q do not
 //! depend on λ) and differing in N and ρ_d. What a renderer needs from it:
 //!

@@ -1,4 +1,4 @@
-//! Facet slope distributions (DESIGN §1.2) and their Smith Λ functions (DESIGN §1.3).
+//! Facet slope distributions (docs/design.md §1.2) and their Smith Λ functions (docs/design.md §1.3).
 
 use super::limits::{within, MAX_Q, MAX_SIGMA, MIN_SIGMA};
 use super::ModelError;
@@ -36,7 +36,7 @@ impl SlopeDistribution {
     }
 
     /// The slope m = tan θ below which a fraction `p` of the facets lie: the inverse CDFs of
-    /// DESIGN §1.2, tan²θ = a((1 − p)^(1/(1−q)) − 1) (Cauchy, a = 2σ²), −2σ² ln(1 − p) (Gaussian).
+    /// docs/design.md §1.2, tan²θ = a((1 − p)^(1/(1−q)) − 1) (Cauchy, a = 2σ²), −2σ² ln(1 − p) (Gaussian).
     pub fn slope_quantile(&self, p: f64) -> f64 {
         let tan2 = match *self {
             SlopeDistribution::Cauchy { sigma, q } => {
@@ -146,7 +146,7 @@ impl PreparedDistribution {
         (exponent, norm * inverse_cos2 * inverse_cos2)
     }
 
-    /// Smith Λ(θ) for a direction at zenith angle θ, μ = cot θ (DESIGN §1.3).
+    /// Smith Λ(θ) for a direction at zenith angle θ, μ = cot θ (docs/design.md §1.3).
     pub(crate) fn smith_lambda(&self, cos_theta: f64) -> f64 {
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
         if sin_theta == 0.0 {
@@ -213,7 +213,7 @@ impl PreparedDistribution {
 /// The Cauchy Smith Λ for callers that evaluate one model at many directions (renderers,
 /// quadratures, `irpol eval`, the Python `mueller`): the exact form needs an incomplete beta
 /// function (~0.2 µs) per direction. With μ = cot θ, s = μ/√(a + μ²) ∈ [0, 1] and
-/// x = 1 − s² = a/(a + μ²), DESIGN §1.3's Λ = Γ(q−½)√a/(Γ(q−1)√π (2q−3) μ) (1 + μ²/a)^(3/2−q)
+/// x = 1 − s² = a/(a + μ²), docs/design.md §1.3's Λ = Γ(q−½)√a/(Γ(q−1)√π (2q−3) μ) (1 + μ²/a)^(3/2−q)
 /// − ½ I_x(q−1, ½) is, since (1 + μ²/a)^(3/2−q) = x^(q−1)/√x and √a/(μ√x) = 1/s,
 ///     Λ = x^(q−1) [K/s − φ(s)/2],  K = Γ(q−½)/(Γ(q−1)√π (2q−3)),  φ(s) = I_x(q−1, ½)/x^(q−1).
 /// φ is [`HalfBetaRatio`] with p = q − 1; G1 = 1/(1+Λ) then agrees with the incomplete-beta

@@ -1,6 +1,6 @@
 //! Hemispherical integrals of the pBRDF: the reflected Stokes vector of an unpolarized environment,
 //! ∫ F_j0(ω_i→ω_r) L(ω_i) cosθ_i dΩ_i, and from it the polarized emissivity by Kirchhoff's law,
-//! ε_j(ω_e) = δ_j0 − ∫ F_j0(ω_i→ω_e) cosθ_i dΩ_i (DESIGN §1.4; Ma et al. eqs. 8–9, Resnick 1999).
+//! ε_j(ω_e) = δ_j0 − ∫ F_j0(ω_i→ω_e) cosθ_i dΩ_i (docs/design.md §1.4; Ma et al. eqs. 8–9, Resnick 1999).
 //!
 //! Why not a grid over ω_i: for σ = 0.02 the specular lobe is a few degrees wide and a direction grid
 //! needs millions of points. Instead the specular part is integrated over facet slopes m, where the
@@ -162,7 +162,7 @@ impl SpecularFacet {
 
 impl Pbrdf {
     /// ∫ F_j0(ω_i→ω_r) L(ω_i) cosθ_i dΩ_i for an unpolarized environment radiance L given in the
-    /// local frame, as a Stokes vector in the psps frame of ω_r (DESIGN §1.5). Zero for ω_r at or
+    /// local frame, as a Stokes vector in the psps frame of ω_r (docs/design.md §1.5). Zero for ω_r at or
     /// below the horizon.
     pub fn reflected_stokes(
         &self,
@@ -219,7 +219,7 @@ impl Pbrdf {
     /// The node placement of [`Pbrdf::visit_specular_nodes`] without the Fresnel factor: calls
     /// `visit(ω_i, facet)` for each node, whose weight for an index of permittivity ε is
     /// `facet.stokes(ε)`. It depends on the slope distribution and shadowing alone, so that
-    /// models differing only in N (one material over wavelength, DESIGN §1.9) share it.
+    /// models differing only in N (one material over wavelength, docs/design.md §1.9) share it.
     pub(crate) fn visit_specular_facets(
         &self,
         scattered: &Direction,
@@ -268,7 +268,7 @@ impl Pbrdf {
                 cos_beta * cos_beta,
                 [self.masking(cos_i), masking_r],
             );
-            // Facet s axis against the psps frame of ω_r (η_r of DESIGN §1.3).
+            // Facet s axis against the psps frame of ω_r (η_r of docs/design.md §1.3).
             let (cos2, sin2) = double_angle(facet_axis_in_scattered_frame(&w_i, scattered));
             let scale = weight * g * cos_beta * sec_h / cos_r;
             visit(
@@ -358,7 +358,7 @@ impl Pbrdf {
     }
 
     /// Hemispherical emissivity ε_h = (1/π) ∫ ε0(θ) cosθ dΩ, the flux-weighted mean of ε0 that a
-    /// surface's thermal balance needs (DESIGN §1.8 default). With t = sin²θ, cosθ dΩ = ½ dt dφ,
+    /// surface's thermal balance needs (docs/design.md §1.8 default). With t = sin²θ, cosθ dΩ = ½ dt dφ,
     /// so ε_h = ∫₀¹ ε0(arcsin √t) dt: Gauss–Legendre in t, whose nodes avoid the grazing end where
     /// ε0 varies fastest. 24 nodes and the default quadrature give ε_h to ~1e-5.
     pub fn hemispherical_emissivity(&self) -> f64 {

@@ -1,4 +1,4 @@
-//! The polarimetric microfacet BRDF of DESIGN §1.3 (Priest–Germer with the Wellems/Cauchy slope
+//! The polarimetric microfacet BRDF of docs/design.md §1.3 (Priest–Germer with the Wellems/Cauchy slope
 //! distribution, as in Ma et al. 2009 eqs. 1–7), its polarized emissivity by Kirchhoff's law
 //! (eqs. 8–9) and the hemispherical reflection integrals that both the emissivity and the scene
 //! renderer use.

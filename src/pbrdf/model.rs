@@ -1,4 +1,4 @@
-//! The polarized microfacet BRDF (DESIGN §1.3; Ma et al. eqs. 4–7, Priest & Germer 2000):
+//! The polarized microfacet BRDF (docs/design.md §1.3; Ma et al. eqs. 4–7, Priest & Germer 2000):
 //! F(ω_i→ω_r) = P(θ) G M(β, η_i, η_r) / (4 cosθ cosθ_i cosθ_r) + (ρ_d/π) diag(1,0,0,0),
 //! M = L(−η_r) F_fres(β) L(η_i).
 
@@ -46,7 +46,7 @@ struct FacetReflection {
 }
 
 impl FacetReflection {
-    /// The elements A = (|r_s|² + |r_p|²)/2 and B = (|r_s|² − |r_p|²)/2 of F_fres (DESIGN §1.3),
+    /// The elements A = (|r_s|² + |r_p|²)/2 and B = (|r_s|² − |r_p|²)/2 of F_fres (docs/design.md §1.3),
     /// times the facet scale: all that the first column needs.
     #[inline(always)]
     fn scaled_a_and_b(&self) -> (f64, f64) {
@@ -108,7 +108,7 @@ impl FacetGeometry {
     }
 }
 
-/// The model-independent part of one (ω_i, ω_r) pair (DESIGN §1.1, §1.3): the facet geometry
+/// The model-independent part of one (ω_i, ω_r) pair (docs/design.md §1.1, §1.3): the facet geometry
 /// (cos θ_i, cos θ_r, tan²θ, cos²β), and the rotations (cos 2η, sin 2η) of the
 /// facet s/p frame against the psps frames of the incident and the scattered light. A caller
 /// that evaluates many models on the same directions (a fit) builds it once per pair and calls
@@ -142,7 +142,7 @@ impl ScatteringGeometry {
         &self.facet
     }
 
-    /// L(−η_r) F_fres L(η_i) + `diffuse` in m00 (DESIGN §1.3) from F_fres's elements
+    /// L(−η_r) F_fres L(η_i) + `diffuse` in m00 (docs/design.md §1.3) from F_fres's elements
     /// [A, B, C, S] with the facet scale folded in.
     #[inline(always)]
     pub(super) fn assemble_mueller(&self, fresnel: [f64; 4], diffuse: f64) -> Mueller {
@@ -238,7 +238,7 @@ impl Pbrdf {
 
     /// The factor of the shadowing G that depends on one direction only, for a direction with
     /// cos θ = `cos_theta`: Smith's G1(θ) = 1/(1+Λ(θ)); 1 for `none` and `torrance-sparrow`
-    /// (DESIGN §1.3). The Cauchy Λ comes from a table built on the model's first call (~0.1 ms,
+    /// (docs/design.md §1.3). The Cauchy Λ comes from a table built on the model's first call (~0.1 ms,
     /// then ~20 ns per direction; within 2e-15 of the incomplete-beta form for q ≤ 4, see
     /// `CauchySmithTable`), so every evaluation of one model — `irpol eval`, renders,
     /// quadratures, the Python `mueller` — uses the same numbers.
@@ -286,7 +286,7 @@ impl Pbrdf {
     }
 
     /// The part of [`Pbrdf::facet_reflection`] that does not depend on N: the facet density and
-    /// the shadowing (shared by a material's models over wavelength, DESIGN §1.9).
+    /// the shadowing (shared by a material's models over wavelength, docs/design.md §1.9).
     #[inline(always)]
     pub(super) fn facet_shape(&self, geometry: &FacetGeometry, masking: [f64; 2]) -> FacetShape {
         let FacetGeometry {
@@ -314,7 +314,7 @@ impl Pbrdf {
     }
 
     /// The full 4×4 Mueller BRDF (sr⁻¹) from `incident` (ω_i, toward the source) to `scattered`
-    /// (ω_r, toward the viewer), in the psps frames of both (DESIGN §1.3). Zero below the horizon.
+    /// (ω_r, toward the viewer), in the psps frames of both (docs/design.md §1.3). Zero below the horizon.
     #[inline]
     pub fn mueller(&self, incident: &Direction, scattered: &Direction) -> Mueller {
         match ScatteringGeometry::new(incident, scattered) {

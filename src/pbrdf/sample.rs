@@ -1,5 +1,5 @@
 //! Importance sampling of incident directions for the renderer's Monte Carlo transport
-//! (DESIGN §1.2, §1.7): a facet normal h drawn from the facets that ω_r sees (the distribution of
+//! (docs/design.md §1.2, §1.7): a facet normal h drawn from the facets that ω_r sees (the distribution of
 //! visible normals, [`super::visible_slopes`]), the incident direction its mirror,
 //! ω_i = 2(ω_r·h)h − ω_r. With h distributed by D_r(h) = G1(ω_r) (ω_r·h) D(h)/cosθ_r and
 //! dΩ_i = 4 cosβ dΩ_h (cos β = ω_r·h), the density of ω_i is G1(ω_r) D(h)/(4 cosθ_r). Where no

@@ -1,4 +1,4 @@
-//! Shadowing/masking functions G (the paper's g(k_np); DESIGN §1.3).
+//! Shadowing/masking functions G (the paper's g(k_np); docs/design.md §1.3).
 
 use super::distribution::PreparedDistribution;
 use serde::{Deserialize, Serialize};

@@ -5,7 +5,7 @@
 //! m = (x, y) (normal ∝ (−x, −y, 1)) presents the projected area ∝ (μ − x)⁺ per unit of macro
 //! surface, so the slopes ω_o sees have the density
 //!     p_o(x, y) = (μ − x)⁺ p(x, y) / (μ (1 + Λ(μ))),
-//! μ(1 + Λ) = ∫ (μ − x)⁺ p_x(x) dx being the Smith normalization (DESIGN §1.3's Λ; p_x is p's
+//! μ(1 + Λ) = ∫ (μ − x)⁺ p_x(x) dx being the Smith normalization (docs/design.md §1.3's Λ; p_x is p's
 //! x-marginal). Its x-marginal is (μ − x)⁺ p_x(x)/(μ(1 + Λ)) and y given x follows p's own
 //! conditional. Both are inverted (u₀ → x, u₁ → y, each monotone, so stratified uniforms stay
 //! stratified) by safeguarded Newton iterations on their CDFs:
@@ -420,7 +420,7 @@ mod tests {
         ]
     }
 
-    /// The sampler's normalization is Smith's G1 from DESIGN §1.3's closed forms (erfc, and the
+    /// The sampler's normalization is Smith's G1 from docs/design.md §1.3's closed forms (erfc, and the
     /// incomplete beta itself for the Cauchy law), which are tested against Λ's integral
     /// definition in `distribution.rs`.
     #[test]

@@ -1,4 +1,4 @@
-//! The film: per-pixel Stokes vectors in the pixel frame (DESIGN §1.6), their standard errors,
+//! The film: per-pixel Stokes vectors in the pixel frame (docs/design.md §1.6), their standard errors,
 //! and the quantities derived from them (DoLP, AoP, polarizer images).
 
 /// Pixels that see no object.
@@ -35,7 +35,7 @@ pub struct SurfaceTruth {
 }
 
 /// DoLP = √(S1² + S2²)/S0 (0 where S0 ≤ 0) and AoP = ½ atan2(S2, S1) in (−π/2, π/2], radians
-/// counter-clockwise from image right (DESIGN §1.6).
+/// counter-clockwise from image right (docs/design.md §1.6).
 #[inline]
 pub fn dolp_aop(s: [f64; 4]) -> (f64, f64) {
     let linear = s[1].hypot(s[2]);
@@ -47,7 +47,7 @@ pub fn dolp_aop(s: [f64; 4]) -> (f64, f64) {
     (dolp, aop)
 }
 
-/// Polarizer image I(α) = ½(S0 + S1 cos2α + S2 sin2α) (DESIGN §1.6).
+/// Polarizer image I(α) = ½(S0 + S1 cos2α + S2 sin2α) (docs/design.md §1.6).
 #[inline]
 pub fn polarizer(s: [f64; 4], alpha: f64) -> f64 {
     let (sin2, cos2) = (2.0 * alpha).sin_cos();

@@ -1,4 +1,4 @@
-//! LWIR polarimetric rendering of a scene held in memory (DESIGN §1.5–1.7, §2.3): primary
+//! LWIR polarimetric rendering of a scene held in memory (docs/design.md §1.5–1.7, §2.3): primary
 //! visibility by z-buffered rasterization ([`raster`]), the Stokes vector leaving each visible
 //! point from the scene's integrator ([`crate::transport`]), Gouraud or per-pixel shading, then
 //! the atmosphere and detector noise ([`sensor`]) onto the [`film`]. Nothing here writes files

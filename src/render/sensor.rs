@@ -1,5 +1,5 @@
 //! What happens between the surface and the detector: the optional atmospheric path
-//! S_sensor = τ S + (1 − τ) L_bb(T_path) δ_j0 with τ = exp(−β·range) (DESIGN §1.5), and detector
+//! S_sensor = τ S + (1 − τ) L_bb(T_path) δ_j0 with τ = exp(−β·range) (docs/design.md §1.5), and detector
 //! noise.
 //!
 //! Noise model: a polarimetric camera records the four polarizer images I(0°, 45°, 90°, 135°); each

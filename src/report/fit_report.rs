@@ -1,4 +1,4 @@
-//! Fit reports (DESIGN §4, `irpol fit … --reports`, `irpol report`): one 3000 × 1800 figure per
+//! Fit reports (docs/design.md §4, `irpol fit … --reports`, `irpol report`): one 3000 × 1800 figure per
 //! material, as PNG and SVG, that a researcher can put in a paper, and each panel as its own PNG
 //! (`<material>/<panel>.png`). It recomputes every model curve
 //! from the material's pBRDF, so the same (material, measurement) always gives the same figure.
@@ -691,7 +691,7 @@ fn draw_linear_block<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Panel (e): DoLP for unpolarized illumination, √(m10² + m20²)/m00 (DESIGN §1.6).
+/// Panel (e): DoLP for unpolarized illumination, √(m10² + m20²)/m00 (docs/design.md §1.6).
 fn draw_dolp<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     data: &ReportData,

@@ -1,4 +1,4 @@
-//! `reports/index.html`: one self-contained page over the material library (DESIGN §4) — every
+//! `reports/index.html`: one self-contained page over the material library (docs/design.md §4) — every
 //! material with its parameters ± 1σ, fit quality, preferred distribution, provenance (source
 //! CSV, SHA-256, whether the file still matches) and its report figure. Inline CSS and relative
 //! links only, so the page works from a file browser and when the folder is copied elsewhere.
@@ -185,7 +185,7 @@ pub fn library_index_html(
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
          <title>irpol material library</title>\n<style>{STYLE}</style>\n</head>\n<body>\n\
          <h1>irpol material library</h1>\n<p class=\"lead\">{} material{} in <code>{}</code>; \
-         polarimetric BRDF fits (DESIGN §1.3), parameters with 1-σ uncertainties.</p>\n",
+         polarimetric BRDF fits (docs/design.md §1.3), parameters with 1-σ uncertainties.</p>\n",
         materials.len(),
         if materials.len() == 1 { "" } else { "s" },
         escape_html(&library_dir.display().to_string())

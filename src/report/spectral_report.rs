@@ -1,4 +1,4 @@
-//! The report of a spectral fit (DESIGN §1.9): n(λ) and k(λ) with their errors, the fit at each
+//! The report of a spectral fit (docs/design.md §1.9): n(λ) and k(λ) with their errors, the fit at each
 //! wavelength, and the directional emissivity over wavelength and angle.
 //!
 //! One 3000 × 1700 figure, `<material>.png` and `.svg`: (a) n(λ), (b) k(λ) (1-σ error bars at the

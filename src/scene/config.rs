@@ -1,4 +1,4 @@
-//! The scene TOML as written by the user (DESIGN §2.3), before paths, meshes and materials are
+//! The scene TOML as written by the user (docs/design.md §2.3), before paths, meshes and materials are
 //! resolved. Every table refuses unknown keys so that a typo is an error, not a silent default.
 //!
 //! ```toml
@@ -111,7 +111,7 @@ pub struct SceneConfig {
     #[serde(default)]
     pub render: RenderConfig,
     pub sun: Option<SunConfig>,
-    /// Temperatures from the thermal model (DESIGN §1.8, §2.4) instead of typed in.
+    /// Temperatures from the thermal model (docs/design.md §1.8, §2.4) instead of typed in.
     pub thermal: Option<ThermalConfig>,
     /// Inline material definitions by name.
     #[serde(default)]
@@ -186,7 +186,7 @@ pub struct EnvironmentConfig {
 #[derive(Debug, Deserialize, Clone)]
 #[serde(tag = "model", rename_all = "lowercase", deny_unknown_fields)]
 pub enum SkyConfig {
-    /// Clear-sky window model ε_sky(θ_z) = 1 − (1 − ε_zenith)^(1/cos θ_z) (DESIGN §1.5).
+    /// Clear-sky window model ε_sky(θ_z) = 1 − (1 − ε_zenith)^(1/cos θ_z) (docs/design.md §1.5).
     Window { zenith_emissivity: f64 },
     /// A user table over elevation (degrees, 0 = horizon, 90 = zenith), in radiance
     /// (W·m⁻²·sr⁻¹, band-integrated) or in brightness temperature (K); linear in between.
@@ -230,7 +230,7 @@ pub struct RenderConfig {
     pub shading: Shading,
     #[serde(default = "default_aop_mask")]
     pub aop_mask_dolp: f64,
-    /// Surface hits followed by the path integrator (DESIGN §1.7, §2.4).
+    /// Surface hits followed by the path integrator (docs/design.md §1.7, §2.4).
     #[serde(default = "default_bounces")]
     pub bounces: u32,
     /// Paths per pixel for the occluded correction.
@@ -311,7 +311,7 @@ fn default_render_seed() -> u64 {
     1
 }
 
-/// `[sun]` (DESIGN §2.4): a direction and an optional band irradiance.
+/// `[sun]` (docs/design.md §2.4): a direction and an optional band irradiance.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SunConfig {
@@ -347,7 +347,7 @@ impl Default for RenderConfig {
     }
 }
 
-/// pBRDF parameters given directly in the scene (DESIGN §1.3); wavelength is not needed to render.
+/// pBRDF parameters given directly in the scene (docs/design.md §1.3); wavelength is not needed to render.
 #[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct InlineMaterialConfig {
@@ -405,7 +405,7 @@ pub struct PartConfig {
     pub thermal: Option<PartThermalConfig>,
 }
 
-/// `[thermal]` (DESIGN §1.8, §2.4): where the weather comes from, where and when the scene is, and
+/// `[thermal]` (docs/design.md §1.8, §2.4): where the weather comes from, where and when the scene is, and
 /// how finely the run is sampled.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -1,4 +1,4 @@
-//! The unpolarized environment seen from the scene (DESIGN §1.5): sky radiance as a function of
+//! The unpolarized environment seen from the scene (docs/design.md §1.5): sky radiance as a function of
 //! elevation above the horizon, and the ground below it. It depends on world elevation only, which
 //! the renderer's reflection tables rely on.
 //!

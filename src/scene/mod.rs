@@ -1,4 +1,4 @@
-//! Scenes (DESIGN §2.3): the scene TOML, meshes (OBJ with groups as parts, PLY with per-vertex
+//! Scenes (docs/design.md §2.3): the scene TOML, meshes (OBJ with groups as parts, PLY with per-vertex
 //! temperature), procedural test objects, the camera, the environment, and the materials of every
 //! part, resolved into one world-space [`ShadedMesh`] ready for `render`.
 //!
@@ -63,7 +63,7 @@ pub struct SceneMaterial {
     /// Where it came from: the material file, or "inline".
     pub origin: String,
     /// Grey (one pBRDF), or for a spectral material its pBRDF at each wavelength node of the
-    /// sensor band (DESIGN §1.9).
+    /// sensor band (docs/design.md §1.9).
     pub optics: MaterialOptics,
     /// The wavelength a grey library material was measured at (inline and spectral materials
     /// have none).
@@ -73,7 +73,7 @@ pub struct SceneMaterial {
 }
 
 impl SceneMaterial {
-    /// The thermal hemispherical emissivity of DESIGN §1.8's default: the grey pBRDF's ε_h, or a
+    /// The thermal hemispherical emissivity of docs/design.md §1.8's default: the grey pBRDF's ε_h, or a
     /// spectral table's Planck-weighted one ([`SpectralModel::thermal_emissivity`]).
     pub fn thermal_emissivity(&self) -> Result<f64, String> {
         match (&self.optics, &self.spectral_model) {
@@ -118,7 +118,7 @@ impl Atmosphere {
     }
 }
 
-/// Monte Carlo settings of the path integrator (`[render]`, DESIGN §2.4).
+/// Monte Carlo settings of the path integrator (`[render]`, docs/design.md §2.4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct PathSettings {
     /// Vertex k (0 = the camera's visible point) traces its correction while k ≤ `bounces`:
@@ -133,9 +133,9 @@ pub struct PathSettings {
 /// How light reaches the visible points.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Transport {
-    /// The paper's model (DESIGN §1.5): every point sees the whole sky and ground; no sun.
+    /// The paper's model (docs/design.md §1.5): every point sees the whole sky and ground; no sun.
     OpenWorld,
-    /// Occlusion, inter-reflection and the sun (DESIGN §1.7).
+    /// Occlusion, inter-reflection and the sun (docs/design.md §1.7).
     Path(PathSettings),
 }
 
@@ -381,7 +381,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
     })
 }
 
-/// Puts every spectral material of a scene on one set of wavelength nodes (DESIGN §1.9,
+/// Puts every spectral material of a scene on one set of wavelength nodes (docs/design.md §1.9,
 /// [`crate::optics::WavelengthNodes::for_tables`]): the band split at the table wavelengths of
 /// all of them, so that light passed from one to another keeps its spectrum node by node.
 fn share_wavelength_nodes(materials: &mut [SceneMaterial], band: &Band) -> Result<(), String> {

@@ -1,5 +1,5 @@
 //! Wavefront OBJ: `v`, `vn`, `f` (any of `v`, `v/vt`, `v//vn`, `v/vt/vn`, negative indices
-//! relative to the end), `g`/`o` start a part (DESIGN §2.3: groups are parts). Polygons are split
+//! relative to the end), `g`/`o` start a part (docs/design.md §2.3: groups are parts). Polygons are split
 //! into triangle fans. Texture and material statements are accepted and ignored; anything else is
 //! refused so that a corrupt file is not half-read. Errors read `line N: what is wrong`.
 //!

@@ -1,5 +1,5 @@
 //! PLY meshes (ASCII or binary, via `ply-rs-bw`): `vertex` elements with x, y, z, optional
-//! nx, ny, nz and an optional per-vertex `temperature` (K; DESIGN §2.3), and `face` elements with
+//! nx, ny, nz and an optional per-vertex `temperature` (K; docs/design.md §2.3), and `face` elements with
 //! a `vertex_indices` (or `vertex_index`) list. A PLY has no groups: all faces form one part,
 //! named `surface`.
 //!

@@ -1,4 +1,4 @@
-//! The `[thermal]` section of a scene, resolved (DESIGN §1.8, §2.4): the weather, the site and
+//! The `[thermal]` section of a scene, resolved (docs/design.md §1.8, §2.4): the weather, the site and
 //! the run's time sampling, and per surface (object part) its layer stack and surface properties.
 //! Nothing is solved here; `thermal_scene` runs the model.
 

@@ -1,4 +1,4 @@
-//! Layer materials, layer stacks and their 1-D finite-volume grid (DESIGN §1.8).
+//! Layer materials, layer stacks and their 1-D finite-volume grid (docs/design.md §1.8).
 //!
 //! A vertex's stack runs from the exposed front surface to the back face; layers are in perfect
 //! contact and only conduct along the normal (no lateral conduction, §1.8).

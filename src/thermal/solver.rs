@@ -1,4 +1,4 @@
-//! Implicit time stepping of ρc ∂T/∂t = ∂/∂x (k ∂T/∂x) for one vertex's layer stack (DESIGN §1.8).
+//! Implicit time stepping of ρc ∂T/∂t = ∂/∂x (k ∂T/∂x) for one vertex's layer stack (docs/design.md §1.8).
 //!
 //! **Scheme: backward Euler with step doubling and Richardson extrapolation.** Each sub-step of
 //! length h is taken once as one implicit (backward) Euler step and once as two steps of h/2; the

@@ -1,4 +1,4 @@
-//! Weather for the thermal model (DESIGN §1.8, §2.5): air temperature, wind, solar and long-wave
+//! Weather for the thermal model (docs/design.md §1.8, §2.5): air temperature, wind, solar and long-wave
 //! irradiance and the sun's direction as rows in time, from a weather CSV ([`Weather::read_csv`])
 //! or a built-in clear day ([`Weather::clear_day`]), read back at any instant by [`Weather::at`].
 //!
@@ -162,7 +162,7 @@ pub struct Weather {
 }
 
 impl Weather {
-    /// DESIGN §2.5 CSV; errors are one line `FILE:LINE:COLUMN: message` (or FILE: message).
+    /// docs/design.md §2.5 CSV; errors are one line `FILE:LINE:COLUMN: message` (or FILE: message).
     pub fn read_csv(path: &Path, site: &Site) -> Result<Weather, WeatherError> {
         site.validate()?;
         let bytes = std::fs::read(path).map_err(|e| WeatherError::Read {
@@ -196,7 +196,7 @@ impl Weather {
     }
 
     /// Linear interpolation in time of every quantity on its own; the sun direction is the
-    /// normalized linear interpolation of the two rows' unit vectors (no azimuth wrap) — DESIGN
+    /// normalized linear interpolation of the two rows' unit vectors (no azimuth wrap) — docs/design.md
     /// §1.8. Outside the span: Err(WeatherError::OutOfRange{..}) naming the time and span.
     pub fn at(&self, time_s: f64) -> Result<WeatherSample, WeatherError> {
         let (first_s, last_s) = self.span_s();
@@ -244,7 +244,7 @@ fn nlerp_defined(a: &Vector3<f64>, b: &Vector3<f64>) -> bool {
     (a + b).norm() > 1e-6
 }
 
-/// The sample a fraction `w` (0…1) of the way from `a` to `b` (DESIGN §1.8).
+/// The sample a fraction `w` (0…1) of the way from `a` to `b` (docs/design.md §1.8).
 fn interpolate(a: &WeatherSample, b: &WeatherSample, w: f64) -> WeatherSample {
     let lerp = |x: f64, y: f64| x + w * (y - x);
     WeatherSample {
@@ -333,7 +333,7 @@ mod tests {
 
     #[test]
     fn clear_days_deserialize_from_the_scene_toml() {
-        // DESIGN §2.4 writes integers; unknown keys are refused by name.
+        // docs/design.md §2.4 writes integers; unknown keys are refused by name.
         let day: ClearDay =
             toml::from_str("air_min_k = 281\nair_max_k = 293.5\nwind_m_s = 2").unwrap();
         assert_eq!(

@@ -1,4 +1,4 @@
-//! What each thermal vertex sees (DESIGN §1.8 with §1.7): the cosine-weighted fraction of its
+//! What each thermal vertex sees (docs/design.md §1.8 with §1.7): the cosine-weighted fraction of its
 //! hemisphere that is open sky, F_sky, and whether the sun is visible from it at each shadow
 //! instant, V_sun, both from the scene's ray tracer.
 //!

@@ -1,5 +1,5 @@
 //! A thermal scene as it is at one recorded instant of its run: the solved surface temperatures,
-//! the sky at that instant's air temperature, and the sun where the weather puts it (DESIGN §2.6,
+//! the sky at that instant's air temperature, and the sun where the weather puts it (docs/design.md §2.6,
 //! `render --time`).
 
 use super::ThermalSolution;

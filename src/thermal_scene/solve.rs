@@ -1,4 +1,4 @@
-//! Runs the thermal model over a scene (DESIGN §1.8): every shading vertex of a part with a thermal
+//! Runs the thermal model over a scene (docs/design.md §1.8): every shading vertex of a part with a thermal
 //! stack gets its own 1-D solve, forced by the weather, the sun it sees and the sky it sees.
 //!
 //! **Front forcing per vertex** (§1.8), n its normal, s the sun direction, at each sample time:

@@ -1,4 +1,4 @@
-//! Ray queries against every triangle of the scene (DESIGN §1.7): closest hit and occlusion, through
+//! Ray queries against every triangle of the scene (docs/design.md §1.7): closest hit and occlusion, through
 //! the bounding-volume hierarchy of `parry3d-f64` (dimforge's collision library: a maintained,
 //! double-precision BVH with two-sided triangle ray casts, so the hit distances agree with the
 //! f64 geometry the shading uses; see the README for why it was chosen).

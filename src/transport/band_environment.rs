@@ -1,4 +1,4 @@
-//! The environment as a band material's reflection tables see it (DESIGN §1.9): its radiance
+//! The environment as a band material's reflection tables see it (docs/design.md §1.9): its radiance
 //! split over the material's wavelength nodes, L_m(u) = L(u) f_m(T_b(u)), with T_b(u) the
 //! brightness temperature of the band radiance L(u) at sin(elevation) u and f_m the Planck
 //! fractions of a grey source at T_b ([`WavelengthNodes::planck_fractions`]): the environment is

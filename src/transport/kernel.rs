@@ -1,4 +1,4 @@
-//! The reflection integral of DESIGN §1.5 as an explicit weighted sum, for the renderer's tables:
+//! The reflection integral of docs/design.md §1.5 as an explicit weighted sum, for the renderer's tables:
 //!
 //!   ∫ F_j0(ω_i→ω_r) L(ω_i) cosθ_i dΩ_i  ≈  Σ_k K_jk L(ω_k)   (specular part, j = 0, 1, 2)
 //!   (ρ_d/π) ∫ L(ω_i) cosθ_i dΩ_i        ≈  Σ_m D_m L(ω_m)    (diffuse part)
@@ -119,7 +119,7 @@ pub fn specular_kernel(
     }
 }
 
-/// The specular kernels of every wavelength node of a band material at once (DESIGN §1.9): the
+/// The specular kernels of every wavelength node of a band material at once (docs/design.md §1.9): the
 /// nodes of each model's quadrature are the same directions ([`BandPbrdf::visit_specular_nodes`]),
 /// merged once, each cell at its mean direction weighted by |K0| of the wavelength node
 /// `merge_node` (the one carrying most of the environment's light). A material that does not

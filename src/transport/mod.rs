@@ -1,4 +1,4 @@
-//! Light transport (DESIGN §1.5, §1.7): what leaves a surface point toward a viewer.
+//! Light transport (docs/design.md §1.5, §1.7): what leaves a surface point toward a viewer.
 //!
 //! - [`open_world`]: the paper's model (every point sees the whole sky and ground), read from
 //!   exact per-material [`tables`] built from the pBRDF's own quadrature ([`kernel`]); no noise.

@@ -1,4 +1,4 @@
-//! The open-world integrator: the paper's model (DESIGN §1.5), where every surface point sees the
+//! The open-world integrator: the paper's model (docs/design.md §1.5), where every surface point sees the
 //! whole sky and ground. The Stokes vector leaving a point along ω,
 //!
 //!   S_j = ε_j(θ) L_bb(T) + ∫ F_j0(ω_i→ω) L_env(ω_i) cosθ_i dΩ_i,
@@ -34,7 +34,7 @@ impl OpenWorld<'_> {
         Stokes::new(e[0] * l + r[0], e[1] * l + r[1], r[2], 0.0)
     }
 
-    /// The open-world Stokes vector seen by `camera` at `point` (pixel frame, DESIGN §1.6), with
+    /// The open-world Stokes vector seen by `camera` at `point` (pixel frame, docs/design.md §1.6), with
     /// unit shading normal `normal` on the side seen (`path::Vertex::seen_from` turns it).
     pub fn toward_camera(
         &self,

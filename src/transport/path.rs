@@ -1,4 +1,4 @@
-//! The path integrator (DESIGN §1.7): occlusion, polarized inter-reflection and the sun, as a
+//! The path integrator (docs/design.md §1.7): occlusion, polarized inter-reflection and the sun, as a
 //! correction to the exact open-world value.
 //!
 //! The Stokes vector leaving a point x along ω_o is
@@ -21,7 +21,7 @@
 //! open-world tables hold no sun), and escaped correction rays never count it, so it is not
 //! counted twice.
 //!
-//! A band material (DESIGN §1.9) scatters each source with its band-weighted Mueller matrix
+//! A band material (docs/design.md §1.9) scatters each source with its band-weighted Mueller matrix
 //! Σ_m f_m F(λ_m), f the shares of that source's spectrum over the wavelength nodes: the sun's
 //! as a 5772 K blackbody through the band; the environment a correction replaces, grey at its
 //! brightness temperature; the light of a surface hit as its emission, node by node, plus what
@@ -98,7 +98,7 @@ pub struct PathTracer<'a> {
     band_sources: Vec<Option<BandSources>>,
 }
 
-/// The spectral shares of the sources a band material scatters (DESIGN §1.9, module docs).
+/// The spectral shares of the sources a band material scatters (docs/design.md §1.9, module docs).
 struct BandSources {
     /// Planck fractions of a grey source by its band radiance (a surface hit, the environment).
     by_radiance: FractionsByRadiance,
@@ -127,7 +127,7 @@ struct BandScattering<'a> {
     masking: [f64; 2],
 }
 
-/// One sample of F (S_in − L_env e₀) at a band material (DESIGN §1.9), S_in the light from a
+/// One sample of F (S_in − L_env e₀) at a band material (docs/design.md §1.9), S_in the light from a
 /// surface hit, each part with its own spectrum over the wavelength nodes m:
 /// - what the hit emits, L_bb(T) (ε0 e₀ + ε1 u) with u its polarization: node by node
 ///   p_m(T) (ε0_m e₀ + ε1_m u), p the Planck shares at the hit's temperature and ε_m its
@@ -230,7 +230,7 @@ impl PathTracer<'_> {
     }
 
     /// The Stokes vector leaving the visible point `vertex` toward the camera along `omega`, in
-    /// the pixel frame (image right `image_right`, DESIGN §1.6), averaged over
+    /// the pixel frame (image right `image_right`, docs/design.md §1.6), averaged over
     /// `settings.samples` paths; `rng` is the pixel's own stream.
     pub fn estimate(
         &self,
@@ -344,7 +344,7 @@ impl PathTracer<'_> {
         let toward_x = -direction;
         let next = Vertex::seen_from(hit, &toward_x);
         let (leaving, s_from) = self.leaving(&next, &toward_x, depth + 1, sampler);
-        // Incident frame at x: k = −ω_i, s = −ê_φ(ω_i) in the local frame (DESIGN §1.3).
+        // Incident frame at x: k = −ω_i, s = −ê_φ(ω_i) in the local frame (docs/design.md §1.3).
         let incident = Direction::from_unit_vector(w_i);
         let s_incident = -frame.to_world(&incident.azimuthal_axis);
         let eta = rotation_between_frames(&s_from, &s_incident, &toward_x);

@@ -1,4 +1,4 @@
-//! Per-material lookup tables that make per-pixel shading cheap (DESIGN §1.4–1.5):
+//! Per-material lookup tables that make per-pixel shading cheap (docs/design.md §1.4–1.5):
 //!
 //! * emissivity ε_j(θ_r), 1-D;
 //! * reflected environment R_j(tilt, θ_r, φ): the environment depends on world elevation only, so
@@ -6,7 +6,7 @@
 //!   toward ω_r by θ_r and the azimuth φ of ω_r measured from the uphill direction;
 //! * the diffuse term (ρ_d/π)∫L cosθ dΩ, which depends on the tilt alone.
 //!
-//! Both ε and R come from the same kernel ([`super::kernel`]), ε_j = δ_j0 − Σ K_j (Kirchhoff, DESIGN
+//! Both ε and R come from the same kernel ([`super::kernel`]), ε_j = δ_j0 − Σ K_j (Kirchhoff, docs/design.md
 //! §1.4), and are interpolated linearly on the same θ_r grid, so an isothermal enclosure gives
 //! S = (L_bb(T), 0, 0) to rounding, whatever the table resolution.
 //!
@@ -129,7 +129,7 @@ pub struct MaterialTables {
 }
 
 /// (ε0, ε1) over the θ_r grid: one row for a grey material; for a band material the band
-/// emissivity ε_band(θ, T) = Σ_m f_m(T) ε(λ_m, θ) (DESIGN §1.9, f the Planck fractions, so that
+/// emissivity ε_band(θ, T) = Σ_m f_m(T) ε(λ_m, θ) (docs/design.md §1.9, f the Planck fractions, so that
 /// ε_band L_bb(T) = Σ w_m ε(λ_m, θ) B_λm(T) to the band's own quadrature), one row per node of a
 /// temperature grid over the scene's temperatures.
 #[derive(Clone, Debug)]
@@ -140,7 +140,7 @@ enum Emission {
         /// Index temperature · n_θ + θ.
         values: Vec<[f64; 2]>,
         /// ε(λ_m, θ_i) itself, index θ · nodes + m (what the path integrator needs to give
-        /// light emitted here its spectrum, DESIGN §1.9).
+        /// light emitted here its spectrum, docs/design.md §1.9).
         per_node: Vec<[f64; 2]>,
     },
 }
@@ -238,7 +238,7 @@ impl ComponentSkies {
     }
 }
 
-/// (ε0, ε1) = (1 − Σ K0 − diffuse albedo, −Σ K1) from a kernel's totals (Kirchhoff, DESIGN §1.4),
+/// (ε0, ε1) = (1 − Σ K0 − diffuse albedo, −Σ K1) from a kernel's totals (Kirchhoff, docs/design.md §1.4),
 /// refusing a reflectance above 1 at grid node `theta_index`.
 fn kirchhoff_emissivity(
     total: [f64; 3],
@@ -258,7 +258,7 @@ fn kirchhoff_emissivity(
 
 impl MaterialTables {
     /// Builds the tables of one grey material in one environment. Refuses a material whose
-    /// directional-hemispherical reflectance exceeds 1 at some tabulated angle (DESIGN §1.4).
+    /// directional-hemispherical reflectance exceeds 1 at some tabulated angle (docs/design.md §1.4).
     pub fn build(
         pbrdf: &Pbrdf,
         environment: &Environment,
@@ -307,7 +307,7 @@ impl MaterialTables {
         })
     }
 
-    /// Builds the tables of a band material (DESIGN §1.9) for scene temperatures within
+    /// Builds the tables of a band material (docs/design.md §1.9) for scene temperatures within
     /// `temperatures_k` (min, max): the band emissivity over θ_r and temperature, and the
     /// reflection of the environment split over the wavelength nodes ([`BandEnvironment`]).
     /// Refuses a model whose reflectance exceeds 1 at some angle and wavelength node.
@@ -387,7 +387,7 @@ impl MaterialTables {
     }
 
     /// (ε0, ε1) at emission angle θ (given as cos θ) of a surface at `temperature`: a grey
-    /// material's does not depend on it, a band material's is its band emissivity (DESIGN §1.9).
+    /// material's does not depend on it, a band material's is its band emissivity (docs/design.md §1.9).
     #[inline]
     pub fn emissivity_at(&self, cos_theta: f64, temperature: f64) -> [f64; 2] {
         let (i, f) = self.theta.locate(theta_coordinate(cos_theta));
@@ -762,7 +762,7 @@ mod tests {
         Environment::new(&config, band).unwrap()
     }
 
-    /// The reflection table as DESIGN §1.9 writes it: one fill per wavelength node m with the
+    /// The reflection table as docs/design.md §1.9 writes it: one fill per wavelength node m with the
     /// environment L(u) f_m(T_b(u)), summed (the split of `BandEnvironment` is checked against it).
     fn reflection_node_by_node(
         material: &BandPbrdf,

@@ -102,7 +102,7 @@ pub fn synthetic_set(
     }
 }
 
-/// The set as a measurement CSV (DESIGN §2.1), with u_ columns when `with_uncertainties`.
+/// The set as a measurement CSV (docs/design.md §2.1), with u_ columns when `with_uncertainties`.
 pub fn to_csv(set: &MeasurementSet, with_uncertainties: bool) -> String {
     use irpol::measure::MUELLER_ELEMENT_NAMES;
     let mut text = format!(

@@ -1,5 +1,5 @@
 //! Shared by the report tests: a synthetic goniometer measurement of a known pBRDF with seeded
-//! noise, written as a real CSV (DESIGN §2.1), and a material whose fit record is filled by hand.
+//! noise, written as a real CSV (docs/design.md §2.1), and a material whose fit record is filled by hand.
 
 use irpol::material::{AlternativeFit, FitRecord, Material, ModelSpec};
 use irpol::measure::{read_measurement_csv, MeasurementSet, MUELLER_ELEMENT_NAMES};
@@ -106,7 +106,7 @@ pub fn synthetic_csv(
             .iter()
             .map(|&e| if e == 0 { 0.03 * m00 } else { 0.01 * m00 })
             .collect();
-        // A measured m00 is never negative (DESIGN §2.1); 3 % noise keeps it so anyway.
+        // A measured m00 is never negative (docs/design.md §2.1); 3 % noise keeps it so anyway.
         let values: Vec<f64> = elements
             .iter()
             .zip(&sigmas)

@@ -1,4 +1,4 @@
-"""irpol.dataset — large sweeps on Dask distributed (DESIGN §2.7).
+"""irpol.dataset — large sweeps on Dask distributed (docs/design.md §2.7).
 
 A sweep spec (TOML) names a scene template and a grid of values for dotted keys of it (renders),
 or a folder tree of measurement files (fits). Each item runs as one Dask task, on a LocalCluster

@@ -11,7 +11,7 @@ from .spec import SpecError
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m irpol.dataset",
-                                     description="Runs a sweep spec (DESIGN §2.7) on Dask.")
+                                     description="Runs a sweep spec (docs/design.md §2.7) on Dask.")
     parser.add_argument("spec", help="the sweep spec TOML")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler "
                         "(default: a LocalCluster on this machine)")

@@ -1,4 +1,4 @@
-"""The sweep spec (DESIGN §2.7): reading, checking, and its items in row-major grid order."""
+"""The sweep spec (docs/design.md §2.7): reading, checking, and its items in row-major grid order."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-//! The joint least-squares problem of a spectral set (DESIGN §1.9): one measurement per
+//! The joint least-squares problem of a spectral set (docs/design.md §1.9): one measurement per
 //! wavelength, σ and q shared by all, and per wavelength either free n, k, ρ_d (a table) or ρ_d
 //! free with n, k from a Lorentz law whose parameters are shared.
 //!

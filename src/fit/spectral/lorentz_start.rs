@@ -1,4 +1,4 @@
-//! A Lorentz law to start the joint fit from (DESIGN §1.9): fitted to the permittivities
+//! A Lorentz law to start the joint fit from (docs/design.md §1.9): fitted to the permittivities
 //! ε_j = (n_j + i k_j)² of the table fit, where the data are already condensed to one complex
 //! number per wavelength. Each oscillator starts at a peak of Im ε (its resonance, with the
 //! strength and width that peak implies); a few ε_∞ are tried; a small Levenberg–Marquardt fit of

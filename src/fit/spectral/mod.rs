@@ -1,4 +1,4 @@
-//! Joint fit of a spectral measurement set (DESIGN §1.9): every wavelength of one material at
+//! Joint fit of a spectral measurement set (docs/design.md §1.9): every wavelength of one material at
 //! once, with σ and q shared (the surface's geometry does not depend on λ) and per wavelength
 //! either n, k, ρ_d free (`--dispersion table`, the default) or ρ_d free and n, k from a Lorentz
 //! law with shared parameters (`--dispersion lorentz:N`).
@@ -42,7 +42,7 @@ pub enum Dispersion {
     /// n and k free at each wavelength.
     #[default]
     Table,
-    /// A Lorentz law of this many oscillators (DESIGN §1.9).
+    /// A Lorentz law of this many oscillators (docs/design.md §1.9).
     Lorentz(usize),
 }
 
@@ -114,7 +114,7 @@ pub struct SpectralFitOutcome {
     pub measurements: Vec<MeasurementSet>,
     pub material: Material,
     pub chosen: SpectralFit,
-    /// The table fit when a law was chosen (for the AIC comparison DESIGN §1.9 asks for).
+    /// The table fit when a law was chosen (for the AIC comparison docs/design.md §1.9 asks for).
     pub table: Option<SpectralFit>,
     /// The other distribution's table fit, when both were fitted.
     pub alternative: Option<SpectralFit>,

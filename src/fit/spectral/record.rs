@@ -1,4 +1,4 @@
-//! The library entry of a spectral fit: the spectral model and its fit record (DESIGN §2.2,
+//! The library entry of a spectral fit: the spectral model and its fit record (docs/design.md §2.2,
 //! §2.6), with the per-wavelength errors mirroring the model's arrays.
 
 use super::super::data::MeasurementData;

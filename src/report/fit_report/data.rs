@@ -1,7 +1,7 @@
 //! The numbers behind a fit report, computed once and drawn twice (PNG and SVG): every measured
 //! point placed on the goniometer's plane of incidence or on an out-of-plane ring, its standard
 //! deviation and normalized residual, and the chosen and competing models evaluated along each
-//! plane and ring and as polarized emissivity (DESIGN §1.3–1.4).
+//! plane and ring and as polarized emissivity (docs/design.md §1.3–1.4).
 
 use crate::fit::MeasurementData;
 use crate::material::Material;
@@ -32,7 +32,7 @@ pub struct Reading {
 pub struct PointView {
     /// Index into [`ReportData::incidences`].
     pub incidence: usize,
-    /// Detector zenith signed for the plane of incidence (DESIGN §1.1): + on the specular side
+    /// Detector zenith signed for the plane of incidence (docs/design.md §1.1): + on the specular side
     /// (φ_r = φ_i + 180°), − toward the source (φ_r = φ_i); `None` off the plane.
     pub signed_zenith: Option<f64>,
     /// Index into [`ReportData::rings`] when the point lies on an out-of-plane ring.
@@ -309,7 +309,7 @@ fn in_plane_zenith(theta_r_deg: f64, relative_azimuth: f64) -> Option<f64> {
 
 /// φ_r − φ_i of the in-plane profile at signed detector zenith `zenith`: the specular side
 /// (180°) for zenith ≥ 0, the source side (0°) below. At zenith 0 (the normal) its psps frame is
-/// therefore the limit θ_r → 0⁺ along φ_i + 180° (DESIGN §1.3).
+/// therefore the limit θ_r → 0⁺ along φ_i + 180° (docs/design.md §1.3).
 fn in_plane_relative_azimuth(zenith: f64) -> f64 {
     if zenith >= 0.0 {
         180.0
@@ -325,7 +325,7 @@ const NEGLIGIBLE_MIXING: f64 = 3.5e-8;
 
 /// The turn η of the outgoing psps frame of a detector at the normal from its own azimuth φ_r
 /// to the in-plane profile's (φ_i + 180°, [`in_plane_relative_azimuth`]). At θ_r = 0 light leaves
-/// along k = ẑ and each frame is the limit θ_r → 0⁺ along its azimuth φ (DESIGN §1.3), with
+/// along k = ẑ and each frame is the limit θ_r → 0⁺ along its azimuth φ (docs/design.md §1.3), with
 /// s = lim unit(ẑ × k) = ê_φ = (−sin φ, cos φ, 0) ([`Direction::azimuthal_axis`]); η is the angle
 /// from the row's s toward its p = k × s at which the in-plane s lies (optics::frame).
 fn normal_detector_turn(phi_i_deg: f64, phi_r_deg: f64) -> f64 {

@@ -1,5 +1,5 @@
 //! The fit's diagnostic panels: normalized residuals against detector zenith and their histogram,
-//! the optimizer's convergence, and the polarized emissivity the fit implies (DESIGN §1.4).
+//! the optimizer's convergence, and the polarized emissivity the fit implies (docs/design.md §1.4).
 
 use super::data::{ReportData, Residual};
 use super::style::{

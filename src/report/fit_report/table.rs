@@ -1,6 +1,6 @@
 //! The report's parameter table: fitted values with 1-σ uncertainties beside the competing
 //! distribution's best fit, fit quality (reduced χ², AIC, BIC), the preferred model, the data
-//! and optimizer, and the provenance of the measurement (DESIGN §2.2).
+//! and optimizer, and the provenance of the measurement (docs/design.md §2.2).
 
 use super::style::{DrawResult, CAPTION_SIZE, LEGEND_SIZE};
 use crate::material::{ConfidenceBound, FitRecord, Material, ModelSpec};
@@ -94,7 +94,7 @@ pub fn parameters(model: &ModelSpec) -> Vec<(&'static str, &'static str, Option<
     ]
 }
 
-/// A fit map entry under the parameter's name, accepting `rho` for `rho_d` (DESIGN §4 spelling).
+/// A fit map entry under the parameter's name, accepting `rho` for `rho_d` (docs/design.md §4 spelling).
 pub fn lookup<'a, T>(map: impl Fn(&str) -> Option<&'a T>, name: &str) -> Option<&'a T> {
     map(name).or_else(|| (name == "rho_d").then(|| map("rho")).flatten())
 }

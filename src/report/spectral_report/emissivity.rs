@@ -1,5 +1,5 @@
 //! Panel (c): the directional emissivity ε0 of the fitted model over wavelength and emission angle,
-//! as a heat map with a colour bar (DESIGN §1.4, §1.9).
+//! as a heat map with a colour bar (docs/design.md §1.4, §1.9).
 
 use super::super::fit_report::style::{
     report_mesh_style, DrawResult, AXIS_DESC_SIZE, CAPTION_SIZE, TICK_SIZE,

@@ -1,4 +1,4 @@
-//! The weather CSV of DESIGN §2.5, read with the `csv` crate and refused, like a measurement CSV,
+//! The weather CSV of docs/design.md §2.5, read with the `csv` crate and refused, like a measurement CSV,
 //! with `file:line:column: what is wrong` (1-based line, 1-based character column of the field).
 //!
 //! Lines starting with `#` are comments and blank lines are skipped; the first other line is the
