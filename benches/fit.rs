@@ -1,4 +1,4 @@
-//! Speed of fitting (issue 3): one evaluation of the weighted least-squares objective, and the
+//! Speed of fitting: one evaluation of the weighted least-squares objective, and the
 //! default fit (`ga+lm`, Cauchy and Gaussian, 5 free parameters, uncertainties and model
 //! comparison included) of ~470-point, 9-element measurements — a synthetic goniometer set made
 //! with irpol's pBRDF and two of the shipped SCATMECH files. Target: ≤ 0.1 s wall on 2 cores.
@@ -84,7 +84,7 @@ fn default_fit(c: &mut Criterion) {
     group.finish();
 }
 
-/// Issue 13: the joint fit of a spectral set (table dispersion, both distributions, each
+/// The joint fit of a spectral set (table dispersion, both distributions, each
 /// wavelength fitted alone first): nine wavelengths of the silicate truth × the 472-geometry
 /// goniometer, and the shipped silicate_glass.csv (nine wavelengths, 3682 rows × 16 elements).
 /// Target: ≤ 1 s for 9 × 500 geometries.

@@ -1,4 +1,4 @@
-//! Thermal benchmark (issue 12): the shipped car of `scenes/car_day.toml` (9694 thermal vertices,
+//! Thermal benchmark: the shipped car of `scenes/car_day.toml` (9694 thermal vertices,
 //! 15 parts with their own stacks, a clear midsummer day in Munich) over 24 h, weather and sun
 //! sampled every 60 s, shadow rays every 10 min, no spin-up. Each iteration is the whole run in
 //! memory: sky view factors, shadows, the grouping of identical vertices and every solve (the

@@ -1,7 +1,7 @@
 """Shared parts of the fit cross-checks (`crosscheck_nlopt.py`, `crosscheck_emcee.py`).
 
 * reading a measurement CSV (docs/design.md §2.1) with its u_ columns into arrays;
-* the weighted least-squares objective of issue 3, chi2 = sum(((model - data) / u)^2) over every
+* the weighted least-squares objective of `irpol fit`, chi2 = sum(((model - data) / u)^2) over every
   Mueller element present, on a fast form of the numpy port (`pbrdf_numpy.py`) that is vectorized
   over parameter sets as well as geometries;
 * irpol's free parameters, bounds and search coordinates (src/fit/parameters.rs on branch `fit`);

@@ -1,4 +1,4 @@
-//! Interrupts and output writes (issue 15). The library never handles signals; it only counts
+//! Interrupts and output writes. The library never handles signals; it only counts
 //! its writes of output sets and refuses to start new ones once the binary's SIGINT/SIGTERM
 //! handler has set [`INTERRUPTED`]. The handler then waits for the writes under way to finish,
 //! removes the temporaries and exits.

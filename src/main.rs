@@ -617,7 +617,7 @@ fn note_all(notes: &[String]) {
     }
 }
 
-/// Each distinct warning once, in order, on stderr (issue 16 item 7).
+/// Each distinct warning once, in order, on stderr.
 fn warn_once(warnings: &[String]) {
     let mut seen = std::collections::BTreeSet::new();
     for w in warnings.iter().filter(|w| seen.insert(w.as_str())) {

@@ -41,7 +41,7 @@ fn eval_reproduces_the_scatmech_reference_through_a_geometry_file() {
         geometry.to_str().unwrap(),
     ]);
     assert!(ok, "{stderr}");
-    // `#` lines state the model, then the CSV (issue 16 item 5).
+    // `#` lines state the model, then the CSV.
     let mut lines = stdout.lines();
     assert!(
         lines
@@ -214,7 +214,7 @@ fn fit_with_one_bad_file_writes_nothing_and_render_refuses_a_missing_scene() {
     assert!(!dir.path().join("out").exists());
 }
 
-/// Issue 16 item 11: `demo` outside the repository says what it needs instead of failing on the
+/// `demo` outside the repository says what it needs instead of failing on the
 /// first missing file, and writes nothing.
 #[test]
 fn demo_outside_the_repository_says_what_it_needs() {
@@ -234,7 +234,7 @@ fn demo_outside_the_repository_says_what_it_needs() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
 
-/// Issue 16 item 5: one default shadowing everywhere. `eval` and `emissivity` without
+/// One default shadowing everywhere. `eval` and `emissivity` without
 /// `--shadowing` use Smith, as `fit` does, and say so in their header.
 #[test]
 fn eval_and_emissivity_default_to_smith_shadowing() {
@@ -260,7 +260,7 @@ fn eval_and_emissivity_default_to_smith_shadowing() {
     assert!(ok && stdout.contains("shadowing = smith"), "{stdout}");
 }
 
-/// Issue 16 item 8: `--free` fixes the other parameters; the summary line and the material TOML
+/// `--free` fixes the other parameters; the summary line and the material TOML
 /// say at which values, and a parameter both free and fixed is refused.
 #[test]
 fn fixed_parameters_are_recorded_and_contradictions_refused() {
@@ -313,7 +313,7 @@ fn mueller_rows(csv: &str) -> Vec<Vec<String>> {
         .collect()
 }
 
-/// Issue 16 item 2: a signed detector zenith θ_r < 0 is the detector across the normal,
+/// A signed detector zenith θ_r < 0 is the detector across the normal,
 /// (|θ_r|, φ_r + 180°), in sweeps and geometry files, with one note; rows are echoed as given.
 #[test]
 fn eval_reads_signed_theta_r_across_the_normal() {
@@ -367,7 +367,7 @@ fn eval_reads_signed_theta_r_across_the_normal() {
     );
 }
 
-/// Issue 16 item 2: `--phi-r` sweeps like `--theta-r`; rows run over φ_r within each θ_r, and
+/// `--phi-r` sweeps like `--theta-r`; rows run over φ_r within each θ_r, and
 /// the sweep bound holds for the product.
 #[test]
 fn eval_sweeps_phi_r_inside_theta_r() {
@@ -447,10 +447,10 @@ fn in_plane_scan(step: usize) -> Vec<(f64, f64, f64)> {
     geometry
 }
 
-/// Issue 16 items 2 and 11: a measurement file with signed θ_r fits (with one note), two files
+/// A measurement file with signed θ_r fits (with one note), two files
 /// of one material at one wavelength are merged as repeat measurements with a note, recorded in
 /// the TOML, and `irpol report` rebuilds from both; with another wavelength they are one spectral
-/// material (issue 13).
+/// material.
 #[test]
 fn fit_merges_repeat_files_of_one_material_and_reads_signed_angles() {
     let dir = tempfile::tempdir().unwrap();
@@ -564,7 +564,7 @@ fn fit_merges_repeat_files_of_one_material_and_reads_signed_angles() {
     );
 }
 
-/// Issue 16 item 11: `irpol library` takes the folder `irpol fit --out` wrote as an argument,
+/// `irpol library` takes the folder `irpol fit --out` wrote as an argument,
 /// and still as `--dir`.
 #[test]
 fn library_takes_its_folder_as_an_argument_or_dir() {

@@ -1,4 +1,4 @@
-//! The documentation works as written (issue 16): every shipped example in docs/examples/
+//! The documentation works as written: every shipped example in docs/examples/
 //! renders, every block of docs/scenes.md marked as a complete scene loads, the shipped example
 //! files are exactly the ones the page shows (so the page and the files cannot drift), and the
 //! hand-written material of docs/materials.md is a valid library entry.

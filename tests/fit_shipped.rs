@@ -1,5 +1,5 @@
 //! Fits of the shipped measurements (measurements/*.csv: NIST SCATMECH + seeded noise, with the
-//! generating parameters in `# truth_*` header lines) — issue 3's acceptance: the parameters are
+//! generating parameters in `# truth_*` header lines) — the parameters are
 //! recovered within σ 3 %, q 10 %, n 2 %, k 0.02, ρ_d 0.005; the reduced χ² lies in [0.8, 1.3];
 //! the generating distribution is the one the model comparison prefers; every seed and every
 //! start of the local stage reaches the same minimum.
@@ -52,7 +52,7 @@ fn truth(set: &MeasurementSet) -> Truth {
     }
 }
 
-/// |fitted − true| allowed by issue 3 (relative for σ, q, n; absolute for k, ρ_d).
+/// |fitted − true| allowed (relative for σ, q, n; absolute for k, ρ_d).
 fn tolerance(parameter: Parameter, true_value: f64) -> f64 {
     match parameter {
         Parameter::Sigma => 0.03 * true_value,
@@ -141,7 +141,7 @@ fn default_fits_recover_the_generating_parameters_and_distribution() {
     }
 }
 
-/// Issue 3: 20 seeds of the default optimizer reach the same minimum (χ² within 1e-6
+/// 20 seeds of the default optimizer reach the same minimum (χ² within 1e-6
 /// relative) on every shipped measurement.
 #[test]
 fn every_seed_reaches_the_same_minimum() {
@@ -168,7 +168,7 @@ fn every_seed_reaches_the_same_minimum() {
     });
 }
 
-/// Issue 3: the local stage alone, from 20 random starts inside the bounds, reaches the same
+/// The local stage alone, from 20 random starts inside the bounds, reaches the same
 /// minimum as the default fit — including the glass, whose linear-only elements make k = 0 a
 /// stationary boundary, and whose narrow lobe has false minima with σ or q pinned at a bound.
 #[test]

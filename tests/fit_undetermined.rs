@@ -1,4 +1,4 @@
-//! Parameters the data bound from one side only (issue 16 item 3): a transparent surface measured
+//! Parameters the data bound from one side only: a transparent surface measured
 //! without circular elements says only that k is small (the linear elements are even in k, so
 //! ∂F/∂k = 0 at k = 0 and the linearized "k = 0.016 ± 0.057" is meaningless). The fit must give a
 //! one-sided profile-likelihood bound instead, in the record, the summary line and the TOML.

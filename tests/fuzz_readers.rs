@@ -1,4 +1,4 @@
-//! Bounded fuzzing of every reader of user files (issue 15): the measurement CSV reader, the OBJ
+//! Bounded fuzzing of every reader of user files: the measurement CSV reader, the OBJ
 //! and PLY mesh readers, the material TOML loader, the eval geometry reader and the thermal
 //! weather CSV reader get random bytes
 //! and mutations of real inputs (the shipped measurements and materials, excerpts of the car

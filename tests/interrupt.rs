@@ -1,4 +1,4 @@
-//! Interrupting `irpol render` (issue 15): SIGTERM or SIGKILL at any moment leaves the output
+//! Interrupting `irpol render`: SIGTERM or SIGKILL at any moment leaves the output
 //! folder holding the complete old set or the complete new one, and SIGTERM leaves no temporary
 //! folder (a SIGKILLed run's staging folder is removed by the next run).
 
@@ -139,8 +139,7 @@ fn temporaries(dirs: &[&Path]) -> Vec<String> {
 }
 
 /// SIGTERM or SIGKILL at any moment of `irpol fit` leaves the library as it was or wholly
-/// replaced; SIGTERM leaves no temporary file, and the next fit removes a SIGKILLed one's
-/// (issue 15).
+/// replaced; SIGTERM leaves no temporary file, and the next fit removes a SIGKILLed one's.
 #[test]
 fn an_interrupted_fit_leaves_the_old_or_the_new_library() {
     let dir = tempfile::tempdir().unwrap();

@@ -104,7 +104,7 @@ fn malformed_toml() {
     expect(&text, &["scene.toml", "unknown field `fov`"]);
 }
 
-/// Issue 16 item 6: a degenerate face is skipped with a warning naming it; a mesh of nothing but
+/// A degenerate face is skipped with a warning naming it; a mesh of nothing but
 /// degenerate faces is refused.
 #[test]
 fn degenerate_triangles_are_skipped_unless_nothing_remains() {
@@ -265,7 +265,7 @@ fn a_sun_below_the_horizon_renders_without_a_sun_term() {
 }
 
 /// Arrays of the wrong length and temperatures beyond finite radiance are refused, not cut or
-/// turned into NaN statistics (issue 15).
+/// turned into NaN statistics.
 #[test]
 fn wrong_lengths_and_absurd_temperatures() {
     let files = [("panel.obj", TRIANGLE_OBJ)];
@@ -306,7 +306,7 @@ fn wrong_lengths_and_absurd_temperatures() {
     }
 }
 
-/// `[render.preview]` ranges are checked when the scene loads (issue 16 item 4).
+/// `[render.preview]` ranges are checked when the scene loads.
 #[test]
 fn preview_ranges_are_checked_by_key() {
     for (table, expected) in [
@@ -335,7 +335,7 @@ fn preview_ranges_are_checked_by_key() {
     }
 }
 
-/// Issue 16 item 7: probable mistakes are warned about on stderr, once each, and listed in
+/// Probable mistakes are warned about on stderr, once each, and listed in
 /// summary.json — a temperature that looks like °C, an inline material nothing uses, an object the
 /// camera cannot see, a PLY property that looks like a temperature but is ignored, a library
 /// material measured outside the sensor band — and the render still succeeds.

@@ -280,7 +280,7 @@ fn read_tiff_with_description(path: &std::path::Path) -> (tiff::decoder::Decodin
     (decoder.read_image().unwrap(), description)
 }
 
-/// Ground truth (issue 16 item 12): a unit sphere 4 m in front of the camera. The centre pixel
+/// Ground truth: a unit sphere 4 m in front of the camera. The centre pixel
 /// sees the sphere's nearest point: depth 3 m, normal toward the camera, the typed temperature,
 /// IDs 1; the apparent temperature is the exact brightness temperature of S0; the background has
 /// zeros and IDs 0; every TIFF names the camera's intrinsics in its ImageDescription.
@@ -347,7 +347,7 @@ fn ground_truth_channels_describe_the_visible_point() {
     assert_eq!(summary["camera"]["forward"][1], 1.0);
 }
 
-/// Issue 16 item 9: with noise, I0…I135 are the recorded polarizer images (S0…S2 are re-estimated
+/// With noise, I0…I135 are the recorded polarizer images (S0…S2 are re-estimated
 /// from them, so the identities hold to f32 rounding), and with `dofp = true` the raw mosaic holds
 /// each pixel's own orientation (pattern 90/45 over 135/0) and the demosaicked S0 follows the
 /// full-resolution S0 inside smooth regions.

@@ -1,4 +1,4 @@
-//! Band rendering of spectral materials (docs/design.md §1.9; issue 13): a material whose n, k, ρ_d are
+//! Band rendering of spectral materials (docs/design.md §1.9): a material whose n, k, ρ_d are
 //! tables over wavelength is integrated over the sensor band, S_j = ∫ R(λ) [∫ F_j0(λ) L_env,λ
 //! cosθ_i dΩ_i + ε_j(λ) B_λ(T)] dλ, against grey materials, a dense wavelength integral and a
 //! wavelength-by-wavelength render.

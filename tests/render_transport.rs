@@ -1,4 +1,4 @@
-//! Acceptance tests of the path integrator (docs/design.md §1.7; issue 11): occlusion, inter-reflection
+//! Acceptance tests of the path integrator (docs/design.md §1.7): occlusion, inter-reflection
 //! and the sun against closed forms and independent computations.
 
 mod common;

@@ -1,4 +1,4 @@
-//! `irpol report` through the CLI after the source CSV was edited (issue 16 item 10): edits that
+//! `irpol report` through the CLI after the source CSV was edited: edits that
 //! leave the data alone (comments, blank lines) rebuild the report; a change of the data is
 //! refused in one line that names the file and says what changed; library entries written before
 //! the data fingerprint existed still rebuild from the unchanged bytes.

@@ -1,4 +1,4 @@
-//! Fit reports of large measurements (issue 15, class 8): a report summarises the data, so that
+//! Fit reports of large measurements: a report summarises the data, so that
 //! its curves, legend entries and file size stay bounded however many rows and distinct incidence
 //! angles the file holds. The old report drew a curve per incidence angle in five panels and a
 //! circle per residual, about 200 KB of SVG per angle.

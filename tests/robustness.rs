@@ -1,4 +1,4 @@
-//! Robustness of the `irpol` binary against hostile or mistaken input (issue 15): no panic, no
+//! Robustness of the `irpol` binary against hostile or mistaken input: no panic, no
 //! hang, no allocation beyond what the input can hold, no wrong input accepted, no corrupt output,
 //! and error messages of one short line without the input's control characters. Every case runs
 //! the built binary in a scratch folder and checks that a refusal is a clean one-line
@@ -465,7 +465,7 @@ fn eval_keeps_quoted_fields_quoted() {
     let command = format!("eval {MODEL} --geometry g.csv");
     let run = irpol(dir.path(), &command.split(' ').collect::<Vec<_>>());
     assert_eq!(run.code, Some(0), "{}", run.stderr);
-    // The `#` lines before the table state the model (issue 16 item 5).
+    // The `#` lines before the table state the model.
     let mut reader = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .from_reader(run.stdout.as_bytes());

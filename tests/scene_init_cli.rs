@@ -1,4 +1,4 @@
-//! `irpol scene init` through the binary (issue 16): the starter scene renders as written, from
+//! `irpol scene init` through the binary: the starter scene renders as written, from
 //! the folder it is written into, and a second init never overwrites it.
 
 mod common;

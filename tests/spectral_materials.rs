@@ -1,4 +1,4 @@
-//! Spectral materials (issue 13, docs/design.md §1.9): a material whose n, k, ρ_d are tables over
+//! Spectral materials (docs/design.md §1.9): a material whose n, k, ρ_d are tables over
 //! wavelength is the pBRDF of SCATMECH at each wavelength; the shipped silicate_glass set (made
 //! with SCATMECH from a Lorentz law, scripts/make_measurements.py) is recovered by the joint fit
 //! and its Lorentz law found; bad spectral input is refused on one line.

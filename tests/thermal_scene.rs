@@ -1,4 +1,4 @@
-//! The thermal model over a scene (docs/design.md §1.8, issue 12 acceptance 3–5 and 7, bad input): a
+//! The thermal model over a scene (docs/design.md §1.8: shade, convergence, energy closure, instants, bad input): a
 //! ball over a ground plane and a thin plate high above it, on a clear midsummer day in Munich.
 
 mod common;

@@ -1,4 +1,4 @@
-//! Acceptance tests of the thermal core (docs/design.md §1.8, issue 12): analytic solutions, energy
+//! Acceptance tests of the thermal core (docs/design.md §1.8): analytic solutions, energy
 //! closure, convergence in time and space, and physical sanity. Run with `--nocapture` to see the
 //! measured errors and the solver speed.
 

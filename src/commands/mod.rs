@@ -90,7 +90,7 @@ impl ModelArgs {
         Ok(Pbrdf::new(
             distribution,
             // One default everywhere (fit, eval, emissivity, inline scene materials): Smith, the
-            // energy-conserving choice (issue 16 item 5).
+            // energy-conserving choice.
             shadowing.unwrap_or(Shadowing::Smith),
             index,
             self.rho.unwrap_or(0.0),

@@ -1,5 +1,5 @@
-//! `irpol scene init`: writes a commented starter scene (issue 16: the scene format was
-//! undiscoverable). The scene is a procedural sphere on a procedural plane with inline materials,
+//! `irpol scene init`: writes a commented starter scene, so that the
+//! scene format can be discovered. The scene is a procedural sphere on a procedural plane with inline materials,
 //! so it renders as written from whatever folder it lands in, with no mesh or material library.
 
 use std::io::Write;

@@ -1,4 +1,4 @@
-//! Fitting pBRDF models to Mueller-matrix measurements (docs/design.md §3, `src/fit/`; issue 3).
+//! Fitting pBRDF models to Mueller-matrix measurements (docs/design.md §3, `src/fit/`).
 //!
 //! A [`MeasurementSet`](crate::measure::MeasurementSet) is fitted by weighted least squares over
 //! every Mueller element it holds ([`objective`](Objective)), with the weights from the file's

@@ -1,4 +1,4 @@
-//! The weighted least-squares objective (issue 3): normalized residuals
+//! The weighted least-squares objective: normalized residuals
 //! r = (F_model − F_measured)/σ over every Mueller element present, and the cost Σ r² = χ², or
 //! Σ ρ(r) with a [`RobustLoss`]. The model is the pBRDF of `pbrdf` (docs/design.md §1.3); nothing here
 //! re-derives physics. One evaluation builds the model once, computes the shadowing factor once

@@ -8,7 +8,7 @@ use super::parameters::Parameter;
 use super::stages::{ConvergenceHistory, Optimizer, Stage};
 use rayon::prelude::*;
 
-/// Settings of every stage (the defaults suit the 3–5 parameter fits of issue 3).
+/// Settings of every stage (the defaults suit fits of 3–5 parameters).
 #[derive(Clone, Debug, PartialEq)]
 pub struct OptimizerSettings {
     /// The GA when a local stage follows it.

@@ -25,7 +25,7 @@ pub struct FitOutcome {
     pub comparison: Option<ModelComparison>,
 }
 
-/// Fits one measurement (issue 3): each requested distribution (both in parallel when
+/// Fits one measurement: each requested distribution (both in parallel when
 /// `options.distribution` is `None`), keeps the one with the lower AIC and records the other as
 /// the alternative. Deterministic for a given `options.seed`.
 pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<FitOutcome, FitError> {
@@ -87,7 +87,7 @@ pub(super) fn names(parameters: &[Parameter]) -> Vec<String> {
     parameters.iter().map(|p| p.name().to_owned()).collect()
 }
 
-/// The chosen family's parameters held fixed, with their values (issue 16 item 8: `--free` fixes
+/// The chosen family's parameters held fixed, with their values (`--free` fixes
 /// the others, and the record and the summary line say at what).
 fn fixed_values(chosen: &ModelFit) -> BTreeMap<String, f64> {
     Parameter::ALL

@@ -1,5 +1,5 @@
 //! One-sided profile-likelihood bounds for parameters the data do not determine, or bound from
-//! one side only (issue 16 item 3).
+//! one side only.
 //!
 //! Where the linearized covariance of [`super::uncertainty`] fails, its 1-σ error means nothing: at
 //! k = 0 without circular elements the linear Mueller elements are even in k, so ∂F/∂k = 0 and

@@ -1,4 +1,4 @@
-//! `#` comments that explain a material TOML to whoever opens it (issue 16 item 11): a line
+//! `#` comments that explain a material TOML to whoever opens it: a line
 //! above each key of the fixed tables, with its unit and meaning, and a block above each table.
 //! Tables whose keys vary (per Mueller element, per parameter) carry only their block. The
 //! comments are added to the serialized document with `toml_edit`, so the values are exactly

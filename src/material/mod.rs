@@ -149,7 +149,7 @@ pub struct FitRecord {
     pub at_bound: Vec<String>,
     /// One-sided profile-likelihood bounds of the parameters whose 1-σ `uncertainty` does not
     /// describe what the data allow: the undetermined ones, and those the data bound from one
-    /// side only (a linear 95 % interval reaching an end of the search interval; issue 16 item 3).
+    /// side only (a linear 95 % interval reaching an end of the search interval).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub profile_bounds: BTreeMap<String, ConfidenceBound>,
     /// A spectral fit's 1-σ errors of the per-wavelength parameters (`n`, `k`, `rho_d`), one per
@@ -483,7 +483,7 @@ mod tests {
         assert_eq!(list_library(dir.path()).unwrap().len(), 1);
     }
 
-    /// Issue 16 item 11: a written material explains each field in `#` comments, and the
+    /// A written material explains each field in `#` comments, and the
     /// comments change nothing that is read back.
     #[test]
     fn written_files_explain_every_field_and_read_back_unchanged() {

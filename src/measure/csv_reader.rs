@@ -593,7 +593,7 @@ mod tests {
         assert_eq!(set.wavelength_um, 8.0);
     }
 
-    /// Issue 16 item 2: in-plane scans are written −80…80°; θ_r < 0 is the detector across the
+    /// In-plane scans are written −80…80°; θ_r < 0 is the detector across the
     /// normal, whatever the column order, with one note for the file.
     #[test]
     fn signed_detector_angles_are_read_across_the_normal() {

@@ -307,7 +307,7 @@ mod tests {
     #[test]
     fn lwir_band_radiance_matches_reference_values() {
         let band = Band::lwir();
-        // Issue 2 reference values (CODATA 2018, R = 1).
+        // Reference band radiances (CODATA 2018, R = 1).
         assert!(
             (band.radiance(300.0) - 54.93346).abs() < 5e-5,
             "{}",

@@ -39,7 +39,7 @@ enum Bar {
 }
 
 /// Fractions of the panel's pixels below and above its colour range, drawn in the map's
-/// under/over colours (issue 16 item 4: a clip is shown, never silent).
+/// under/over colours (a clip is shown, never silent).
 #[derive(Clone, Copy, Default)]
 struct Clipped {
     below: f64,

@@ -1,4 +1,4 @@
-//! Ground truth for users who train or validate algorithms (issue 16 item 12): per pixel the
+//! Ground truth for users who train or validate algorithms: per pixel the
 //! object and part seen, the depth, the world normal, the surface temperature and the apparent
 //! (brightness) temperature, plus the camera, band and units as metadata (in `summary.json` and
 //! in every TIFF's ImageDescription tag and the EXR header).

@@ -233,9 +233,9 @@ pub struct RenderSummary {
     /// The instant of the thermal run shown (`render --time`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub thermal_instant: Option<crate::scene::ThermalInstant>,
-    /// Probable mistakes noticed while loading and rendering (issue 16 item 7).
+    /// Probable mistakes noticed while loading and rendering.
     pub warnings: Vec<String>,
-    /// Intrinsics and pose (ground truth, issue 16 item 12).
+    /// Intrinsics and pose (ground truth).
     pub camera: CameraSummary,
     /// What the IDs of `object_id.tif` and `part_id.tif` are.
     pub ids: IdMaps,

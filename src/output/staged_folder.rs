@@ -1,4 +1,4 @@
-//! An output folder replaced as a whole (issue 15: a render's outputs change together or not at
+//! An output folder replaced as a whole (a render's outputs change together or not at
 //! all). Files are written into a hidden staging folder beside the target,
 //! `.<name>.irpol-staging-<pid>`, and the finished folder is swapped with the target in one
 //! `renameat2(RENAME_EXCHANGE)` (Linux; a plain rename where there is no target yet), so a reader

@@ -96,7 +96,7 @@ pub struct ThermalSummary {
     #[serde(skip_deserializing)]
     pub stats: SolveStats,
     pub seconds: f64,
-    /// Probable mistakes noticed while loading the scene (issue 16 item 7).
+    /// Probable mistakes noticed while loading the scene.
     #[serde(default)]
     pub warnings: Vec<String>,
     pub files: Vec<String>,

@@ -1,4 +1,4 @@
-//! A division-of-focal-plane (DoFP) polarization camera (issue 16 item 9): every pixel has its own
+//! A division-of-focal-plane (DoFP) polarization camera: every pixel has its own
 //! wire-grid polarizer, repeating over 2×2 superpixels, so each pixel records one of I0, I45, I90,
 //! I135 and the other three must be interpolated ("demosaicked") before Stokes images exist.
 //!

@@ -22,7 +22,7 @@ pub struct StokesImage {
     pub recorded_polarizers: Vec<[f32; 4]>,
 }
 
-/// The visible point at a pixel, for users who train or validate algorithms (issue 16 item 12).
+/// The visible point at a pixel, for users who train or validate algorithms.
 /// Single precision: these become 32-bit float images.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SurfaceTruth {

@@ -246,7 +246,7 @@ pub struct RenderConfig {
     pub preview: PreviewConfig,
 }
 
-/// `[render.preview]` (issue 16 item 4): how the PNG previews map values to colours. The data
+/// `[render.preview]`: how the PNG previews map values to colours. The data
 /// files (TIFF, EXR) are never affected.
 #[derive(Debug, Deserialize, Clone, Default, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -358,7 +358,7 @@ pub struct InlineMaterialConfig {
     pub k: f64,
     #[serde(default)]
     pub rho_d: f64,
-    /// Default Smith, as everywhere in irpol (issue 16 item 5).
+    /// Default Smith, as everywhere in irpol.
     #[serde(default = "smith")]
     pub shadowing: crate::pbrdf::Shadowing,
 }

@@ -237,7 +237,7 @@ fn area_normal(face: &RawFace, positions: &[Vector3<f64>]) -> Vector3<f64> {
     (b - a).cross(&(c - a))
 }
 
-/// Faces kept to those with an area (issue 16 item 6: one degenerate face in a scanned mesh is
+/// Faces kept to those with an area (one degenerate face in a scanned mesh is
 /// common and should not reject the whole mesh), and a warning naming the skipped ones. Refused
 /// only when no face remains.
 fn without_degenerate_faces(

@@ -162,7 +162,7 @@ pub struct Scene {
     pub thermal: Option<std::sync::Arc<thermal::ThermalSetup>>,
     /// Set when the scene is a thermal scene at an instant of its run (`thermal_scene::scene_at`).
     pub thermal_instant: Option<ThermalInstant>,
-    /// What is probably a mistake but not an error (issue 16 item 7): the binary prints each once
+    /// What is probably a mistake but not an error: the binary prints each once
     /// and `summary.json` lists them.
     pub warnings: Vec<String>,
 }
@@ -410,7 +410,7 @@ fn share_wavelength_nodes(materials: &mut [SceneMaterial], band: &Band) -> Resul
 /// night, is ~180 K; nothing a thermal camera images is colder in an irpol scene).
 const CELSIUS_SUSPECT_K: f64 = 200.0;
 
-/// Probable mistakes that are not errors (issue 16 item 7): temperatures that look like °C, inline
+/// Probable mistakes that are not errors: temperatures that look like °C, inline
 /// materials nothing uses, library materials measured outside the sensor band.
 fn likely_mistakes(config: &SceneConfig, materials: &[SceneMaterial], band: &Band) -> Vec<String> {
     let mut warnings = Vec::new();

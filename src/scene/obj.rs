@@ -5,7 +5,7 @@
 //!
 //! Own reader rather than a crate because part boundaries must keep the file's vertex indices (a
 //! vertex shared by two groups gets the average of their temperatures) and every error must name
-//! its line: `tobj` (considered for issue 15) re-indexes vertices per model and its `LoadError`
+//! its line: `tobj` re-indexes vertices per model and its `LoadError`
 //! variants (`PositionParseError`, `FaceParseError`, …) carry no line or column.
 
 use super::mesh::{FaceOrigin, RawFace, RawMesh};

@@ -1,4 +1,4 @@
-//! Temperatures from a thermal model (docs/design.md §1.8, issue 12): per-vertex 1-D conduction through a
+//! Temperatures from a thermal model (docs/design.md §1.8): per-vertex 1-D conduction through a
 //! layer stack with the front surface energy balance. This is the numerical core; weather, the sun
 //! and scenes feed it numbers per step.
 //!

@@ -1,4 +1,4 @@
-//! Temperatures of a scene over time (docs/design.md §1.8, issue 12): the thermal model of `thermal`
+//! Temperatures of a scene over time (docs/design.md §1.8): the thermal model of `thermal`
 //! applied to every shading vertex of the parts that have a layer stack, with the sky and sun each
 //! vertex sees from the ray tracer, and the scene rebuilt at an instant of the run for rendering.
 //!

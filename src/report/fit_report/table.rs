@@ -692,7 +692,7 @@ mod tests {
         assert_eq!(cells("cost χ²").0[1], "18.00");
     }
 
-    /// Issue 16 item 10: no text of the table overlaps another or leaves the panel, whatever the
+    /// No text of the table overlaps another or leaves the panel, whatever the
     /// labels' lengths (fixed column stops let "cost, huber(1.5)" run into its value), and a
     /// panel too small for the full size shrinks the font instead of cutting rows off.
     #[test]
