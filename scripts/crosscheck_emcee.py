@@ -1,4 +1,4 @@
-"""Cross-check of irpol's fit uncertainties against an MCMC posterior (emcee), issue 3.
+"""Cross-check of irpol's fit uncertainties against an MCMC posterior (emcee).
 
     .venv/bin/python scripts/crosscheck_emcee.py [--irpol PATH] [--file measurements/paper_paint.csv ...]
 

@@ -1,4 +1,4 @@
-"""Cross-check of `irpol fit` against NLopt on an independent numpy form of the model (issue 3).
+"""Cross-check of `irpol fit` against NLopt on an independent numpy form of the model.
 
     .venv/bin/python scripts/crosscheck_nlopt.py [--irpol PATH] [--files measurements/*.csv]
 
