@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""irpol's polarized path integrator against Mitsuba 3's polarized path tracer against Mitsuba 3.
+"""irpol's polarized path integrator against Mitsuba 3's polarized path tracer.
 
 Run by hand (not in CI); it needs Mitsuba 3 (see scripts/mitsuba_requirements.txt) and a release
 build of irpol:
