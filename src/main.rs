@@ -191,7 +191,8 @@ enum Command {
         #[arg(long = "dir", conflicts_with = "dir", hide = true)]
         dir_flag: Option<PathBuf>,
     },
-    /// Runs the main job on shipped defaults and prints where everything went.
+    /// Runs the main job on shipped defaults (fit the shipped measurements, render the car and
+    /// its day) into out/demo/, and prints where everything went.
     Demo,
 }
 
@@ -723,15 +724,22 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The demo's own folder: everything it writes goes here (ignored by git), so a fresh clone stays
+/// clean and the shipped library `fits/` is never rewritten (a fit's last digits differ between
+/// CPUs, through the system math library's CPU-specific exp/log).
+const DEMO_OUT: &str = "out/demo";
+
 fn demo() -> anyhow::Result<()> {
+    let out = PathBuf::from(DEMO_OUT);
     let (measurements, fits, reports) = (
         PathBuf::from("measurements"),
-        PathBuf::from("fits"),
-        PathBuf::from("reports"),
+        out.join("fits"),
+        out.join("reports"),
     );
     // The demo works on the repository's shipped files; anywhere else say what it needs.
     let needed = [
         "measurements",
+        "fits",
         "scenes/car.toml",
         "scenes/car.obj",
         "scenes/car_day.toml",
@@ -748,8 +756,9 @@ fn demo() -> anyhow::Result<()> {
         );
     }
     say!(
-        "irpol demo: fit the shipped measurements in {}",
-        measurements.display()
+        "irpol demo: fit the shipped measurements in {} (into {})",
+        measurements.display(),
+        fits.display()
     );
     fit_and_summarize(&[measurements], &FitOptions::default(), &fits, &reports)?;
     say!("the paper's model figures:");
@@ -758,11 +767,22 @@ fn demo() -> anyhow::Result<()> {
             say!("  wrote {}", path.display());
         }
     }
-    say!("the car scene, with the library just fitted:");
-    render_and_summarize(Path::new("scenes/car.toml"), None)?;
+    say!("the car scene, with the shipped library (fits/):");
+    render_and_summarize(Path::new("scenes/car.toml"), Some(out.join("car")))?;
+    demo_day(&out)?;
+    say!(
+        "open {0}/reports/index.html for the fits, {0}/car/composite.png for the imagery, \
+         {0}/car_day_thermal/temperatures.png and {0}/car_day/preview.gif for the day",
+        out.display()
+    );
+    Ok(())
+}
+
+/// The demo's thermal day: the car's temperatures through a clear summer day, rendered every 3 h.
+fn demo_day(out: &Path) -> anyhow::Result<()> {
     let day = Path::new("scenes/car_day.toml");
     say!("the car through a clear summer day, temperatures from the thermal model:");
-    let (thermal_out, render_out) = (thermal_output_dir(day), default_output_dir(day));
+    let (thermal_out, render_out) = (out.join("car_day_thermal"), out.join("car_day"));
     let (summary, renders) = run_thermal_and_render(
         day,
         &thermal_out,
@@ -772,9 +792,5 @@ fn demo() -> anyhow::Result<()> {
     )?;
     report_thermal(day, &thermal_out, &summary);
     report_instants(day, &render_out, &renders);
-    say!(
-        "open reports/index.html for the fits, out/car/composite.png for the imagery, \
-         out/car_day_thermal/temperatures.png and out/car_day/preview.gif for the day"
-    );
     Ok(())
 }

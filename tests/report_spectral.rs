@@ -82,7 +82,10 @@ fn check_files(outcome: &SpectralFitOutcome, out: &Path, files: &[(PathBuf, Vec<
 #[test]
 fn a_spectral_report_is_a_figure_its_svg_and_one_fit_report_per_wavelength() {
     let outcome = fit_silicate(Dispersion::Table);
-    let out = Path::new("reports");
+    // A folder that does not exist, so that "nothing is written" holds whatever the working
+    // tree holds (the demo writes reports too).
+    let scratch = tempfile::tempdir().unwrap();
+    let out = &scratch.path().join("reports");
     let report = encode_spectral_report(&outcome, out).unwrap();
     check_files(&outcome, out, &report.files);
     assert!(
@@ -95,7 +98,8 @@ fn a_spectral_report_is_a_figure_its_svg_and_one_fit_report_per_wavelength() {
 fn a_lorentz_fit_reports_its_law_and_the_table_it_was_compared_with() {
     let outcome = fit_silicate(Dispersion::Lorentz(1));
     assert!(outcome.table.is_some());
-    let out = Path::new("reports");
+    let scratch = tempfile::tempdir().unwrap();
+    let out = &scratch.path().join("reports");
     let report = encode_spectral_report(&outcome, out).unwrap();
     check_files(&outcome, out, &report.files);
     let svg = String::from_utf8(report.files[1].1.clone()).unwrap();
