@@ -336,7 +336,7 @@ fn the_summary_names_band_integrated_materials() {
     assert!(band_nodes("m").is_null());
 }
 
-/// The Monte Carlo parts' spectral approximation (docs/design.md §1.7, §1.9; README "Band rendering").
+/// The Monte Carlo parts' spectral approximation (docs/design.md §1.7, §1.9; docs/spectral.md "Band rendering").
 /// The correction at a band material takes the light of a surface hit as its emission, exact
 /// node by node, plus what it reflects, modelled as a uniform grey source reflected by the hit;
 /// the environment grey at its brightness temperature; the sun a 5772 K blackbody. Checked
@@ -424,7 +424,7 @@ fn the_monte_carlo_spectral_approximation_is_small() {
 }
 
 /// The thermal model (docs/design.md §1.8) takes a spectral material's default emissivity as its
-/// hemispherical emissivity Planck-weighted at 300 K over its table (README "Band rendering").
+/// hemispherical emissivity Planck-weighted at 300 K over its table (docs/spectral.md "Band rendering").
 #[test]
 fn a_spectral_material_has_a_planck_weighted_thermal_emissivity() {
     let dir = tempfile::tempdir().unwrap();

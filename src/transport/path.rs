@@ -26,7 +26,7 @@
 //! as a 5772 K blackbody through the band; the environment a correction replaces, grey at its
 //! brightness temperature; the light of a surface hit as its emission, node by node, plus what
 //! it reflects, modelled as a uniform grey source reflected by the hit (`band_scattering`).
-//! Only the hit's emission is exact: the approximation is measured in the README ("Band
+//! Only the hit's emission is exact: the approximation is measured in docs/spectral.md ("Band
 //! rendering"). A ray that escapes still adds exactly zero (no hit, no correction).
 
 use super::accel::Accelerator;
