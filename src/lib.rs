@@ -5,6 +5,7 @@
 //! [`scene`] → [`transport`] → [`render`] → [`output`]. The physics lives in [`optics`] and
 //! [`pbrdf`]; everything else calls it.
 
+pub mod atomic;
 pub mod commands;
 pub mod elementary;
 pub mod emitter;
@@ -15,6 +16,7 @@ pub mod measure;
 pub mod optics;
 pub mod output;
 pub mod pbrdf;
+pub mod plot_style;
 pub mod progress;
 pub mod render;
 pub mod report;

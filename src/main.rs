@@ -5,6 +5,7 @@ mod cli;
 
 use clap::{Args, Parser, Subcommand};
 use cli::progress::TerminalProgress;
+use irpol::atomic::staging_folder;
 use irpol::commands::evaluate::{
     read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
 };
@@ -19,7 +20,6 @@ use irpol::commands::{parse_sweep, ModelArgs};
 use irpol::emitter::parse_time_utc;
 use irpol::fit::{FitOptions, MaterialFit};
 use irpol::material::MaterialModel;
-use irpol::output::staged_folder::staging_folder;
 use irpol::output::thermal::ThermalSummary;
 use irpol::report::fit_report::rebuild_report;
 use irpol::report::index::write_library_index;
@@ -443,7 +443,13 @@ fn fit_and_summarize(
     reports_dir: &Path,
 ) -> anyhow::Result<()> {
     cli::signals::remove_on_interrupt(vec![], vec![fits_dir.to_owned(), reports_dir.to_owned()]);
-    let written = fit_and_write(inputs, options, fits_dir, reports_dir, true)?;
+    let written = fit_and_write(
+        inputs,
+        options,
+        fits_dir,
+        reports_dir,
+        &TerminalProgress::counting(),
+    )?;
     for outcome in &written.outcomes {
         note_all(&outcome.notes());
     }

@@ -44,7 +44,13 @@ fn every_input_of_a_folder_is_fitted_and_written_to_the_library() {
     write_synthetic(inputs.path(), "glossy", 0.08);
     let library = tempfile::tempdir().unwrap();
     let fits = library.path().join("fits");
-    let outcomes = fit_files(&[inputs.path().to_owned()], &options(), &fits, true).unwrap();
+    let outcomes = fit_files(
+        &[inputs.path().to_owned()],
+        &options(),
+        &fits,
+        &irpol::progress::Silent,
+    )
+    .unwrap();
     // Folder files come sorted by name.
     let names: Vec<&str> = outcomes
         .iter()
@@ -79,7 +85,7 @@ fn a_bad_input_fails_the_run_before_anything_is_written() {
     .unwrap();
     let library = tempfile::tempdir().unwrap();
     let fits = library.path().join("fits");
-    let error = fit_files(&[good, bad], &options(), &fits, false).unwrap_err();
+    let error = fit_files(&[good, bad], &options(), &fits, &irpol::progress::Silent).unwrap_err();
     assert!(matches!(error, FitError::Read(_)), "{error}");
     assert!(error.to_string().contains("bad.csv:3:"), "{error}");
     assert!(!fits.exists());
@@ -96,7 +102,13 @@ fn a_bad_input_fails_the_run_before_anything_is_written() {
         let header = format!("# wavelength_um: {wavelength}\n# distribution: {distribution}\n");
         std::fs::write(path, text.replace("# wavelength_um: 10\n", &header)).unwrap();
     }
-    let error = fit_files(&[first, second], &options(), &fits, false).unwrap_err();
+    let error = fit_files(
+        &[first, second],
+        &options(),
+        &fits,
+        &irpol::progress::Silent,
+    )
+    .unwrap_err();
     assert!(matches!(error, FitError::Measurement { .. }), "{error}");
     assert!(
         error
@@ -112,11 +124,11 @@ fn a_bad_input_fails_the_run_before_anything_is_written() {
     invalid.distribution = Some(DistributionKind::Cauchy);
     invalid.fixed.insert(irpol::fit::Parameter::Q, 1.2);
     let good = inputs.path().join("good.csv");
-    let error = fit_files(&[good], &invalid, &fits, false).unwrap_err();
+    let error = fit_files(&[good], &invalid, &fits, &irpol::progress::Silent).unwrap_err();
     assert!(matches!(error, FitError::Options(_)), "{error}");
     assert!(!fits.exists());
     assert!(matches!(
-        fit_files(&[], &options(), &fits, false),
+        fit_files(&[], &options(), &fits, &irpol::progress::Silent),
         Err(FitError::Options(_))
     ));
 }

@@ -17,7 +17,7 @@ fn fit_silicate(dispersion: Dispersion) -> SpectralFitOutcome {
         dispersion,
         ..FitOptions::default()
     };
-    let mut fits = fit_inputs(&[csv], &options, false).unwrap();
+    let mut fits = fit_inputs(&[csv], &options, &irpol::progress::Silent).unwrap();
     assert_eq!(fits.len(), 1);
     match fits.remove(0) {
         MaterialFit::Spectral(outcome) => *outcome,

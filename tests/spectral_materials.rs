@@ -161,7 +161,10 @@ fn fit_silicate(inputs: &[PathBuf], dispersion: Dispersion) -> Box<irpol::fit::S
         dispersion,
         ..FitOptions::default()
     };
-    match fit_inputs(inputs, &options, false).unwrap().remove(0) {
+    match fit_inputs(inputs, &options, &irpol::progress::Silent)
+        .unwrap()
+        .remove(0)
+    {
         MaterialFit::Spectral(outcome) => outcome,
         MaterialFit::Grey(_) => panic!("the silicate set is spectral"),
     }
@@ -299,9 +302,13 @@ fn ambiguous_spectral_folders_are_refused_naming_files() {
     };
     file("a_8um.csv", "", 8.0);
     file("a_9um.csv", "", 9.0);
-    let message = fit_inputs(&[dir.path().to_path_buf()], &FitOptions::default(), false)
-        .unwrap_err()
-        .to_string();
+    let message = fit_inputs(
+        &[dir.path().to_path_buf()],
+        &FitOptions::default(),
+        &irpol::progress::Silent,
+    )
+    .unwrap_err()
+    .to_string();
     assert!(
         message.contains("a_8um.csv") && message.contains("has no '# material:' line"),
         "{message}"
@@ -314,9 +321,13 @@ fn ambiguous_spectral_folders_are_refused_naming_files() {
         "# material: a\n# distribution: gaussian\n",
         9.0,
     );
-    let message = fit_inputs(&[dir.path().to_path_buf()], &FitOptions::default(), false)
-        .unwrap_err()
-        .to_string();
+    let message = fit_inputs(
+        &[dir.path().to_path_buf()],
+        &FitOptions::default(),
+        &irpol::progress::Silent,
+    )
+    .unwrap_err()
+    .to_string();
     assert!(
         message.contains("a_9um.csv")
             && message.contains("a_8um.csv")

@@ -46,7 +46,7 @@ pub fn fit_materials(
     let paths: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     let options = flags.options().map_err(|e| raised(e, &[]))?;
     let outcomes = py
-        .detach(|| fit_inputs(&inputs, &options, false))
+        .detach(|| fit_inputs(&inputs, &options, &irpol::progress::Silent))
         .map_err(|e| raised(e.into(), &paths))?;
     outcomes.iter().map(|o| outcome_dict(py, o)).collect()
 }

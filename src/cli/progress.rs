@@ -10,14 +10,47 @@ use std::sync::Mutex;
 pub struct TerminalProgress {
     bar: Mutex<Option<ProgressBar>>,
     enabled: bool,
+    /// Whether the bar counts named items ("fitting ▕…▏ 2/5 paint") instead of a percentage.
+    counting: bool,
 }
 
 impl TerminalProgress {
+    /// Bars with the percentage done and the time taken.
     pub fn new() -> TerminalProgress {
         TerminalProgress {
             bar: Mutex::new(None),
             enabled: std::io::stderr().is_terminal(),
+            counting: false,
         }
+    }
+
+    /// Bars that count items and name the one under way (`irpol fit`'s materials).
+    pub fn counting() -> TerminalProgress {
+        TerminalProgress {
+            counting: true,
+            ..TerminalProgress::new()
+        }
+    }
+
+    fn template(&self, stage: &str) -> String {
+        if self.counting {
+            format!("{stage} {{bar:30}} {{pos}}/{{len}} {{msg}}")
+        } else {
+            format!("{stage} {{bar:40}} {{percent:>3}}% {{elapsed}}")
+        }
+    }
+
+    fn with_bar(&self, act: impl FnOnce(&ProgressBar)) {
+        if let Ok(slot) = self.bar.lock() {
+            if let Some(bar) = slot.as_ref() {
+                act(bar);
+            }
+        }
+    }
+
+    /// Takes the stage's bar out (it is finished with).
+    fn take_bar(&self) -> Option<ProgressBar> {
+        self.bar.lock().ok().and_then(|mut slot| slot.take())
     }
 }
 
@@ -27,8 +60,7 @@ impl Progress for TerminalProgress {
             return;
         }
         let bar = ProgressBar::new(total);
-        let template = format!("{stage} {{bar:40}} {{percent:>3}}% {{elapsed}}");
-        if let Ok(style) = ProgressStyle::with_template(&template) {
+        if let Ok(style) = ProgressStyle::with_template(&self.template(stage)) {
             bar.set_style(style);
         }
         if let Ok(mut slot) = self.bar.lock() {
@@ -36,19 +68,23 @@ impl Progress for TerminalProgress {
         }
     }
 
+    fn message(&self, text: &str) {
+        self.with_bar(|bar| bar.set_message(text.to_owned()));
+    }
+
     fn advance(&self, steps: u64) {
-        if let Ok(slot) = self.bar.lock() {
-            if let Some(bar) = slot.as_ref() {
-                bar.inc(steps);
-            }
-        }
+        self.with_bar(|bar| bar.inc(steps));
     }
 
     fn end(&self) {
-        if let Ok(mut slot) = self.bar.lock() {
-            if let Some(bar) = slot.take() {
-                bar.finish_and_clear();
-            }
+        if let Some(bar) = self.take_bar() {
+            bar.finish_and_clear();
+        }
+    }
+
+    fn abandon(&self) {
+        if let Some(bar) = self.take_bar() {
+            bar.abandon();
         }
     }
 }

@@ -10,7 +10,7 @@ use std::sync::atomic::Ordering;
 
 /// Watches for SIGINT/SIGTERM on a background thread; on one, removes the folders `staging` and,
 /// in each folder of `temporaries_in`, this process's staged files (`.<name>.<pid>.tmp`, see
-/// `irpol::commands::output_set`), then exits.
+/// `irpol::atomic`), then exits.
 pub fn remove_on_interrupt(staging: Vec<PathBuf>, temporaries_in: Vec<PathBuf>) {
     let Ok(mut signals) = Signals::new([SIGINT, SIGTERM]) else {
         return;

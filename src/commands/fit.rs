@@ -3,7 +3,7 @@
 //! before the first byte is written, so a fit or a report that fails leaves the library and the
 //! reports exactly as they were; the library entries are renamed into place last.
 
-use super::output_set::OutputSet;
+use crate::atomic::OutputSet;
 use crate::fit::{
     fit_inputs, parse_parameter_list, parse_parameter_values, Dispersion, DistributionKind,
     FitOptions, MaterialFit, Optimizer, RobustLoss,
@@ -104,7 +104,7 @@ pub fn fit_and_write(
     options: &FitOptions,
     fits_dir: &Path,
     reports_dir: &Path,
-    progress: bool,
+    progress: &dyn crate::progress::Progress,
 ) -> anyhow::Result<FitWritten> {
     let outcomes = fit_inputs(inputs, options, progress)?;
     let mut entries = Vec::new();

@@ -3,7 +3,6 @@
 
 pub mod evaluate;
 pub mod fit;
-pub mod output_set;
 pub mod render;
 pub mod scene_init;
 pub mod sun;

@@ -1,7 +1,7 @@
 //! `irpol render`: scene file in, output files out; for a scene with `[thermal]`, at instants of
 //! its thermal run (docs/design.md §2.6).
 
-use crate::material::write_atomically;
+use crate::atomic::write_atomically;
 use crate::output::{write_outputs, RenderSummary};
 use crate::progress::Progress;
 use crate::render::{render, RenderError};
@@ -231,11 +231,11 @@ fn animated_preview(renders: &[TimedRender]) -> anyhow::Result<Vec<u8>> {
 fn caption_strip(text: &str, width: u32) -> anyhow::Result<RgbaImage> {
     use plotters::prelude::*;
     const HEIGHT: u32 = 26;
-    crate::report::register_fonts();
+    crate::plot_style::register_fonts();
     let mut rgb = vec![255u8; (width * HEIGHT * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (width, HEIGHT)).into_drawing_area();
-        let style = (crate::report::FONT, 17).into_font().color(&BLACK);
+        let style = (crate::plot_style::FONT, 17).into_font().color(&BLACK);
         root.draw(&Text::new(text.to_owned(), (8, 4), style))
             .map_err(|e| anyhow::anyhow!("cannot draw the preview caption: {e}"))?;
         root.present()

@@ -2,7 +2,7 @@
 //! scene format can be discovered. The scene is a procedural sphere on a procedural plane with inline materials,
 //! so it renders as written from whatever folder it lands in, with no mesh or material library.
 
-use std::io::Write;
+use crate::atomic::write_new_file;
 use std::path::{Path, PathBuf};
 
 /// The starter scene's text (docs/scenes.md describes every key it uses).
@@ -42,29 +42,6 @@ pub fn write_starter_scene(path: &Path) -> Result<(), SceneInitError> {
             }
         }
     })
-}
-
-/// Writes `bytes` to a temporary sibling, then hard-links it to `path`. Unlike the rename of
-/// [`crate::material::write_atomically`], a link never replaces an existing file, so a file that
-/// appears between the check and the write (another `scene init`) is not overwritten either.
-fn write_new_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)?;
-    let name = path
-        .file_name()
-        .map_or("scene.toml".into(), |n| n.to_string_lossy().into_owned());
-    let temp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let written = (|| {
-        let mut file = std::fs::File::create(&temp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::hard_link(&temp, path)
-    })();
-    let _ = std::fs::remove_file(&temp);
-    written
 }
 
 #[cfg(test)]

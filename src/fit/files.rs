@@ -12,8 +12,7 @@ use crate::measure::{
     collect_measurement_files, merge_repeat_measurements, read_measurement_sets, MeasurementSet,
     SAME_WAVELENGTH_UM,
 };
-use indicatif::{ProgressBar, ProgressStyle};
-use std::io::IsTerminal;
+use crate::progress::Progress;
 use std::path::{Path, PathBuf};
 
 /// One material's fit: of one wavelength, or jointly of several (a spectral set, docs/design.md §1.9).
@@ -50,13 +49,13 @@ impl MaterialFit {
 ///
 /// Nothing is written unless every input reads, validates and fits: malformed files, options
 /// that make no valid model, and files of one material that cannot be merged as repeat
-/// measurements are refused up front (those that can are merged, with a note in the set). A
-/// progress bar is drawn on stderr when `progress` is set and stderr is a terminal.
+/// measurements are refused up front (those that can are merged, with a note in the set).
+/// `progress` hears of each material as it is fitted (the binary draws a bar from it).
 pub fn fit_files(
     inputs: &[PathBuf],
     options: &FitOptions,
     fits_dir: &Path,
-    progress: bool,
+    progress: &dyn Progress,
 ) -> Result<Vec<MaterialFit>, FitError> {
     let outcomes = fit_inputs(inputs, options, progress)?;
     for outcome in &outcomes {
@@ -73,42 +72,25 @@ pub fn fit_files(
 pub fn fit_inputs(
     inputs: &[PathBuf],
     options: &FitOptions,
-    progress: bool,
+    progress: &dyn Progress,
 ) -> Result<Vec<MaterialFit>, FitError> {
     let materials = read_all(inputs)?;
     validate_options(options)?;
 
-    let bar = (progress && std::io::stderr().is_terminal()).then(|| {
-        let bar = ProgressBar::new(materials.len() as u64);
-        bar.set_style(
-            ProgressStyle::with_template("fitting {bar:30} {pos}/{len} {msg}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        bar
-    });
+    progress.begin("fitting", materials.len() as u64);
     let mut outcomes = Vec::with_capacity(materials.len());
     for sets in materials {
-        if let Some(bar) = &bar {
-            bar.set_message(sets[0].material.clone());
-        }
+        progress.message(&sets[0].material);
         let outcome = if sets.len() == 1 {
             fit_measurement(&sets[0], options).map(|o| MaterialFit::Grey(Box::new(o)))
         } else {
             fit_spectral(sets, options, options.dispersion)
                 .map(|o| MaterialFit::Spectral(Box::new(o)))
         };
-        if let Some(bar) = &bar {
-            bar.inc(1);
-        }
-        outcomes.push(outcome.inspect_err(|_| {
-            if let Some(bar) = &bar {
-                bar.abandon();
-            }
-        })?);
+        progress.advance(1);
+        outcomes.push(outcome.inspect_err(|_| progress.abandon())?);
     }
-    if let Some(bar) = &bar {
-        bar.finish_and_clear();
-    }
+    progress.end();
     Ok(outcomes)
 }
 

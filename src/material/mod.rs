@@ -9,12 +9,12 @@ pub use spectral::{
     BandModelError, MaterialModel, OutsideTable, SpectralModel, THERMAL_EMISSIVITY_REFERENCE_K,
 };
 
+use crate::atomic::write_atomically;
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};
 use crate::text::{number, shown, shown_at_most, significant};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
@@ -396,30 +396,6 @@ pub fn list_library(dir: &Path) -> Result<Vec<(PathBuf, Material)>, MaterialErro
         .into_iter()
         .map(|p| Material::load(&p).map(|m| (p, m)))
         .collect()
-}
-
-/// Writes `bytes` to `path` through a temporary sibling and a rename (atomic on one filesystem).
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)?;
-    let file_name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let temp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut file = std::fs::File::create(&temp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&temp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&temp);
-    }
-    result
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! the SCATMECH "psps" convention, and Planck band radiance. Nothing here knows about microfacets.
 
 pub mod band_nodes;
+mod brightness;
 mod dispersion;
 pub mod frame;
 mod fresnel;
@@ -9,6 +10,7 @@ mod planck;
 mod polarization;
 
 pub use band_nodes::{SpectralMix, TableMissesBand, WavelengthNodes};
+pub use brightness::TemperatureLookup;
 pub use dispersion::{LorentzDispersion, LorentzOscillator};
 pub use frame::{rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame};
 pub use fresnel::{fresnel_amplitudes, FresnelFractions, RefractiveIndex};

@@ -7,12 +7,12 @@
 //! Text is drawn with plotters using the embedded DejaVu Sans font.
 
 use super::colormap::{cyclic, ColorMap, Lut, DIVERGING, GRAY, MASKED, SEQUENTIAL, THERMAL};
+use crate::optics::TemperatureLookup;
+use crate::plot_style::{register_fonts, FONT};
 use crate::render::film::{dolp_aop, StokesImage, BACKGROUND};
-use crate::report::{register_fonts, FONT};
 use crate::scene::config::Shading;
 use crate::scene::config::{PreviewConfig, PreviewRange, S0Colormap};
 use crate::scene::{Scene, Transport};
-use crate::transport::tables::TemperatureLookup;
 use image::ImageEncoder;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -443,102 +443,162 @@ fn draw_panel(
     img_h: usize,
 ) -> io::Result<Canvas> {
     register_fonts();
-    let font = (img_h as f64 / 24.0).clamp(11.0, 26.0);
-    let margin = 8usize;
-    let title_h = (font * 1.9).round() as usize;
-    let bar_w = ((img_w as f64 / 40.0).round() as usize).max(12);
-    let label_w = (font * 5.0).round() as usize;
-    let (width, height) = (
-        margin + img_w + margin + bar_w + 6 + label_w,
-        title_h + img_h + margin,
-    );
-    let mut canvas = Canvas::white(width, height);
+    let layout = PanelLayout::new(&panel.bar, img_w, img_h);
+    let mut canvas = Canvas::white(layout.width, layout.height);
+    draw_resampled(&mut canvas, panel, (src_w, src_h), &layout);
+    draw_colour_bar(&mut canvas, &panel.bar, &layout);
+    draw_panel_text(&mut canvas, panel, &layout)?;
+    Ok(canvas)
+}
+
+/// Where everything of a panel goes, in pixels, for an image of img_w × img_h.
+struct PanelLayout {
+    /// Text size (px) the title and tick labels are scaled from.
+    font: f64,
+    margin: usize,
+    title_h: usize,
+    img_w: usize,
+    img_h: usize,
+    bar_x: usize,
+    bar_w: usize,
+    /// Heights of the under/over caps at the top and bottom of the bar (0 without clipping).
+    cap_top: usize,
+    cap_bottom: usize,
+    gradient_h: usize,
+    width: usize,
+    height: usize,
+}
+
+impl PanelLayout {
+    fn new(bar: &Bar, img_w: usize, img_h: usize) -> PanelLayout {
+        let font = (img_h as f64 / 24.0).clamp(11.0, 26.0);
+        let margin = 8usize;
+        let title_h = (font * 1.9).round() as usize;
+        let bar_w = ((img_w as f64 / 40.0).round() as usize).max(12);
+        let label_w = (font * 5.0).round() as usize;
+        // Clipped values get a cap of the map's under/over colour at that end of the bar.
+        let cap = (img_h / 14).max(6).min(img_h / 4);
+        let (cap_top, cap_bottom) = match bar {
+            Bar::Linear { clipped, .. } => (
+                if clipped.above > 0.0 { cap } else { 0 },
+                if clipped.below > 0.0 { cap } else { 0 },
+            ),
+            Bar::Cyclic => (0, 0),
+        };
+        PanelLayout {
+            font,
+            margin,
+            title_h,
+            img_w,
+            img_h,
+            bar_x: margin + img_w + margin,
+            bar_w,
+            cap_top,
+            cap_bottom,
+            gradient_h: img_h - cap_top - cap_bottom,
+            width: margin + img_w + margin + bar_w + 6 + label_w,
+            height: title_h + img_h + margin,
+        }
+    }
+}
+
+/// The panel's image, resampled from src_w × src_h by nearest neighbour.
+fn draw_resampled(
+    canvas: &mut Canvas,
+    panel: &Panel,
+    (src_w, src_h): (usize, usize),
+    layout: &PanelLayout,
+) {
+    let (img_w, img_h) = (layout.img_w, layout.img_h);
     for y in 0..img_h {
         let sy = (y * src_h / img_h).min(src_h - 1);
         for x in 0..img_w {
             let sx = (x * src_w / img_w).min(src_w - 1);
-            canvas.set(margin + x, title_h + y, panel.colors[sy * src_w + sx]);
+            canvas.set(
+                layout.margin + x,
+                layout.title_h + y,
+                panel.colors[sy * src_w + sx],
+            );
         }
     }
-    let bar_x = margin + img_w + margin;
-    // Clipped values get a cap of the map's under/over colour at that end of the bar.
-    let cap = (img_h / 14).max(6).min(img_h / 4);
-    let (cap_top, cap_bottom) = match &panel.bar {
-        Bar::Linear { clipped, .. } => (
-            if clipped.above > 0.0 { cap } else { 0 },
-            if clipped.below > 0.0 { cap } else { 0 },
-        ),
-        Bar::Cyclic => (0, 0),
-    };
-    let gradient_h = img_h - cap_top - cap_bottom;
+}
+
+/// The colour bar beside the image: the gradient, high end on top, between the caps.
+fn draw_colour_bar(canvas: &mut Canvas, bar: &Bar, layout: &PanelLayout) {
+    let (img_h, cap_top, cap_bottom) = (layout.img_h, layout.cap_top, layout.cap_bottom);
     for y in 0..img_h {
-        let color = match &panel.bar {
+        let color = match bar {
             Bar::Linear { map, .. } if y < cap_top => map.over,
             Bar::Linear { map, .. } if y >= img_h - cap_bottom => map.under,
             bar => {
                 // Top of the gradient is the high end.
-                let t = 1.0 - ((y - cap_top) as f64 + 0.5) / gradient_h as f64;
+                let t = 1.0 - ((y - cap_top) as f64 + 0.5) / layout.gradient_h as f64;
                 match bar {
                     Bar::Linear { map, .. } => map.at(t),
                     Bar::Cyclic => cyclic(t),
                 }
             }
         };
-        for x in 0..bar_w {
-            canvas.set(bar_x + x, title_h + y, color);
+        for x in 0..layout.bar_w {
+            canvas.set(layout.bar_x + x, layout.title_h + y, color);
         }
     }
+}
 
-    let (w, h) = (width as u32, height as u32);
-    {
-        let root = BitMapBackend::with_buffer(&mut canvas.rgb, (w, h)).into_drawing_area();
-        let title = (FONT, font * 1.05)
-            .into_font()
-            .style(FontStyle::Bold)
-            .color(&BLACK);
-        root.draw_text(
-            &panel.title,
-            &title.pos(Pos::new(HPos::Left, VPos::Center)),
-            (margin as i32, title_h as i32 / 2),
-        )
-        .map_err(draw_error)?;
-        let ticks: Vec<(f64, String)> = match &panel.bar {
-            Bar::Linear { lo, hi, format, .. } => (0..5)
-                .map(|k| {
-                    let t = k as f64 / 4.0;
-                    (t, format(lo + t * (hi - lo)))
-                })
-                .collect(),
-            Bar::Cyclic => [-90, -45, 0, 45, 90]
-                .iter()
-                .enumerate()
-                .map(|(k, d)| (k as f64 / 4.0, format!("{d}°")))
-                .collect(),
-        };
-        let label = (FONT, font * 0.85)
-            .into_font()
-            .color(&BLACK)
-            .pos(Pos::new(HPos::Left, VPos::Center));
-        let x = (bar_x + bar_w) as i32;
-        let top = (title_h + cap_top) as i32;
-        for (t, text) in ticks {
-            let y = top + ((1.0 - t) * (gradient_h as f64 - 1.0)).round() as i32;
-            root.draw(&PathElement::new(vec![(x, y), (x + 4, y)], BLACK))
-                .map_err(draw_error)?;
-            root.draw_text(&text, &label, (x + 6, y))
-                .map_err(draw_error)?;
-        }
-        root.draw(&Rectangle::new(
-            [
-                (bar_x as i32, title_h as i32),
-                (x, (title_h + img_h) as i32),
-            ],
-            BLACK.stroke_width(1),
-        ))
-        .map_err(draw_error)?;
-        root.present().map_err(draw_error)?;
+/// The colour bar's tick labels at fractions 0, ¼, ½, ¾, 1 of its range.
+fn bar_ticks(bar: &Bar) -> Vec<(f64, String)> {
+    match bar {
+        Bar::Linear { lo, hi, format, .. } => (0..5)
+            .map(|k| {
+                let t = k as f64 / 4.0;
+                (t, format(lo + t * (hi - lo)))
+            })
+            .collect(),
+        Bar::Cyclic => [-90, -45, 0, 45, 90]
+            .iter()
+            .enumerate()
+            .map(|(k, d)| (k as f64 / 4.0, format!("{d}°")))
+            .collect(),
     }
-    Ok(canvas)
+}
+
+/// The title, the colour bar's ticks and labels, and its frame, drawn with plotters.
+fn draw_panel_text(canvas: &mut Canvas, panel: &Panel, layout: &PanelLayout) -> io::Result<()> {
+    let (w, h) = (canvas.width as u32, canvas.height as u32);
+    let (font, title_h) = (layout.font, layout.title_h);
+    let root = BitMapBackend::with_buffer(&mut canvas.rgb, (w, h)).into_drawing_area();
+    let title = (FONT, font * 1.05)
+        .into_font()
+        .style(FontStyle::Bold)
+        .color(&BLACK);
+    root.draw_text(
+        &panel.title,
+        &title.pos(Pos::new(HPos::Left, VPos::Center)),
+        (layout.margin as i32, title_h as i32 / 2),
+    )
+    .map_err(draw_error)?;
+    let label = (FONT, font * 0.85)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let x = (layout.bar_x + layout.bar_w) as i32;
+    let top = (title_h + layout.cap_top) as i32;
+    for (t, text) in bar_ticks(&panel.bar) {
+        let y = top + ((1.0 - t) * (layout.gradient_h as f64 - 1.0)).round() as i32;
+        root.draw(&PathElement::new(vec![(x, y), (x + 4, y)], BLACK))
+            .map_err(draw_error)?;
+        root.draw_text(&text, &label, (x + 6, y))
+            .map_err(draw_error)?;
+    }
+    root.draw(&Rectangle::new(
+        [
+            (layout.bar_x as i32, title_h as i32),
+            (x, (title_h + layout.img_h) as i32),
+        ],
+        BLACK.stroke_width(1),
+    ))
+    .map_err(draw_error)?;
+    root.present().map_err(draw_error)
 }
 
 fn draw_error<E: std::fmt::Debug>(e: E) -> io::Error {

@@ -3,9 +3,9 @@
 //! (brightness) temperature, plus the camera, band and units as metadata (in `summary.json` and
 //! in every TIFF's ImageDescription tag and the EXR header).
 
+use crate::optics::TemperatureLookup;
 use crate::render::film::{StokesImage, BACKGROUND};
 use crate::scene::Scene;
-use crate::transport::tables::TemperatureLookup;
 use serde::Serialize;
 use std::collections::BTreeMap;
 

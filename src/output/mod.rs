@@ -2,27 +2,27 @@
 //! `stokes.exr` with every channel, PNG previews with colour bars, `composite.png` (the paper's
 //! Fig. 5 layout) and `summary.json`. Every file is encoded in memory first; the set is then
 //! written into a staging folder and swapped with the output folder in one step
-//! ([`staged_folder`]), so the folder holds the complete old set or the complete new one.
+//! ([`StagedFolder`]), so the folder holds the complete old set or the complete new one.
 
 pub mod colormap;
 pub mod figure;
 pub mod ground_truth;
-pub mod staged_folder;
 pub mod thermal;
 pub mod thermal_plot;
 
+use crate::atomic::StagedFolder;
+use crate::optics::TemperatureLookup;
 use crate::render::film::{dolp_aop, polarizer, StokesImage, BACKGROUND};
+use crate::render::TableResolution;
 use crate::render::{RenderError, Rendered, Timings};
 use crate::scene::config::Shading;
 use crate::scene::{Scene, Transport};
-use crate::transport::tables::{TableResolution, TemperatureLookup};
 use ground_truth::{
     camera_summary, id_maps, truth_images, CameraSummary, FileMetadata, IdMaps, TruthData,
     TruthImage,
 };
 use rayon::prelude::*;
 use serde::Serialize;
-use staged_folder::StagedFolder;
 use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::Path;
@@ -253,34 +253,11 @@ pub fn write_outputs(
 ) -> Result<RenderSummary, RenderError> {
     let write_start = Instant::now();
     let image = &rendered.image;
-    let (w, h) = (image.width, image.height);
     let channels: Vec<(Channel, Vec<f32>)> = Channel::ALL
         .par_iter()
         .map(|&c| (c, image.channel(c)))
         .collect();
-    let previews = figure::Previews::new(scene, image);
     let camera = camera_summary(scene);
-    let mut truth = truth_images(scene, image);
-    if scene.sensor.dofp {
-        truth.extend(dofp_images(image));
-    }
-    let metadata = |file: &str, unit: &str| FileMetadata::new(scene, &camera, file, unit).json();
-
-    // Encode everything in memory, in parallel; write only when every encoding succeeded.
-    enum Job {
-        Tiff(usize),
-        StandardError,
-        Truth(usize),
-        Exr,
-        Panel(usize),
-        Composite,
-    }
-    let mut jobs: Vec<Job> = (0..channels.len()).map(Job::Tiff).collect();
-    jobs.push(Job::StandardError);
-    jobs.extend((0..truth.len()).map(Job::Truth));
-    jobs.push(Job::Exr);
-    jobs.extend((0..previews.len()).map(Job::Panel));
-    jobs.push(Job::Composite);
     let write_error = |source| RenderError::Write {
         path: out_dir.to_owned(),
         source,
@@ -288,121 +265,14 @@ pub fn write_outputs(
     // Each file goes into the staging folder as soon as it is encoded (the folder is swapped in
     // as a whole at the end), so no more than a file per thread is held in memory.
     let staged = StagedFolder::begin(out_dir).map_err(write_error)?;
-    let mut files: Vec<String> = jobs
-        .par_iter()
-        .map(|job| {
-            let (name, bytes) = match job {
-                Job::Tiff(i) => {
-                    let (channel, data) = &channels[*i];
-                    let name = format!("{}.tif", channel.name());
-                    let description = metadata(&name, channel.unit());
-                    let bytes = encode_tiff(w, h, &TruthData::Float(data.clone()), &description);
-                    (name, bytes)
-                }
-                Job::StandardError => {
-                    let data: Vec<f32> = image.standard_error.iter().map(|e| e[0] as f32).collect();
-                    let description = metadata("stderr_S0.tif", Channel::S0.unit());
-                    let bytes = encode_tiff(w, h, &TruthData::Float(data), &description);
-                    ("stderr_S0.tif".to_owned(), bytes)
-                }
-                Job::Truth(i) => {
-                    let t = &truth[*i];
-                    let bytes = encode_tiff(w, h, &t.data, &metadata(t.file, t.unit));
-                    (t.file.to_owned(), bytes)
-                }
-                Job::Exr => {
-                    let description = metadata("stokes.exr", "per channel as in the TIFFs");
-                    let bytes = encode_exr(w, h, &channels, &description);
-                    ("stokes.exr".to_owned(), bytes)
-                }
-                Job::Panel(i) => (previews.file_name(*i).to_owned(), previews.panel_png(*i)),
-                Job::Composite => ("composite.png".to_owned(), previews.composite_png()),
-            };
-            bytes
-                .and_then(|b| staged.write(&name, &b))
-                .map(|()| name.clone())
-                .map_err(|source| RenderError::Write {
-                    path: out_dir.join(&name),
-                    source,
-                })
-        })
-        .collect::<Result<_, _>>()?;
-
-    let summary_stats: Vec<ChannelSummary> = channels
-        .iter()
-        .map(|(c, data)| ChannelSummary {
-            name: c.name(),
-            unit: c.unit(),
-            object_pixels: image.object_stats(data),
-            relative_standard_error: stokes_index(*c).and_then(|j| image.relative_error(j)),
-        })
-        .collect();
-    let apparent = image.object_stats(&channels[0].1).map(|s| {
-        let lookup = TemperatureLookup::new(&scene.sensor.band, s.min.max(0.0), s.max.max(0.0));
-        let temperatures: Vec<f32> = channels[0]
-            .1
-            .iter()
-            .map(|&r| lookup.at(r as f64) as f32)
-            .collect();
-        let mean = image.object_stats(&temperatures).map_or(0.0, |t| t.mean);
-        Stats {
-            min: lookup.at(s.min),
-            max: lookup.at(s.max),
-            mean,
-        }
-    });
-    let mut per_surface = vec![0usize; scene.surfaces.len()];
-    for &s in image.surface.iter().filter(|&&s| s != BACKGROUND) {
-        per_surface[s as usize] += 1;
-    }
-    let (mut per_object, mut per_part) = (BTreeMap::new(), BTreeMap::new());
-    for (surface, &count) in scene.surfaces.iter().zip(&per_surface) {
-        let object = scene.object_names[surface.object].clone();
-        per_part.insert(format!("{object}/{}", surface.part), count);
-        *per_object.entry(object).or_insert(0) += count;
-    }
-    let object_pixels: usize = per_surface.iter().sum();
-    let warnings = render_warnings(scene, &per_object);
+    let images = ImageFiles::new(scene, image, &channels, &camera);
+    let mut files = images.stage(&staged, out_dir)?;
+    files.push("summary.json".into());
     let mut timings = rendered.timings;
+    let mut summary = summarize(scene, rendered, out_dir, &channels, camera, files);
     timings.write = write_start.elapsed().as_secs_f64();
     timings.total = started.elapsed().as_secs_f64();
-    let (lo, hi) = scene.sensor.band.limits_um();
-    files.push("summary.json".into());
-    let summary = RenderSummary {
-        scene: scene.path.display().to_string(),
-        output_dir: out_dir.display().to_string(),
-        width: w,
-        height: h,
-        shading: scene.shading,
-        band_um: [lo, hi],
-        pixels: PixelCounts {
-            total: w * h,
-            object: object_pixels,
-            background: w * h - object_pixels,
-            per_object,
-            per_part,
-        },
-        channels: summary_stats,
-        apparent_temperature_k: apparent,
-        transport: transport_summary(scene),
-        thermal_instant: scene.thermal_instant.clone(),
-        warnings,
-        camera,
-        ids: id_maps(scene),
-        materials: scene
-            .materials
-            .iter()
-            .zip(&rendered.table_resolutions)
-            .map(|(m, &table)| MaterialSummary {
-                name: m.name.clone(),
-                origin: m.origin.clone(),
-                table,
-                band_nodes: m.optics.band().map(|b| b.nodes().len()),
-            })
-            .collect(),
-        timings_s: timings,
-        files,
-    };
+    summary.timings_s = timings;
     let json = serde_json::to_vec_pretty(&summary).map_err(|e| RenderError::Write {
         path: out_dir.join("summary.json"),
         source: std::io::Error::other(e),
@@ -418,6 +288,220 @@ pub fn write_outputs(
         .commit(&|name| earlier.iter().any(|f| f == name))
         .map_err(write_error)?;
     Ok(summary)
+}
+
+/// One image file of a render's outputs.
+enum ImageJob {
+    Tiff(usize),
+    StandardError,
+    Truth(usize),
+    Exr,
+    Panel(usize),
+    Composite,
+}
+
+/// The image files of a render: channel and ground-truth TIFFs, `stokes.exr`, the PNG previews
+/// and the composite, each with its JSON metadata.
+struct ImageFiles<'a> {
+    scene: &'a Scene,
+    image: &'a StokesImage,
+    channels: &'a [(Channel, Vec<f32>)],
+    camera: &'a CameraSummary,
+    truth: Vec<TruthImage>,
+    previews: figure::Previews,
+}
+
+impl<'a> ImageFiles<'a> {
+    fn new(
+        scene: &'a Scene,
+        image: &'a StokesImage,
+        channels: &'a [(Channel, Vec<f32>)],
+        camera: &'a CameraSummary,
+    ) -> ImageFiles<'a> {
+        let previews = figure::Previews::new(scene, image);
+        let mut truth = truth_images(scene, image);
+        if scene.sensor.dofp {
+            truth.extend(dofp_images(image));
+        }
+        ImageFiles {
+            scene,
+            image,
+            channels,
+            camera,
+            truth,
+            previews,
+        }
+    }
+
+    fn jobs(&self) -> Vec<ImageJob> {
+        let mut jobs: Vec<ImageJob> = (0..self.channels.len()).map(ImageJob::Tiff).collect();
+        jobs.push(ImageJob::StandardError);
+        jobs.extend((0..self.truth.len()).map(ImageJob::Truth));
+        jobs.push(ImageJob::Exr);
+        jobs.extend((0..self.previews.len()).map(ImageJob::Panel));
+        jobs.push(ImageJob::Composite);
+        jobs
+    }
+
+    /// Encodes every file in memory, in parallel, each written into `staged` as soon as it is
+    /// encoded; the names written, in job order.
+    fn stage(&self, staged: &StagedFolder, out_dir: &Path) -> Result<Vec<String>, RenderError> {
+        self.jobs()
+            .par_iter()
+            .map(|job| {
+                let (name, bytes) = self.encode(job);
+                bytes
+                    .and_then(|b| staged.write(&name, &b))
+                    .map(|()| name.clone())
+                    .map_err(|source| RenderError::Write {
+                        path: out_dir.join(&name),
+                        source,
+                    })
+            })
+            .collect()
+    }
+
+    fn metadata(&self, file: &str, unit: &str) -> String {
+        FileMetadata::new(self.scene, self.camera, file, unit).json()
+    }
+
+    /// A file's name and bytes.
+    fn encode(&self, job: &ImageJob) -> (String, std::io::Result<Vec<u8>>) {
+        let (w, h) = (self.image.width, self.image.height);
+        match job {
+            ImageJob::Tiff(i) => {
+                let (channel, data) = &self.channels[*i];
+                let name = format!("{}.tif", channel.name());
+                let description = self.metadata(&name, channel.unit());
+                let bytes = encode_tiff(w, h, &TruthData::Float(data.clone()), &description);
+                (name, bytes)
+            }
+            ImageJob::StandardError => {
+                let data: Vec<f32> = self
+                    .image
+                    .standard_error
+                    .iter()
+                    .map(|e| e[0] as f32)
+                    .collect();
+                let description = self.metadata("stderr_S0.tif", Channel::S0.unit());
+                let bytes = encode_tiff(w, h, &TruthData::Float(data), &description);
+                ("stderr_S0.tif".to_owned(), bytes)
+            }
+            ImageJob::Truth(i) => {
+                let t = &self.truth[*i];
+                let bytes = encode_tiff(w, h, &t.data, &self.metadata(t.file, t.unit));
+                (t.file.to_owned(), bytes)
+            }
+            ImageJob::Exr => {
+                let description = self.metadata("stokes.exr", "per channel as in the TIFFs");
+                let bytes = encode_exr(w, h, self.channels, &description);
+                ("stokes.exr".to_owned(), bytes)
+            }
+            ImageJob::Panel(i) => (
+                self.previews.file_name(*i).to_owned(),
+                self.previews.panel_png(*i),
+            ),
+            ImageJob::Composite => ("composite.png".to_owned(), self.previews.composite_png()),
+        }
+    }
+}
+
+/// `summary.json` of a render whose files are `files` (timings as the render measured them).
+fn summarize(
+    scene: &Scene,
+    rendered: &Rendered,
+    out_dir: &Path,
+    channels: &[(Channel, Vec<f32>)],
+    camera: CameraSummary,
+    files: Vec<String>,
+) -> RenderSummary {
+    let image = &rendered.image;
+    let (w, h) = (image.width, image.height);
+    let pixels = pixel_counts(scene, image);
+    let warnings = render_warnings(scene, &pixels.per_object);
+    let (lo, hi) = scene.sensor.band.limits_um();
+    RenderSummary {
+        scene: scene.path.display().to_string(),
+        output_dir: out_dir.display().to_string(),
+        width: w,
+        height: h,
+        shading: scene.shading,
+        band_um: [lo, hi],
+        pixels,
+        channels: channel_summaries(image, channels),
+        apparent_temperature_k: apparent_temperature(scene, image, &channels[0].1),
+        transport: transport_summary(scene),
+        thermal_instant: scene.thermal_instant.clone(),
+        warnings,
+        camera,
+        ids: id_maps(scene),
+        materials: material_summaries(scene, rendered),
+        timings_s: rendered.timings,
+        files,
+    }
+}
+
+fn channel_summaries(image: &StokesImage, channels: &[(Channel, Vec<f32>)]) -> Vec<ChannelSummary> {
+    channels
+        .iter()
+        .map(|(c, data)| ChannelSummary {
+            name: c.name(),
+            unit: c.unit(),
+            object_pixels: image.object_stats(data),
+            relative_standard_error: stokes_index(*c).and_then(|j| image.relative_error(j)),
+        })
+        .collect()
+}
+
+/// Brightness temperature of S0 (`s0`) over the object pixels.
+fn apparent_temperature(scene: &Scene, image: &StokesImage, s0: &[f32]) -> Option<Stats> {
+    image.object_stats(s0).map(|s| {
+        let lookup = TemperatureLookup::new(&scene.sensor.band, s.min.max(0.0), s.max.max(0.0));
+        let temperatures: Vec<f32> = s0.iter().map(|&r| lookup.at(r as f64) as f32).collect();
+        let mean = image.object_stats(&temperatures).map_or(0.0, |t| t.mean);
+        Stats {
+            min: lookup.at(s.min),
+            max: lookup.at(s.max),
+            mean,
+        }
+    })
+}
+
+/// Pixels in all, on objects, on background, per object and per part.
+fn pixel_counts(scene: &Scene, image: &StokesImage) -> PixelCounts {
+    let mut per_surface = vec![0usize; scene.surfaces.len()];
+    for &s in image.surface.iter().filter(|&&s| s != BACKGROUND) {
+        per_surface[s as usize] += 1;
+    }
+    let (mut per_object, mut per_part) = (BTreeMap::new(), BTreeMap::new());
+    for (surface, &count) in scene.surfaces.iter().zip(&per_surface) {
+        let object = scene.object_names[surface.object].clone();
+        per_part.insert(format!("{object}/{}", surface.part), count);
+        *per_object.entry(object).or_insert(0) += count;
+    }
+    let object_pixels: usize = per_surface.iter().sum();
+    let total = image.width * image.height;
+    PixelCounts {
+        total,
+        object: object_pixels,
+        background: total - object_pixels,
+        per_object,
+        per_part,
+    }
+}
+
+fn material_summaries(scene: &Scene, rendered: &Rendered) -> Vec<MaterialSummary> {
+    scene
+        .materials
+        .iter()
+        .zip(&rendered.table_resolutions)
+        .map(|(m, &table)| MaterialSummary {
+            name: m.name.clone(),
+            origin: m.origin.clone(),
+            table,
+            band_nodes: m.optics.band().map(|b| b.nodes().len()),
+        })
+        .collect()
 }
 
 /// The files an earlier render listed in `out_dir/summary.json` (they are replaced as a set;

@@ -1,9 +1,9 @@
 //! Outputs of `irpol thermal` (docs/design.md §2.6): the per-part temperature table, per-vertex PLY meshes
 //! at each recorded instant, the temperature plot and a JSON summary, swapped into the output
-//! folder as one set (see `staged_folder`).
+//! folder as one set (see [`StagedFolder`]).
 
-use super::staged_folder::StagedFolder;
 use super::thermal_plot::temperature_plot_png;
+use crate::atomic::StagedFolder;
 use crate::scene::Scene;
 use crate::thermal_scene::{part_series, PartSeries, SolveStats, ThermalSolution};
 use ply_rs_bw::ply::{

@@ -1,8 +1,7 @@
 //! The temperature plot of a thermal run: every part's surface temperature over time (mean line,
 //! min–max band over its vertices), the air temperature dashed, sunrise and sunset marked.
 
-use crate::report::paper_figures::encode_png;
-use crate::report::{register_fonts, FONT, TABLEAU20};
+use crate::plot_style::{encode_png, register_fonts, FONT, TABLEAU20};
 use crate::scene::Scene;
 use crate::thermal_scene::{PartSeries, ThermalSolution};
 use plotters::prelude::*;

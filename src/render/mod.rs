@@ -19,7 +19,9 @@ use crate::transport::accel::Accelerator;
 use crate::transport::kernel::KernelQuadrature;
 use crate::transport::open_world::OpenWorld;
 use crate::transport::path::{PathTracer, Vertex};
-use crate::transport::tables::{MaterialTables, RadianceTable, TableResolution};
+/// Grid sizes of a material's reflection table, as [`Rendered::table_resolutions`] reports them.
+pub use crate::transport::tables::TableResolution;
+use crate::transport::tables::{MaterialTables, RadianceTable};
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

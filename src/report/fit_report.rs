@@ -23,13 +23,14 @@ pub(crate) use table::{
     sha_prefix,
 };
 
-use super::paper_figures::encode_png;
-use super::{register_fonts, ReportError, FONT};
-use crate::material::{write_atomically, FitRecord, Material};
+use super::ReportError;
+use crate::atomic::write_atomically;
+use crate::material::{FitRecord, Material};
 use crate::measure::{
     hex, merge_repeat_measurements, parse_measurement_csv, MeasureError, MeasureErrorKind,
     MeasurementSet, SourceData,
 };
+use crate::plot_style::{encode_png, register_fonts, FONT};
 use data::ReportData;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -8,7 +8,8 @@ use super::fit_report::{
     sha_prefix, verified_source,
 };
 use super::ReportError;
-use crate::material::{list_library, write_atomically, Material, MaterialModel};
+use crate::atomic::write_atomically;
+use crate::material::{list_library, Material, MaterialModel};
 use crate::pbrdf::SlopeDistribution;
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};

@@ -2,10 +2,11 @@
 //! θ_i = 60°, λ = 9.925 µm, N = 1.2 + 0.2i — Fig. 2 at σ = 0.1 for q = 1.5, 1.8, 2.5, Fig. 3 at
 //! q = 1.8 for σ = 0.1, 0.2, 0.3. Drawn with G = 1 (shadowing none), as the paper's eq. 4 curves.
 
-use super::{register_fonts, ReportError, FONT};
-use crate::material::write_atomically;
+use super::ReportError;
+use crate::atomic::write_atomically;
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{Direction, Pbrdf, Shadowing, SlopeDistribution};
+use crate::plot_style::{encode_png, register_fonts, FONT};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -122,19 +123,6 @@ pub fn write_paper_figure(
         source,
     })?;
     Ok(vec![png, svg])
-}
-
-/// PNG bytes of an RGB8 buffer (so the file can be written atomically).
-pub fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, image::ImageError> {
-    let mut bytes = Vec::new();
-    image::ImageEncoder::write_image(
-        image::codecs::png::PngEncoder::new(&mut bytes),
-        rgb,
-        width,
-        height,
-        image::ExtendedColorType::Rgb8,
-    )?;
-    Ok(bytes)
 }
 
 fn draw_curves<DB: DrawingBackend>(

@@ -17,9 +17,10 @@ pub use emissivity::{emissivity_grid, EmissivityGrid};
 
 use super::fit_report::style::{DrawResult, LEGEND_SIZE, TITLE_SIZE};
 use super::fit_report::{draw_error, encode_bitmap, report_stem, EncodedReport};
-use super::{register_fonts, ReportError, FONT};
+use super::ReportError;
 use crate::fit::SpectralFitOutcome;
 use crate::material::SpectralModel;
+use crate::plot_style::{register_fonts, FONT};
 use crate::text::number;
 use plotters::coord::Shift;
 use plotters::prelude::*;

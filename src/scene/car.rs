@@ -477,7 +477,7 @@ pub fn write_car_obj(path: &Path) -> std::io::Result<(usize, usize, usize)> {
     let header = "irpol procedural sedan on a ground plane (irpol::scene::car).\n\
                   Metres; z up; nose toward +x; left side toward +y; ground at z = 0.\n\
                   Groups are parts: give each a material and temperature in the scene TOML.";
-    crate::material::write_atomically(path, format_obj(&mesh, header).as_bytes())?;
+    crate::atomic::write_atomically(path, format_obj(&mesh, header).as_bytes())?;
     Ok((mesh.positions.len(), mesh.faces.len(), mesh.parts.len()))
 }
 

@@ -5,7 +5,7 @@
 use super::style::{draw_framed_box, draw_note, DrawResult, CAPTION_SIZE, LEGEND_SIZE, TICK_SIZE};
 use super::table::symbol;
 use crate::material::FitRecord;
-use crate::report::FONT;
+use crate::plot_style::FONT;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

@@ -8,7 +8,7 @@ use super::style::{
     LEGEND_SIZE, TICK_SIZE,
 };
 use crate::material::FitRecord;
-use crate::report::FONT;
+use crate::plot_style::FONT;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -10,7 +10,7 @@ use super::style::{
 };
 use crate::measure::MUELLER_ELEMENT_NAMES;
 use crate::optics::Mueller;
-use crate::report::FONT;
+use crate::plot_style::FONT;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;

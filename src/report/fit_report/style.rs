@@ -1,7 +1,7 @@
 //! Colours, markers, legends and line clipping shared by the report's panels. Every text uses the
 //! embedded font ([`FONT`]) so that the figure renders without system fonts.
 
-use super::super::FONT;
+use crate::plot_style::FONT;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -20,7 +20,7 @@ pub const SMALL_TICK_SIZE: i32 = 14;
 
 /// Colour of incidence angle number `index` (Tableau 10, readable on white and in grey print).
 pub fn incidence_color(index: usize) -> RGBColor {
-    crate::report::TABLEAU20[index % 10]
+    crate::plot_style::TABLEAU20[index % 10]
 }
 
 pub const GREY: RGBColor = RGBColor(110, 110, 110);

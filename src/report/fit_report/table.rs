@@ -5,7 +5,7 @@
 use super::style::{DrawResult, CAPTION_SIZE, LEGEND_SIZE};
 use crate::material::{ConfidenceBound, FitRecord, Material, ModelSpec};
 use crate::pbrdf::SlopeDistribution;
-use crate::report::FONT;
+use crate::plot_style::FONT;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -697,7 +697,7 @@ mod tests {
     /// panel too small for the full size shrinks the font instead of cutting rows off.
     #[test]
     fn table_text_never_overlaps_or_leaves_its_panel() {
-        crate::report::register_fonts();
+        crate::plot_style::register_fonts();
         let mut m = material(24.0, 36.5);
         let fit = m.fit.as_mut().unwrap();
         fit.settings

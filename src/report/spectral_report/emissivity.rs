@@ -7,7 +7,7 @@ use super::super::fit_report::style::{
 use super::super::ReportError;
 use crate::material::Material;
 use crate::pbrdf::HemisphereQuadrature;
-use crate::report::FONT;
+use crate::plot_style::FONT;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

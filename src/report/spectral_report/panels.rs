@@ -7,7 +7,7 @@ use super::super::fit_report::style::{
 };
 use crate::fit::SpectralFitOutcome;
 use crate::material::SpectralModel;
-use crate::report::{FONT, TABLEAU20};
+use crate::plot_style::{FONT, TABLEAU20};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

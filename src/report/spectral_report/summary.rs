@@ -6,7 +6,7 @@ use super::super::fit_report::{format_plain, format_with_uncertainty, sha_prefix
 use crate::fit::SpectralFitOutcome;
 use crate::material::{FitRecord, SpectralModel};
 use crate::pbrdf::SlopeDistribution;
-use crate::report::FONT;
+use crate::plot_style::FONT;
 use crate::text::{number, shown_at_most};
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -4,8 +4,8 @@
 //! renames leaves every target as it was, and the temporaries and any folders made for them are
 //! removed.
 
-use crate::interrupt::{process_is_alive, WriteGuard};
-use std::io::Write;
+use super::{file_name_of, parent_of, stale_entries, temporary_beside, write_synced};
+use crate::interrupt::WriteGuard;
 use std::path::{Path, PathBuf};
 
 /// Files staged for one output set; dropped without [`OutputSet::commit`], it removes them.
@@ -25,21 +25,12 @@ impl OutputSet {
     /// Writes `bytes` to a temporary file beside `target` (creating its folder), synced to disk.
     pub fn stage(&mut self, target: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let _guard = WriteGuard::start()?;
-        let dir = target
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
+        let dir = parent_of(target);
         self.create_dir(dir)?;
-        let file_name = target
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        remove_stale_temporary(dir, &file_name);
-        let temp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
+        remove_stale_temporaries(target);
+        let temp = temporary_beside(target);
         self.staged.push((temp.clone(), target.to_owned()));
-        let mut file = std::fs::File::create(&temp)?;
-        file.write_all(bytes)?;
-        file.sync_all()
+        write_synced(&temp, bytes)
     }
 
     /// Creates `dir` and its missing ancestors, remembering which were missing.
@@ -74,24 +65,12 @@ impl OutputSet {
     }
 }
 
-/// Removes `.<file_name>.<pid>.tmp` files beside the target left by processes that no longer run
+/// Removes `.<name>.<pid>.tmp` files beside `target` left by processes that no longer run
 /// (a SIGKILL during staging; SIGINT/SIGTERM clean up themselves).
-fn remove_stale_temporary(dir: &Path, file_name: &str) {
-    let prefix = format!(".{file_name}.");
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let name = entry.file_name().to_string_lossy().into_owned();
-        let pid = name
-            .strip_prefix(&prefix)
-            .and_then(|rest| rest.strip_suffix(".tmp"))
-            .and_then(|pid| pid.parse::<u32>().ok());
-        if let Some(pid) = pid {
-            if !process_is_alive(pid) {
-                let _ = std::fs::remove_file(entry.path());
-            }
-        }
+fn remove_stale_temporaries(target: &Path) {
+    let prefix = format!(".{}.", file_name_of(target));
+    for stale in stale_entries(parent_of(target), &prefix, ".tmp", false) {
+        let _ = std::fs::remove_file(stale);
     }
 }
 

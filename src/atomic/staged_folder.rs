@@ -9,7 +9,8 @@
 //! SIGINT/SIGTERM handler ([`staging_folder`] names it), and, after a SIGKILL, by the next run
 //! into the same target.
 
-use crate::interrupt::{process_is_alive, WriteGuard};
+use super::{parent_of, stale_entries};
+use crate::interrupt::WriteGuard;
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -25,12 +26,6 @@ fn staging_prefix(target: &Path) -> String {
         .file_name()
         .map_or("out".into(), |n| n.to_string_lossy().into_owned());
     format!(".{name}.irpol-staging-")
-}
-
-fn parent_of(path: &Path) -> &Path {
-    path.parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."))
 }
 
 /// A folder being written; [`StagedFolder::commit`] swaps it into place.
@@ -120,23 +115,11 @@ impl Drop for StagedFolder {
     }
 }
 
-/// Removes staging folders of `target` whose process no longer runs (a SIGKILL mid-write).
+/// Removes staging folders of `target` whose process no longer runs (a SIGKILL mid-write), and
+/// one of this process's left by an earlier set.
 fn remove_stale_staging(target: &Path) {
-    let prefix = staging_prefix(target);
-    let Ok(entries) = fs::read_dir(parent_of(target)) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let name = entry.file_name().to_string_lossy().into_owned();
-        let Some(pid) = name
-            .strip_prefix(&prefix)
-            .and_then(|p| p.parse::<u32>().ok())
-        else {
-            continue;
-        };
-        if !process_is_alive(pid) || pid == std::process::id() {
-            let _ = fs::remove_dir_all(entry.path());
-        }
+    for stale in stale_entries(parent_of(target), &staging_prefix(target), "", true) {
+        let _ = fs::remove_dir_all(stale);
     }
 }
 
