@@ -7,20 +7,20 @@ use clap::{Args, Parser, Subcommand};
 use cli::progress::TerminalProgress;
 use irpol::atomic::staging_folder;
 use irpol::commands::evaluate::{
-    read_geometry_csv, sweep_table, write_emissivity_csv, write_mueller_csv,
+    geometry_table, write_emissivity_csv, write_mueller_csv, GeometryTable,
 };
 use irpol::commands::fit::{fit_and_write, FitFlags};
 use irpol::commands::render::{
     default_output_dir, instant_folder, render_scene, render_scene_at, Instants, TimedRender,
 };
 use irpol::commands::scene_init::write_starter_scene;
-use irpol::commands::sun::{read_times_file, write_sun_csv};
+use irpol::commands::sun::{given_times, write_sun_csv};
 use irpol::commands::thermal::{run_thermal, run_thermal_and_render};
-use irpol::commands::{parse_sweep, ModelArgs};
-use irpol::emitter::parse_time_utc;
+use irpol::commands::{parse_sweep, AppError, ModelArgs};
 use irpol::fit::{FitOptions, MaterialFit};
 use irpol::material::MaterialModel;
 use irpol::output::thermal::ThermalSummary;
+use irpol::pbrdf::Pbrdf;
 use irpol::report::fit_report::rebuild_report;
 use irpol::report::index::write_library_index;
 use irpol::report::paper_figures::{write_paper_figure, PaperFigure};
@@ -292,9 +292,13 @@ fn is_broken_pipe(error: &anyhow::Error) -> bool {
         cause
             .downcast_ref::<std::io::Error>()
             .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+            || cause
+                .downcast_ref::<AppError>()
+                .is_some_and(AppError::is_broken_pipe)
     })
 }
 
+/// Runs one subcommand.
 fn run(command: Command) -> anyhow::Result<()> {
     match command {
         Command::Eval {
@@ -306,45 +310,20 @@ fn run(command: Command) -> anyhow::Result<()> {
             phi_r,
         } => {
             let model = model.model_args().build()?;
-            let table = match (geometry, theta_i, theta_r) {
-                (Some(path), _, _) => read_geometry_csv(&path)?,
-                (None, Some(ti), Some(tr)) => sweep_table(
-                    &parse_sweep(&ti, "theta-i")?,
-                    phi_i,
-                    &parse_sweep(&tr, "theta-r")?,
-                    &parse_sweep(&phi_r, "phi-r")?,
-                )?,
-                _ => anyhow::bail!("give --geometry FILE.csv, or --theta-i and --theta-r"),
-            };
-            note_all(&table.notes);
-            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-            write_mueller_csv(&model, &table, &mut out)?;
-            out.flush()?;
+            let table = geometry_table(
+                geometry.as_deref(),
+                theta_i.as_deref(),
+                theta_r.as_deref(),
+                phi_i,
+                &phi_r,
+            )?;
+            eval(&model, &table)
         }
         Command::Emissivity { model, theta } => {
             let model = model.model_args().build()?;
-            let thetas = parse_sweep(&theta, "theta")?;
-            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-            let excess = write_emissivity_csv(&model, &thetas, &mut out)?;
-            out.flush()?;
-            if !excess.is_empty() {
-                eprintln!(
-                    "irpol: warning: hemispherical reflectance exceeds 1 (ε0 < 0) at θ = {:?}°: this model \
-                     does not conserve energy there; values are reported unclamped (use --shadowing smith)",
-                    excess
-                );
-            }
+            emissivity(&model, &theta)
         }
-        Command::Figure { which, out } => {
-            let figure = if which == "paper-fig2" {
-                PaperFigure::Fig2
-            } else {
-                PaperFigure::Fig3
-            };
-            for path in write_paper_figure(figure, &out)? {
-                say!("wrote {}", path.display());
-            }
-        }
+        Command::Figure { which, out } => figure(&which, &out),
         Command::Fit {
             inputs,
             distribution,
@@ -358,7 +337,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             out,
             reports,
         } => {
-            let options = FitFlags {
+            let flags = FitFlags {
                 distribution,
                 shadowing,
                 free,
@@ -367,51 +346,24 @@ fn run(command: Command) -> anyhow::Result<()> {
                 seed,
                 robust,
                 dispersion,
-            }
-            .options()?;
-            fit_and_summarize(&inputs, &options, &out, &reports)?;
+            };
+            fit_and_summarize(&inputs, &flags.options()?, &out, &reports)
         }
-        Command::Report { material, reports } => {
-            for path in rebuild_report(&material, &reports)? {
-                say!("wrote {}", path.display());
-            }
-            let library = material
-                .parent()
-                .filter(|p| !p.as_os_str().is_empty())
-                .unwrap_or(Path::new("."));
-            say!(
-                "wrote {}",
-                write_library_index(library, &reports)?.display()
-            );
-        }
+        Command::Report { material, reports } => report(&material, &reports),
         Command::Render {
             scene,
             out,
             time,
             time_utc,
             times,
-        } => {
-            let instants = match (time, time_utc, times) {
-                (Some(t), _, _) => Some(Instants::Seconds(vec![t])),
-                (_, Some(text), _) => Some(Instants::Utc(text)),
-                (_, _, Some(sweep)) => Some(Instants::Seconds(parse_sweep(&sweep, "times")?)),
-                _ => None,
-            };
-            match instants {
-                Some(instants) => render_instants(&scene, out, &instants)?,
-                None => render_and_summarize(&scene, out)?,
-            }
-        }
-        Command::Thermal { scene, out } => thermal_and_summarize(&scene, out)?,
+        } => match Instants::from_flags(time, time_utc, times.as_deref())? {
+            Some(instants) => render_instants(&scene, out, &instants),
+            None => render_and_summarize(&scene, out),
+        },
+        Command::Thermal { scene, out } => thermal_and_summarize(&scene, out),
         Command::Scene {
             command: SceneCommand::Init { out },
-        } => {
-            write_starter_scene(&out)?;
-            say!(
-                "wrote {0}: a sphere on a plane under a clear sky; render it with `irpol render {0}`",
-                out.display()
-            );
-        }
+        } => scene_init(&out),
         Command::Sun {
             latitude,
             longitude,
@@ -419,18 +371,71 @@ fn run(command: Command) -> anyhow::Result<()> {
             times_file,
             clear_sky,
         } => {
-            let times = match (time_utc, times_file) {
-                (Some(text), None) => vec![parse_time_utc(&text)?],
-                (None, Some(path)) => read_times_file(&path)?,
-                _ => anyhow::bail!("give either --time-utc RFC3339 or --times-file FILE"),
-            };
+            let times = given_times(time_utc.as_deref(), times_file.as_deref())?;
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
             write_sun_csv(latitude, longitude, &times, clear_sky, &mut out)?;
-            out.flush()?;
+            Ok(out.flush()?)
         }
-        Command::Library { dir, dir_flag } => print_library(&dir_flag.unwrap_or(dir))?,
-        Command::Demo => demo()?,
+        Command::Library { dir, dir_flag } => print_library(&dir_flag.unwrap_or(dir)),
+        Command::Demo => demo(),
     }
+}
+
+/// `irpol eval`: the Mueller CSV on stdout, after the notes on how the rows were read.
+fn eval(model: &Pbrdf, table: &GeometryTable) -> anyhow::Result<()> {
+    note_all(&table.notes);
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    write_mueller_csv(model, table, &mut out)?;
+    Ok(out.flush()?)
+}
+
+/// `irpol emissivity`: the table on stdout, and a warning where the model creates energy.
+fn emissivity(model: &Pbrdf, theta: &str) -> anyhow::Result<()> {
+    let thetas = parse_sweep(theta, "theta")?;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let excess = write_emissivity_csv(model, &thetas, &mut out)?;
+    out.flush()?;
+    if !excess.is_empty() {
+        eprintln!(
+            "irpol: warning: hemispherical reflectance exceeds 1 (ε0 < 0) at θ = {:?}°: this model \
+             does not conserve energy there; values are reported unclamped (use --shadowing smith)",
+            excess
+        );
+    }
+    Ok(())
+}
+
+fn figure(which: &str, out: &Path) -> anyhow::Result<()> {
+    let figure = if which == "paper-fig2" {
+        PaperFigure::Fig2
+    } else {
+        PaperFigure::Fig3
+    };
+    for path in write_paper_figure(figure, out)? {
+        say!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// `irpol report`: the material's report rebuilt, and the index of its library folder.
+fn report(material: &Path, reports: &Path) -> anyhow::Result<()> {
+    for path in rebuild_report(material, reports)? {
+        say!("wrote {}", path.display());
+    }
+    let library = material
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    say!("wrote {}", write_library_index(library, reports)?.display());
+    Ok(())
+}
+
+fn scene_init(out: &Path) -> anyhow::Result<()> {
+    write_starter_scene(out)?;
+    say!(
+        "wrote {0}: a sphere on a plane under a clear sky; render it with `irpol render {0}`",
+        out.display()
+    );
     Ok(())
 }
 

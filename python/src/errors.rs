@@ -1,19 +1,17 @@
 //! Library errors as Python exceptions carrying the command line's one-line message (the CLI
-//! prints `irpol: error: {error:#}`): `OSError` when a file could not be read or written,
-//! `ValueError` for everything else (bad input).
+//! prints `irpol: error: ` and the error with its causes, [`one_line`]), the exception chosen by
+//! the error's type: `OSError` when a file could not be read or written (an I/O error among its
+//! causes, [`AppError::is_io`]), `ValueError` for everything else (bad input).
 
+use irpol::commands::{one_line, AppError};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::PyErr;
-use std::path::Path;
 
-/// `error` as the exception Python code should catch. `inputs` are the files the call reads: a
-/// missing one makes the error an `OSError` even where the library reports it as text.
-pub fn raised(error: anyhow::Error, inputs: &[&Path]) -> PyErr {
-    let message = format!("{error:#}");
-    let io = error
-        .chain()
-        .any(|cause| cause.downcast_ref::<std::io::Error>().is_some());
-    if io || inputs.iter().any(|p| !p.exists()) {
+/// `error` as the exception Python code should catch.
+pub fn raised(error: impl Into<AppError>) -> PyErr {
+    let error = error.into();
+    let message = one_line(&error);
+    if error.is_io() {
         PyOSError::new_err(message)
     } else {
         PyValueError::new_err(message)

@@ -11,7 +11,7 @@ use irpol::optics::Mueller;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Fits every material among `inputs` (CSV files or folders) with the options `irpol fit` takes
 /// as flags (same names, same defaults, same messages); one dict per material, in the order
@@ -43,11 +43,10 @@ pub fn fit_materials(
         robust,
         dispersion,
     };
-    let paths: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
-    let options = flags.options().map_err(|e| raised(e, &[]))?;
+    let options = flags.options().map_err(raised)?;
     let outcomes = py
         .detach(|| fit_inputs(&inputs, &options, &irpol::progress::Silent))
-        .map_err(|e| raised(e.into(), &paths))?;
+        .map_err(raised)?;
     outcomes.iter().map(|o| outcome_dict(py, o)).collect()
 }
 
@@ -84,9 +83,7 @@ fn outcome_dict<'py>(py: Python<'py>, outcome: &MaterialFit) -> PyResult<Bound<'
         },
     )?;
     let entry = PathBuf::from(format!("{}.toml", material.name));
-    let toml = material
-        .to_toml(&entry)
-        .map_err(|e| raised(e.into(), &[]))?;
+    let toml = material.to_toml(&entry).map_err(raised)?;
     d.set_item("toml", toml)?;
     d.set_item("notes", outcome.notes())?;
     match outcome {

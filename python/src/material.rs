@@ -99,7 +99,7 @@ impl PyMaterial {
     fn load(path: PathBuf) -> PyResult<PyMaterial> {
         Material::load(&path)
             .map(|inner| PyMaterial { inner })
-            .map_err(|e| raised(e.into(), &[&path]))
+            .map_err(raised)
     }
 
     /// A material from the text of a material TOML.
@@ -107,27 +107,24 @@ impl PyMaterial {
     fn from_toml(text: &str) -> PyResult<PyMaterial> {
         Material::from_toml(text, std::path::Path::new("<text>"))
             .map(|inner| PyMaterial { inner })
-            .map_err(|e| raised(e.into(), &[]))
+            .map_err(raised)
     }
 
     /// The material TOML text, with its explanatory comments, as `save` writes it.
     fn to_toml(&self) -> PyResult<String> {
         let path = PathBuf::from(format!("{}.toml", self.inner.name));
-        self.inner.to_toml(&path).map_err(|e| raised(e.into(), &[]))
+        self.inner.to_toml(&path).map_err(raised)
     }
 
     /// Writes the material TOML atomically (temporary file + rename).
     fn save(&self, path: PathBuf) -> PyResult<()> {
-        self.inner.save(&path).map_err(|e| raised(e.into(), &[]))
+        self.inner.save(&path).map_err(raised)
     }
 
     /// The grey material at `wavelength_um` (µm): a spectral table interpolated linearly, a grey
     /// material itself. Raises ValueError outside a spectral table.
     fn at(&self, wavelength_um: f64) -> PyResult<PyMaterial> {
-        let spec = self
-            .inner
-            .at(wavelength_um)
-            .map_err(|e| raised(e.into(), &[]))?;
+        let spec = self.inner.at(wavelength_um).map_err(raised)?;
         Ok(PyMaterial {
             inner: Material {
                 model: MaterialModel::Grey(spec),

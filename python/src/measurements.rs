@@ -14,7 +14,7 @@ use std::path::PathBuf;
 pub fn read_measurement_sets(py: Python<'_>, path: PathBuf) -> PyResult<Vec<Bound<'_, PyDict>>> {
     let sets = py
         .detach(|| irpol::measure::read_measurement_sets(&path))
-        .map_err(|e| raised(e.into(), &[&path]))?;
+        .map_err(raised)?;
     sets.iter().map(|set| set_dict(py, set)).collect()
 }
 

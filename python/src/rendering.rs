@@ -4,6 +4,7 @@
 use crate::errors::{bad_argument, raised};
 use crate::scene_patch::{patched, scene_text, toml_value, Missing};
 use irpol::commands::render::scene_to_render;
+use irpol::commands::AppError;
 use irpol::output::{write_outputs, Channel};
 use irpol::progress::Silent;
 use irpol::render::render;
@@ -26,7 +27,7 @@ fn render_images(
     text: &str,
     time_s: Option<f64>,
     out: Option<&std::path::Path>,
-) -> anyhow::Result<Images> {
+) -> Result<Images, AppError> {
     let start = Instant::now();
     let loaded = scene_to_render(scene, text, time_s, &Silent)?;
     let rendered = render(&loaded, &Silent)?;
@@ -40,7 +41,9 @@ fn render_images(
     let summary_json = match out {
         Some(dir) => {
             let summary = write_outputs(&loaded, &rendered, dir, start)?;
-            Some(serde_json::to_string(&summary)?)
+            let json =
+                serde_json::to_string(&summary).map_err(|e| AppError::invalid(e.to_string()))?;
+            Some(json)
         }
         None => None,
     };
@@ -89,7 +92,7 @@ pub fn render_scene<'py>(
     let text = apply(&scene, text, overrides, Missing::Create)?;
     let images = py
         .detach(|| render_images(&scene, &text, time_s, out.as_deref()))
-        .map_err(|e| raised(e, &[&scene]))?;
+        .map_err(raised)?;
     let d = PyDict::new(py);
     for (name, data) in images.channels {
         let array = PyArray1::from_vec(py, data).reshape([images.height, images.width])?;

@@ -172,10 +172,7 @@ pub fn patched(
 
 /// A scene file's text, refused as `irpol render` refuses an unreadable scene.
 pub fn scene_text(path: &Path) -> PyResult<String> {
-    std::fs::read_to_string(path).map_err(|e| {
-        let error = irpol::scene::SceneError::new(path, format!("cannot read the scene: {e}"));
-        raised(anyhow::Error::new(error), &[path])
-    })
+    irpol::commands::render::read_scene_text(path).map_err(raised)
 }
 
 /// Checks that every dotted key names an entry of the scene file (a sweep does this before

@@ -11,10 +11,10 @@
 //! lists. Output goes through the csv crate's writer, so a passed-through field such as "a,b"
 //! stays quoted and the CSV stays rectangular.
 
+use super::AppError;
 use crate::measure::MUELLER_ELEMENT_NAMES;
 use crate::pbrdf::{signed_zenith_note, Direction, HemisphereQuadrature, Pbrdf};
 use crate::text::{shown, shown_at_most};
-use anyhow::Context;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -89,20 +89,35 @@ fn geometry_reader(bytes: &[u8]) -> csv::Reader<&[u8]> {
 }
 
 /// Reads and validates a geometry CSV: every row must hold valid angles.
-pub fn read_geometry_csv(path: &Path) -> anyhow::Result<GeometryTable> {
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot open", path.display()))?;
+pub fn read_geometry_csv(path: &Path) -> Result<GeometryTable, AppError> {
+    let bytes = std::fs::read(path).map_err(|source| AppError::Open {
+        path: path.to_owned(),
+        source,
+    })?;
     parse_geometry_csv(path, bytes)
 }
 
+/// A refused geometry CSV: `path` then `at` (`:line`, `:line:column` or nothing), the message.
+fn geometry_error(path: &Path, at: impl Into<String>, message: impl Into<String>) -> AppError {
+    AppError::Geometry {
+        path: path.to_owned(),
+        at: at.into(),
+        message: message.into(),
+    }
+}
+
 /// [`read_geometry_csv`] of a file's bytes; `path` names it in messages.
-pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> anyhow::Result<GeometryTable> {
+pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> Result<GeometryTable, AppError> {
     let headers: Vec<String> = geometry_reader(&bytes)
         .headers()
         .map_err(|e| {
-            anyhow::anyhow!(
-                "{}:1:1: cannot read the header: {}",
-                path.display(),
-                shown_at_most(&e.to_string(), HEADER_EXCERPT_CHARS)
+            geometry_error(
+                path,
+                ":1:1",
+                format!(
+                    "cannot read the header: {}",
+                    shown_at_most(&e.to_string(), HEADER_EXCERPT_CHARS)
+                ),
             )
         })?
         .iter()
@@ -125,7 +140,7 @@ pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> anyhow::Result<Geometr
         Ok(())
     })?;
     if count == 0 {
-        anyhow::bail!("{}: no geometry rows", path.display());
+        return Err(geometry_error(path, "", "no geometry rows"));
     }
     table
         .notes
@@ -135,32 +150,40 @@ pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> anyhow::Result<Geometr
 
 /// The angle columns of a header row, refusing duplicate names (which value would be meant?) and
 /// names of the Mueller elements that eval appends (the output would hold two m00 columns).
-fn geometry_columns(path: &Path, headers: &[String]) -> anyhow::Result<GeometryColumns> {
+fn geometry_columns(path: &Path, headers: &[String]) -> Result<GeometryColumns, AppError> {
     for (index, name) in headers.iter().enumerate() {
+        let at = format!(":1:{}", index + 1);
         if let Some(first) = headers[..index].iter().position(|h| h == name) {
-            anyhow::bail!(
-                "{}:1:{}: duplicate column '{}' (already column {})",
-                path.display(),
-                index + 1,
-                shown(name),
-                first + 1
-            );
+            return Err(geometry_error(
+                path,
+                at,
+                format!(
+                    "duplicate column '{}' (already column {})",
+                    shown(name),
+                    first + 1
+                ),
+            ));
         }
         if MUELLER_ELEMENT_NAMES.contains(&name.as_str()) {
-            anyhow::bail!(
-                "{}:1:{}: column '{name}' clashes with the Mueller elements eval appends; rename it",
-                path.display(),
-                index + 1
-            );
+            return Err(geometry_error(
+                path,
+                at,
+                format!(
+                    "column '{name}' clashes with the Mueller elements eval appends; rename it"
+                ),
+            ));
         }
     }
     let column = |name: &str| headers.iter().position(|h| h == name);
     let required = |name: &str| {
         column(name).ok_or_else(|| {
-            anyhow::anyhow!(
-                "{}:1:1: missing column '{name}' (have: {})",
-                path.display(),
-                shown_at_most(&headers.join(","), HEADER_EXCERPT_CHARS)
+            geometry_error(
+                path,
+                ":1:1",
+                format!(
+                    "missing column '{name}' (have: {})",
+                    shown_at_most(&headers.join(","), HEADER_EXCERPT_CHARS)
+                ),
             )
         })
     };
@@ -178,20 +201,22 @@ fn record_geometry(
     headers: &[String],
     columns: GeometryColumns,
     record: &csv::StringRecord,
-) -> anyhow::Result<Geometry> {
+) -> Result<Geometry, AppError> {
     let line = record.position().map_or(0, |p| p.line());
-    let field = |index: usize| -> anyhow::Result<f64> {
+    let field = |index: usize| -> Result<f64, AppError> {
         let text = &record[index];
         text.parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
             .ok_or_else(|| {
-                anyhow::anyhow!(
-                    "{}:{line}:{}: {} = '{}' is not a finite number",
-                    path.display(),
-                    index + 1,
-                    shown(&headers[index]),
-                    shown(text)
+                geometry_error(
+                    path,
+                    format!(":{line}:{}", index + 1),
+                    format!(
+                        "{} = '{}' is not a finite number",
+                        shown(&headers[index]),
+                        shown(text)
+                    ),
                 )
             })
     };
@@ -203,7 +228,7 @@ fn record_geometry(
     };
     geometry
         .directions()
-        .map_err(|e| anyhow::anyhow!("{}:{line}: {e}", path.display()))?;
+        .map_err(|e| geometry_error(path, format!(":{line}"), e.to_string()))?;
     Ok(geometry)
 }
 
@@ -211,8 +236,8 @@ impl GeometryTable {
     /// Calls `visit` with each row's fields (as they are echoed) and its geometry, in order.
     fn for_each_row(
         &self,
-        mut visit: impl FnMut(&[&str], &Geometry) -> anyhow::Result<()>,
-    ) -> anyhow::Result<()> {
+        mut visit: impl FnMut(&[&str], &Geometry) -> Result<(), AppError>,
+    ) -> Result<(), AppError> {
         match &self.rows {
             Rows::File {
                 path,
@@ -223,10 +248,10 @@ impl GeometryTable {
                 let mut record = csv::StringRecord::new();
                 loop {
                     let more = reader.read_record(&mut record).map_err(|e| {
-                        anyhow::anyhow!(
-                            "{}: {}",
-                            path.display(),
-                            shown_at_most(&e.to_string(), HEADER_EXCERPT_CHARS)
+                        geometry_error(
+                            path,
+                            "",
+                            shown_at_most(&e.to_string(), HEADER_EXCERPT_CHARS),
                         )
                     })?;
                     if !more {
@@ -268,10 +293,10 @@ impl GeometryTable {
 
 /// The csv writer's error, with an I/O error kept as one so that `main` can tell a closed pipe
 /// (`irpol eval … | head`) from a failure.
-fn write_error(error: csv::Error) -> anyhow::Error {
+fn write_error(error: csv::Error) -> AppError {
     match error.into_kind() {
-        csv::ErrorKind::Io(io) => io.into(),
-        other => anyhow::anyhow!("cannot write the CSV: {other:?}"),
+        csv::ErrorKind::Io(io) => AppError::Stream(io),
+        other => AppError::Csv(format!("{other:?}")),
     }
 }
 
@@ -280,7 +305,7 @@ pub fn write_mueller_csv(
     model: &Pbrdf,
     table: &GeometryTable,
     out: &mut impl Write,
-) -> anyhow::Result<()> {
+) -> Result<(), AppError> {
     out.write_all(super::model_header(model).as_bytes())?;
     // Readers skip the `#` model lines as comments, so a data field starting with '#' is quoted.
     let mut writer = csv::WriterBuilder::new()
@@ -319,22 +344,22 @@ pub fn sweep_table(
     phi_i: f64,
     theta_r: &[f64],
     phi_r: &[f64],
-) -> anyhow::Result<GeometryTable> {
+) -> Result<GeometryTable, AppError> {
     let rows = theta_i
         .len()
         .saturating_mul(theta_r.len())
         .saturating_mul(phi_r.len());
     if rows > MAX_SWEEP_ROWS {
-        anyhow::bail!(
+        return Err(AppError::invalid(format!(
             "the sweep asks for {} × {} × {} = {rows} rows (θ_i × θ_r × φ_r); at most \
              {MAX_SWEEP_ROWS}",
             theta_i.len(),
             theta_r.len(),
             phi_r.len()
-        );
+        )));
     }
     if rows == 0 {
-        anyhow::bail!("the sweep has no rows");
+        return Err(AppError::invalid("the sweep has no rows"));
     }
     // Every angle on its own: a sweep is valid when each of its θ_i, θ_r and φ_r values is.
     for &ti in theta_i {
@@ -365,13 +390,36 @@ pub fn sweep_table(
     })
 }
 
+/// The geometries `irpol eval` is given: a geometry CSV, or the sweep of `--theta-i`,
+/// `--theta-r` and `--phi-r` (each a value or `START:STOP:STEP`) at azimuth `phi_i`.
+pub fn geometry_table(
+    geometry: Option<&Path>,
+    theta_i: Option<&str>,
+    theta_r: Option<&str>,
+    phi_i: f64,
+    phi_r: &str,
+) -> Result<GeometryTable, AppError> {
+    match (geometry, theta_i, theta_r) {
+        (Some(path), _, _) => read_geometry_csv(path),
+        (None, Some(ti), Some(tr)) => sweep_table(
+            &super::parse_sweep(ti, "theta-i")?,
+            phi_i,
+            &super::parse_sweep(tr, "theta-r")?,
+            &super::parse_sweep(phi_r, "phi-r")?,
+        ),
+        _ => Err(AppError::invalid(
+            "give --geometry FILE.csv, or --theta-i and --theta-r",
+        )),
+    }
+}
+
 /// Writes theta_deg,e0,e1,e2,e3 and returns the angles where the hemispherical reflectance
 /// exceeds 1 (ε0 < 0), which the caller must report.
 pub fn write_emissivity_csv(
     model: &Pbrdf,
     thetas_deg: &[f64],
     out: &mut impl Write,
-) -> anyhow::Result<Vec<f64>> {
+) -> Result<Vec<f64>, AppError> {
     for &theta in thetas_deg {
         Direction::from_degrees_checked("theta", theta, 0.0)?;
     }
@@ -405,7 +453,7 @@ mod tests {
         .unwrap()
     }
 
-    fn eval_file(text: &str) -> anyhow::Result<String> {
+    fn eval_file(text: &str) -> Result<String, AppError> {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("g.csv");
         std::fs::write(&path, text).unwrap();

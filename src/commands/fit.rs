@@ -3,6 +3,7 @@
 //! before the first byte is written, so a fit or a report that fails leaves the library and the
 //! reports exactly as they were; the library entries are renamed into place last.
 
+use super::AppError;
 use crate::atomic::OutputSet;
 use crate::fit::{
     fit_inputs, parse_parameter_list, parse_parameter_values, Dispersion, DistributionKind,
@@ -14,7 +15,6 @@ use crate::report::fit_report::encode_fit_report;
 use crate::report::index::library_index_html;
 use crate::report::spectral_report::encode_spectral_report;
 use crate::report::ReportError;
-use anyhow::Context;
 use std::path::{Path, PathBuf};
 
 /// The options of `irpol fit` as its flags give them, as text: parsed into [`FitOptions`] by one
@@ -56,32 +56,34 @@ impl Default for FitFlags {
 
 impl FitFlags {
     /// The fit options, or the message naming the flag that is wrong.
-    pub fn options(&self) -> anyhow::Result<FitOptions> {
+    pub fn options(&self) -> Result<FitOptions, AppError> {
         let shadowing = &self.shadowing;
         let mut options = FitOptions {
-            dispersion: Dispersion::parse(&self.dispersion).map_err(anyhow::Error::msg)?,
+            dispersion: Dispersion::parse(&self.dispersion)?,
             shadowing: Shadowing::parse(shadowing).ok_or_else(|| {
-                anyhow::anyhow!(
+                AppError::invalid(format!(
                     "unknown shadowing '{shadowing}': use none, torrance-sparrow or smith"
-                )
+                ))
             })?,
-            optimizer: Optimizer::parse(&self.optimizer).map_err(anyhow::Error::msg)?,
+            optimizer: Optimizer::parse(&self.optimizer)?,
             seed: self.seed,
             ..FitOptions::default()
         };
         if let Some(name) = &self.distribution {
             options.distribution = Some(DistributionKind::parse(name).ok_or_else(|| {
-                anyhow::anyhow!("unknown distribution '{name}': use cauchy or gaussian")
+                AppError::invalid(format!(
+                    "unknown distribution '{name}': use cauchy or gaussian"
+                ))
             })?);
         }
         if let Some(list) = &self.free {
-            options.free = Some(parse_parameter_list(list).map_err(anyhow::Error::msg)?);
+            options.free = Some(parse_parameter_list(list)?);
         }
         if let Some(values) = &self.fix {
-            options.fixed = parse_parameter_values(values).map_err(anyhow::Error::msg)?;
+            options.fixed = parse_parameter_values(values)?;
         }
         if let Some(loss) = &self.robust {
-            options.robust = Some(RobustLoss::parse(loss).map_err(anyhow::Error::msg)?);
+            options.robust = Some(RobustLoss::parse(loss)?);
         }
         Ok(options)
     }
@@ -105,7 +107,7 @@ pub fn fit_and_write(
     fits_dir: &Path,
     reports_dir: &Path,
     progress: &dyn crate::progress::Progress,
-) -> anyhow::Result<FitWritten> {
+) -> Result<FitWritten, AppError> {
     let outcomes = fit_inputs(inputs, options, progress)?;
     let mut entries = Vec::new();
     let mut report_files = Vec::new();
@@ -126,8 +128,10 @@ pub fn fit_and_write(
 
     let mut set = OutputSet::new();
     let stage = |set: &mut OutputSet, path: &Path, bytes: &[u8]| {
-        set.stage(path, bytes)
-            .with_context(|| format!("{}: cannot write", path.display()))
+        set.stage(path, bytes).map_err(|source| AppError::Write {
+            path: path.to_owned(),
+            source,
+        })
     };
     for (path, bytes) in &report_files {
         stage(&mut set, path, bytes)?;
@@ -136,8 +140,10 @@ pub fn fit_and_write(
     for (path, text) in &entries {
         stage(&mut set, path, text.as_bytes())?;
     }
-    set.commit()
-        .with_context(|| format!("{}: cannot write the fit's outputs", fits_dir.display()))?;
+    set.commit().map_err(|source| AppError::WriteFit {
+        dir: fits_dir.to_owned(),
+        source,
+    })?;
     Ok(FitWritten {
         outcomes,
         entries: entries.into_iter().map(|(path, _)| path).collect(),

@@ -1,12 +1,15 @@
 //! What the `irpol` subcommands do, as library functions the thin `main.rs` calls: model
 //! selection from flags or a material file, angle sweeps, geometry CSVs and CSV output.
 
+pub mod error;
 pub mod evaluate;
 pub mod fit;
 pub mod render;
 pub mod scene_init;
 pub mod sun;
 pub mod thermal;
+
+pub use error::{one_line, AppError};
 
 use crate::material::Material;
 use crate::optics::RefractiveIndex;
@@ -59,7 +62,7 @@ impl ModelArgs {
                 );
             }
             let material = Material::load(path)?;
-            return material_pbrdf(&material, self.wavelength_um, shadowing);
+            return Ok(material_pbrdf(&material, self.wavelength_um, shadowing)?);
         }
         if self.wavelength_um.is_some() {
             anyhow::bail!(
@@ -104,18 +107,17 @@ pub fn material_pbrdf(
     material: &Material,
     wavelength_um: Option<f64>,
     shadowing: Option<Shadowing>,
-) -> anyhow::Result<Pbrdf> {
+) -> Result<Pbrdf, AppError> {
     let mut spec = match (wavelength_um, material.model.spectral()) {
         (Some(wavelength), _) => material.at(wavelength)?,
         (None, None) => material.grey_model()?.clone(),
         (None, Some(table)) => {
-            let (first, last) = table.range_um();
-            anyhow::bail!(
-                "material '{}' is spectral ({}–{} µm): give --wavelength UM",
-                material.name,
-                crate::text::number(first),
-                crate::text::number(last)
-            )
+            let (first_um, last_um) = table.range_um();
+            return Err(AppError::SpectralNeedsWavelength {
+                name: material.name.clone(),
+                first_um,
+                last_um,
+            });
         }
     };
     if let Some(shadowing) = shadowing {
@@ -149,17 +151,17 @@ pub const MAX_SWEEP_VALUES: usize = 1_000_000;
 
 /// Parses `START:STOP:STEP` (inclusive of STOP within rounding) or a single value. A sweep holds
 /// at least one value and at most [`MAX_SWEEP_VALUES`].
-pub fn parse_sweep(text: &str, name: &str) -> anyhow::Result<Vec<f64>> {
+pub fn parse_sweep(text: &str, name: &str) -> Result<Vec<f64>, AppError> {
     let parts: Vec<&str> = text.split(':').collect();
-    let number = |s: &str| -> anyhow::Result<f64> {
+    let number = |s: &str| -> Result<f64, AppError> {
         let value: f64 = s
             .trim()
             .parse()
-            .map_err(|_| anyhow::anyhow!("--{name}: '{s}' is not a number"))?;
+            .map_err(|_| AppError::invalid(format!("--{name}: '{s}' is not a number")))?;
         if value.is_finite() {
             Ok(value)
         } else {
-            anyhow::bail!("--{name}: '{s}' is not finite")
+            Err(AppError::invalid(format!("--{name}: '{s}' is not finite")))
         }
     };
     match parts.as_slice() {
@@ -167,27 +169,29 @@ pub fn parse_sweep(text: &str, name: &str) -> anyhow::Result<Vec<f64>> {
         [start, stop, step] => {
             let (start, stop, step) = (number(start)?, number(stop)?, number(step)?);
             if step <= 0.0 || stop < start {
-                anyhow::bail!(
+                return Err(AppError::invalid(format!(
                     "--{name}: need STEP > 0 and STOP ≥ START in START:STOP:STEP, got '{text}'"
-                );
+                )));
             }
             // Counted in floating point first: a tiny step (1e-300) makes the quotient overflow
             // any integer, and a saturated count + 1 would wrap to an empty sweep.
             let steps = ((stop - start) / step + 1e-9).floor();
             if !steps.is_finite() || steps >= MAX_SWEEP_VALUES as f64 {
-                anyhow::bail!(
+                return Err(AppError::invalid(format!(
                     "--{name}: '{text}' asks for {} values; at most {MAX_SWEEP_VALUES}",
                     if steps.is_finite() {
                         crate::text::number(steps + 1.0)
                     } else {
                         "infinitely many".to_owned()
                     }
-                );
+                )));
             }
             let count = steps as usize + 1;
             Ok((0..count).map(|i| start + i as f64 * step).collect())
         }
-        _ => anyhow::bail!("--{name}: expected a number or START:STOP:STEP, got '{text}'"),
+        _ => Err(AppError::invalid(format!(
+            "--{name}: expected a number or START:STOP:STEP, got '{text}'"
+        ))),
     }
 }
 

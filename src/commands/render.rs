@@ -1,13 +1,15 @@
 //! `irpol render`: scene file in, output files out; for a scene with `[thermal]`, at instants of
 //! its thermal run (docs/design.md §2.6).
 
+use super::error::single_line;
+use super::thermal::solve;
+use super::AppError;
 use crate::atomic::write_atomically;
 use crate::output::{write_outputs, RenderSummary};
 use crate::progress::Progress;
-use crate::render::{render, RenderError};
-use crate::scene::{load_scene, load_scene_text, Scene, SceneError};
-use crate::thermal_scene::{scene_at, solve_scene, ThermalSolution};
-use anyhow::Context;
+use crate::render::render;
+use crate::scene::{load_scene, load_scene_text, Scene};
+use crate::thermal_scene::{scene_at, ThermalSolution};
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbaImage};
 use std::path::{Path, PathBuf};
@@ -28,11 +30,11 @@ pub fn render_scene(
     scene_path: &Path,
     out_dir: &Path,
     progress: &dyn Progress,
-) -> Result<RenderSummary, RenderError> {
+) -> Result<RenderSummary, AppError> {
     let start = Instant::now();
     let scene = load_scene(scene_path)?;
     if scene.thermal.is_some() {
-        return Err(thermal_needs_instant(scene_path));
+        return Err(AppError::ThermalNeedsInstant(scene_path.to_owned()));
     }
     render_loaded(&scene, out_dir, progress, start)
 }
@@ -42,11 +44,11 @@ fn render_loaded(
     out_dir: &Path,
     progress: &dyn Progress,
     start: Instant,
-) -> Result<RenderSummary, RenderError> {
+) -> Result<RenderSummary, AppError> {
     let load = start.elapsed().as_secs_f64();
     let mut rendered = render(scene, progress)?;
     rendered.timings.load = load;
-    write_outputs(scene, &rendered, out_dir, start)
+    Ok(write_outputs(scene, &rendered, out_dir, start)?)
 }
 
 /// When to render a thermal scene.
@@ -57,6 +59,22 @@ pub enum Instants {
     Seconds(Vec<f64>),
     /// One RFC 3339 instant.
     Utc(String),
+}
+
+impl Instants {
+    /// The instants `--time`, `--time-utc` or `--times` (`START:STOP:STEP`) give, if any.
+    pub fn from_flags(
+        time: Option<f64>,
+        time_utc: Option<String>,
+        times: Option<&str>,
+    ) -> Result<Option<Instants>, AppError> {
+        Ok(match (time, time_utc, times) {
+            (Some(t), _, _) => Some(Instants::Seconds(vec![t])),
+            (_, Some(text), _) => Some(Instants::Utc(text)),
+            (_, _, Some(sweep)) => Some(Instants::Seconds(super::parse_sweep(sweep, "times")?)),
+            _ => None,
+        })
+    }
 }
 
 /// One rendered instant.
@@ -73,21 +91,20 @@ pub fn render_scene_at(
     out_dir: &Path,
     instants: &Instants,
     progress: &dyn Progress,
-) -> anyhow::Result<Vec<TimedRender>> {
+) -> Result<Vec<TimedRender>, AppError> {
     let scene = load_scene(scene_path)?;
     let setup = scene
         .thermal
         .as_deref()
-        .ok_or_else(|| instant_needs_thermal(scene_path))?;
+        .ok_or_else(|| AppError::InstantNeedsThermal(scene_path.to_owned()))?;
     let times = match instants {
         Instants::Seconds(times) => times.clone(),
         Instants::Utc(text) => {
-            let at = crate::emitter::parse_time_utc(text).context("--time-utc")?;
+            let at = crate::emitter::parse_time_utc(text).map_err(AppError::TimeFlag)?;
             vec![(at - setup.site.start_utc).num_milliseconds() as f64 / 1000.0]
         }
     };
-    let solution = solve_scene(&scene, &times, progress)
-        .with_context(|| format!("{}: thermal run", scene_path.display()))?;
+    let solution = solve(&scene, scene_path, &times, progress)?;
     render_solution_at(&scene, &solution, &times, out_dir, progress)
 }
 
@@ -100,7 +117,7 @@ pub fn render_solution_at(
     times: &[f64],
     out_dir: &Path,
     progress: &dyn Progress,
-) -> anyhow::Result<Vec<TimedRender>> {
+) -> Result<Vec<TimedRender>, AppError> {
     let series = times.len() > 1;
     let mut renders = Vec::with_capacity(times.len());
     for (i, &time_s) in times.iter().enumerate() {
@@ -116,8 +133,10 @@ pub fn render_solution_at(
     }
     if series {
         let gif = animated_preview(&renders)?;
-        write_atomically(&out_dir.join("preview.gif"), &gif)
-            .with_context(|| format!("{}: cannot write", out_dir.display()))?;
+        write_atomically(&out_dir.join("preview.gif"), &gif).map_err(|source| AppError::Write {
+            path: out_dir.to_owned(),
+            source,
+        })?;
     }
     Ok(renders)
 }
@@ -127,13 +146,25 @@ fn solution_instant(
     scene: &Scene,
     solution: &ThermalSolution,
     time_s: f64,
-) -> anyhow::Result<Scene> {
+) -> Result<Scene, AppError> {
     let index = solution
         .times_s
         .iter()
         .position(|&t| (t - time_s).abs() < 1e-6)
-        .ok_or_else(|| anyhow::anyhow!("t = {time_s} s is not an instant of the thermal run"))?;
-    Ok(scene_at(scene, solution, index).map_err(|e| SceneError::new(&scene.path, e))?)
+        .ok_or(AppError::NotAnInstant(time_s))?;
+    scene_at(scene, solution, index).map_err(|e| AppError::SceneAt {
+        path: scene.path.clone(),
+        message: single_line(&e.to_string()),
+    })
+}
+
+/// A scene file's text, refused as `irpol render` refuses an unreadable scene (for callers such
+/// as the Python bindings that change the text before [`scene_to_render`]).
+pub fn read_scene_text(path: &Path) -> Result<String, AppError> {
+    std::fs::read_to_string(path).map_err(|source| AppError::ReadScene {
+        path: path.to_owned(),
+        source,
+    })
 }
 
 /// The scene of `path` read from `text` (the file's own, or changed by a caller such as the
@@ -145,35 +176,17 @@ pub fn scene_to_render(
     text: &str,
     time_s: Option<f64>,
     progress: &dyn Progress,
-) -> anyhow::Result<Scene> {
+) -> Result<Scene, AppError> {
     let scene = load_scene_text(path, text)?;
     match (time_s, scene.thermal.is_some()) {
         (None, false) => Ok(scene),
-        (None, true) => Err(thermal_needs_instant(path).into()),
-        (Some(_), false) => Err(instant_needs_thermal(path)),
+        (None, true) => Err(AppError::ThermalNeedsInstant(path.to_owned())),
+        (Some(_), false) => Err(AppError::InstantNeedsThermal(path.to_owned())),
         (Some(time_s), true) => {
-            let solution = solve_scene(&scene, &[time_s], progress)
-                .with_context(|| format!("{}: thermal run", path.display()))?;
+            let solution = solve(&scene, path, &[time_s], progress)?;
             solution_instant(&scene, &solution, time_s)
         }
     }
-}
-
-fn thermal_needs_instant(path: &Path) -> RenderError {
-    SceneError::new(
-        path,
-        "has a [thermal] section: say when to render it with --time SECONDS, \
-         --time-utc INSTANT or --times START:STOP:STEP (seconds from thermal.start_utc)",
-    )
-    .into()
-}
-
-fn instant_needs_thermal(path: &Path) -> anyhow::Error {
-    anyhow::anyhow!(
-        "{}: --time/--times need temperatures from the thermal model, but the scene has no \
-         [thermal] section",
-        path.display()
-    )
 }
 
 /// Where instant `i` at `time_s` is written: `out_dir` itself, or `out_dir/NNN_<t>s/` in a series.
@@ -186,13 +199,13 @@ pub fn instant_folder(out_dir: &Path, i: usize, time_s: f64, series: bool) -> Pa
 }
 
 /// One second per frame: the instant above S0.png beside DoLP.png of each rendered instant.
-fn animated_preview(renders: &[TimedRender]) -> anyhow::Result<Vec<u8>> {
+fn animated_preview(renders: &[TimedRender]) -> Result<Vec<u8>, AppError> {
     let mut frames = Vec::with_capacity(renders.len());
     for r in renders {
-        let panel = |name: &str| -> anyhow::Result<RgbaImage> {
+        let panel = |name: &str| -> Result<RgbaImage, AppError> {
             let path = r.folder.join(name);
             Ok(image::open(&path)
-                .with_context(|| format!("{}: cannot read", path.display()))?
+                .map_err(|source| AppError::ReadImage { path, source })?
                 .to_rgba8())
         };
         let (s0, dolp) = (panel("S0.png")?, panel("DoLP.png")?);
@@ -228,7 +241,7 @@ fn animated_preview(renders: &[TimedRender]) -> anyhow::Result<Vec<u8>> {
 }
 
 /// A white strip `width` pixels wide with `text` on it.
-fn caption_strip(text: &str, width: u32) -> anyhow::Result<RgbaImage> {
+fn caption_strip(text: &str, width: u32) -> Result<RgbaImage, AppError> {
     use plotters::prelude::*;
     const HEIGHT: u32 = 26;
     crate::plot_style::register_fonts();
@@ -237,11 +250,11 @@ fn caption_strip(text: &str, width: u32) -> anyhow::Result<RgbaImage> {
         let root = BitMapBackend::with_buffer(&mut rgb, (width, HEIGHT)).into_drawing_area();
         let style = (crate::plot_style::FONT, 17).into_font().color(&BLACK);
         root.draw(&Text::new(text.to_owned(), (8, 4), style))
-            .map_err(|e| anyhow::anyhow!("cannot draw the preview caption: {e}"))?;
+            .map_err(|e| AppError::Caption(e.to_string()))?;
         root.present()
-            .map_err(|e| anyhow::anyhow!("cannot draw the preview caption: {e}"))?;
+            .map_err(|e| AppError::Caption(e.to_string()))?;
     }
     let strip = image::RgbImage::from_raw(width, HEIGHT, rgb)
-        .ok_or_else(|| anyhow::anyhow!("caption buffer has the wrong size"))?;
+        .ok_or_else(|| AppError::invalid("caption buffer has the wrong size"))?;
     Ok(image::DynamicImage::ImageRgb8(strip).to_rgba8())
 }

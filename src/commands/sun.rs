@@ -3,9 +3,9 @@
 //! irradiance at that elevation (`thermal::weather::solis`, its default atmosphere). The batch form
 //! exists so that a cross-check over a year of hours runs one process, not thousands.
 
+use super::AppError;
 use crate::emitter::{format_time_utc, parse_time_utc, sun_position, SunPosition};
 use crate::thermal::{simplified_solis, SolisAtmosphere};
-use anyhow::Context;
 use chrono::{DateTime, Utc};
 use std::io::Write;
 use std::path::Path;
@@ -16,26 +16,42 @@ pub const CLEAR_SKY_COLUMNS: &str = "dni_w_m2,dhi_w_m2,ghi_w_m2";
 
 /// One RFC 3339 instant per line; blank lines and lines starting with `#` are skipped. A bad line is
 /// refused as `FILE:LINE: …`.
-pub fn read_times_file(path: &Path) -> anyhow::Result<Vec<DateTime<Utc>>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
+pub fn read_times_file(path: &Path) -> Result<Vec<DateTime<Utc>>, AppError> {
+    let text = std::fs::read_to_string(path).map_err(|source| AppError::Read {
+        path: path.to_owned(),
+        source,
+    })?;
     let mut times = Vec::new();
     for (index, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let time =
-            parse_time_utc(line).with_context(|| format!("{}:{}", path.display(), index + 1))?;
+        let time = parse_time_utc(line).map_err(|source| AppError::TimesLine {
+            path: path.to_owned(),
+            line: index + 1,
+            source,
+        })?;
         times.push(time);
     }
     if times.is_empty() {
-        anyhow::bail!(
-            "{}: no times (expected one RFC 3339 instant per line, e.g. 2026-06-21T10:00:00Z)",
-            path.display()
-        );
+        return Err(AppError::NoTimes(path.to_owned()));
     }
     Ok(times)
+}
+
+/// The instants `irpol sun` is given: one `--time-utc`, or the lines of a `--times-file`.
+pub fn given_times(
+    time_utc: Option<&str>,
+    times_file: Option<&Path>,
+) -> Result<Vec<DateTime<Utc>>, AppError> {
+    match (time_utc, times_file) {
+        (Some(text), None) => Ok(vec![parse_time_utc(text)?]),
+        (None, Some(path)) => read_times_file(path),
+        _ => Err(AppError::invalid(
+            "give either --time-utc RFC3339 or --times-file FILE",
+        )),
+    }
 }
 
 /// The sun position at every instant, or the first error (nothing is returned half-done).
@@ -43,7 +59,7 @@ pub fn sun_table(
     latitude_deg: f64,
     longitude_deg: f64,
     times: &[DateTime<Utc>],
-) -> anyhow::Result<Vec<(DateTime<Utc>, SunPosition)>> {
+) -> Result<Vec<(DateTime<Utc>, SunPosition)>, AppError> {
     times
         .iter()
         .map(|time| Ok((*time, sun_position(latitude_deg, longitude_deg, time)?)))
@@ -60,7 +76,7 @@ pub fn write_sun_csv(
     times: &[DateTime<Utc>],
     clear_sky: bool,
     out: &mut impl Write,
-) -> anyhow::Result<()> {
+) -> Result<(), AppError> {
     let table = sun_table(latitude_deg, longitude_deg, times)?;
     if clear_sky {
         writeln!(out, "{SUN_HEADER},{CLEAR_SKY_COLUMNS}")?;
@@ -171,14 +187,17 @@ mod tests {
         assert_eq!(read_times_file(&good).unwrap().len(), 2);
         let bad = dir.path().join("bad.txt");
         std::fs::write(&bad, "2026-06-21T10:00:00Z\n2026-06-21 11:00\n").unwrap();
-        let error = format!("{:#}", read_times_file(&bad).unwrap_err());
+        let error = crate::commands::one_line(&read_times_file(&bad).unwrap_err());
         assert!(
             error.contains("bad.txt:2:") && error.contains("RFC 3339"),
             "{error}"
         );
         let empty = dir.path().join("empty.txt");
         std::fs::write(&empty, "# nothing\n").unwrap();
-        assert!(format!("{:#}", read_times_file(&empty).unwrap_err()).contains("no times"));
+        assert!(read_times_file(&empty)
+            .unwrap_err()
+            .to_string()
+            .contains("no times"));
         assert!(read_times_file(&dir.path().join("missing.txt")).is_err());
     }
 

@@ -1,11 +1,11 @@
 //! `irpol thermal`: a scene's temperatures over its `[thermal]` run (docs/design.md §1.8, §2.6).
 
 use super::render::{render_solution_at, TimedRender};
+use super::AppError;
 use crate::output::thermal::{write_thermal_outputs, ThermalSummary};
 use crate::progress::Progress;
-use crate::scene::load_scene;
-use crate::thermal_scene::solve_scene;
-use anyhow::Context;
+use crate::scene::{load_scene, Scene};
+use crate::thermal_scene::{solve_scene, ThermalSolution};
 use std::path::Path;
 use std::time::Instant;
 
@@ -15,14 +15,12 @@ pub fn run_thermal(
     scene_path: &Path,
     out_dir: &Path,
     progress: &dyn Progress,
-) -> anyhow::Result<ThermalSummary> {
+) -> Result<ThermalSummary, AppError> {
     let start = Instant::now();
     let scene = load_scene(scene_path)?;
-    let solution = solve_scene(&scene, &[], progress)
-        .with_context(|| format!("{}: thermal run", scene_path.display()))?;
+    let solution = solve(&scene, scene_path, &[], progress)?;
     let seconds = start.elapsed().as_secs_f64();
-    write_thermal_outputs(&scene, &solution, out_dir, seconds)
-        .with_context(|| format!("{}: cannot write", out_dir.display()))
+    write_thermal(&scene, &solution, out_dir, seconds)
 }
 
 /// The thermal run written to `thermal_out` and rendered at `times` into `render_out`, from one
@@ -33,14 +31,37 @@ pub fn run_thermal_and_render(
     render_out: &Path,
     times: &[f64],
     progress: &dyn Progress,
-) -> anyhow::Result<(ThermalSummary, Vec<TimedRender>)> {
+) -> Result<(ThermalSummary, Vec<TimedRender>), AppError> {
     let start = Instant::now();
     let scene = load_scene(scene_path)?;
-    let solution = solve_scene(&scene, times, progress)
-        .with_context(|| format!("{}: thermal run", scene_path.display()))?;
+    let solution = solve(&scene, scene_path, times, progress)?;
     let seconds = start.elapsed().as_secs_f64();
-    let summary = write_thermal_outputs(&scene, &solution, thermal_out, seconds)
-        .with_context(|| format!("{}: cannot write", thermal_out.display()))?;
+    let summary = write_thermal(&scene, &solution, thermal_out, seconds)?;
     let renders = render_solution_at(&scene, &solution, times, render_out, progress)?;
     Ok((summary, renders))
+}
+
+/// The scene's thermal run (recording `times` too), its failure naming the scene file.
+pub(crate) fn solve(
+    scene: &Scene,
+    scene_path: &Path,
+    times: &[f64],
+    progress: &dyn Progress,
+) -> Result<ThermalSolution, AppError> {
+    solve_scene(scene, times, progress).map_err(|source| AppError::ThermalRun {
+        path: scene_path.to_owned(),
+        source,
+    })
+}
+
+fn write_thermal(
+    scene: &Scene,
+    solution: &ThermalSolution,
+    out_dir: &Path,
+    seconds: f64,
+) -> Result<ThermalSummary, AppError> {
+    write_thermal_outputs(scene, solution, out_dir, seconds).map_err(|source| AppError::Write {
+        path: out_dir.to_owned(),
+        source,
+    })
 }

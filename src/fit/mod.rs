@@ -46,7 +46,7 @@ pub use model_fit::ModelFit;
 pub use nelder_mead::NelderMeadSettings;
 pub use objective::{BoxCost, Objective};
 pub use optimize::OptimizerSettings;
-pub use options::{parse_parameter_list, parse_parameter_values, FitOptions};
+pub use options::{parse_parameter_list, parse_parameter_values, FitOptions, OptionError};
 pub use outcome::{fit_measurement, FitOutcome};
 pub use parameters::{
     DistributionKind, Interval, Parameter, ParameterBounds, ParameterValues, SMITH_MIN_Q,

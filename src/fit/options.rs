@@ -92,58 +92,91 @@ impl FitOptions {
     }
 }
 
+/// Why the text of a fit option (`--free`, `--fix`, `--robust`, `--optimizer`, `--dispersion`)
+/// is refused. Quoted user text goes through [`shown`] when displayed, so a message stays one
+/// line of printable characters whatever was typed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum OptionError {
+    #[error("unknown parameter '{}' (use sigma, q, n, k, rho_d)", shown(.0))]
+    UnknownParameter(String),
+    #[error("parameter '{}' is listed twice", shown(.0))]
+    ListedTwice(String),
+    #[error("the parameter list is empty")]
+    EmptyList,
+    #[error("'{}' is not name=value (e.g. k=0.1)", shown(.0))]
+    NotNameValue(String),
+    #[error("the value of {parameter} in '{}' is not a finite number", shown(.pair))]
+    NotFinite { parameter: Parameter, pair: String },
+    /// A value outside the parameter's domain ([`Parameter::check`]'s message).
+    #[error("{0}")]
+    OutsideDomain(String),
+    #[error("{0} is given twice")]
+    GivenTwice(Parameter),
+    #[error("no name=value pair given")]
+    NoPairs,
+    #[error("robust loss scale '{0}' is not a number")]
+    RobustScaleNotNumber(String),
+    #[error("robust loss scale {0} must be finite and > 0")]
+    RobustScale(f64),
+    #[error("unknown robust loss '{0}' (huber or cauchy)")]
+    UnknownRobustLoss(String),
+    #[error("the optimizer needs at least one stage")]
+    NoStage,
+    #[error("the genetic stage (ga) can only come first")]
+    GeneticNotFirst,
+    #[error(
+        "unknown optimizer stage '{stage}' in '{text}' (use ga, nm, lm joined by +, e.g. ga+nm)"
+    )]
+    UnknownStage { stage: String, text: String },
+    #[error(
+        "unknown dispersion '{}': use table or lorentz:N with N = 1…6 oscillators",
+        shown(.0)
+    )]
+    UnknownDispersion(String),
+}
+
 /// Parses a comma-separated parameter list such as `sigma,q,n` (`--free`).
-pub fn parse_parameter_list(text: &str) -> Result<Vec<Parameter>, String> {
+pub fn parse_parameter_list(text: &str) -> Result<Vec<Parameter>, OptionError> {
     let mut list = Vec::new();
     for name in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let parameter = Parameter::parse(name).ok_or_else(|| {
-            format!(
-                "unknown parameter '{}' (use sigma, q, n, k, rho_d)",
-                shown(name)
-            )
-        })?;
+        let parameter =
+            Parameter::parse(name).ok_or_else(|| OptionError::UnknownParameter(name.to_owned()))?;
         if list.contains(&parameter) {
-            return Err(format!("parameter '{}' is listed twice", shown(name)));
+            return Err(OptionError::ListedTwice(name.to_owned()));
         }
         list.push(parameter);
     }
     if list.is_empty() {
-        return Err("the parameter list is empty".into());
+        return Err(OptionError::EmptyList);
     }
     Ok(list)
 }
 
 /// Parses comma-separated `name=value` pairs such as `k=0.1,rho=0` (`--fix`).
-pub fn parse_parameter_values(text: &str) -> Result<BTreeMap<Parameter, f64>, String> {
+pub fn parse_parameter_values(text: &str) -> Result<BTreeMap<Parameter, f64>, OptionError> {
     let mut values = BTreeMap::new();
     for pair in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let (name, value) = pair
             .split_once('=')
-            .ok_or_else(|| format!("'{}' is not name=value (e.g. k=0.1)", shown(pair)))?;
-        let parameter = Parameter::parse(name).ok_or_else(|| {
-            format!(
-                "unknown parameter '{}' (use sigma, q, n, k, rho_d)",
-                shown(name.trim())
-            )
-        })?;
+            .ok_or_else(|| OptionError::NotNameValue(pair.to_owned()))?;
+        let parameter = Parameter::parse(name)
+            .ok_or_else(|| OptionError::UnknownParameter(name.trim().to_owned()))?;
         let value: f64 = value
             .trim()
             .parse()
             .ok()
             .filter(|v: &f64| v.is_finite())
-            .ok_or_else(|| {
-                format!(
-                    "the value of {parameter} in '{}' is not a finite number",
-                    shown(pair)
-                )
+            .ok_or_else(|| OptionError::NotFinite {
+                parameter,
+                pair: pair.to_owned(),
             })?;
-        parameter.check(value)?;
+        parameter.check(value).map_err(OptionError::OutsideDomain)?;
         if values.insert(parameter, value).is_some() {
-            return Err(format!("{parameter} is given twice"));
+            return Err(OptionError::GivenTwice(parameter));
         }
     }
     if values.is_empty() {
-        return Err("no name=value pair given".into());
+        return Err(OptionError::NoPairs);
     }
     Ok(values)
 }
@@ -177,6 +210,7 @@ mod tests {
         assert!(parse_parameter_list("sigma,sigma").is_err());
         assert!(parse_parameter_list("sigma,alpha")
             .unwrap_err()
+            .to_string()
             .contains("alpha"));
         assert!(parse_parameter_list("").is_err());
         assert!(parse_parameter_values("k:0.1").is_err());
@@ -185,6 +219,7 @@ mod tests {
         assert!(parse_parameter_values("k=1,k=2").is_err());
         assert!(parse_parameter_values("sigma=1e308")
             .unwrap_err()
+            .to_string()
             .contains("sigma = 1e308 is outside"));
         assert!(parse_parameter_values("q=0.5").is_err());
         assert_eq!(parse_parameter_values("n=2.2").unwrap()[&Parameter::N], 2.2);

@@ -2,6 +2,7 @@
 //! detector spike) from pulling the fit. Off by default: with honest uncertainties plain least
 //! squares is the maximum-likelihood estimate and its χ² is what the statistics assume.
 
+use super::options::OptionError;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -22,15 +23,15 @@ impl RobustLoss {
     pub const CAUCHY: RobustLoss = RobustLoss::Cauchy { scale: 2.385 };
 
     /// Parses `huber` or `cauchy`, optionally with a scale: `huber:2`.
-    pub fn parse(text: &str) -> Result<RobustLoss, String> {
+    pub fn parse(text: &str) -> Result<RobustLoss, OptionError> {
         let (name, scale) = match text.split_once(':') {
             Some((name, scale)) => {
                 let scale: f64 = scale
                     .trim()
                     .parse()
-                    .map_err(|_| format!("robust loss scale '{scale}' is not a number"))?;
+                    .map_err(|_| OptionError::RobustScaleNotNumber(scale.to_owned()))?;
                 if !(scale.is_finite() && scale > 0.0) {
-                    return Err(format!("robust loss scale {scale} must be finite and > 0"));
+                    return Err(OptionError::RobustScale(scale));
                 }
                 (name.trim(), Some(scale))
             }
@@ -39,7 +40,7 @@ impl RobustLoss {
         let loss = match name {
             "huber" => RobustLoss::HUBER,
             "cauchy" => RobustLoss::CAUCHY,
-            _ => return Err(format!("unknown robust loss '{name}' (huber or cauchy)")),
+            _ => return Err(OptionError::UnknownRobustLoss(name.to_owned())),
         };
         Ok(match (loss, scale) {
             (RobustLoss::Huber { .. }, Some(scale)) => RobustLoss::Huber { scale },

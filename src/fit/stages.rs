@@ -1,5 +1,6 @@
 //! The optimizer stages of a fit and the record each leaves behind (its convergence history).
 
+use super::options::OptionError;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -41,26 +42,27 @@ impl fmt::Display for Stage {
 pub struct Optimizer(Vec<Stage>);
 
 impl Optimizer {
-    pub fn new(stages: Vec<Stage>) -> Result<Optimizer, String> {
+    pub fn new(stages: Vec<Stage>) -> Result<Optimizer, OptionError> {
         if stages.is_empty() {
-            return Err("the optimizer needs at least one stage".into());
+            return Err(OptionError::NoStage);
         }
         if stages.iter().skip(1).any(|s| *s == Stage::Ga) {
-            return Err("the genetic stage (ga) can only come first".into());
+            return Err(OptionError::GeneticNotFirst);
         }
         Ok(Optimizer(stages))
     }
 
-    pub fn parse(text: &str) -> Result<Optimizer, String> {
+    pub fn parse(text: &str) -> Result<Optimizer, OptionError> {
         let stages = text
             .split('+')
             .map(|name| match name.trim() {
                 "ga" => Ok(Stage::Ga),
                 "nm" => Ok(Stage::Nm),
                 "lm" => Ok(Stage::Lm),
-                other => Err(format!(
-                    "unknown optimizer stage '{other}' in '{text}' (use ga, nm, lm joined by +, e.g. ga+nm)"
-                )),
+                other => Err(OptionError::UnknownStage {
+                    stage: other.to_owned(),
+                    text: text.to_owned(),
+                }),
             })
             .collect::<Result<Vec<_>, _>>()?;
         Optimizer::new(stages)
@@ -156,7 +158,13 @@ mod tests {
         assert_eq!(o.stages(), &[Stage::Ga, Stage::Nm, Stage::Lm]);
         assert!(!o.starts_locally());
         assert!(Optimizer::parse("nm").unwrap().starts_locally());
-        assert!(Optimizer::parse("nm+ga").unwrap_err().contains("first"));
-        assert!(Optimizer::parse("ga+bfgs").unwrap_err().contains("bfgs"));
+        assert!(Optimizer::parse("nm+ga")
+            .unwrap_err()
+            .to_string()
+            .contains("first"));
+        assert!(Optimizer::parse("ga+bfgs")
+            .unwrap_err()
+            .to_string()
+            .contains("bfgs"));
     }
 }

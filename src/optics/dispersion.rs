@@ -13,6 +13,22 @@ use super::RefractiveIndex;
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
 
+/// Why a Lorentz law is not physical.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LorentzError {
+    #[error("eps_inf = {0} must be ≥ 1")]
+    EpsInf(f64),
+    #[error("a Lorentz dispersion needs at least one oscillator")]
+    NoOscillator,
+    /// `oscillator` counts from 1.
+    #[error("oscillator {oscillator}: {name} = {value} must be positive")]
+    Oscillator {
+        oscillator: usize,
+        name: &'static str,
+        value: f64,
+    },
+}
+
 /// One Lorentz oscillator (a resonance of the lattice, e.g. silicate's Si–O stretch near 9.3 µm).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -56,12 +72,12 @@ impl LorentzDispersion {
 
     /// Why the law is not physical, if it is not: ε_∞ ≥ 1 and each oscillator's resonance,
     /// strength and width positive and finite.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), LorentzError> {
         if !(self.eps_inf.is_finite() && self.eps_inf >= 1.0) {
-            return Err(format!("eps_inf = {} must be ≥ 1", self.eps_inf));
+            return Err(LorentzError::EpsInf(self.eps_inf));
         }
         if self.oscillators.is_empty() {
-            return Err("a Lorentz dispersion needs at least one oscillator".into());
+            return Err(LorentzError::NoOscillator);
         }
         for (j, o) in self.oscillators.iter().enumerate() {
             for (name, value) in [
@@ -70,10 +86,11 @@ impl LorentzDispersion {
                 ("damping_um", o.damping_um),
             ] {
                 if !(value.is_finite() && value > 0.0) {
-                    return Err(format!(
-                        "oscillator {}: {name} = {value} must be positive",
-                        j + 1
-                    ));
+                    return Err(LorentzError::Oscillator {
+                        oscillator: j + 1,
+                        name,
+                        value,
+                    });
                 }
             }
         }
@@ -123,9 +140,13 @@ mod tests {
         let mut law = silicate();
         assert!(law.validate().is_ok());
         law.oscillators[0].damping_um = 0.0;
-        assert!(law.validate().unwrap_err().contains("damping_um"));
+        assert!(law
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("damping_um"));
         law = silicate();
         law.eps_inf = 0.5;
-        assert!(law.validate().unwrap_err().contains("eps_inf"));
+        assert!(law.validate().unwrap_err().to_string().contains("eps_inf"));
     }
 }

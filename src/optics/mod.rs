@@ -11,7 +11,7 @@ mod polarization;
 
 pub use band_nodes::{SpectralMix, TableMissesBand, WavelengthNodes};
 pub use brightness::TemperatureLookup;
-pub use dispersion::{LorentzDispersion, LorentzOscillator};
+pub use dispersion::{LorentzDispersion, LorentzError, LorentzOscillator};
 pub use frame::{rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame};
 pub use fresnel::{fresnel_amplitudes, FresnelFractions, RefractiveIndex};
 pub use planck::{

@@ -48,17 +48,14 @@ pub enum Dispersion {
 
 impl Dispersion {
     /// `table` or `lorentz:N` (N ≥ 1).
-    pub fn parse(text: &str) -> Result<Dispersion, String> {
+    pub fn parse(text: &str) -> Result<Dispersion, super::OptionError> {
         let text = text.trim();
         if text == "table" {
             return Ok(Dispersion::Table);
         }
         match text.strip_prefix("lorentz:").map(str::parse::<usize>) {
             Some(Ok(n)) if (1..=6).contains(&n) => Ok(Dispersion::Lorentz(n)),
-            _ => Err(format!(
-                "unknown dispersion '{}': use table or lorentz:N with N = 1…6 oscillators",
-                crate::text::shown(text)
-            )),
+            _ => Err(super::OptionError::UnknownDispersion(text.to_owned())),
         }
     }
 }

@@ -1,0 +1,246 @@
+//! Why a subcommand failed: [`AppError`], the one error type of the application layer that the
+//! command line and the Python bindings share. Library errors are wrapped as they are (their
+//! message is the message); the application adds the context the library cannot know (which
+//! file, which flag, which step) as a variant whose `source` is the library's error.
+//!
+//! Both front ends show an error as one line, its message followed by the message of each
+//! `source` in turn, separated by `: ` ([`one_line`]; the CLI's `{error:#}` joins the chain the
+//! same way). The texts are what `irpol` has always printed: tests and scripts match on them.
+
+use crate::fit::{FitError, OptionError};
+use crate::material::MaterialError;
+use crate::measure::{MeasureError, MeasureErrorKind};
+use crate::pbrdf::ModelError;
+use crate::render::RenderError;
+use crate::report::ReportError;
+use crate::scene::SceneError;
+use crate::thermal_scene::ThermalRunError;
+use std::error::Error;
+use std::io;
+use std::path::PathBuf;
+
+#[derive(Debug, thiserror::Error)]
+pub enum AppError {
+    // --- library errors, as the library words them ---
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    #[error(transparent)]
+    Material(#[from] MaterialError),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error(transparent)]
+    Measure(#[from] MeasureError),
+    #[error(transparent)]
+    Fit(#[from] FitError),
+    #[error(transparent)]
+    FitOption(#[from] OptionError),
+    #[error(transparent)]
+    Report(#[from] ReportError),
+    #[error(transparent)]
+    Sun(#[from] crate::emitter::SunError),
+    /// Writing a table to the output stream (stdout for the CLI); kept as the bare I/O error so
+    /// that the CLI can tell a reader that went away (`irpol eval … | head`) from a failure.
+    #[error(transparent)]
+    Stream(#[from] io::Error),
+    #[error(transparent)]
+    Image(#[from] image::ImageError),
+
+    // --- files the application reads or writes ---
+    #[error("{}: cannot open", path.display())]
+    Open {
+        path: PathBuf,
+        #[source]
+        source: io::Error,
+    },
+    #[error("{}: cannot read", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: io::Error,
+    },
+    #[error("{}: cannot read the scene", path.display())]
+    ReadScene {
+        path: PathBuf,
+        #[source]
+        source: io::Error,
+    },
+    #[error("{}: cannot read", path.display())]
+    ReadImage {
+        path: PathBuf,
+        #[source]
+        source: image::ImageError,
+    },
+    #[error("{}: cannot write", path.display())]
+    Write {
+        path: PathBuf,
+        #[source]
+        source: io::Error,
+    },
+    /// The fit's library entries, reports and index could not be put in place together.
+    #[error("{}: cannot write the fit's outputs", dir.display())]
+    WriteFit {
+        dir: PathBuf,
+        #[source]
+        source: io::Error,
+    },
+    #[error("cannot write the CSV: {0}")]
+    Csv(String),
+    #[error("cannot draw the preview caption: {0}")]
+    Caption(String),
+
+    // --- input the application refuses ---
+    /// A command-line argument (or the Python argument of the same name) that makes no sense.
+    #[error("{0}")]
+    Invalid(String),
+    /// A geometry CSV of `irpol eval`; `at` is the `:line` or `:line:column` after the path, or
+    /// nothing for the whole file.
+    #[error("{}{at}: {message}", path.display())]
+    Geometry {
+        path: PathBuf,
+        at: String,
+        message: String,
+    },
+    /// A bad line of a `--times-file`.
+    #[error("{}:{line}", path.display())]
+    TimesLine {
+        path: PathBuf,
+        line: usize,
+        #[source]
+        source: crate::emitter::SunError,
+    },
+    #[error(
+        "{}: no times (expected one RFC 3339 instant per line, e.g. 2026-06-21T10:00:00Z)",
+        .0.display()
+    )]
+    NoTimes(PathBuf),
+    #[error("--time-utc")]
+    TimeFlag(#[source] crate::emitter::SunError),
+    #[error(
+        "material '{name}' is spectral ({first}–{last} µm): give --wavelength UM",
+        first = crate::text::number(*.first_um),
+        last = crate::text::number(*.last_um)
+    )]
+    SpectralNeedsWavelength {
+        name: String,
+        first_um: f64,
+        last_um: f64,
+    },
+
+    // --- thermal scenes ---
+    #[error("{}: thermal run", path.display())]
+    ThermalRun {
+        path: PathBuf,
+        #[source]
+        source: ThermalRunError,
+    },
+    #[error(
+        "{}: has a [thermal] section: say when to render it with --time SECONDS, --time-utc \
+         INSTANT or --times START:STOP:STEP (seconds from thermal.start_utc)",
+        .0.display()
+    )]
+    ThermalNeedsInstant(PathBuf),
+    #[error(
+        "{}: --time/--times need temperatures from the thermal model, but the scene has no \
+         [thermal] section",
+        .0.display()
+    )]
+    InstantNeedsThermal(PathBuf),
+    #[error("t = {0} s is not an instant of the thermal run")]
+    NotAnInstant(f64),
+    /// The scene at an instant of its thermal run could not be built.
+    #[error("{}: {message}", path.display())]
+    SceneAt { path: PathBuf, message: String },
+}
+
+impl AppError {
+    /// A refused argument.
+    pub fn invalid(message: impl Into<String>) -> AppError {
+        AppError::Invalid(message.into())
+    }
+
+    /// Whether a file or stream could not be read or written (the Python bindings raise
+    /// `OSError`), as opposed to input that is wrong (`ValueError`): an [`io::Error`] among the
+    /// causes, or a measurement path that is missing or unreadable (the measurement reader names
+    /// the file and line where others keep the I/O error as a source).
+    pub fn is_io(&self) -> bool {
+        match self {
+            AppError::Stream(_) => true,
+            AppError::Image(image::ImageError::IoError(_)) => true,
+            _ => {
+                self.measure_error().is_some_and(measure_path_failed)
+                    || causes(self).any(|cause| cause.is::<io::Error>())
+            }
+        }
+    }
+
+    /// The reader of the output stream went away: not a failure of the command.
+    pub fn is_broken_pipe(&self) -> bool {
+        let broken = |e: &io::Error| e.kind() == io::ErrorKind::BrokenPipe;
+        match self {
+            AppError::Stream(e) => broken(e),
+            _ => causes(self).any(|cause| cause.downcast_ref::<io::Error>().is_some_and(broken)),
+        }
+    }
+
+    /// The measurement error inside, however it is wrapped (a wrapped error displays as its own
+    /// message, so it does not appear among the causes).
+    fn measure_error(&self) -> Option<&MeasureError> {
+        match self {
+            AppError::Measure(e)
+            | AppError::Fit(FitError::Read(e))
+            | AppError::Report(ReportError::Measure(e))
+            | AppError::Report(ReportError::Fit(FitError::Read(e))) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// A measurement path that could not be read at all (as opposed to a file that reads but is
+/// malformed).
+fn measure_path_failed(error: &MeasureError) -> bool {
+    matches!(
+        error.kind,
+        MeasureErrorKind::NotFound
+            | MeasureErrorKind::IsDirectory
+            | MeasureErrorKind::Unreadable { .. }
+    )
+}
+
+/// `error` and each of its sources in turn.
+fn causes<'a>(error: &'a (dyn Error + 'static)) -> impl Iterator<Item = &'a (dyn Error + 'static)> {
+    std::iter::successors(Some(error), |&e| e.source())
+}
+
+/// `error` as one line: its message and each source's, joined by `: ` (what the CLI prints after
+/// `irpol: error: `).
+pub fn one_line(error: &(dyn Error + 'static)) -> String {
+    causes(error)
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join(": ")
+}
+
+/// `message` on one line: runs of whitespace (line breaks of a parser's message) as one space.
+pub(crate) fn single_line(message: &str) -> String {
+    message.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_line_joins_the_causes_and_io_is_told_from_bad_input() {
+        let error = AppError::Write {
+            path: "out/x.csv".into(),
+            source: io::Error::new(io::ErrorKind::PermissionDenied, "denied"),
+        };
+        assert_eq!(one_line(&error), "out/x.csv: cannot write: denied");
+        assert!(error.is_io() && !error.is_broken_pipe());
+        let error = AppError::invalid("give --geometry FILE.csv, or --theta-i and --theta-r");
+        assert!(!error.is_io());
+        assert!(AppError::Stream(io::ErrorKind::BrokenPipe.into()).is_broken_pipe());
+    }
+}
