@@ -3,8 +3,9 @@
 //! with the same zenith angle, and one standard deviation per observation (the weights of the
 //! least-squares objective).
 
-use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
+use crate::measure::{MeasurementPoint, MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::pbrdf::{Direction, ScatteringGeometry};
+use std::collections::HashMap;
 
 use super::FitError;
 
@@ -53,62 +54,24 @@ pub struct MeasurementData {
 
 impl MeasurementData {
     pub fn new(set: &MeasurementSet) -> Result<MeasurementData, FitError> {
-        let bad = |message: String| FitError::Measurement {
-            file: set.source.clone(),
-            message,
-        };
-        if set.points.is_empty() {
-            return Err(bad("the file has no data rows".into()));
-        }
-        if set.elements.first() != Some(&0) {
-            return Err(bad("the set has no m00 (it must come first)".into()));
-        }
-        if let Some(&e) = set.elements.iter().find(|&&e| e >= 16) {
-            return Err(bad(format!(
-                "Mueller index {e} is not an element of a 4×4 matrix"
-            )));
-        }
+        check_elements(set)?;
         let width = set.elements.len();
         let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
         let floor = DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE);
 
-        // Distinct zenith cosines, found by hash: a goniometer export can have as many distinct
-        // angles as rows, and a linear search per row made 2e5 such rows take 20 s.
-        let mut zenith_cosines: Vec<f64> = Vec::new();
-        let mut zenith_positions: std::collections::HashMap<u64, usize> =
-            std::collections::HashMap::new();
-        let mut zenith_index = |cos: f64| -> usize {
-            // == on floats: +0 and −0 are one key (the cosines are finite).
-            let key = if cos == 0.0 { 0 } else { cos.to_bits() };
-            *zenith_positions.entry(key).or_insert_with(|| {
-                zenith_cosines.push(cos);
-                zenith_cosines.len() - 1
-            })
-        };
+        let mut zeniths = DistinctCosines::default();
         let mut geometry = Vec::with_capacity(set.points.len());
         let mut values = Vec::with_capacity(set.points.len() * width);
         let mut inverse_sigma = Vec::with_capacity(set.points.len() * width);
         for point in &set.points {
-            let at_line = |what: String| bad(format!("line {}: {what}", point.line));
+            let at_line = |what: String| refusal(set, format!("line {}: {what}", point.line));
             if point.values.len() != width || point.uncertainties.len() != width {
                 return Err(at_line(format!(
                     "{} values for {width} elements",
                     point.values.len()
                 )));
             }
-            let incident =
-                Direction::from_degrees_checked("theta_i_deg", point.theta_i_deg, point.phi_i_deg)
-                    .map_err(|e| at_line(e.to_string()))?;
-            let scattered =
-                Direction::from_degrees_checked("theta_r_deg", point.theta_r_deg, point.phi_r_deg)
-                    .map_err(|e| at_line(e.to_string()))?;
-            let scattering = ScatteringGeometry::new(&incident, &scattered)
-                .ok_or_else(|| at_line("a direction lies on the horizon".into()))?;
-            geometry.push(PreparedGeometry {
-                scattering,
-                incident_zenith: zenith_index(scattering.cos_incident()),
-                scattered_zenith: zenith_index(scattering.cos_scattered()),
-            });
+            geometry.push(prepare_geometry(point, &mut zeniths, &at_line)?);
             let m00 = point.values[0];
             for (column, (&value, uncertainty)) in
                 point.values.iter().zip(&point.uncertainties).enumerate()
@@ -128,21 +91,13 @@ impl MeasurementData {
                 inverse_sigma.push(1.0 / sigma);
             }
         }
-        let error_sources = set.points[0]
-            .uncertainties
-            .iter()
-            .map(|u| match u {
-                Some(_) => ErrorSource::File,
-                None => ErrorSource::DefaultModel,
-            })
-            .collect();
         Ok(MeasurementData {
             geometry,
-            zenith_cosines,
+            zenith_cosines: zeniths.cosines,
             elements: set.elements.iter().map(|&e| (e / 4, e % 4)).collect(),
             values,
             inverse_sigma,
-            error_sources,
+            error_sources: error_sources(set),
         })
     }
 
@@ -175,4 +130,87 @@ impl MeasurementData {
     pub fn observation(&self, index: usize) -> (f64, f64) {
         (self.values[index], 1.0 / self.inverse_sigma[index])
     }
+}
+
+/// The refusal of `set` for `message`.
+fn refusal(set: &MeasurementSet, message: String) -> FitError {
+    FitError::Measurement {
+        file: set.source.clone(),
+        message,
+    }
+}
+
+/// Refuses a set without rows, without m00 first, or with an index outside the 4×4 matrix.
+fn check_elements(set: &MeasurementSet) -> Result<(), FitError> {
+    if set.points.is_empty() {
+        return Err(refusal(set, "the file has no data rows".into()));
+    }
+    if set.elements.first() != Some(&0) {
+        return Err(refusal(
+            set,
+            "the set has no m00 (it must come first)".into(),
+        ));
+    }
+    if let Some(&e) = set.elements.iter().find(|&&e| e >= 16) {
+        return Err(refusal(
+            set,
+            format!("Mueller index {e} is not an element of a 4×4 matrix"),
+        ));
+    }
+    Ok(())
+}
+
+/// Distinct zenith cosines, found by hash: a goniometer export can have as many distinct
+/// angles as rows, and a linear search per row made 2e5 such rows take 20 s.
+#[derive(Default)]
+struct DistinctCosines {
+    cosines: Vec<f64>,
+    positions: HashMap<u64, usize>,
+}
+
+impl DistinctCosines {
+    /// Position of `cos` in the list, added if new.
+    fn index(&mut self, cos: f64) -> usize {
+        // == on floats: +0 and −0 are one key (the cosines are finite).
+        let key = if cos == 0.0 { 0 } else { cos.to_bits() };
+        let cosines = &mut self.cosines;
+        *self.positions.entry(key).or_insert_with(|| {
+            cosines.push(cos);
+            cosines.len() - 1
+        })
+    }
+}
+
+/// The scattering geometry of `point`, its zenith cosines entered in `zeniths`; `at_line` makes
+/// the refusal of an invalid direction.
+fn prepare_geometry(
+    point: &MeasurementPoint,
+    zeniths: &mut DistinctCosines,
+    at_line: &impl Fn(String) -> FitError,
+) -> Result<PreparedGeometry, FitError> {
+    let incident =
+        Direction::from_degrees_checked("theta_i_deg", point.theta_i_deg, point.phi_i_deg)
+            .map_err(|e| at_line(e.to_string()))?;
+    let scattered =
+        Direction::from_degrees_checked("theta_r_deg", point.theta_r_deg, point.phi_r_deg)
+            .map_err(|e| at_line(e.to_string()))?;
+    let scattering = ScatteringGeometry::new(&incident, &scattered)
+        .ok_or_else(|| at_line("a direction lies on the horizon".into()))?;
+    Ok(PreparedGeometry {
+        scattering,
+        incident_zenith: zeniths.index(scattering.cos_incident()),
+        scattered_zenith: zeniths.index(scattering.cos_scattered()),
+    })
+}
+
+/// Where each element's standard deviations come from, judged by the first row.
+fn error_sources(set: &MeasurementSet) -> Vec<ErrorSource> {
+    set.points[0]
+        .uncertainties
+        .iter()
+        .map(|u| match u {
+            Some(_) => ErrorSource::File,
+            None => ErrorSource::DefaultModel,
+        })
+        .collect()
 }

@@ -84,18 +84,51 @@ impl LeastSquares for Objective<'_> {
     }
 }
 
+/// Marquardt's damping λ and Nielsen's growth factor ν for the next rejection.
+struct Damping {
+    lambda: f64,
+    nu: f64,
+}
+
+impl Damping {
+    fn new() -> Self {
+        Damping {
+            lambda: 1e-3,
+            nu: 2.0,
+        }
+    }
+
+    /// After a rejected (or unsolvable) step: damp harder, twice as fast as last time.
+    fn increase(&mut self) {
+        self.lambda *= self.nu;
+        self.nu *= 2.0;
+    }
+
+    /// After an accepted step with gain ratio `gain` (Nielsen's rule).
+    fn relax(&mut self, gain: f64) {
+        self.lambda *= (1.0 - (2.0 * gain - 1.0).powi(3)).max(1.0 / 3.0);
+        self.nu = 2.0;
+    }
+}
+
+/// The iterate of a Levenberg–Marquardt run and its record.
+struct Iterate {
+    s: Vec<f64>,
+    r: DVector<f64>,
+    cost: f64,
+    /// ∂r/∂s at `s`, evaluated again after each accepted step.
+    jacobian: Option<DMatrix<f64>>,
+    damping: Damping,
+    history: StageHistory,
+}
+
 /// Runs Levenberg–Marquardt from the search-box point `start`.
 pub(crate) fn levenberg_marquardt(
     problem: &impl LeastSquares,
     start: &[f64],
     settings: &LevenbergMarquardtSettings,
 ) -> (Vec<f64>, StageHistory) {
-    let (lower, upper) = (problem.lower(), problem.upper());
-    let mut s: Vec<f64> = start
-        .iter()
-        .zip(lower.iter().zip(upper))
-        .map(|(&x, (&lo, &hi))| x.clamp(lo, hi))
-        .collect();
+    let s = clamp_to_box(start, problem.lower(), problem.upper());
     let mut history = StageHistory {
         stage: Stage::Lm,
         best_cost: Vec::new(),
@@ -103,102 +136,159 @@ pub(crate) fn levenberg_marquardt(
         evaluations: 0,
         termination: String::new(),
     };
-    // One residual vector per trial point, and those of a Jacobian.
-    let columns = problem.jacobian_evaluations();
-    let finish = |history: &mut StageHistory, reason: &str| {
-        history.termination = reason.to_owned();
-    };
-    let Some(mut r) = problem.residuals(&s) else {
-        finish(&mut history, "invalid starting point");
+    let Some(r) = problem.residuals(&s) else {
+        history.termination = "invalid starting point".to_owned();
         return (s, history);
     };
-    let mut cost = r.norm_squared();
+    let cost = r.norm_squared();
     history.best_cost.push(cost);
     history.evaluations = 1;
-    let (mut lambda, mut nu) = (1e-3, 2.0);
-    let mut jacobian = None;
-    for _ in 0..settings.max_iterations {
-        history.iterations += 1;
-        if jacobian.is_none() {
-            jacobian = problem.jacobian(&s, &r);
-            history.evaluations += columns;
+    let mut iterate = Iterate {
+        s,
+        r,
+        cost,
+        jacobian: None,
+        damping: Damping::new(),
+        history,
+    };
+    let reason = iterate.run(problem, settings);
+    iterate.history.termination = reason.to_owned();
+    (iterate.s, iterate.history)
+}
+
+fn clamp_to_box(start: &[f64], lower: &[f64], upper: &[f64]) -> Vec<f64> {
+    start
+        .iter()
+        .zip(lower.iter().zip(upper))
+        .map(|(&x, (&lo, &hi))| x.clamp(lo, hi))
+        .collect()
+}
+
+impl Iterate {
+    /// Iterates until a stopping rule holds; returns which.
+    fn run(
+        &mut self,
+        problem: &impl LeastSquares,
+        settings: &LevenbergMarquardtSettings,
+    ) -> &'static str {
+        let (lower, upper) = (problem.lower(), problem.upper());
+        // One residual vector per trial point, and those of a Jacobian.
+        let columns = problem.jacobian_evaluations();
+        for _ in 0..settings.max_iterations {
+            self.history.iterations += 1;
+            if self.jacobian.is_none() {
+                self.jacobian = problem.jacobian(&self.s, &self.r);
+                self.history.evaluations += columns;
+            }
+            let Some(j) = &self.jacobian else {
+                return "the Jacobian could not be evaluated";
+            };
+            let a = j.transpose() * j;
+            let g = j.transpose() * &self.r;
+            let free = free_parameters(&self.s, &g, lower, upper);
+            if free.is_empty() {
+                return "every parameter rests on a bound";
+            }
+            let Some(step) = damped_step(&a, &g, &free, self.damping.lambda) else {
+                self.damping.increase();
+                self.history.best_cost.push(self.cost);
+                continue;
+            };
+            let trial = step_in_box(&self.s, &step, &free, lower, upper);
+            let delta: DVector<f64> = DVector::from_fn(self.s.len(), |i, _| trial[i] - self.s[i]);
+            // Gain ratio: actual decrease over the decrease the linear model predicts.
+            let predicted = -(2.0 * g.dot(&delta) + (j * &delta).norm_squared());
+            let stop = self.accept_or_reject(problem, trial, &delta, predicted, settings);
+            if let Some(reason) = stop {
+                return reason;
+            }
         }
-        let Some(j) = &jacobian else {
-            finish(&mut history, "the Jacobian could not be evaluated");
-            return (s, history);
-        };
-        let a = j.transpose() * j;
-        let g = j.transpose() * &r;
-        // Active set: a parameter on a bound stays there while the descent direction −g points
-        // out of the box.
-        let free: Vec<usize> = (0..s.len())
-            .filter(|&i| {
-                let at_lower = s[i] <= lower[i] && g[i] > 0.0;
-                let at_upper = s[i] >= upper[i] && g[i] < 0.0;
-                !(at_lower || at_upper)
-            })
-            .collect();
-        if free.is_empty() {
-            finish(&mut history, "every parameter rests on a bound");
-            return (s, history);
-        }
-        let scale_floor = 1e-12 * a.diagonal().max();
-        let mut system = DMatrix::from_fn(free.len(), free.len(), |p, q| a[(free[p], free[q])]);
-        let rhs = DVector::from_fn(free.len(), |p, _| -g[free[p]]);
-        for p in 0..free.len() {
-            system[(p, p)] += lambda * a[(free[p], free[p])].max(scale_floor);
-        }
-        let Some(step) = system.cholesky().map(|c| c.solve(&rhs)) else {
-            lambda *= nu;
-            nu *= 2.0;
-            history.best_cost.push(cost);
-            continue;
-        };
-        let mut trial = s.clone();
-        for (p, &i) in free.iter().enumerate() {
-            trial[i] = (s[i] + step[p]).clamp(lower[i], upper[i]);
-        }
-        let delta: DVector<f64> = DVector::from_fn(s.len(), |i, _| trial[i] - s[i]);
-        // Gain ratio: actual decrease over the decrease the linear model predicts.
-        let predicted = -(2.0 * g.dot(&delta) + (j * &delta).norm_squared());
+        "maximum number of iterations reached"
+    }
+
+    /// Moves to `trial` if it lowers the cost, else damps harder; returns the reason to stop
+    /// when the run has converged.
+    fn accept_or_reject(
+        &mut self,
+        problem: &impl LeastSquares,
+        trial: Vec<f64>,
+        delta: &DVector<f64>,
+        predicted: f64,
+        settings: &LevenbergMarquardtSettings,
+    ) -> Option<&'static str> {
         let trial_residuals = problem.residuals(&trial);
-        history.evaluations += 1;
+        self.history.evaluations += 1;
         let trial_cost = trial_residuals
             .as_ref()
             .map_or(f64::INFINITY, |r| r.norm_squared());
-        if trial_cost < cost {
-            let decrease = cost - trial_cost;
+        if trial_cost < self.cost {
+            let decrease = self.cost - trial_cost;
             let gain = if predicted > 0.0 {
                 decrease / predicted
             } else {
                 0.0
             };
-            lambda *= (1.0 - (2.0 * gain - 1.0).powi(3)).max(1.0 / 3.0);
-            nu = 2.0;
-            s = trial;
-            r = trial_residuals.unwrap_or(r);
-            cost = trial_cost;
-            jacobian = None;
-            history.best_cost.push(cost);
-            if decrease <= settings.relative_tolerance * cost {
-                finish(
-                    &mut history,
-                    "converged (relative decrease below tolerance)",
-                );
-                return (s, history);
+            self.damping.relax(gain);
+            self.s = trial;
+            if let Some(r) = trial_residuals {
+                self.r = r;
             }
+            self.cost = trial_cost;
+            self.jacobian = None;
+            self.history.best_cost.push(self.cost);
+            (decrease <= settings.relative_tolerance * self.cost)
+                .then_some("converged (relative decrease below tolerance)")
         } else {
-            lambda *= nu;
-            nu *= 2.0;
-            history.best_cost.push(cost);
-            if delta.norm() <= 1e-14 * (1.0 + s.iter().map(|x| x * x).sum::<f64>().sqrt())
-                || lambda > 1e16
-            {
-                finish(&mut history, "converged (no step lowers the cost)");
-                return (s, history);
-            }
+            self.damping.increase();
+            self.history.best_cost.push(self.cost);
+            let stalled = delta.norm()
+                <= 1e-14 * (1.0 + self.s.iter().map(|x| x * x).sum::<f64>().sqrt())
+                || self.damping.lambda > 1e16;
+            stalled.then_some("converged (no step lowers the cost)")
         }
     }
-    finish(&mut history, "maximum number of iterations reached");
-    (s, history)
+}
+
+/// Active set: the parameters free to move this step. One on a bound stays there while the
+/// descent direction −g points out of the box.
+fn free_parameters(s: &[f64], g: &DVector<f64>, lower: &[f64], upper: &[f64]) -> Vec<usize> {
+    (0..s.len())
+        .filter(|&i| {
+            let at_lower = s[i] <= lower[i] && g[i] > 0.0;
+            let at_upper = s[i] >= upper[i] && g[i] < 0.0;
+            !(at_lower || at_upper)
+        })
+        .collect()
+}
+
+/// The step δ of the `free` parameters solving (A + λ diag A) δ = −g with A = JᵀJ, the diagonal
+/// floored at 1e-12 of its largest entry; `None` when the system is not positive definite.
+fn damped_step(
+    a: &DMatrix<f64>,
+    g: &DVector<f64>,
+    free: &[usize],
+    lambda: f64,
+) -> Option<DVector<f64>> {
+    let scale_floor = 1e-12 * a.diagonal().max();
+    let mut system = DMatrix::from_fn(free.len(), free.len(), |p, q| a[(free[p], free[q])]);
+    let rhs = DVector::from_fn(free.len(), |p, _| -g[free[p]]);
+    for p in 0..free.len() {
+        system[(p, p)] += lambda * a[(free[p], free[p])].max(scale_floor);
+    }
+    system.cholesky().map(|c| c.solve(&rhs))
+}
+
+/// `s` moved by `step` on the `free` parameters, projected onto the search box.
+fn step_in_box(
+    s: &[f64],
+    step: &DVector<f64>,
+    free: &[usize],
+    lower: &[f64],
+    upper: &[f64],
+) -> Vec<f64> {
+    let mut trial = s.to_vec();
+    for (p, &i) in free.iter().enumerate() {
+        trial[i] = (s[i] + step[p]).clamp(lower[i], upper[i]);
+    }
+    trial
 }

@@ -175,22 +175,7 @@ fn fit_record(
 /// The settings that, with the optimizer name and seed, reproduce the fit.
 pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap<String, String> {
     let mut settings = BTreeMap::new();
-    let from_file = data
-        .error_sources()
-        .iter()
-        .filter(|s| **s == ErrorSource::File)
-        .count();
-    let default_model = format!(
-        "default: {} % of m00 on m00, {} % of m00 on the others",
-        100.0 * DEFAULT_M00_RELATIVE_ERROR,
-        100.0 * super::data::DEFAULT_OTHER_ERROR_PER_M00
-    );
-    let errors = match from_file {
-        0 => default_model,
-        n if n == data.element_count() => "u_ columns of the file".to_owned(),
-        _ => format!("u_ columns where present, else {default_model}"),
-    };
-    settings.insert("uncertainties".into(), errors);
+    settings.insert("uncertainties".into(), uncertainty_setting(data));
     settings.insert(
         "robust_loss".into(),
         options
@@ -204,18 +189,7 @@ pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap
             None => "cauchy and gaussian fitted, lower AIC kept".into(),
         },
     );
-    let bounds = options.bounds.effective(options.shadowing);
-    settings.insert(
-        "bounds".into(),
-        Parameter::ALL
-            .iter()
-            .map(|&p| {
-                let i = bounds.get(p);
-                format!("{p} [{}, {}]", i.lower, i.upper)
-            })
-            .collect::<Vec<_>>()
-            .join(", "),
-    );
+    settings.insert("bounds".into(), bounds_setting(options));
     if !options.fixed.is_empty() {
         settings.insert(
             "fixed".into(),
@@ -227,11 +201,51 @@ pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap
                 .join(", "),
         );
     }
+    settings.extend(stage_settings(options));
+    settings
+}
+
+/// Where the standard deviations came from: the file's `u_` columns, the default noise model,
+/// or both.
+fn uncertainty_setting(data: &MeasurementData) -> String {
+    let from_file = data
+        .error_sources()
+        .iter()
+        .filter(|s| **s == ErrorSource::File)
+        .count();
+    let default_model = format!(
+        "default: {} % of m00 on m00, {} % of m00 on the others",
+        100.0 * DEFAULT_M00_RELATIVE_ERROR,
+        100.0 * super::data::DEFAULT_OTHER_ERROR_PER_M00
+    );
+    match from_file {
+        0 => default_model,
+        n if n == data.element_count() => "u_ columns of the file".to_owned(),
+        _ => format!("u_ columns where present, else {default_model}"),
+    }
+}
+
+/// Every parameter's effective search interval.
+fn bounds_setting(options: &FitOptions) -> String {
+    let bounds = options.bounds.effective(options.shadowing);
+    Parameter::ALL
+        .iter()
+        .map(|&p| {
+            let i = bounds.get(p);
+            format!("{p} [{}, {}]", i.lower, i.upper)
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The stopping rules of each stage the optimizer runs, keyed by stage.
+fn stage_settings(options: &FitOptions) -> Vec<(String, String)> {
     let stages = options.optimizer.stages();
     let s = &options.settings;
+    let mut settings = Vec::new();
     if stages.contains(&Stage::Ga) {
         let ga = s.genetic_for(stages);
-        settings.insert(
+        settings.push((
             "ga".into(),
             format!(
                 "population {}, at most {} generations, stop after {} without {:e} relative gain",
@@ -240,10 +254,10 @@ pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap
                 ga.stagnation_generations,
                 ga.stagnation_tolerance
             ),
-        );
+        ));
     }
     if stages.contains(&Stage::Nm) {
-        settings.insert(
+        settings.push((
             "nm".into(),
             format!(
                 "initial step {} rad (sine-mapped box), cost spread < {:e} × cost, at most {} steps, {} restarts",
@@ -252,16 +266,16 @@ pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap
                 s.nelder_mead.max_iterations,
                 s.nelder_mead.restarts
             ),
-        );
+        ));
     }
     if stages.contains(&Stage::Lm) {
-        settings.insert(
+        settings.push((
             "lm".into(),
             format!(
                 "relative decrease < {:e}, at most {} iterations",
                 s.levenberg_marquardt.relative_tolerance, s.levenberg_marquardt.max_iterations
             ),
-        );
+        ));
     }
     settings
 }

@@ -70,42 +70,73 @@ pub(crate) fn parse_header_row(line: u64, fields: &[Field<'_>]) -> Result<Layout
     let mut quantities = Vec::with_capacity(fields.len());
     let mut names = Vec::with_capacity(fields.len());
     for field in fields {
-        let name = field.text.as_ref();
-        if !field.quoted {
-            if let Some(refusal) = wrong_delimiter(line, field) {
-                return Err(refusal);
-            }
-        }
-        if name.is_empty() {
-            return Err(Refusal::new(
-                line,
-                field.column,
-                MeasureErrorKind::EmptyColumnName,
-            ));
-        }
-        let Some(quantity) = Quantity::from_name(name) else {
-            return Err(Refusal::new(
-                line,
-                field.column,
-                MeasureErrorKind::UnknownColumn {
-                    name: shown(name),
-                    hint: unknown_column_hint(name),
-                },
-            ));
-        };
-        if let Some(first) = quantities.iter().position(|&q| q == quantity) {
-            return Err(Refusal::new(
-                line,
-                field.column,
-                MeasureErrorKind::DuplicateColumn {
-                    name: name.to_string(),
-                    first_column: fields[first].column,
-                },
-            ));
-        }
+        let quantity = column_quantity(line, field, fields, &quantities)?;
         quantities.push(quantity);
-        names.push(name.to_string());
+        names.push(field.text.to_string());
     }
+    check_required_columns(line, &quantities)?;
+    check_uncertainty_columns(line, fields, &quantities)?;
+    let mut elements: Vec<usize> = quantities
+        .iter()
+        .filter_map(|q| match q {
+            Quantity::Element(index) => Some(*index),
+            _ => None,
+        })
+        .collect();
+    elements.sort_unstable();
+    Ok(Layout {
+        quantities,
+        names,
+        elements,
+    })
+}
+
+/// The quantity `field` names, refusing a wrong delimiter, an empty or unknown name, and a
+/// name already among the `earlier` columns (of `fields`).
+fn column_quantity(
+    line: u64,
+    field: &Field<'_>,
+    fields: &[Field<'_>],
+    earlier: &[Quantity],
+) -> Result<Quantity, Refusal> {
+    let name = field.text.as_ref();
+    if !field.quoted {
+        if let Some(refusal) = wrong_delimiter(line, field) {
+            return Err(refusal);
+        }
+    }
+    if name.is_empty() {
+        return Err(Refusal::new(
+            line,
+            field.column,
+            MeasureErrorKind::EmptyColumnName,
+        ));
+    }
+    let Some(quantity) = Quantity::from_name(name) else {
+        return Err(Refusal::new(
+            line,
+            field.column,
+            MeasureErrorKind::UnknownColumn {
+                name: shown(name),
+                hint: unknown_column_hint(name),
+            },
+        ));
+    };
+    if let Some(first) = earlier.iter().position(|&q| q == quantity) {
+        return Err(Refusal::new(
+            line,
+            field.column,
+            MeasureErrorKind::DuplicateColumn {
+                name: name.to_string(),
+                first_column: fields[first].column,
+            },
+        ));
+    }
+    Ok(quantity)
+}
+
+/// Refuses a header without theta_i_deg, theta_r_deg or m00 (pointing at its first column).
+fn check_required_columns(line: u64, quantities: &[Quantity]) -> Result<(), Refusal> {
     for (quantity, name) in [
         (Quantity::ThetaI, THETA_I),
         (Quantity::ThetaR, THETA_R),
@@ -121,7 +152,16 @@ pub(crate) fn parse_header_row(line: u64, fields: &[Field<'_>]) -> Result<Layout
             ));
         }
     }
-    for (field, quantity) in fields.iter().zip(&quantities) {
+    Ok(())
+}
+
+/// Refuses an uncertainty column whose element has no column.
+fn check_uncertainty_columns(
+    line: u64,
+    fields: &[Field<'_>],
+    quantities: &[Quantity],
+) -> Result<(), Refusal> {
+    for (field, quantity) in fields.iter().zip(quantities) {
         if let Quantity::Uncertainty(index) = *quantity {
             if !quantities.contains(&Quantity::Element(index)) {
                 return Err(Refusal::new(
@@ -135,19 +175,7 @@ pub(crate) fn parse_header_row(line: u64, fields: &[Field<'_>]) -> Result<Layout
             }
         }
     }
-    let mut elements: Vec<usize> = quantities
-        .iter()
-        .filter_map(|q| match q {
-            Quantity::Element(index) => Some(*index),
-            _ => None,
-        })
-        .collect();
-    elements.sort_unstable();
-    Ok(Layout {
-        quantities,
-        names,
-        elements,
-    })
+    Ok(())
 }
 
 /// A refusal if an unquoted field holds a ';', tab or '|': the file is separated by that

@@ -351,6 +351,41 @@ fn parse_row(
     wavelength: &WavelengthCheck,
 ) -> Result<(MeasurementPoint, Option<(HeaderWavelength, u64)>), Refusal> {
     let fields = fields_of(line_number, line)?;
+    check_row_fields(line_number, line, &fields, layout.quantities.len())?;
+    let mut point = MeasurementPoint {
+        theta_i_deg: f64::NAN,
+        phi_i_deg: DEFAULT_PHI_I_DEG,
+        theta_r_deg: f64::NAN,
+        phi_r_deg: DEFAULT_PHI_R_DEG,
+        values: vec![f64::NAN; layout.elements.len()],
+        uncertainties: vec![None; layout.elements.len()],
+        line: line_number,
+    };
+    let mut row_wavelength = None;
+    for ((field, &quantity), name) in fields.iter().zip(&layout.quantities).zip(&layout.names) {
+        let refuse = |kind| Refusal::new(line_number, field.column, kind);
+        let text = field.text.as_ref();
+        let value = parse_number(name, text).map_err(refuse)?;
+        if quantity == Quantity::Wavelength {
+            if let Some(kind) = wavelength_refusal(value, text) {
+                return Err(refuse(kind));
+            }
+            row_wavelength = wavelength.check(line_number, field.column, value, text)?;
+        } else {
+            store_value(&mut point, layout, quantity, name, value, text).map_err(refuse)?;
+        }
+    }
+    Ok((point, row_wavelength))
+}
+
+/// Refuses a row with a field separated by another delimiter than ',', or with another number
+/// of fields than the header's `expected`.
+fn check_row_fields(
+    line_number: u64,
+    line: &str,
+    fields: &[Field<'_>],
+    expected: usize,
+) -> Result<(), Refusal> {
     if let Some(refusal) = fields
         .iter()
         .filter(|f| !f.quoted)
@@ -358,7 +393,6 @@ fn parse_row(
     {
         return Err(refusal);
     }
-    let expected = layout.quantities.len();
     if fields.len() != expected {
         // Point at the first extra field, or at the end of a short row.
         let column = match fields.get(expected) {
@@ -374,75 +408,63 @@ fn parse_row(
             },
         ));
     }
+    Ok(())
+}
 
-    let mut point = MeasurementPoint {
-        theta_i_deg: f64::NAN,
-        phi_i_deg: DEFAULT_PHI_I_DEG,
-        theta_r_deg: f64::NAN,
-        phi_r_deg: DEFAULT_PHI_R_DEG,
-        values: vec![f64::NAN; layout.elements.len()],
-        uncertainties: vec![None; layout.elements.len()],
-        line: line_number,
-    };
-    let mut row_wavelength = None;
-    for ((field, &quantity), name) in fields.iter().zip(&layout.quantities).zip(&layout.names) {
-        let refuse = |kind| Err(Refusal::new(line_number, field.column, kind));
-        let text = field.text.as_ref();
-        let value = match parse_number(name, text) {
-            Ok(value) => value,
-            Err(kind) => return refuse(kind),
-        };
-        match quantity {
-            // Zenith angles of directions above the surface; 90° is grazing and leaves the
-            // BRDF's 1/cosθ undefined (docs/design.md §1.3). The detector's may be signed (in-plane
-            // scans are written −80…80°); parse_text folds the negative ones.
-            Quantity::ThetaI => {
-                if !(0.0..90.0).contains(&value) {
-                    return refuse(MeasureErrorKind::ThetaOutOfRange {
-                        column: name.clone(),
-                        value: shown(text),
-                    });
-                }
-                point.theta_i_deg = value;
+/// Stores `value` (written `text`) of column `name`, holding `quantity` (not the wavelength),
+/// in `point`, or says why it is refused.
+fn store_value(
+    point: &mut MeasurementPoint,
+    layout: &Layout,
+    quantity: Quantity,
+    name: &str,
+    value: f64,
+    text: &str,
+) -> Result<(), MeasureErrorKind> {
+    match quantity {
+        // Zenith angles of directions above the surface; 90° is grazing and leaves the
+        // BRDF's 1/cosθ undefined (docs/design.md §1.3). The detector's may be signed (in-plane
+        // scans are written −80…80°); parse_text folds the negative ones.
+        Quantity::ThetaI => {
+            if !(0.0..90.0).contains(&value) {
+                return Err(MeasureErrorKind::ThetaOutOfRange {
+                    column: name.to_owned(),
+                    value: shown(text),
+                });
             }
-            Quantity::ThetaR => {
-                if !(value > -90.0 && value < 90.0) {
-                    return refuse(MeasureErrorKind::DetectorThetaOutOfRange {
-                        value: shown(text),
-                    });
-                }
-                point.theta_r_deg = value;
+            point.theta_i_deg = value;
+        }
+        Quantity::ThetaR => {
+            if !(value > -90.0 && value < 90.0) {
+                return Err(MeasureErrorKind::DetectorThetaOutOfRange { value: shown(text) });
             }
-            Quantity::PhiI => point.phi_i_deg = value,
-            Quantity::PhiR => point.phi_r_deg = value,
-            Quantity::Wavelength => {
-                if let Some(kind) = wavelength_refusal(value, text) {
-                    return refuse(kind);
-                }
-                row_wavelength = wavelength.check(line_number, field.column, value, text)?;
+            point.theta_r_deg = value;
+        }
+        Quantity::PhiI => point.phi_i_deg = value,
+        Quantity::PhiR => point.phi_r_deg = value,
+        // Checked against the header's or kept as the row's own by parse_row.
+        Quantity::Wavelength => {}
+        Quantity::Element(index) => {
+            if index == 0 && value < 0.0 {
+                return Err(MeasureErrorKind::NegativeM00 { value: shown(text) });
             }
-            Quantity::Element(index) => {
-                if index == 0 && value < 0.0 {
-                    return refuse(MeasureErrorKind::NegativeM00 { value: shown(text) });
-                }
-                if let Some(slot) = layout.slot(index) {
-                    point.values[slot] = value;
-                }
+            if let Some(slot) = layout.slot(index) {
+                point.values[slot] = value;
             }
-            Quantity::Uncertainty(index) => {
-                if value <= 0.0 {
-                    return refuse(MeasureErrorKind::NonPositiveUncertainty {
-                        column: name.clone(),
-                        value: shown(text),
-                    });
-                }
-                if let Some(slot) = layout.slot(index) {
-                    point.uncertainties[slot] = Some(value);
-                }
+        }
+        Quantity::Uncertainty(index) => {
+            if value <= 0.0 {
+                return Err(MeasureErrorKind::NonPositiveUncertainty {
+                    column: name.to_owned(),
+                    value: shown(text),
+                });
+            }
+            if let Some(slot) = layout.slot(index) {
+                point.uncertainties[slot] = Some(value);
             }
         }
     }
-    Ok((point, row_wavelength))
+    Ok(())
 }
 
 /// Why a wavelength_um field's (finite) value is not a wavelength irpol models, if it is not.

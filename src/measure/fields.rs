@@ -7,6 +7,8 @@
 //! spreadsheets write column names. A quoted field cannot span lines.
 
 use std::borrow::Cow;
+use std::iter::Peekable;
+use std::str::CharIndices;
 
 use super::error::MeasureErrorKind;
 
@@ -24,86 +26,117 @@ pub(crate) struct Field<'a> {
 /// and the reason.
 pub(crate) fn split_fields(line: &str) -> Result<Vec<Field<'_>>, (u64, MeasureErrorKind)> {
     let mut fields = Vec::new();
-    let mut chars = line.char_indices().peekable();
-    // 1-based column of the character `chars` yields next.
-    let mut column: u64 = 1;
+    let mut cursor = Cursor {
+        line,
+        chars: line.char_indices().peekable(),
+        column: 1,
+    };
     loop {
         // Skip leading blanks of the field (a ',' is not blank).
-        let blank_start = column;
-        while let Some(&(_, c)) = chars.peek() {
+        let blank_start = cursor.column;
+        cursor.skip_blanks();
+        let field_column = cursor.column;
+        let field = match cursor.peek() {
+            Some((_, '"')) => cursor.quoted_field(field_column)?,
+            Some((start, _)) => cursor.bare_field(start, field_column),
+            None => Field {
+                text: Cow::Borrowed(""),
+                column: blank_start,
+                quoted: false,
+            },
+        };
+        fields.push(field);
+        // Here the next character is ',' or the line has ended.
+        if cursor.advance().is_none() {
+            return Ok(fields);
+        }
+    }
+}
+
+/// A position in a line, counting character columns.
+struct Cursor<'a> {
+    line: &'a str,
+    chars: Peekable<CharIndices<'a>>,
+    /// 1-based column of the character `chars` yields next.
+    column: u64,
+}
+
+impl<'a> Cursor<'a> {
+    fn peek(&mut self) -> Option<(usize, char)> {
+        self.chars.peek().copied()
+    }
+
+    /// The next character, moving past it.
+    fn advance(&mut self) -> Option<(usize, char)> {
+        let next = self.chars.next();
+        if next.is_some() {
+            self.column += 1;
+        }
+        next
+    }
+
+    /// Moves past blanks, stopping at a ',' or anything else.
+    fn skip_blanks(&mut self) {
+        while let Some((_, c)) = self.peek() {
             if c == ',' || !c.is_whitespace() {
                 break;
             }
-            chars.next();
-            column += 1;
+            self.advance();
         }
-        let field_column = column;
-        match chars.peek().copied() {
-            Some((_, '"')) => {
-                chars.next();
-                column += 1;
-                let mut text = String::new();
-                let mut closed = false;
-                while let Some((_, c)) = chars.next() {
-                    column += 1;
-                    if c != '"' {
-                        text.push(c);
-                    } else if matches!(chars.peek(), Some(&(_, '"'))) {
-                        chars.next();
-                        column += 1;
-                        text.push('"');
-                    } else {
-                        closed = true;
-                        break;
-                    }
-                }
-                if !closed {
-                    return Err((field_column, MeasureErrorKind::UnterminatedQuote));
-                }
-                while let Some(&(_, c)) = chars.peek() {
-                    if c == ',' {
-                        break;
-                    }
-                    if !c.is_whitespace() {
-                        return Err((column, MeasureErrorKind::TextAfterQuote));
-                    }
-                    chars.next();
-                    column += 1;
-                }
-                fields.push(Field {
-                    text: Cow::Owned(text),
-                    column: field_column,
-                    quoted: true,
-                });
-            }
-            Some((start, _)) => {
-                let mut end = line.len();
-                while let Some(&(i, c)) = chars.peek() {
-                    if c == ',' {
-                        end = i;
-                        break;
-                    }
-                    chars.next();
-                    column += 1;
-                }
-                fields.push(Field {
-                    text: Cow::Borrowed(line[start..end].trim_end()),
-                    column: field_column,
-                    quoted: false,
-                });
-            }
-            None => {
-                fields.push(Field {
-                    text: Cow::Borrowed(""),
-                    column: blank_start,
-                    quoted: false,
-                });
+    }
+
+    /// The field whose opening quote is next (at `field_column`): its text up to the closing
+    /// quote with `""` read as '"'; only blanks may follow before the next ','.
+    fn quoted_field(&mut self, field_column: u64) -> Result<Field<'a>, (u64, MeasureErrorKind)> {
+        self.advance();
+        let mut text = String::new();
+        let mut closed = false;
+        while let Some((_, c)) = self.advance() {
+            if c != '"' {
+                text.push(c);
+            } else if matches!(self.peek(), Some((_, '"'))) {
+                self.advance();
+                text.push('"');
+            } else {
+                closed = true;
+                break;
             }
         }
-        // Here the next character is ',' or the line has ended.
-        match chars.next() {
-            Some(_) => column += 1,
-            None => return Ok(fields),
+        if !closed {
+            return Err((field_column, MeasureErrorKind::UnterminatedQuote));
+        }
+        while let Some((_, c)) = self.peek() {
+            if c == ',' {
+                break;
+            }
+            if !c.is_whitespace() {
+                return Err((self.column, MeasureErrorKind::TextAfterQuote));
+            }
+            self.advance();
+        }
+        Ok(Field {
+            text: Cow::Owned(text),
+            column: field_column,
+            quoted: true,
+        })
+    }
+
+    /// The unquoted field starting at byte `start` (column `field_column`), up to the next ','
+    /// or the end of the line, its trailing blanks trimmed.
+    fn bare_field(&mut self, start: usize, field_column: u64) -> Field<'a> {
+        let line = self.line;
+        let mut end = line.len();
+        while let Some((i, c)) = self.peek() {
+            if c == ',' {
+                end = i;
+                break;
+            }
+            self.advance();
+        }
+        Field {
+            text: Cow::Borrowed(line[start..end].trim_end()),
+            column: field_column,
+            quoted: false,
         }
     }
 }

@@ -226,96 +226,32 @@ impl Pbrdf {
         quadrature: &HemisphereQuadrature,
         mut visit: impl FnMut(&Vector3<f64>, SpecularFacet),
     ) {
-        let w_r = scattered.vector;
-        let cos_r = w_r.z;
-        if cos_r <= 0.0 {
+        let Some(frame) = MirrorFrame::new(self, scattered) else {
             return;
-        }
-        let sin_r = (1.0 - cos_r * cos_r).max(0.0).sqrt();
-        let tangential = scattered.azimuthal_axis;
-        let radial = tangential.cross(&Vector3::z());
+        };
         let distribution = self.prepared_distribution();
-
-        // The facet tilted by slope u toward azimuth Δ (from ω_r's azimuth) mirrors ω_r above the
-        // horizon iff cosΔ > κ(u) = cosθ_r (u² − 1) / (2u sinθ_r). Hence every azimuth is kept for
-        // u ≤ u_full = cosθ_r/(1 + sinθ_r), none for u ≥ u_none = (1 + sinθ_r)/cosθ_r, and
-        // |Δ| < arccos κ(u) in between, where the azimuthal width has √ end-point behaviour.
-        let u_full = cos_r / (1.0 + sin_r);
-        let u_none = (1.0 + sin_r) / cos_r;
-        let u_last = u_none.min(distribution.slope_cutoff());
+        let u_last = frame.u_none.min(distribution.slope_cutoff());
         let edges = radial_panel_edges(
             quadrature.first_panel * distribution.slope_scale(),
             quadrature.panel_growth,
-            u_full,
+            frame.u_full,
             u_last,
         );
-
-        // The scattered direction's shadowing factor is the same for every facet.
-        let masking_r = self.masking(cos_r);
         let mut add_facet = |u: f64, delta: f64, weight: f64| {
-            let (sin_d, cos_d) = delta.sin_cos();
-            let sec_h = (1.0 + u * u).sqrt();
-            let h = ((radial * cos_d + tangential * sin_d) * u + Vector3::z()) / sec_h;
-            let cos_beta = h.dot(&w_r);
-            let w_i = h * (2.0 * cos_beta) - w_r;
-            let cos_i = w_i.z;
-            if cos_i <= 0.0 {
-                return; // rounding at the horizon cut
+            if let Some((w_i, facet)) = frame.facet(u, delta, weight) {
+                visit(&w_i, facet);
             }
-            let g = self.shadowing().factor_with_masking(
-                cos_i,
-                cos_r,
-                cos_beta * cos_beta,
-                [self.masking(cos_i), masking_r],
-            );
-            // Facet s axis against the psps frame of ω_r (η_r of docs/design.md §1.3).
-            let (cos2, sin2) = double_angle(facet_axis_in_scattered_frame(&w_i, scattered));
-            let scale = weight * g * cos_beta * sec_h / cos_r;
-            visit(
-                &w_i,
-                SpecularFacet {
-                    cos_beta,
-                    scale,
-                    cos2,
-                    sin2,
-                },
-            );
         };
-
-        let n_full = quadrature.full_circle_nodes;
         for panel in edges.windows(2) {
             let (a, b) = (panel[0], panel[1]);
             // √ end points (at u_full on the left, u_none on the right) are smoothed by
             // u = a + (b − a) sin²(πv/2).
-            let singular_ends = a == u_full || b == u_none;
+            let singular_ends = a == frame.u_full || b == frame.u_none;
             for &(v, wv) in &quadrature.panel_rule {
-                let (u, du) = if singular_ends {
-                    let half_angle = 0.5 * PI * v;
-                    (
-                        a + (b - a) * half_angle.sin().powi(2),
-                        (b - a) * 0.5 * PI * (PI * v).sin(),
-                    )
-                } else {
-                    (a + (b - a) * v, b - a)
-                };
+                let (u, du) = radial_node(a, b, v, singular_ends);
                 // Polar slope measure u du dΔ times the slope density.
                 let radial_weight = wv * du * u * distribution.slope_pdf(u * u);
-                if u <= u_full {
-                    let step = 2.0 * PI / n_full as f64;
-                    for j in 0..n_full {
-                        add_facet(u, (j as f64 + 0.5) * step, radial_weight * step);
-                    }
-                } else {
-                    let kappa = cos_r * (u * u - 1.0) / (2.0 * u * sin_r);
-                    let half_width = kappa.clamp(-1.0, 1.0).acos();
-                    for &(t, wt) in &quadrature.arc_rule {
-                        add_facet(
-                            u,
-                            half_width * (2.0 * t - 1.0),
-                            radial_weight * wt * 2.0 * half_width,
-                        );
-                    }
-                }
+                frame.visit_azimuths(u, radial_weight, quadrature, &mut add_facet);
             }
         }
     }
@@ -377,5 +313,129 @@ impl Pbrdf {
         quadrature: &HemisphereQuadrature,
     ) -> f64 {
         self.reflected_stokes(&Direction::from_angles(theta, 0.0), |_| 1.0, quadrature)[0]
+    }
+}
+
+/// Slope u and du/dv of node v ∈ [0, 1] of the radial panel [a, b]; with `singular_ends`, through
+/// u = a + (b − a) sin²(πv/2).
+fn radial_node(a: f64, b: f64, v: f64, singular_ends: bool) -> (f64, f64) {
+    if singular_ends {
+        let half_angle = 0.5 * PI * v;
+        (
+            a + (b - a) * half_angle.sin().powi(2),
+            (b - a) * 0.5 * PI * (PI * v).sin(),
+        )
+    } else {
+        (a + (b - a) * v, b - a)
+    }
+}
+
+/// What every specular facet node of one scattered direction ω_r shares
+/// ([`Pbrdf::visit_specular_facets`]).
+struct MirrorFrame<'a> {
+    pbrdf: &'a Pbrdf,
+    scattered: &'a Direction,
+    w_r: Vector3<f64>,
+    cos_r: f64,
+    sin_r: f64,
+    tangential: Vector3<f64>,
+    radial: Vector3<f64>,
+    /// The scattered direction's shadowing factor is the same for every facet.
+    masking_r: f64,
+    /// Slopes up to this mirror ω_r above the horizon at every azimuth.
+    u_full: f64,
+    /// Slopes from this on mirror ω_r below the horizon at every azimuth.
+    u_none: f64,
+}
+
+impl<'a> MirrorFrame<'a> {
+    /// `None` for ω_r at or below the horizon.
+    fn new(pbrdf: &'a Pbrdf, scattered: &'a Direction) -> Option<MirrorFrame<'a>> {
+        let w_r = scattered.vector;
+        let cos_r = w_r.z;
+        if cos_r <= 0.0 {
+            return None;
+        }
+        let sin_r = (1.0 - cos_r * cos_r).max(0.0).sqrt();
+        let tangential = scattered.azimuthal_axis;
+        let radial = tangential.cross(&Vector3::z());
+        // The facet tilted by slope u toward azimuth Δ (from ω_r's azimuth) mirrors ω_r above the
+        // horizon iff cosΔ > κ(u) = cosθ_r (u² − 1) / (2u sinθ_r). Hence every azimuth is kept for
+        // u ≤ u_full = cosθ_r/(1 + sinθ_r), none for u ≥ u_none = (1 + sinθ_r)/cosθ_r, and
+        // |Δ| < arccos κ(u) in between, where the azimuthal width has √ end-point behaviour.
+        let u_full = cos_r / (1.0 + sin_r);
+        let u_none = (1.0 + sin_r) / cos_r;
+        Some(MirrorFrame {
+            pbrdf,
+            scattered,
+            w_r,
+            cos_r,
+            sin_r,
+            tangential,
+            radial,
+            masking_r: pbrdf.masking(cos_r),
+            u_full,
+            u_none,
+        })
+    }
+
+    /// Calls `add_facet(u, Δ, weight)` for the azimuth nodes of slope `u` whose radial weight is
+    /// `radial_weight`: the trapezoid rule over the full circle where no azimuth is cut,
+    /// Gauss–Legendre over |Δ| < arccos κ(u) where some are.
+    fn visit_azimuths(
+        &self,
+        u: f64,
+        radial_weight: f64,
+        quadrature: &HemisphereQuadrature,
+        add_facet: &mut impl FnMut(f64, f64, f64),
+    ) {
+        if u <= self.u_full {
+            let n_full = quadrature.full_circle_nodes;
+            let step = 2.0 * PI / n_full as f64;
+            for j in 0..n_full {
+                add_facet(u, (j as f64 + 0.5) * step, radial_weight * step);
+            }
+        } else {
+            let kappa = self.cos_r * (u * u - 1.0) / (2.0 * u * self.sin_r);
+            let half_width = kappa.clamp(-1.0, 1.0).acos();
+            for &(t, wt) in &quadrature.arc_rule {
+                add_facet(
+                    u,
+                    half_width * (2.0 * t - 1.0),
+                    radial_weight * wt * 2.0 * half_width,
+                );
+            }
+        }
+    }
+
+    /// The incident direction ω_i mirrored by the facet of slope `u` toward azimuth `delta`, and
+    /// its node with quadrature weight `weight`; `None` where rounding at the horizon cut puts
+    /// ω_i below the horizon.
+    fn facet(&self, u: f64, delta: f64, weight: f64) -> Option<(Vector3<f64>, SpecularFacet)> {
+        let (sin_d, cos_d) = delta.sin_cos();
+        let sec_h = (1.0 + u * u).sqrt();
+        let h = ((self.radial * cos_d + self.tangential * sin_d) * u + Vector3::z()) / sec_h;
+        let cos_beta = h.dot(&self.w_r);
+        let w_i = h * (2.0 * cos_beta) - self.w_r;
+        let cos_i = w_i.z;
+        if cos_i <= 0.0 {
+            return None;
+        }
+        let g = self.pbrdf.shadowing().factor_with_masking(
+            cos_i,
+            self.cos_r,
+            cos_beta * cos_beta,
+            [self.pbrdf.masking(cos_i), self.masking_r],
+        );
+        // Facet s axis against the psps frame of ω_r (η_r of docs/design.md §1.3).
+        let (cos2, sin2) = double_angle(facet_axis_in_scattered_frame(&w_i, self.scattered));
+        let scale = weight * g * cos_beta * sec_h / self.cos_r;
+        let facet = SpecularFacet {
+            cos_beta,
+            scale,
+            cos2,
+            sin2,
+        };
+        Some((w_i, facet))
     }
 }

@@ -300,77 +300,35 @@ fn solve(
     let values: Vec<_> = (0..sets.len())
         .map(|j| problem.block_values(&best, j))
         .collect();
-    let mut chi2_per_wavelength = Vec::new();
-    let mut model_muellers = Vec::new();
-    let mut normalized_residuals = Vec::new();
-    for (j, block) in problem.blocks.iter().enumerate() {
-        let residuals = block
-            .objective
-            .normalized_residuals(&values[j])
-            .ok_or_else(invalid)?;
-        chi2_per_wavelength.push((residuals.iter().map(|x| x * x).sum(), residuals.len()));
-        normalized_residuals.push(residuals);
-        model_muellers.push(
-            block
-                .objective
-                .model_muellers(&values[j])
-                .ok_or_else(invalid)?,
-        );
-    }
-    let chi2: f64 = chi2_per_wavelength.iter().map(|c| c.0).sum();
+    let blocks = BlockResults::new(problem, &values).ok_or_else(invalid)?;
+    let chi2: f64 = blocks.chi2_per_wavelength.iter().map(|c| c.0).sum();
     let free = best.len();
     let observations = problem.observations;
     let degrees_of_freedom = observations.saturating_sub(free).max(1);
     let reduced_chi2 = chi2 / degrees_of_freedom as f64;
     let coordinates = coordinates(problem, sets);
-    let mut physical = jacobian;
-    let mut physical_values = Vec::with_capacity(free);
-    for (c, coordinate) in coordinates.iter().enumerate() {
-        let (value, per_coordinate) = match coordinate.1 {
-            Some(p) => (from_search(p, best[c]), value_per_coordinate(p, best[c])),
-            None => (best[c], 1.0),
-        };
-        physical_values.push(value);
-        physical.column_mut(c).unscale_mut(per_coordinate);
-    }
+    let (physical_values, physical) = physical_coordinates(&coordinates, &best, jacobian);
     let (errors, correlation, _) =
         linearized_errors(&(physical.transpose() * &physical), reduced_chi2);
     let law = problem.law(&best);
-    let model = SpectralModel {
-        distribution: kind.distribution(&values[0]),
-        shadowing: options.shadowing,
-        wavelength_um: sets.iter().map(|s| s.wavelength_um).collect(),
-        n: values.iter().map(|v| v.get(Parameter::N)).collect(),
-        k: values.iter().map(|v| v.get(Parameter::K)).collect(),
-        rho_d: values.iter().map(|v| v.get(Parameter::RhoD)).collect(),
-        dispersion: law.clone(),
-    };
-    let family_errors = |p: Parameter| {
-        (0..sets.len())
-            .map(|j| {
-                coordinates
-                    .iter()
-                    .position(|c| c.1 == Some(p) && c.2 == Some(j))
-                    .map_or(0.0, |c| errors[c])
-            })
-            .collect::<Vec<_>>()
-    };
-    let (n_errors, k_errors) = match &law {
-        None => (family_errors(Parameter::N), family_errors(Parameter::K)),
-        Some(law) => {
-            propagate_law_errors(law, problem, &model.wavelength_um, &errors, &correlation)
-        }
-    };
-    let rho_d_errors = family_errors(Parameter::RhoD);
+    let model = spectral_model(sets, &values, kind, options, law.clone());
+    let wavelength_errors = WavelengthErrors::new(
+        problem,
+        &coordinates,
+        law.as_ref(),
+        &model.wavelength_um,
+        &errors,
+        &correlation,
+    );
     Ok(SpectralFit {
         distribution: kind,
         dispersion,
         model,
         names: coordinates.into_iter().map(|c| c.0).collect(),
         values: physical_values,
-        n_errors,
-        k_errors,
-        rho_d_errors,
+        n_errors: wavelength_errors.n,
+        k_errors: wavelength_errors.k,
+        rho_d_errors: wavelength_errors.rho_d,
         errors,
         correlation,
         chi2,
@@ -379,12 +337,122 @@ fn solve(
         reduced_chi2,
         aic: aic(chi2, free),
         bic: bic(chi2, free, observations),
-        chi2_per_wavelength,
-        model_muellers,
-        normalized_residuals,
+        chi2_per_wavelength: blocks.chi2_per_wavelength,
+        model_muellers: blocks.model_muellers,
+        normalized_residuals: blocks.normalized_residuals,
         evaluations: history.evaluations,
         history,
     })
+}
+
+/// What each wavelength's block of the joint problem gives at the optimum.
+struct BlockResults {
+    chi2_per_wavelength: Vec<(f64, usize)>,
+    model_muellers: Vec<Vec<Mueller>>,
+    normalized_residuals: Vec<Vec<f64>>,
+}
+
+impl BlockResults {
+    /// `None` when a block's model cannot be evaluated at its `values`.
+    fn new(
+        problem: &JointProblem,
+        values: &[super::parameters::ParameterValues],
+    ) -> Option<BlockResults> {
+        let mut chi2_per_wavelength = Vec::new();
+        let mut model_muellers = Vec::new();
+        let mut normalized_residuals = Vec::new();
+        for (j, block) in problem.blocks.iter().enumerate() {
+            let residuals = block.objective.normalized_residuals(&values[j])?;
+            chi2_per_wavelength.push((residuals.iter().map(|x| x * x).sum(), residuals.len()));
+            normalized_residuals.push(residuals);
+            model_muellers.push(block.objective.model_muellers(&values[j])?);
+        }
+        Some(BlockResults {
+            chi2_per_wavelength,
+            model_muellers,
+            normalized_residuals,
+        })
+    }
+}
+
+/// The physical value of each search coordinate at `best`, and the Jacobian with respect to
+/// the physical values (each column divided by its coordinate's d(value)/d(search)).
+fn physical_coordinates(
+    coordinates: &[(String, Option<Parameter>, Option<usize>)],
+    best: &[f64],
+    jacobian: nalgebra::DMatrix<f64>,
+) -> (Vec<f64>, nalgebra::DMatrix<f64>) {
+    let mut physical = jacobian;
+    let mut physical_values = Vec::with_capacity(best.len());
+    for (c, coordinate) in coordinates.iter().enumerate() {
+        let (value, per_coordinate) = match coordinate.1 {
+            Some(p) => (from_search(p, best[c]), value_per_coordinate(p, best[c])),
+            None => (best[c], 1.0),
+        };
+        physical_values.push(value);
+        physical.column_mut(c).unscale_mut(per_coordinate);
+    }
+    (physical_values, physical)
+}
+
+/// The fitted spectral model: each wavelength's block `values`, and the `law` when n and k
+/// follow one.
+fn spectral_model(
+    sets: &[MeasurementSet],
+    values: &[super::parameters::ParameterValues],
+    kind: DistributionKind,
+    options: &FitOptions,
+    law: Option<LorentzDispersion>,
+) -> SpectralModel {
+    SpectralModel {
+        distribution: kind.distribution(&values[0]),
+        shadowing: options.shadowing,
+        wavelength_um: sets.iter().map(|s| s.wavelength_um).collect(),
+        n: values.iter().map(|v| v.get(Parameter::N)).collect(),
+        k: values.iter().map(|v| v.get(Parameter::K)).collect(),
+        rho_d: values.iter().map(|v| v.get(Parameter::RhoD)).collect(),
+        dispersion: law,
+    }
+}
+
+/// 1-σ errors of n, k and ρ_d at each wavelength.
+struct WavelengthErrors {
+    n: Vec<f64>,
+    k: Vec<f64>,
+    rho_d: Vec<f64>,
+}
+
+impl WavelengthErrors {
+    /// From the coordinates' `errors` and `correlation`: a family's own coordinate (0 where
+    /// fixed), or for a law's n and k, propagated from the law's coordinates.
+    fn new(
+        problem: &JointProblem,
+        coordinates: &[(String, Option<Parameter>, Option<usize>)],
+        law: Option<&LorentzDispersion>,
+        wavelengths: &[f64],
+        errors: &[f64],
+        correlation: &[Vec<f64>],
+    ) -> WavelengthErrors {
+        let family_errors = |p: Parameter| {
+            (0..wavelengths.len())
+                .map(|j| {
+                    coordinates
+                        .iter()
+                        .position(|c| c.1 == Some(p) && c.2 == Some(j))
+                        .map_or(0.0, |c| errors[c])
+                })
+                .collect::<Vec<_>>()
+        };
+        let (n, k) = match law {
+            None => (family_errors(Parameter::N), family_errors(Parameter::K)),
+            Some(law) => propagate_law_errors(law, problem, wavelengths, errors, correlation),
+        };
+        WavelengthErrors {
+            n,
+            k,
+            rho_d: family_errors(Parameter::RhoD),
+        }
+    }
 }
 
 /// Name, model parameter (None for a law coordinate) and wavelength index of each coordinate.

@@ -22,13 +22,6 @@ pub(super) fn material(
     alternative: Option<&SpectralFit>,
 ) -> Material {
     let table_fit = table.unwrap_or(chosen);
-    let mut settings = settings(&data[0], options);
-    settings.insert(
-        "spectral".into(),
-        "each wavelength fitted alone (the stages above), then jointly by lm from the medians of \
-         σ and q"
-            .into(),
-    );
     let record = FitRecord {
         source: sets[0].source.clone(),
         source_sha256: sets[0].sha256.clone(),
@@ -44,7 +37,7 @@ pub(super) fn material(
             .collect(),
         optimizer: format!("{} per wavelength, then joint lm", options.optimizer),
         seed: options.seed,
-        settings,
+        settings: spectral_settings(&data[0], options),
         iterations: chosen.history.iterations,
         evaluations: chosen.evaluations,
         cost: chosen.chi2,
@@ -54,42 +47,15 @@ pub(super) fn material(
         bic: chosen.bic,
         termination: format!("joint lm: {}", chosen.history.termination),
         rmse: rmse(sets, chosen),
-        uncertainty: chosen
-            .names
-            .iter()
-            .zip(&chosen.errors)
-            .filter(|(name, _)| !name.contains('('))
-            .map(|(name, &e)| (name.clone(), e))
-            .collect(),
+        uncertainty: shared_uncertainty(chosen),
         correlation: chosen.correlation.clone(),
         undetermined: Vec::new(),
         at_bound: Vec::new(),
         profile_bounds: BTreeMap::new(),
-        uncertainty_per_wavelength: [
-            ("n", &chosen.n_errors),
-            ("k", &chosen.k_errors),
-            ("rho_d", &chosen.rho_d_errors),
-        ]
-        .into_iter()
-        .map(|(name, errors)| (name.to_owned(), errors.clone()))
-        .collect(),
+        uncertainty_per_wavelength: uncertainty_per_wavelength(chosen),
         wavelengths: wavelength_quality(sets, chosen),
-        dispersion: Some(DispersionChoice {
-            chosen: chosen.dispersion.to_string(),
-            table_aic: table_fit.aic,
-            table_bic: table_fit.bic,
-            law_aic: table.map(|_| chosen.aic),
-            law_bic: table.map(|_| chosen.bic),
-        }),
-        model_choice: alternative.map(|other| {
-            format!(
-                "{} preferred over {} (ΔAIC = {:.1}, ΔBIC = {:.1}, table fits)",
-                table_fit.distribution,
-                other.distribution,
-                other.aic - table_fit.aic,
-                other.bic - table_fit.bic
-            )
-        }),
+        dispersion: Some(dispersion_choice(chosen, table)),
+        model_choice: alternative.map(|other| model_choice(table_fit, other)),
         alternative: None,
         convergence: chosen.history.best_cost.clone(),
         global_iterations: 0,
@@ -100,6 +66,65 @@ pub(super) fn material(
         model: MaterialModel::Spectral(chosen.model.clone()),
         fit: Some(record),
     }
+}
+
+/// The settings of one wavelength's fit, and how the joint fit followed.
+fn spectral_settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap<String, String> {
+    let mut settings = settings(data, options);
+    settings.insert(
+        "spectral".into(),
+        "each wavelength fitted alone (the stages above), then jointly by lm from the medians of \
+         σ and q"
+            .into(),
+    );
+    settings
+}
+
+/// 1-σ errors of the coordinates shared by every wavelength (a per-wavelength name has '(').
+fn shared_uncertainty(chosen: &SpectralFit) -> BTreeMap<String, f64> {
+    chosen
+        .names
+        .iter()
+        .zip(&chosen.errors)
+        .filter(|(name, _)| !name.contains('('))
+        .map(|(name, &e)| (name.clone(), e))
+        .collect()
+}
+
+/// 1-σ errors of n, k and ρ_d at each wavelength, by name.
+fn uncertainty_per_wavelength(chosen: &SpectralFit) -> BTreeMap<String, Vec<f64>> {
+    [
+        ("n", &chosen.n_errors),
+        ("k", &chosen.k_errors),
+        ("rho_d", &chosen.rho_d_errors),
+    ]
+    .into_iter()
+    .map(|(name, errors)| (name.to_owned(), errors.clone()))
+    .collect()
+}
+
+/// The dispersion chosen, with the table fit's criteria and, when a law was chosen over the
+/// `table` fit, the law's.
+fn dispersion_choice(chosen: &SpectralFit, table: Option<&SpectralFit>) -> DispersionChoice {
+    let table_fit = table.unwrap_or(chosen);
+    DispersionChoice {
+        chosen: chosen.dispersion.to_string(),
+        table_aic: table_fit.aic,
+        table_bic: table_fit.bic,
+        law_aic: table.map(|_| chosen.aic),
+        law_bic: table.map(|_| chosen.bic),
+    }
+}
+
+/// Why the table fit's distribution was preferred over the `other`'s.
+fn model_choice(table_fit: &SpectralFit, other: &SpectralFit) -> String {
+    format!(
+        "{} preferred over {} (ΔAIC = {:.1}, ΔBIC = {:.1}, table fits)",
+        table_fit.distribution,
+        other.distribution,
+        other.aic - table_fit.aic,
+        other.bic - table_fit.bic
+    )
 }
 
 /// Every file after the first, once each (a spectral file gives several sets), with its rows.
