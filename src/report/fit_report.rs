@@ -43,8 +43,8 @@ use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use style::{
-    draw_legend_column, draw_legend_row, draw_note, incidence_color, DrawResult, LegendEntry,
-    LineKind, Marker, YAxis, TITLE_SIZE,
+    draw_caption, draw_legend_column, draw_legend_row, draw_note, incidence_color, DrawResult,
+    LegendEntry, LineKind, Marker, YAxis, TITLE_SIZE,
 };
 
 /// Pixel size of the report figure: five columns of panels in three rows.
@@ -457,7 +457,12 @@ fn draw_header<DB: DrawingBackend>(
         .color(&BLACK)
         .pos(Pos::new(HPos::Left, VPos::Top));
     root.draw_text(&title, &title_style.into_text_style(root), (24, 14))?;
+    draw_legend_row(root, &header_legend(data), (28, 72))
+}
 
+/// The key shared by every data panel: the colour of each incidence angle with curves, the
+/// measured points' marker, and the chosen and competing fits' lines.
+fn header_legend(data: &ReportData) -> Vec<LegendEntry> {
     let mut entries: Vec<LegendEntry> = data
         .shown
         .iter()
@@ -472,22 +477,17 @@ fn draw_header<DB: DrawingBackend>(
         .collect();
     if data.shown.len() < data.incidences.len() {
         // Curves at a few angles spread over the range; every point is in (g) and (h).
-        entries.push(LegendEntry::line(
-            format!(
-                "(curves at {} of {} incidence angles)",
-                data.shown.len(),
-                data.incidences.len()
-            ),
-            WHITE,
-            LineKind::Solid,
-        ));
+        entries.push(LegendEntry::text(format!(
+            "(curves at {} of {} incidence angles)",
+            data.shown.len(),
+            data.incidences.len()
+        )));
     }
-    entries.push(LegendEntry {
-        label: "measured ± 1σ".into(),
-        color: RGBColor(60, 60, 60),
-        line: None,
-        marker: Some(Marker::FilledCircle),
-    });
+    entries.push(LegendEntry::marker(
+        "measured ± 1σ",
+        RGBColor(60, 60, 60),
+        Marker::FilledCircle,
+    ));
     entries.push(LegendEntry::line(
         format!("{} fit (chosen)", data.chosen_label),
         BLACK,
@@ -500,7 +500,7 @@ fn draw_header<DB: DrawingBackend>(
             LineKind::Dashed,
         ));
     }
-    draw_legend_row(root, &entries, (28, 72))
+    entries
 }
 
 fn draw_in_plane_m00<DB: DrawingBackend>(
@@ -512,13 +512,35 @@ fn draw_in_plane_m00<DB: DrawingBackend>(
     let Some(y) = log_axis(&series) else {
         return draw_note(area, caption, "no measurements in the plane of incidence");
     };
+    draw_m00_profile(
+        area,
+        Domain::InPlane,
+        &with_binning(caption, binned),
+        "m00 = f00, BRDF (sr⁻¹)",
+        y,
+        series,
+        binned,
+    )
+}
+
+/// An m00 profile along `domain` on the log axis `y`: full-size text, error bars unless the
+/// points are medians per bin.
+fn draw_m00_profile<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    domain: Domain,
+    caption: &str,
+    y_desc: &str,
+    y: YAxis,
+    series: Vec<profiles::ProfileSeries>,
+    binned: bool,
+) -> DrawResult<DB> {
     draw_profile(
         area,
         &Profile {
-            caption: with_binning(caption, binned),
-            x_desc: Domain::InPlane.x_desc(false).into(),
-            y_desc: "m00 = f00, BRDF (sr⁻¹)".into(),
-            x_axis: Domain::InPlane.axis(area.dim_in_pixel().0),
+            caption: caption.to_owned(),
+            x_desc: domain.x_desc(false).into(),
+            y_desc: y_desc.into(),
+            x_axis: domain.axis(area.dim_in_pixel().0),
             y,
             series,
             error_bars: !binned,
@@ -541,6 +563,7 @@ const RING_LEGEND_WIDTH: i32 = 150;
 /// Rings listed in the legend before "+ N more".
 const RING_LEGEND_ROWS: usize = 18;
 
+/// Panel (b): m00 against φr − φi on each drawn ring, with the rings' key in a strip at the right.
 fn draw_rings_m00<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     data: &ReportData,
@@ -555,21 +578,23 @@ fn draw_rings_m00<DB: DrawingBackend>(
         };
         return draw_note(area, caption, &note);
     };
-    let (width, height) = area.dim_in_pixel();
+    let (width, _) = area.dim_in_pixel();
     let (chart_area, legend_area) = area.split_horizontally(width as i32 - RING_LEGEND_WIDTH);
-    draw_profile(
+    draw_m00_profile(
         &chart_area,
-        &Profile {
-            caption: with_binning(caption, binned),
-            x_desc: Domain::Rings.x_desc(false).into(),
-            y_desc: "m00 (sr⁻¹)".into(),
-            x_axis: Domain::Rings.axis(chart_area.dim_in_pixel().0),
-            y,
-            series,
-            error_bars: !binned,
-            compact: false,
-        },
+        Domain::Rings,
+        &with_binning(caption, binned),
+        "m00 (sr⁻¹)",
+        y,
+        series,
+        binned,
     )?;
+    draw_ring_legend(&legend_area, &ring_legend(data))
+}
+
+/// The rings' key: incidence angle → detector zenith of each ring listed (in its colour and
+/// marker), then counts of the off-plane points the panel does not show.
+fn ring_legend(data: &ReportData) -> Vec<LegendEntry> {
     let mut entries: Vec<LegendEntry> = data
         .rings
         .iter()
@@ -587,21 +612,16 @@ fn draw_rings_m00<DB: DrawingBackend>(
         })
         .collect();
     if data.rings.len() > RING_LEGEND_ROWS {
-        entries.push(LegendEntry::line(
-            format!("+ {} more", data.rings.len() - RING_LEGEND_ROWS),
-            WHITE,
-            LineKind::Solid,
-        ));
+        entries.push(LegendEntry::text(format!(
+            "+ {} more",
+            data.rings.len() - RING_LEGEND_ROWS
+        )));
     }
     let off_ring = data.off_ring_points();
     if off_ring > 0 {
         // A raster around specular is not a ring; its points are among the residuals only.
-        entries.push(LegendEntry::line(
-            format!("{off_ring} raster pts"),
-            WHITE,
-            LineKind::Solid,
-        ));
-        entries.push(LegendEntry::line("only in (g)", WHITE, LineKind::Solid));
+        entries.push(LegendEntry::text(format!("{off_ring} raster pts")));
+        entries.push(LegendEntry::text("only in (g)"));
     }
     if data.unshown_ring_points > 0 {
         // Rings beyond the drawn ones (other incidence angles, or more than MAX_RINGS).
@@ -610,9 +630,18 @@ fn draw_rings_m00<DB: DrawingBackend>(
             "other rings".to_owned(),
             "only in (g)".to_owned(),
         ] {
-            entries.push(LegendEntry::line(line, WHITE, LineKind::Solid));
+            entries.push(LegendEntry::text(line));
         }
     }
+    entries
+}
+
+/// The ring key in its strip under a heading, moved up when it is too long for the panel.
+fn draw_ring_legend<DB: DrawingBackend>(
+    legend_area: &DrawingArea<DB, Shift>,
+    entries: &[LegendEntry],
+) -> DrawResult<DB> {
+    let (_, height) = legend_area.dim_in_pixel();
     let heading = (FONT, style::LEGEND_SIZE)
         .into_font()
         .color(&BLACK)
@@ -620,8 +649,7 @@ fn draw_rings_m00<DB: DrawingBackend>(
     legend_area.draw_text("ring θi → θr", &heading, (4, 48))?;
     let rows = entries.len() as i32;
     let top = (48 + 24).min(height as i32 - rows * (style::LEGEND_SIZE + 7) - 10);
-    draw_legend_column(&legend_area, &entries, (4, top))?;
-    Ok(())
+    draw_legend_column(legend_area, entries, (4, top))
 }
 
 /// Said by the profile panels when the geometry has neither an in-plane sweep nor a ring.
@@ -648,12 +676,8 @@ fn draw_linear_block<DB: DrawingBackend>(
     if !has_in_plane && data.rings.is_empty() {
         return draw_note(area, caption, NO_PROFILE_NOTE);
     }
+    draw_caption(area, caption)?;
     let (width, _) = area.dim_in_pixel();
-    let caption_style = (FONT, style::CAPTION_SIZE)
-        .into_font()
-        .color(&BLACK)
-        .pos(Pos::new(HPos::Center, VPos::Top));
-    area.draw_text(caption, &caption_style, (width as i32 / 2, 12))?;
     let grid = area
         .clone()
         .shrink((0, 40), (width, area.dim_in_pixel().1 - 40));
@@ -661,35 +685,45 @@ fn draw_linear_block<DB: DrawingBackend>(
     let rows = elements.len().div_ceil(4);
     let cells = grid.split_evenly((rows, columns));
     for (cell, &element) in cells.iter().zip(&elements) {
-        let on_rings =
-            !data.rings.is_empty() && (ZERO_IN_PLANE.contains(&element) || !has_in_plane);
-        let domain = if on_rings {
-            Domain::Rings
-        } else {
-            Domain::InPlane
-        };
-        let quantity = Quantity::Ratio(element);
-        let (series, binned) = profile_series(data, quantity, domain);
-        draw_profile(
-            cell,
-            &Profile {
-                caption: format!(
-                    "{}{}{}",
-                    quantity.label(),
-                    if on_rings { " (rings)" } else { "" },
-                    if binned { ", medians" } else { "" }
-                ),
-                x_desc: domain.x_desc(true).into(),
-                y_desc: String::new(),
-                x_axis: domain.axis(cell.dim_in_pixel().0),
-                y: linear_axis(&series, 1.5),
-                series,
-                error_bars: false,
-                compact: true,
-            },
-        )?;
+        draw_ratio(cell, data, element, has_in_plane)?;
     }
     Ok(())
+}
+
+/// One small plot of panel (d): m_ij/m00 of `element` in the plane of incidence, or on the rings
+/// when it vanishes in the plane by symmetry or the measurement has no in-plane sweep.
+fn draw_ratio<DB: DrawingBackend>(
+    cell: &DrawingArea<DB, Shift>,
+    data: &ReportData,
+    element: usize,
+    has_in_plane: bool,
+) -> DrawResult<DB> {
+    let on_rings = !data.rings.is_empty() && (ZERO_IN_PLANE.contains(&element) || !has_in_plane);
+    let domain = if on_rings {
+        Domain::Rings
+    } else {
+        Domain::InPlane
+    };
+    let quantity = Quantity::Ratio(element);
+    let (series, binned) = profile_series(data, quantity, domain);
+    draw_profile(
+        cell,
+        &Profile {
+            caption: format!(
+                "{}{}{}",
+                quantity.label(),
+                if on_rings { " (rings)" } else { "" },
+                if binned { ", medians" } else { "" }
+            ),
+            x_desc: domain.x_desc(true).into(),
+            y_desc: String::new(),
+            x_axis: domain.axis(cell.dim_in_pixel().0),
+            y: linear_axis(&series, 1.5),
+            series,
+            error_bars: false,
+            compact: true,
+        },
+    )
 }
 
 /// Panel (e): DoLP for unpolarized illumination, √(m10² + m20²)/m00 (docs/design.md §1.6).

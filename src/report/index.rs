@@ -9,7 +9,7 @@ use super::fit_report::{
 };
 use super::ReportError;
 use crate::atomic::write_atomically;
-use crate::material::{list_library, Material, MaterialModel};
+use crate::material::{list_library, FitRecord, Material, MaterialModel};
 use crate::pbrdf::SlopeDistribution;
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
@@ -333,6 +333,8 @@ fn parameter_table(html: &mut String, material: &Material) {
     html.push_str("</table>\n");
 }
 
+/// A material's section: its heading and model, its parameter and fit tables, and its report
+/// figure (linked to the SVG) or how to draw one.
 fn material_section(
     html: &mut String,
     reports_dir: &Path,
@@ -342,94 +344,109 @@ fn material_section(
 ) {
     let model = &material.model;
     let wavelengths = model.wavelengths_um();
-    let name = escape_html(&material.name);
     let _ = write!(
         html,
-        "<section class=\"material\" id=\"{}\">\n<h2>{name}</h2>\n<p>{} slopes, {} shadowing, \
+        "<section class=\"material\" id=\"{}\">\n<h2>{}</h2>\n<p>{} slopes, {} shadowing, \
          λ = {} µm — <a href=\"{}\">material file</a></p>\n<div class=\"facts\">\n",
         anchor(material),
+        escape_html(&material.name),
         model.distribution().name(),
         model.shadowing().name(),
         escape_html(&span(&wavelengths)),
         escape_html(&url_of(&relative_to(reports_dir, path)))
     );
     parameter_table(html, material);
-
     match material.fit.as_ref() {
-        Some(fit) => {
-            html.push_str("<table>\n<tr><th>fit quality</th><th></th></tr>\n");
-            let mut rows = vec![
-                ("reduced χ²", format_plain(fit.reduced_chi2)),
-                ("χ² (cost)", format_plain(fit.cost)),
-                (
-                    "AIC / BIC",
-                    format!("{} / {}", format_plain(fit.aic), format_plain(fit.bic)),
-                ),
-                (
-                    "data",
-                    format!(
-                        "{} points × {} elements, {} degrees of freedom",
-                        fit.points,
-                        fit.elements.len(),
-                        fit.degrees_of_freedom
-                    ),
-                ),
-                (
-                    "optimizer",
-                    format!("{} (seed {}), {}", fit.optimizer, fit.seed, fit.termination),
-                ),
-                ("fitted by", material.tool_version.clone()),
-            ];
-            if let Some(alt) = &fit.alternative {
-                rows.push((
-                    "competing fit",
-                    format!(
-                        "{}: reduced χ² {}, AIC {}, BIC {}",
-                        alt.model.distribution.name(),
-                        format_plain(alt.reduced_chi2),
-                        format_plain(alt.aic),
-                        format_plain(alt.bic)
-                    ),
-                ));
-            }
-            rows.push((
-                "preferred",
-                preference(material).unwrap_or_else(|| "no competing distribution fitted".into()),
-            ));
-            if !fit.undetermined.is_empty() {
-                rows.push(("not determined", fit.undetermined.join(", ")));
-            }
-            for (key, value) in rows {
-                let _ = writeln!(
-                    html,
-                    "<tr><td>{}</td><td>{}</td></tr>",
-                    escape_html(key),
-                    escape_html(&value)
-                );
-            }
-            let (status, class) = provenance(path, material);
-            let _ = writeln!(
-                html,
-                "<tr><td>source</td><td><code>{}</code> sha256 <code>{}</code> \
-                 <span class=\"{class}\">{}</span></td></tr>\n</table>",
-                escape_html(&fit.source.display().to_string()),
-                escape_html(&sha_prefix(&fit.source_sha256)),
-                escape_html(&status)
-            );
-        }
+        Some(fit) => fit_table(html, path, material, fit),
         None => html.push_str("<p class=\"warn\">Not fitted by irpol: no fit record.</p>\n"),
     }
     html.push_str("</div>\n");
+    report_figure(html, path, material, has_report);
+    html.push_str("</section>\n");
+}
 
+/// The fit-quality table of a section: [`fit_facts`], then the source with its SHA-256 prefix
+/// and whether the file still matches.
+fn fit_table(html: &mut String, path: &Path, material: &Material, fit: &FitRecord) {
+    html.push_str("<table>\n<tr><th>fit quality</th><th></th></tr>\n");
+    for (key, value) in fit_facts(material, fit) {
+        let _ = writeln!(
+            html,
+            "<tr><td>{}</td><td>{}</td></tr>",
+            escape_html(key),
+            escape_html(&value)
+        );
+    }
+    let (status, class) = provenance(path, material);
+    let _ = writeln!(
+        html,
+        "<tr><td>source</td><td><code>{}</code> sha256 <code>{}</code> \
+         <span class=\"{class}\">{}</span></td></tr>\n</table>",
+        escape_html(&fit.source.display().to_string()),
+        escape_html(&sha_prefix(&fit.source_sha256)),
+        escape_html(&status)
+    );
+}
+
+/// The (key, value) rows of the fit-quality table: χ², AIC/BIC, data, optimizer, the competing
+/// fit, the preferred distribution and any undetermined parameters (not yet escaped).
+fn fit_facts(material: &Material, fit: &FitRecord) -> Vec<(&'static str, String)> {
+    let mut rows = vec![
+        ("reduced χ²", format_plain(fit.reduced_chi2)),
+        ("χ² (cost)", format_plain(fit.cost)),
+        (
+            "AIC / BIC",
+            format!("{} / {}", format_plain(fit.aic), format_plain(fit.bic)),
+        ),
+        (
+            "data",
+            format!(
+                "{} points × {} elements, {} degrees of freedom",
+                fit.points,
+                fit.elements.len(),
+                fit.degrees_of_freedom
+            ),
+        ),
+        (
+            "optimizer",
+            format!("{} (seed {}), {}", fit.optimizer, fit.seed, fit.termination),
+        ),
+        ("fitted by", material.tool_version.clone()),
+    ];
+    if let Some(alt) = &fit.alternative {
+        rows.push((
+            "competing fit",
+            format!(
+                "{}: reduced χ² {}, AIC {}, BIC {}",
+                alt.model.distribution.name(),
+                format_plain(alt.reduced_chi2),
+                format_plain(alt.aic),
+                format_plain(alt.bic)
+            ),
+        ));
+    }
+    rows.push((
+        "preferred",
+        preference(material).unwrap_or_else(|| "no competing distribution fitted".into()),
+    ));
+    if !fit.undetermined.is_empty() {
+        rows.push(("not determined", fit.undetermined.join(", ")));
+    }
+    rows
+}
+
+/// The report figure of a section (the PNG, linking to the SVG), or the command that draws it.
+fn report_figure(html: &mut String, path: &Path, material: &Material, has_report: bool) {
     let png = format!("{}.png", material.name);
     if has_report {
         let svg = format!("{}.svg", material.name);
         let _ = writeln!(
             html,
-            "<a href=\"{}\"><img class=\"report\" src=\"{}\" alt=\"fit report of {name}\" \
+            "<a href=\"{}\"><img class=\"report\" src=\"{}\" alt=\"fit report of {}\" \
              loading=\"lazy\"></a>",
             escape_html(&url_of(Path::new(&svg))),
-            escape_html(&url_of(Path::new(&png)))
+            escape_html(&url_of(Path::new(&png))),
+            escape_html(&material.name)
         );
     } else {
         let _ = writeln!(
@@ -438,5 +455,4 @@ fn material_section(
             escape_html(&path.display().to_string())
         );
     }
-    html.push_str("</section>\n");
 }

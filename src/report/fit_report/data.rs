@@ -113,64 +113,12 @@ pub struct ReportData {
 }
 
 impl ReportData {
+    /// Places every measured point of `set`, takes its residuals and evaluates the models of
+    /// `material` (and of its competing fit) along the planes, rings and emission angles drawn.
     pub fn new(material: &Material, set: &MeasurementSet) -> Result<ReportData, ReportError> {
-        let chosen = ModelCurveSource {
-            label: material.model.distribution().name().to_owned(),
-            pbrdf: material.grey_model()?.pbrdf()?,
-        };
-        let alternative = match material.fit.as_ref().and_then(|f| f.alternative.as_ref()) {
-            Some(alt) => Some(ModelCurveSource {
-                label: alt.model.distribution.name().to_owned(),
-                pbrdf: alt.model.pbrdf()?,
-            }),
-            None => None,
-        };
-
+        let (chosen, alternative) = curve_sources(material)?;
         let incidences = distinct_sorted(set.points.iter().map(|p| p.theta_i_deg));
-        // The standard deviations the fit weighted by (the file's u_ columns or the fit's default
-        // noise model), so that report residuals are the ones the optimizer minimized.
-        let weights = MeasurementData::new(set)?;
-        let elements_per_point = set.elements.len();
-
-        let mut points = Vec::with_capacity(set.points.len());
-        let mut residuals = Vec::with_capacity(set.points.len() * elements_per_point);
-        for (point, p) in set.points.iter().enumerate() {
-            let incident = checked_direction("theta_i_deg", p.theta_i_deg, p.phi_i_deg)?;
-            let scattered = checked_direction("theta_r_deg", p.theta_r_deg, p.phi_r_deg)?;
-            let relative_azimuth = (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0);
-            let signed_zenith = in_plane_zenith(p.theta_r_deg, relative_azimuth);
-            let forward_zenith = signed_zenith.unwrap_or({
-                if (90.0..=270.0).contains(&relative_azimuth) {
-                    p.theta_r_deg
-                } else {
-                    -p.theta_r_deg
-                }
-            });
-            let mut readings = [None; 16];
-            for (column, &element) in set.elements.iter().enumerate() {
-                let value = p.values[column];
-                let (_, sigma) = weights.observation(point * elements_per_point + column);
-                readings[element] = Some(Reading { value, sigma });
-            }
-            let model = chosen.pbrdf.mueller(&incident, &scattered);
-            // Residuals in the row's own frame: the model is evaluated at the row's own φ_r, as
-            // the fit compared them.
-            residuals.extend(normalized_residuals(&readings, &model, forward_zenith));
-            let (readings, model) = if at_normal(p.theta_r_deg) {
-                in_plane_frame_at_normal(&readings, &model, p.phi_i_deg, p.phi_r_deg)
-            } else {
-                (readings, model)
-            };
-            points.push(PointView {
-                incidence: position_of(&incidences, p.theta_i_deg),
-                signed_zenith,
-                ring: None,
-                relative_azimuth,
-                readings,
-                model,
-            });
-        }
-
+        let (mut points, residuals) = point_views(set, &incidences, &chosen)?;
         let shown = representatives(&incidences, MAX_CURVE_INCIDENCES);
         let mut slot = vec![None; incidences.len()];
         for (position, &incidence) in shown.iter().enumerate() {
@@ -184,17 +132,7 @@ impl ReportData {
             &chosen,
             alternative.as_ref(),
         );
-        let mut has_in_plane = vec![false; incidences.len()];
-        for p in points.iter().filter(|p| p.signed_zenith.is_some()) {
-            has_in_plane[p.incidence] = true;
-        }
-        let in_plane = shown
-            .iter()
-            .map(|&incidence| {
-                has_in_plane[incidence]
-                    .then(|| in_plane_sweep(incidences[incidence], &chosen, alternative.as_ref()))
-            })
-            .collect();
+        let in_plane = in_plane_sweeps(&points, &incidences, &shown, &chosen, alternative.as_ref());
         let emissivity = emissivity_curves(&chosen, alternative.as_ref());
 
         Ok(ReportData {
@@ -223,6 +161,98 @@ impl ReportData {
     pub fn off_ring_points(&self) -> usize {
         self.raster_points
     }
+}
+
+/// The chosen model and, when the fit recorded one, the competing distribution's best fit.
+fn curve_sources(
+    material: &Material,
+) -> Result<(ModelCurveSource, Option<ModelCurveSource>), ReportError> {
+    let chosen = ModelCurveSource {
+        label: material.model.distribution().name().to_owned(),
+        pbrdf: material.grey_model()?.pbrdf()?,
+    };
+    let alternative = match material.fit.as_ref().and_then(|f| f.alternative.as_ref()) {
+        Some(alt) => Some(ModelCurveSource {
+            label: alt.model.distribution.name().to_owned(),
+            pbrdf: alt.model.pbrdf()?,
+        }),
+        None => None,
+    };
+    Ok((chosen, alternative))
+}
+
+/// Every measured point as the report sees it (not yet on a ring), and the normalized residuals
+/// of all of them, in the order of the file.
+fn point_views(
+    set: &MeasurementSet,
+    incidences: &[f64],
+    chosen: &ModelCurveSource,
+) -> Result<(Vec<PointView>, Vec<Residual>), ReportError> {
+    // The standard deviations the fit weighted by (the file's u_ columns or the fit's default
+    // noise model), so that report residuals are the ones the optimizer minimized.
+    let weights = MeasurementData::new(set)?;
+    let elements_per_point = set.elements.len();
+    let mut points = Vec::with_capacity(set.points.len());
+    let mut residuals = Vec::with_capacity(set.points.len() * elements_per_point);
+    for (point, p) in set.points.iter().enumerate() {
+        let incident = checked_direction("theta_i_deg", p.theta_i_deg, p.phi_i_deg)?;
+        let scattered = checked_direction("theta_r_deg", p.theta_r_deg, p.phi_r_deg)?;
+        let relative_azimuth = (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0);
+        let signed_zenith = in_plane_zenith(p.theta_r_deg, relative_azimuth);
+        let forward_zenith = signed_zenith.unwrap_or({
+            if (90.0..=270.0).contains(&relative_azimuth) {
+                p.theta_r_deg
+            } else {
+                -p.theta_r_deg
+            }
+        });
+        let mut readings = [None; 16];
+        for (column, &element) in set.elements.iter().enumerate() {
+            let value = p.values[column];
+            let (_, sigma) = weights.observation(point * elements_per_point + column);
+            readings[element] = Some(Reading { value, sigma });
+        }
+        let model = chosen.pbrdf.mueller(&incident, &scattered);
+        // Residuals in the row's own frame: the model is evaluated at the row's own φ_r, as
+        // the fit compared them.
+        residuals.extend(normalized_residuals(&readings, &model, forward_zenith));
+        let (readings, model) = if at_normal(p.theta_r_deg) {
+            in_plane_frame_at_normal(&readings, &model, p.phi_i_deg, p.phi_r_deg)
+        } else {
+            (readings, model)
+        };
+        points.push(PointView {
+            incidence: position_of(incidences, p.theta_i_deg),
+            signed_zenith,
+            ring: None,
+            relative_azimuth,
+            readings,
+            model,
+        });
+    }
+    Ok((points, residuals))
+}
+
+/// The in-plane model sweeps of the `shown` incidence angles: `None` for an angle without a
+/// point in the plane of incidence.
+fn in_plane_sweeps(
+    points: &[PointView],
+    incidences: &[f64],
+    shown: &[usize],
+    chosen: &ModelCurveSource,
+    alternative: Option<&ModelCurveSource>,
+) -> Vec<Option<ModelSweep>> {
+    let mut has_in_plane = vec![false; incidences.len()];
+    for p in points.iter().filter(|p| p.signed_zenith.is_some()) {
+        has_in_plane[p.incidence] = true;
+    }
+    shown
+        .iter()
+        .map(|&incidence| {
+            has_in_plane[incidence]
+                .then(|| in_plane_sweep(incidences[incidence], chosen, alternative))
+        })
+        .collect()
 }
 
 /// Most incidence angles drawn with model curves: beyond it, curves and their points are shown
@@ -429,6 +459,53 @@ fn find_rings(
     chosen: &ModelCurveSource,
     alternative: Option<&ModelCurveSource>,
 ) -> FoundRings {
+    let order = setting_order(points, set);
+    let groups = settings(&order, points, set);
+    let (candidates, raster_points) = ring_candidates(groups, points);
+    let drawable: Vec<&[usize]> = candidates
+        .iter()
+        .copied()
+        .filter(|group| slot[points[group[0]].incidence].is_some())
+        .collect();
+    let kept: Vec<&[usize]> = evenly(drawable.len(), MAX_RINGS)
+        .into_iter()
+        .map(|i| drawable[i])
+        .collect();
+    let off_plane_on_rings = |groups: &[&[usize]]| -> usize {
+        groups
+            .iter()
+            .flat_map(|g| g.iter())
+            .filter(|&&i| points[i].signed_zenith.is_none())
+            .count()
+    };
+    let unshown_points = off_plane_on_rings(&candidates) - off_plane_on_rings(&kept);
+    let mut rings = Vec::with_capacity(kept.len());
+    for (index, group) in kept.iter().enumerate() {
+        let incidence = points[group[0]].incidence;
+        let theta_r_deg = set.points[group[0]].theta_r_deg;
+        for &i in group.iter() {
+            points[i].ring = Some(index);
+        }
+        let rank = rings
+            .iter()
+            .filter(|r: &&Ring| r.incidence == incidence)
+            .count();
+        rings.push(Ring {
+            incidence,
+            theta_r_deg,
+            rank,
+            sweep: ring_sweep(incidences[incidence], theta_r_deg, chosen, alternative),
+        });
+    }
+    FoundRings {
+        rings,
+        raster_points,
+        unshown_points,
+    }
+}
+
+/// Indices of the points sorted by incidence angle, then detector zenith θ_r.
+fn setting_order(points: &[PointView], set: &MeasurementSet) -> Vec<usize> {
     let mut order: Vec<usize> = (0..points.len()).collect();
     let theta_r = |i: usize| set.points[i].theta_r_deg;
     order.sort_by(|&a, &b| {
@@ -437,7 +514,17 @@ fn find_rings(
             .cmp(&points[b].incidence)
             .then(theta_r(a).total_cmp(&theta_r(b)))
     });
-    // Runs of one incidence angle whose θ_r agree with the run's first to a microdegree.
+    order
+}
+
+/// The runs of `order` (from [`setting_order`]) of one incidence angle whose θ_r agree with the
+/// run's first to a microdegree: the points of one goniometer setting (θ_i, θ_r).
+fn settings<'o>(
+    order: &'o [usize],
+    points: &[PointView],
+    set: &MeasurementSet,
+) -> Vec<&'o [usize]> {
+    let theta_r = |i: usize| set.points[i].theta_r_deg;
     let mut groups: Vec<&[usize]> = Vec::new();
     let mut start = 0;
     for end in 1..=order.len() {
@@ -451,6 +538,15 @@ fn find_rings(
             start = end;
         }
     }
+    groups
+}
+
+/// The settings with off-plane points that span at least [`RING_MIN_SPAN_DEG`] of azimuth (the
+/// rings), and the number of off-plane points in the others (rasters around specular).
+fn ring_candidates<'o>(
+    groups: Vec<&'o [usize]>,
+    points: &[PointView],
+) -> (Vec<&'o [usize]>, usize) {
     let mut raster_points = 0;
     let mut candidates: Vec<&[usize]> = Vec::new();
     for group in groups {
@@ -473,46 +569,7 @@ fn find_rings(
             raster_points += off_plane;
         }
     }
-    let drawable: Vec<&[usize]> = candidates
-        .iter()
-        .copied()
-        .filter(|group| slot[points[group[0]].incidence].is_some())
-        .collect();
-    let kept: Vec<&[usize]> = evenly(drawable.len(), MAX_RINGS)
-        .into_iter()
-        .map(|i| drawable[i])
-        .collect();
-    let off_plane_on_rings = |groups: &[&[usize]]| -> usize {
-        groups
-            .iter()
-            .flat_map(|g| g.iter())
-            .filter(|&&i| points[i].signed_zenith.is_none())
-            .count()
-    };
-    let unshown_points = off_plane_on_rings(&candidates) - off_plane_on_rings(&kept);
-    let mut rings = Vec::with_capacity(kept.len());
-    for (index, group) in kept.iter().enumerate() {
-        let incidence = points[group[0]].incidence;
-        let theta_r_deg = theta_r(group[0]);
-        for &i in group.iter() {
-            points[i].ring = Some(index);
-        }
-        let rank = rings
-            .iter()
-            .filter(|r: &&Ring| r.incidence == incidence)
-            .count();
-        rings.push(Ring {
-            incidence,
-            theta_r_deg,
-            rank,
-            sweep: ring_sweep(incidences[incidence], theta_r_deg, chosen, alternative),
-        });
-    }
-    FoundRings {
-        rings,
-        raster_points,
-        unshown_points,
-    }
+    (candidates, raster_points)
 }
 
 /// Detector zeniths for an in-plane curve: every 0.5° to ±89.5°, and every 0.05° within 3° of

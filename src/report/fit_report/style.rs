@@ -3,6 +3,7 @@
 
 use crate::plot_style::FONT;
 use plotters::coord::Shift;
+use plotters::element::Drawable;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
@@ -51,30 +52,15 @@ impl Marker {
         }
     }
 
-    /// The marker as a drawable element at a backend (pixel) position.
-    pub fn element<DB: DrawingBackend>(
-        self,
-        at: (i32, i32),
-        size: i32,
-        color: RGBColor,
-    ) -> DynElement<'static, DB, (i32, i32)> {
-        match self {
-            Marker::FilledCircle | Marker::HollowCircle => {
-                Circle::new(at, size, self.style(color)).into_dyn()
-            }
-            Marker::FilledTriangle | Marker::HollowTriangle => {
-                TriangleMarker::new(at, size + 1, self.style(color)).into_dyn()
-            }
-        }
-    }
-
-    /// The marker at a data coordinate.
-    pub fn at<DB: DrawingBackend>(
-        self,
-        at: (f64, f64),
-        size: i32,
-        color: RGBColor,
-    ) -> DynElement<'static, DB, (f64, f64)> {
+    /// The marker as a drawable element at `at`: a data coordinate in a chart, or a backend
+    /// (pixel) position in a drawing area.
+    pub fn at<DB, C>(self, at: C, size: i32, color: RGBColor) -> DynElement<'static, DB, C>
+    where
+        DB: DrawingBackend,
+        C: Clone + 'static,
+        Circle<C, i32>: Drawable<DB>,
+        TriangleMarker<C, i32>: Drawable<DB>,
+    {
         match self {
             Marker::FilledCircle | Marker::HollowCircle => {
                 Circle::new(at, size, self.style(color)).into_dyn()
@@ -120,6 +106,11 @@ impl LegendEntry {
             marker: Some(marker),
         }
     }
+    /// A line of text among the entries (a count, a remark): its sample is a white line, which
+    /// does not show on the legend's white box.
+    pub fn text(label: impl Into<String>) -> LegendEntry {
+        LegendEntry::line(label, WHITE, LineKind::Solid)
+    }
 }
 
 const SAMPLE_WIDTH: i32 = 34;
@@ -150,7 +141,7 @@ fn draw_sample<DB: DrawingBackend>(
         None => {}
     }
     if let Some(marker) = entry.marker {
-        area.draw(&marker.element((x + SAMPLE_WIDTH / 2, y), 4, entry.color))?;
+        area.draw(&marker.at((x + SAMPLE_WIDTH / 2, y), 4, entry.color))?;
     }
     Ok(())
 }
@@ -235,6 +226,38 @@ pub fn draw_legend_row<DB: DrawingBackend>(
             + 26;
     }
     Ok(())
+}
+
+/// A chart builder with the report's caption font, 12-pixel margins (`margin_right` at the right)
+/// and label areas of 58 pixels under the x axis and 78 beside the y axis: the frame of every
+/// single-chart panel.
+pub fn panel_chart<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    margin_right: u32,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(caption, (FONT, CAPTION_SIZE))
+        .margin(12)
+        .margin_right(margin_right)
+        .x_label_area_size(58)
+        .y_label_area_size(78);
+    builder
+}
+
+/// A panel's caption centred at the top of `area`, for panels that are not one chart (which
+/// draws its own caption).
+pub fn draw_caption<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: &str,
+) -> DrawResult<DB> {
+    let (width, _) = area.dim_in_pixel();
+    let style = (FONT, CAPTION_SIZE)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Center, VPos::Top));
+    area.draw_text(caption, &style, (width as i32 / 2, 12))
 }
 
 /// A message in the middle of an empty panel, so a missing quantity is said rather than blank.

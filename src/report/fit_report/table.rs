@@ -2,13 +2,12 @@
 //! distribution's best fit, fit quality (reduced χ², AIC, BIC), the preferred model, the data
 //! and optimizer, and the provenance of the measurement (docs/design.md §2.2).
 
-use super::style::{DrawResult, CAPTION_SIZE, LEGEND_SIZE};
+use super::style::{draw_caption, DrawResult, LEGEND_SIZE};
 use crate::material::{ConfidenceBound, FitRecord, Material, ModelSpec};
 use crate::pbrdf::SlopeDistribution;
 use crate::plot_style::FONT;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::FontStyle;
 
 /// Characters of the SHA-256 shown in the table and the index.
@@ -153,13 +152,31 @@ pub fn sha_prefix(sha: &str) -> String {
     }
 }
 
-/// The rows of the table.
+/// The rows of the table: the parameters, then (for a fitted material) the fit quality, its
+/// caveats and where the data and the fit came from.
 pub fn table_rows(material: &Material) -> Vec<Row> {
     // A spectral material has its own report; ReportData::new refuses it before this.
     let Some(model) = material.model.grey() else {
         return Vec::new();
     };
     let fit = material.fit.as_ref();
+    let mut rows = parameter_rows(model, fit);
+    let Some(fit) = fit else {
+        rows.push(Row::Text(
+            "No fit record: the model was not fitted by irpol.".into(),
+            Tone::Warning,
+        ));
+        return rows;
+    };
+    rows.extend(quality_rows(material, fit));
+    rows.extend(caveat_rows(fit));
+    rows.extend(provenance_rows(fit));
+    rows
+}
+
+/// The parameter heading, the column header and one row per parameter: the chosen model's
+/// value with its ± cell, beside the competing distribution's value when there is one.
+fn parameter_rows(model: &ModelSpec, fit: Option<&FitRecord>) -> Vec<Row> {
     let alternative = fit.and_then(|f| f.alternative.as_ref());
     let mut rows = vec![Row::Heading(format!(
         "Parameters ({} slopes, {} shadowing)",
@@ -192,30 +209,7 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
             continue;
         };
         let (text, sigma_text, tone) = match fit {
-            Some(fit) if is_free(fit, name) => {
-                let sigma = lookup(|k| fit.uncertainty.get(k), name).copied();
-                let (text, sigma_text) = format_with_uncertainty(value, sigma);
-                let undetermined = fit.undetermined.iter().any(|u| u == name);
-                // An undetermined parameter's ± means nothing: its profile bound instead.
-                let bound = lookup(|k| fit.profile_bounds.get(k), name);
-                let sigma_text = match (bound, sigma_text, undetermined) {
-                    (Some(bound), _, _) => bound_cell(bound),
-                    (None, Some(s), false) => format!("± {s}"),
-                    (None, Some(s), true) => format!("± {s} undetermined"),
-                    (None, None, _) => "± ? undetermined".into(),
-                };
-                let tone = if undetermined {
-                    Tone::Warning
-                } else {
-                    Tone::Normal
-                };
-                let text = if at_bound(fit, name) {
-                    format!("{text} †")
-                } else {
-                    text
-                };
-                (text, sigma_text, tone)
-            }
+            Some(fit) if is_free(fit, name) => fitted_cells(fit, name, value),
             Some(_) => (format_plain(value), "fixed".into(), Tone::Muted),
             None => (format_plain(value), String::new(), Tone::Normal),
         };
@@ -225,15 +219,41 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
         }
         rows.push(Row::Cells(cells, tone));
     }
-    let Some(fit) = fit else {
-        rows.push(Row::Text(
-            "No fit record: the model was not fitted by irpol.".into(),
-            Tone::Warning,
-        ));
-        return rows;
-    };
+    rows
+}
 
-    rows.push(Row::Heading("Fit quality".into()));
+/// The value and ± cells of free parameter `name` and their tone: the value marked † on a bound
+/// of its search interval; an undetermined parameter's ± means nothing, so it is flagged, or
+/// replaced by its profile bound when the fit has one.
+fn fitted_cells(fit: &FitRecord, name: &str, value: f64) -> (String, String, Tone) {
+    let sigma = lookup(|k| fit.uncertainty.get(k), name).copied();
+    let (text, sigma_text) = format_with_uncertainty(value, sigma);
+    let undetermined = fit.undetermined.iter().any(|u| u == name);
+    let bound = lookup(|k| fit.profile_bounds.get(k), name);
+    let sigma_text = match (bound, sigma_text, undetermined) {
+        (Some(bound), _, _) => bound_cell(bound),
+        (None, Some(s), false) => format!("± {s}"),
+        (None, Some(s), true) => format!("± {s} undetermined"),
+        (None, None, _) => "± ? undetermined".into(),
+    };
+    let tone = if undetermined {
+        Tone::Warning
+    } else {
+        Tone::Normal
+    };
+    let text = if at_bound(fit, name) {
+        format!("{text} †")
+    } else {
+        text
+    };
+    (text, sigma_text, tone)
+}
+
+/// "Fit quality": reduced χ², cost, AIC and BIC of both fits, which distribution they prefer and
+/// the strongest correlation.
+fn quality_rows(material: &Material, fit: &FitRecord) -> Vec<Row> {
+    let alternative = fit.alternative.as_ref();
+    let mut rows = vec![Row::Heading("Fit quality".into())];
     let cost_label = match robust_loss(fit) {
         Some(loss) => format!("cost, {loss}"),
         None => "cost χ²".to_owned(),
@@ -265,6 +285,13 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
     if let Some(text) = strongest_correlation(fit) {
         rows.push(Row::Text(text, Tone::Normal));
     }
+    rows
+}
+
+/// What the fit could not pin down: undetermined parameters, parameters on a bound (the † of
+/// their value) and one-sided profile bounds (the ‡ of their ± cell).
+fn caveat_rows(fit: &FitRecord) -> Vec<Row> {
+    let mut rows = Vec::new();
     if !fit.undetermined.is_empty() {
         rows.push(Row::Text(
             format!(
@@ -281,7 +308,6 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
             Tone::Muted,
         ));
     }
-
     if !fit.profile_bounds.is_empty() {
         let names: Vec<&str> = fit.profile_bounds.keys().map(|n| symbol(n)).collect();
         rows.push(Row::Text(
@@ -293,48 +319,61 @@ pub fn table_rows(material: &Material) -> Vec<Row> {
             Tone::Warning,
         ));
     }
+    rows
+}
 
-    rows.push(Row::Heading("Data and optimizer".into()));
+/// "Data and optimizer": what was fitted, how, and the source files with their SHA-256 prefixes.
+fn provenance_rows(fit: &FitRecord) -> Vec<Row> {
     let rmse = fit
         .rmse
         .get("m00")
         .map(|r| format!(", RMSE m00 = {} sr⁻¹", format_plain(*r)))
         .unwrap_or_default();
-    rows.push(Row::Text(
-        format!(
-            "{} points × {} elements ({}), {} dof{rmse}",
-            fit.points,
-            fit.elements.len(),
-            element_span(&fit.elements),
-            fit.degrees_of_freedom,
-        ),
-        Tone::Normal,
-    ));
     let local = fit.convergence.len().saturating_sub(fit.global_iterations);
-    rows.push(Row::Text(
-        format!(
-            "{}, seed {}: {} generations + {} local iterations, {} evaluations; {}",
-            fit.optimizer, fit.seed, fit.global_iterations, local, fit.evaluations, fit.termination
+    let sources = fit
+        .merged_sources
+        .iter()
+        .map(|m| {
+            format!(
+                " + {} ({})",
+                m.source.display(),
+                sha_prefix(&m.source_sha256)
+            )
+        })
+        .collect::<String>();
+    vec![
+        Row::Heading("Data and optimizer".into()),
+        Row::Text(
+            format!(
+                "{} points × {} elements ({}), {} dof{rmse}",
+                fit.points,
+                fit.elements.len(),
+                element_span(&fit.elements),
+                fit.degrees_of_freedom,
+            ),
+            Tone::Normal,
         ),
-        Tone::Normal,
-    ));
-    rows.push(Row::Text(
-        format!(
-            "source {} (sha256 {}){}",
-            fit.source.display(),
-            sha_prefix(&fit.source_sha256),
-            fit.merged_sources
-                .iter()
-                .map(|m| format!(
-                    " + {} ({})",
-                    m.source.display(),
-                    sha_prefix(&m.source_sha256)
-                ))
-                .collect::<String>()
+        Row::Text(
+            format!(
+                "{}, seed {}: {} generations + {} local iterations, {} evaluations; {}",
+                fit.optimizer,
+                fit.seed,
+                fit.global_iterations,
+                local,
+                fit.evaluations,
+                fit.termination
+            ),
+            Tone::Normal,
         ),
-        Tone::Muted,
-    ));
-    rows
+        Row::Text(
+            format!(
+                "source {} (sha256 {}){sources}",
+                fit.source.display(),
+                sha_prefix(&fit.source_sha256),
+            ),
+            Tone::Muted,
+        ),
+    ]
 }
 
 /// The table's symbol of a parameter name ("sigma" → "σ").
@@ -380,16 +419,7 @@ pub fn draw_table<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     material: &Material,
 ) -> DrawResult<DB> {
-    let (width, _) = area.dim_in_pixel();
-    let caption = (FONT, CAPTION_SIZE)
-        .into_font()
-        .color(&BLACK)
-        .pos(Pos::new(HPos::Center, VPos::Top));
-    area.draw_text(
-        &format!("(c) {} — fitted parameters", material.name),
-        &caption,
-        (width as i32 / 2, 12),
-    )?;
+    draw_caption(area, &format!("(c) {} — fitted parameters", material.name))?;
     let layout = layout_table(area, material)?;
     for piece in &layout.pieces {
         area.draw_text(&piece.text, &piece.style(), (piece.x, piece.y))?;
@@ -481,26 +511,7 @@ fn layout_at<DB: DrawingBackend>(
     right: i32,
 ) -> Result<TableLayout, DrawingAreaErrorKind<DB::ErrorType>> {
     let line = size + 8;
-    let mut widths: Vec<i32> = Vec::new();
-    for row in rows {
-        if let Row::Cells(cells, tone) = row {
-            for (i, cell) in cells.iter().enumerate() {
-                let w = area.estimate_text_size(cell, &tone_style(*tone, size))?.0 as i32;
-                match widths.get_mut(i) {
-                    Some(widest) => *widest = (*widest).max(w),
-                    None => widths.push(w),
-                }
-            }
-        }
-    }
-    let stops: Vec<i32> = widths
-        .iter()
-        .scan(TABLE_LEFT, |x, w| {
-            let stop = *x;
-            *x += w + COLUMN_GAP;
-            Some(stop)
-        })
-        .collect();
+    let stops = column_stops(area, rows, size)?;
     let mut pieces = Vec::new();
     let mut y = TABLE_TOP;
     let mut place = |text: &str, x: i32, y: i32, kind: PieceKind| {
@@ -539,6 +550,35 @@ fn layout_at<DB: DrawingBackend>(
         line,
         right,
     })
+}
+
+/// The left edge of each column of the cell rows at font `size`: each column as wide as its
+/// widest cell plus [`COLUMN_GAP`].
+fn column_stops<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    rows: &[Row],
+    size: i32,
+) -> Result<Vec<i32>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut widths: Vec<i32> = Vec::new();
+    for row in rows {
+        if let Row::Cells(cells, tone) = row {
+            for (i, cell) in cells.iter().enumerate() {
+                let w = area.estimate_text_size(cell, &tone_style(*tone, size))?.0 as i32;
+                match widths.get_mut(i) {
+                    Some(widest) => *widest = (*widest).max(w),
+                    None => widths.push(w),
+                }
+            }
+        }
+    }
+    Ok(widths
+        .iter()
+        .scan(TABLE_LEFT, |x, w| {
+            let stop = *x;
+            *x += w + COLUMN_GAP;
+            Some(stop)
+        })
+        .collect())
 }
 
 fn tone_style(tone: Tone, size: i32) -> TextStyle<'static> {

@@ -2,15 +2,13 @@
 //! as a heat map with a colour bar (docs/design.md §1.4, §1.9).
 
 use super::super::fit_report::style::{
-    report_mesh_style, DrawResult, AXIS_DESC_SIZE, CAPTION_SIZE, TICK_SIZE,
+    draw_caption, report_mesh_style, DrawResult, AXIS_DESC_SIZE, TICK_SIZE,
 };
 use super::super::ReportError;
 use crate::material::Material;
 use crate::pbrdf::HemisphereQuadrature;
-use crate::plot_style::FONT;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 use rayon::prelude::*;
 
 /// The largest emission angle of the map, degrees (the quadrature is accurate to 1e-5 below 88°).
@@ -135,14 +133,9 @@ pub fn draw_map<DB: DrawingBackend>(
     nodes: &[f64],
 ) -> DrawResult<DB> {
     let (width, height) = area.dim_in_pixel();
-    let caption = (FONT, CAPTION_SIZE)
-        .into_font()
-        .color(&BLACK)
-        .pos(Pos::new(HPos::Center, VPos::Top));
-    area.draw_text(
+    draw_caption(
+        area,
         "(c) Directional emissivity ε0(λ, θe) of the material (n, k, ρd linear between the measured λ, white ticks)",
-        &caption,
-        (width as i32 / 2, 12),
     )?;
     let body = area.clone().shrink(
         (0, CAPTION_ROOM),

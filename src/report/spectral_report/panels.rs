@@ -2,12 +2,13 @@
 
 use super::super::fit_report::format_plain;
 use super::super::fit_report::style::{
-    draw_legend_top_right, report_mesh_style, sane_linear_range, DrawResult, LegendEntry, LineKind,
-    Marker, AXIS_DESC_SIZE, CAPTION_SIZE, GREY, TICK_SIZE,
+    draw_legend_top_right, panel_chart, report_mesh_style, sane_linear_range, DrawResult,
+    LegendEntry, LineKind, Marker, AXIS_DESC_SIZE, GREY, TICK_SIZE,
 };
 use crate::fit::SpectralFitOutcome;
 use crate::material::SpectralModel;
 use crate::plot_style::{FONT, TABLEAU20};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -109,22 +110,13 @@ pub fn draw_index<DB: DrawingBackend>(
     panel: &IndexPanel,
     (x0, x1): (f64, f64),
 ) -> DrawResult<DB> {
-    let (low, high) = index_range(panel);
-    let mut chart = ChartBuilder::on(area)
-        .caption(panel.caption, (FONT, CAPTION_SIZE))
-        .margin(12)
-        .margin_right(24)
-        .x_label_area_size(58)
-        .y_label_area_size(78)
-        .build_cartesian_2d(x0..x1, low..high)?;
-    let mesh = &mut chart.configure_mesh();
-    mesh.x_labels(10)
-        .y_labels(8)
-        .x_label_formatter(&|v| format!("{v:.1}"))
-        .y_label_formatter(&|v| format!("{v:.2}"))
-        .x_desc("wavelength λ (µm)")
-        .y_desc(panel.y_desc);
-    report_mesh_style(mesh, TICK_SIZE, AXIS_DESC_SIZE).draw()?;
+    let mut chart = wavelength_chart(
+        area,
+        panel.caption,
+        (x0, x1),
+        index_range(panel),
+        panel.y_desc,
+    )?;
     let color = TABLEAU20[0];
     let mut entries = Vec::new();
     if let Some((line, label)) = &panel.law {
@@ -163,6 +155,43 @@ pub fn draw_index<DB: DrawingBackend>(
     draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 10)
 }
 
+type Chart2d<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A chart over wavelength `x0`…`x1` (µm) and `low`…`high`, its grid, ticks and axis titles
+/// drawn: the frame of panels (a), (b) and (d).
+fn wavelength_chart<'a, DB: DrawingBackend>(
+    area: &'a Area<DB>,
+    caption: &str,
+    (x0, x1): (f64, f64),
+    (low, high): (f64, f64),
+    y_desc: &str,
+) -> Result<Chart2d<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut chart = panel_chart(area, caption, 24).build_cartesian_2d(x0..x1, low..high)?;
+    let mesh = &mut chart.configure_mesh();
+    mesh.x_labels(10)
+        .y_labels(8)
+        .x_label_formatter(&|v| format!("{v:.1}"))
+        .y_label_formatter(&|v| format!("{v:.2}"))
+        .x_desc("wavelength λ (µm)")
+        .y_desc(y_desc);
+    report_mesh_style(mesh, TICK_SIZE, AXIS_DESC_SIZE).draw()?;
+    Ok(chart)
+}
+
+/// (λ, χ²/observation) of `fit` at each measured wavelength of `outcome` (finite values only).
+fn chi2_per_observation(
+    outcome: &SpectralFitOutcome,
+    fit: &crate::fit::SpectralFit,
+) -> Vec<(f64, f64)> {
+    outcome
+        .measurements
+        .iter()
+        .zip(&fit.chi2_per_wavelength)
+        .map(|(set, &(chi2, n))| (set.wavelength_um, chi2 / n.max(1) as f64))
+        .filter(|p| p.1.is_finite())
+        .collect()
+}
+
 /// Panel (d): χ²/observation at each wavelength as bars (the kept fit), the table fit's as hollow
 /// circles when a law was kept, and the line χ²/obs = 1 of a fit at the noise level.
 pub fn draw_chi2<DB: DrawingBackend>(
@@ -170,57 +199,25 @@ pub fn draw_chi2<DB: DrawingBackend>(
     outcome: &SpectralFitOutcome,
     (x0, x1): (f64, f64),
 ) -> DrawResult<DB> {
-    let per_observation = |fit: &crate::fit::SpectralFit| -> Vec<(f64, f64)> {
-        outcome
-            .measurements
-            .iter()
-            .zip(&fit.chi2_per_wavelength)
-            .map(|(set, &(chi2, n))| (set.wavelength_um, chi2 / n.max(1) as f64))
-            .filter(|p| p.1.is_finite())
-            .collect()
-    };
-    let bars = per_observation(&outcome.chosen);
-    let table = outcome.table.as_ref().map(per_observation);
+    let bars = chi2_per_observation(outcome, &outcome.chosen);
+    let table = outcome
+        .table
+        .as_ref()
+        .map(|fit| chi2_per_observation(outcome, fit));
     let top = bars
         .iter()
         .chain(table.iter().flatten())
         .map(|p| p.1)
         .fold(1.0, f64::max);
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            "(d) χ² per observation at each wavelength",
-            (FONT, CAPTION_SIZE),
-        )
-        .margin(12)
-        .margin_right(24)
-        .x_label_area_size(58)
-        .y_label_area_size(78)
-        .build_cartesian_2d(x0..x1, 0.0..top * 1.35)?;
-    let mesh = &mut chart.configure_mesh();
-    mesh.x_labels(10)
-        .y_labels(8)
-        .x_label_formatter(&|v| format!("{v:.1}"))
-        .y_label_formatter(&|v| format!("{v:.2}"))
-        .x_desc("wavelength λ (µm)")
-        .y_desc("χ² / observation");
-    report_mesh_style(mesh, TICK_SIZE, AXIS_DESC_SIZE).draw()?;
-    let spacing = bars
-        .windows(2)
-        .map(|p| p[1].0 - p[0].0)
-        .fold(x1 - x0, f64::min);
-    let half = 0.3 * spacing;
+    let mut chart = wavelength_chart(
+        area,
+        "(d) χ² per observation at each wavelength",
+        (x0, x1),
+        (0.0, top * 1.35),
+        "χ² / observation",
+    )?;
     let color = TABLEAU20[0];
-    chart.draw_series(bars.iter().map(|&(x, v)| {
-        Rectangle::new([(x - half, 0.0), (x + half, v)], color.mix(0.55).filled())
-    }))?;
-    // Inside the bar's top, clear of the line at 1 that most bars reach.
-    let label = (FONT, TICK_SIZE)
-        .into_font()
-        .color(&BLACK)
-        .pos(Pos::new(HPos::Center, VPos::Top));
-    chart.draw_series(bars.iter().map(|&(x, v)| {
-        EmptyElement::at((x, v)) + Text::new(format!("{v:.2}"), (0, 14), label.clone())
-    }))?;
+    draw_chi2_bars(&mut chart, &bars, x1 - x0, color)?;
     chart.draw_series(DashedLineSeries::new(
         vec![(x0, 1.0), (x1, 1.0)],
         7,
@@ -251,4 +248,31 @@ pub fn draw_chi2<DB: DrawingBackend>(
         LineKind::Dashed,
     ));
     draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 10)
+}
+
+/// The bars of `bars` (λ, value), 0.6 of their closest spacing wide (at most 0.6 of `span`), each
+/// labelled with its value.
+fn draw_chi2_bars<DB: DrawingBackend>(
+    chart: &mut Chart2d<'_, DB>,
+    bars: &[(f64, f64)],
+    span: f64,
+    color: RGBColor,
+) -> DrawResult<DB> {
+    let spacing = bars
+        .windows(2)
+        .map(|p| p[1].0 - p[0].0)
+        .fold(span, f64::min);
+    let half = 0.3 * spacing;
+    chart.draw_series(bars.iter().map(|&(x, v)| {
+        Rectangle::new([(x - half, 0.0), (x + half, v)], color.mix(0.55).filled())
+    }))?;
+    // Inside the bar's top, clear of the line at 1 that most bars reach.
+    let label = (FONT, TICK_SIZE)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Center, VPos::Top));
+    chart.draw_series(bars.iter().map(|&(x, v)| {
+        EmptyElement::at((x, v)) + Text::new(format!("{v:.2}"), (0, 14), label.clone())
+    }))?;
+    Ok(())
 }

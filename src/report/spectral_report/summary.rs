@@ -1,7 +1,7 @@
 //! Panel (e): the shared parameters ± 1σ, the dispersion chosen with the AIC of the table and the
 //! law, the fit's quality, and n, k, ρd ± 1σ and χ²/obs at each wavelength.
 
-use super::super::fit_report::style::{DrawResult, CAPTION_SIZE, GREY};
+use super::super::fit_report::style::{draw_caption, DrawResult, GREY};
 use super::super::fit_report::{format_plain, format_with_uncertainty, sha_prefix};
 use crate::fit::SpectralFitOutcome;
 use crate::material::{FitRecord, SpectralModel};
@@ -183,12 +183,7 @@ pub fn draw_summary<DB: DrawingBackend>(
     model: &SpectralModel,
 ) -> DrawResult<DB> {
     let (width, height) = area.dim_in_pixel();
-    let caption = (FONT, CAPTION_SIZE)
-        .into_font()
-        .color(&BLACK)
-        .pos(Pos::new(HPos::Center, VPos::Top));
-    let title = format!("(e) {} — joint fit", outcome.material.name);
-    area.draw_text(&title, &caption, (width as i32 / 2, 12))?;
+    draw_caption(area, &format!("(e) {} — joint fit", outcome.material.name))?;
     let lines = summary_lines(outcome, model);
     let room = (height as i32 - TOP - 10).max(1);
     let line_height = LINE_HEIGHT.min(room / lines.len().max(1) as i32).max(12);
