@@ -173,7 +173,10 @@ pub fn patched(
 /// A scene file's text, refused as `irpol render` refuses an unreadable scene.
 pub fn scene_text(path: &Path) -> PyResult<String> {
     std::fs::read_to_string(path).map_err(|e| {
-        let error = irpol::scene::SceneError::new(path, format!("cannot read the scene: {e}"));
+        let error = irpol::scene::SceneError::Read {
+            file: path.to_owned(),
+            source: e,
+        };
         raised(anyhow::Error::new(error), &[path])
     })
 }

@@ -133,7 +133,10 @@ fn solution_instant(
         .iter()
         .position(|&t| (t - time_s).abs() < 1e-6)
         .ok_or_else(|| anyhow::anyhow!("t = {time_s} s is not an instant of the thermal run"))?;
-    Ok(scene_at(scene, solution, index).map_err(|e| SceneError::new(&scene.path, e))?)
+    Ok(
+        scene_at(scene, solution, index)
+            .map_err(|e| SceneError::new(&scene.path, e.to_string()))?,
+    )
 }
 
 /// The scene of `path` read from `text` (the file's own, or changed by a caller such as the
