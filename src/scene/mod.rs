@@ -3,7 +3,14 @@
 //! part, resolved into one world-space [`ShadedMesh`] ready for `render`.
 //!
 //! Paths in a scene are relative to the scene file. Every error names the file and the item
-//! ("scenes/car.toml: objects\[0\] 'car', part 'hood': …", "scenes/car.obj: line 12: …").
+//! ("scenes/car.toml: objects\[0\] 'car', part 'hood': …", "scenes/car.obj: line 12: …"); see
+//! [`SceneError`].
+//!
+//! This module assembles; each section is resolved by the module that owns it: `[materials]` by
+//! [`crate::material::MaterialResolver`], `[sun]` by [`crate::emitter::SunConfig`], the
+//! `[thermal]` keys by [`crate::thermal::setup`] (their ties to the scene's parts in [`thermal`]),
+//! objects in `object`, camera, sensor, environment and atmosphere in `viewing`, `[render]` in
+//! `render_settings` (here, not in `transport`, because `transport` reads the scene).
 
 pub mod camera;
 pub mod car;
