@@ -304,8 +304,8 @@ proptest! {
 
     #[test]
     fn obj_reader_never_panics(bytes in prop_oneof![mutated(mesh_seeds()), noise()]) {
-        if let Err(message) = parse_obj(&text(&bytes)) {
-            check_message(&message)?;
+        if let Err(error) = parse_obj(&text(&bytes)) {
+            check_message(&error.to_string())?;
         }
     }
 
@@ -313,8 +313,8 @@ proptest! {
     fn ply_reader_never_panics(
         bytes in prop_oneof![mutated(vec![ASCII_PLY.as_bytes().to_vec(), binary_ply()]), noise()]
     ) {
-        if let Err(message) = parse_ply(&bytes) {
-            check_message(&message)?;
+        if let Err(error) = parse_ply(&bytes) {
+            check_message(&error.to_string())?;
         }
     }
 

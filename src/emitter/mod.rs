@@ -7,9 +7,11 @@
 //! in their names, because they come straight from scene files, weather files and the CLI.
 
 pub mod disc;
+pub mod scene_sun;
 pub mod sun;
 
 pub use disc::{DiscQuadrature, Sun};
+pub use scene_sun::{moving_sun_irradiance, SunConfig, SunConfigError, DEFAULT_SUN_TRANSMITTANCE};
 
 pub use sun::{
     default_band_irradiance, disc_radiance, format_time_utc, parse_time_utc, sun_direction,

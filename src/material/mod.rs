@@ -2,8 +2,13 @@
 //! was fitted, and its uncertainties. Written atomically; read by `render` and `report`.
 
 mod comments;
+mod scene_materials;
 mod spectral;
 
+pub use scene_materials::{
+    inline_pbrdf, share_wavelength_nodes, InlineMaterialConfig, InlineMaterialError,
+    MaterialResolver, SceneMaterial, SceneMaterialError,
+};
 use spectral::{check_wavelength, DistributionName};
 pub use spectral::{
     BandModelError, MaterialModel, OutsideTable, SpectralModel, THERMAL_EMISSIVITY_REFERENCE_K,

@@ -106,7 +106,7 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
         Transport::OpenWorld => None,
         Transport::Path(settings) => {
             accel = Accelerator::new(mesh, bounding_diagonal(&mesh.positions))
-                .map_err(|e| RenderError::Scene(SceneError::new(&scene.path, e)))?;
+                .map_err(|e| RenderError::Scene(SceneError::new(&scene.path, e.to_string())))?;
             Some(PathTracer::new(scene, &open_world, &accel, settings))
         }
     };

@@ -3,6 +3,23 @@
 
 use nalgebra::Vector3;
 
+/// A camera that cannot be built: the key at fault and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct CameraError(pub String);
+
+impl From<String> for CameraError {
+    fn from(message: String) -> Self {
+        CameraError(message)
+    }
+}
+
+impl From<&str> for CameraError {
+    fn from(message: &str) -> Self {
+        CameraError(message.to_owned())
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct Camera {
     pub position: Vector3<f64>,
@@ -25,7 +42,7 @@ impl Camera {
         fov_y_deg: f64,
         width: u32,
         height: u32,
-    ) -> Result<Camera, String> {
+    ) -> Result<Camera, CameraError> {
         if !(position.iter().chain(look_at.iter()).chain(up_hint.iter())).all(|c| c.is_finite()) {
             return Err("camera position, look_at and up must be finite".into());
         }
@@ -41,9 +58,7 @@ impl Camera {
         let right = right.normalize();
         let up = right.cross(&forward);
         if !(fov_y_deg.is_finite() && fov_y_deg > 0.0 && fov_y_deg < 179.0) {
-            return Err(format!(
-                "camera fov_deg = {fov_y_deg} must be within (0°, 179°)"
-            ));
+            return Err(format!("camera fov_deg = {fov_y_deg} must be within (0°, 179°)").into());
         }
         // ~200 bytes per pixel in flight (Stokes, fragments, channels, encoded files): 8K UHD
         // stays within a few GiB.
@@ -51,7 +66,8 @@ impl Camera {
             return Err(format!(
                 "camera resolution {width}×{height} must be at least 1×1 and at most 7680×4320 \
                  pixels in total"
-            ));
+            )
+            .into());
         }
         let tan_half_fov_y = (0.5 * fov_y_deg.to_radians()).tan();
         Ok(Camera {

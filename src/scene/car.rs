@@ -211,18 +211,42 @@ fn lower_body(b: &mut Builder) {
     }
 }
 
+/// Segments of the cabin across the car on its front and rear edges.
+const ACROSS: usize = 8;
+/// Segments of the cabin along each side.
+const ALONG: usize = 16;
+/// Bands of the cabin from belt to roof.
+const RINGS: usize = 6;
+
 /// Cabin: rings from the belt rectangle up to the roof rectangle (front edge = windshield, rear
 /// edge = rear window, sides = side windows between pillars), then the crowned roof.
 fn greenhouse(b: &mut Builder) {
-    const ACROSS: usize = 8; // segments across the car on the front and rear edges
-    const ALONG: usize = 16; // segments along each side
-    const RINGS: usize = 6; // bands from belt to roof
-    let (belt_rear, belt_front, belt_w, belt_z) = (-1.22, 1.22, 0.74, 0.99);
-    let (roof_rear, roof_front, roof_w, roof_z) = (-0.55, 0.45, 0.62, 1.44);
+    let loop_uv = cabin_loop();
+    let point = |k: usize, (u, t): (f64, f64)| {
+        let (rear, front, w, z) = ring_geometry(k);
+        Vector3::new(front + t * (rear - front), u * w, z)
+    };
+    let rings: Vec<Vec<u32>> = (0..=RINGS)
+        .map(|k| loop_uv.iter().map(|&uv| b.vertex(point(k, uv))).collect())
+        .collect();
+    let n = loop_uv.len();
+    for k in 0..RINGS {
+        let (rear, front, _, z0) = ring_geometry(k);
+        let (_, _, _, z1) = ring_geometry(k + 1);
+        let inside = Vector3::new(0.5 * (rear + front), 0.0, 0.5 * (z0 + z1));
+        for m in 0..n {
+            let m1 = (m + 1) % n;
+            let quad = [rings[k][m], rings[k][m1], rings[k + 1][m1], rings[k + 1][m]];
+            b.quad(quad, inside, cabin_part(k, m));
+        }
+    }
+    roof(b, &rings[RINGS], n);
+}
 
-    // Boundary loop of an ACROSS × ALONG grid: front edge (left → right), right side (front →
-    // rear), rear edge (right → left), left side (rear → front); entries are (u, t) with u across
-    // (+1 left) and t along (0 front, 1 rear).
+/// Boundary loop of an ACROSS × ALONG grid: front edge (left → right), right side (front →
+/// rear), rear edge (right → left), left side (rear → front); entries are (u, t) with u across
+/// (+1 left) and t along (0 front, 1 rear).
+fn cabin_loop() -> Vec<(f64, f64)> {
     let mut loop_uv: Vec<(f64, f64)> = Vec::new();
     for j in 0..ACROSS {
         loop_uv.push((1.0 - 2.0 * j as f64 / ACROSS as f64, 0.0));
@@ -236,64 +260,58 @@ fn greenhouse(b: &mut Builder) {
     for j in 0..ALONG {
         loop_uv.push((1.0, 1.0 - j as f64 / ALONG as f64));
     }
-    let ring_geometry = |k: usize| {
-        let s = k as f64 / RINGS as f64;
-        let bulge = (PI * s).sin();
-        let rear = belt_rear + s * (roof_rear - belt_rear) - 0.03 * bulge;
-        let front = belt_front + s * (roof_front - belt_front) + 0.03 * bulge;
-        let w = belt_w + s * (roof_w - belt_w) + 0.04 * bulge;
-        let z = belt_z + s * (roof_z - belt_z);
-        (rear, front, w, z)
-    };
-    let point = |k: usize, (u, t): (f64, f64)| {
-        let (rear, front, w, z) = ring_geometry(k);
-        Vector3::new(front + t * (rear - front), u * w, z)
-    };
-    let rings: Vec<Vec<u32>> = (0..=RINGS)
-        .map(|k| loop_uv.iter().map(|&uv| b.vertex(point(k, uv))).collect())
-        .collect();
-    let n = loop_uv.len();
-    for k in 0..RINGS {
-        let (rear, front, _, z0) = ring_geometry(k);
-        let (_, _, _, z1) = ring_geometry(k + 1);
-        let inside = Vector3::new(0.5 * (rear + front), 0.0, 0.5 * (z0 + z1));
-        let frame_band = k == 0 || k == RINGS - 1;
-        for m in 0..n {
-            let part = if m < ACROSS {
-                if m == 0 || m == ACROSS - 1 {
-                    "pillars"
-                } else {
-                    "windshield"
-                }
-            } else if (ACROSS + ALONG..2 * ACROSS + ALONG).contains(&m) {
-                let j = m - ACROSS - ALONG;
-                if j == 0 || j == ACROSS - 1 {
-                    "pillars"
-                } else {
-                    "rear_window"
-                }
-            } else {
-                // Along a side, j counts from the front (right side) or from the rear (left).
-                let j = if m < ACROSS + ALONG {
-                    m - ACROSS
-                } else {
-                    ALONG - 1 - (m - 2 * ACROSS - ALONG)
-                };
-                let pillar = j == 0 || j == ALONG / 2 || j == ALONG - 1;
-                if pillar || frame_band {
-                    "pillars"
-                } else {
-                    "side_windows"
-                }
-            };
-            let m1 = (m + 1) % n;
-            let quad = [rings[k][m], rings[k][m1], rings[k + 1][m1], rings[k + 1][m]];
-            b.quad(quad, inside, part);
+    loop_uv
+}
+
+/// Ring `k` of the cabin (0 = belt, RINGS = roof edge): its rear and front x, half width and
+/// height, bulging outward between belt and roof.
+fn ring_geometry(k: usize) -> (f64, f64, f64, f64) {
+    let (belt_rear, belt_front, belt_w, belt_z) = (-1.22, 1.22, 0.74, 0.99);
+    let (roof_rear, roof_front, roof_w, roof_z) = (-0.55, 0.45, 0.62, 1.44);
+    let s = k as f64 / RINGS as f64;
+    let bulge = (PI * s).sin();
+    let rear = belt_rear + s * (roof_rear - belt_rear) - 0.03 * bulge;
+    let front = belt_front + s * (roof_front - belt_front) + 0.03 * bulge;
+    let w = belt_w + s * (roof_w - belt_w) + 0.04 * bulge;
+    let z = belt_z + s * (roof_z - belt_z);
+    (rear, front, w, z)
+}
+
+/// The part of the cabin quad of band `k` starting at loop entry `m`: glass between pillars,
+/// frame on the first and last bands of the sides.
+fn cabin_part(k: usize, m: usize) -> &'static str {
+    let frame_band = k == 0 || k == RINGS - 1;
+    if m < ACROSS {
+        if m == 0 || m == ACROSS - 1 {
+            "pillars"
+        } else {
+            "windshield"
+        }
+    } else if (ACROSS + ALONG..2 * ACROSS + ALONG).contains(&m) {
+        let j = m - ACROSS - ALONG;
+        if j == 0 || j == ACROSS - 1 {
+            "pillars"
+        } else {
+            "rear_window"
+        }
+    } else {
+        // Along a side, j counts from the front (right side) or from the rear (left).
+        let j = if m < ACROSS + ALONG {
+            m - ACROSS
+        } else {
+            ALONG - 1 - (m - 2 * ACROSS - ALONG)
+        };
+        let pillar = j == 0 || j == ALONG / 2 || j == ALONG - 1;
+        if pillar || frame_band {
+            "pillars"
+        } else {
+            "side_windows"
         }
     }
+}
 
-    // Roof grid sharing its boundary with the top ring.
-    let top = &rings[RINGS];
+/// Roof grid sharing its boundary with the top ring `top` (`n` loop entries), crowned upward.
+fn roof(b: &mut Builder, top: &[u32], n: usize) {
     let boundary_index = |a: usize, c: usize| -> Option<usize> {
         // Grid point (a across from the left, c along from the front) on the loop, if any.
         if c == 0 {

@@ -11,6 +11,23 @@ use crate::optics::Band;
 use crate::text::number;
 use nalgebra::Vector3;
 
+/// An `[environment]` that cannot be used: the key at fault and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct EnvironmentError(pub String);
+
+impl From<String> for EnvironmentError {
+    fn from(message: String) -> Self {
+        EnvironmentError(message)
+    }
+}
+
+impl From<&str> for EnvironmentError {
+    fn from(message: &str) -> Self {
+        EnvironmentError(message.to_owned())
+    }
+}
+
 /// Samples of the sky radiance over u = sin(elevation) ∈ [0, 1]. The window model is smooth and a
 /// 1/1024 step keeps linear interpolation within ~1e-7 relative.
 const SKY_SAMPLES: usize = 1025;
@@ -24,13 +41,14 @@ pub struct Environment {
 
 impl Environment {
     /// Builds the environment for a sensor band. Errors name the offending key.
-    pub fn new(config: &EnvironmentConfig, band: &Band) -> Result<Environment, String> {
+    pub fn new(config: &EnvironmentConfig, band: &Band) -> Result<Environment, EnvironmentError> {
         let air = config.air_temperature_k;
         if !valid_temperature(air) {
             return Err(format!(
                 "environment.air_temperature_k = {} must be within [0, {MAX_TEMPERATURE_K}] K",
                 number(air)
-            ));
+            )
+            .into());
         }
         let sky_at = sky_model(&config.sky, air, band)?;
         let sky: Vec<f64> = (0..SKY_SAMPLES)
@@ -138,14 +156,15 @@ fn sky_model<'a>(
     sky: &'a SkyConfig,
     air_k: f64,
     band: &'a Band,
-) -> Result<Box<dyn Fn(f64) -> f64 + 'a>, String> {
+) -> Result<Box<dyn Fn(f64) -> f64 + 'a>, EnvironmentError> {
     match sky {
         SkyConfig::Window { zenith_emissivity } => {
             let e = *zenith_emissivity;
             if !(e.is_finite() && e > 0.0 && e <= 1.0) {
                 return Err(format!(
                     "environment.sky.zenith_emissivity = {e} must be within (0, 1]"
-                ));
+                )
+                .into());
             }
             let air = band.radiance(air_k);
             // ε_sky(θ_z) = 1 − (1 − ε_zenith)^(1/cos θ_z), cos θ_z = u; → 1 at the horizon.
@@ -193,13 +212,14 @@ fn sky_model<'a>(
     }
 }
 
-fn validate_sky_table(elevation_deg: &[f64], values: &[f64]) -> Result<(), String> {
+fn validate_sky_table(elevation_deg: &[f64], values: &[f64]) -> Result<(), EnvironmentError> {
     if elevation_deg.len() < 2 || elevation_deg.len() != values.len() {
         return Err(format!(
             "environment.sky table needs ≥ 2 elevations and as many values (got {} and {})",
             elevation_deg.len(),
             values.len()
-        ));
+        )
+        .into());
     }
     if elevation_deg[0] != 0.0 || *elevation_deg.last().unwrap_or(&0.0) != 90.0 {
         return Err(
@@ -212,9 +232,7 @@ fn validate_sky_table(elevation_deg: &[f64], values: &[f64]) -> Result<(), Strin
         return Err("environment.sky.elevation_deg must be strictly increasing".into());
     }
     if let Some(v) = values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-        return Err(format!(
-            "environment.sky table value {v} must be finite and ≥ 0"
-        ));
+        return Err(format!("environment.sky table value {v} must be finite and ≥ 0").into());
     }
     Ok(())
 }
@@ -227,18 +245,21 @@ fn interpolate(knots: &[(f64, f64)], x: f64) -> f64 {
     y0 + (y1 - y0) * ((x - x0) / (x1 - x0)).clamp(0.0, 1.0)
 }
 
-fn ground_radiance(ground: &GroundConfig, sky: &[f64], band: &Band) -> Result<f64, String> {
+fn ground_radiance(
+    ground: &GroundConfig,
+    sky: &[f64],
+    band: &Band,
+) -> Result<f64, EnvironmentError> {
     let (t, e) = (ground.temperature_k, ground.emissivity);
     if !valid_temperature(t) {
         return Err(format!(
             "environment.ground.temperature_k = {} must be within [0, {MAX_TEMPERATURE_K}] K",
             number(t)
-        ));
+        )
+        .into());
     }
     if !(e.is_finite() && (0.0..=1.0).contains(&e)) {
-        return Err(format!(
-            "environment.ground.emissivity = {e} must be within [0, 1]"
-        ));
+        return Err(format!("environment.ground.emissivity = {e} must be within [0, 1]").into());
     }
     // E_sky/π = 2∫₀¹ L(u) u du by the trapezoid rule on the sample grid.
     let h = 1.0 / (sky.len() - 1) as f64;
@@ -362,7 +383,9 @@ mod tests {
             ),
         ];
         for (sky, expected) in cases {
-            let err = Environment::new(&config(sky, 288.0, 0.9), &band).unwrap_err();
+            let err = Environment::new(&config(sky, 288.0, 0.9), &band)
+                .unwrap_err()
+                .to_string();
             assert!(err.contains(expected), "{err}");
         }
         let err = Environment::new(
@@ -375,7 +398,8 @@ mod tests {
             ),
             &band,
         )
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
         assert!(err.contains("ground.emissivity"));
     }
 }

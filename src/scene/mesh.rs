@@ -8,6 +8,33 @@
 use nalgebra::{Rotation3, Vector3};
 use std::collections::HashMap;
 
+/// What is wrong with a mesh: its file's content (an OBJ statement, a PLY header or element) or
+/// its geometry once placed in the world.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    #[error("an OBJ file must be UTF-8 text")]
+    NotUtf8,
+    #[error("unknown mesh format: the file name must end in .obj or .ply")]
+    UnknownFormat,
+    /// An OBJ statement (`line` from 1).
+    #[error("line {line}: {message}")]
+    Line { line: usize, message: String },
+    #[error("{0}")]
+    Content(String),
+}
+
+impl From<String> for MeshError {
+    fn from(message: String) -> Self {
+        MeshError::Content(message)
+    }
+}
+
+impl From<&str> for MeshError {
+    fn from(message: &str) -> Self {
+        MeshError::Content(message.to_owned())
+    }
+}
+
 /// Where a face came from in its file, for error messages ("line 12", "face 7").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FaceOrigin {
@@ -185,7 +212,7 @@ pub struct ObjectShading<'a> {
 pub fn shade_mesh(
     raw: &RawMesh,
     setup: &ObjectShading,
-) -> Result<(ShadedMesh, Option<String>), String> {
+) -> Result<(ShadedMesh, Option<String>), MeshError> {
     let positions: Vec<Vector3<f64>> = raw
         .positions
         .iter()
@@ -195,7 +222,7 @@ pub fn shade_mesh(
         .iter()
         .position(|p| !p.iter().all(|c| c.is_finite()))
     {
-        return Err(format!("vertex {} has a non-finite coordinate", i + 1));
+        return Err(format!("vertex {} has a non-finite coordinate", i + 1).into());
     }
     let (kept, skipped) = without_degenerate_faces(raw, &positions)?;
     let raw = &kept;
@@ -243,7 +270,7 @@ fn area_normal(face: &RawFace, positions: &[Vector3<f64>]) -> Vector3<f64> {
 fn without_degenerate_faces(
     raw: &RawMesh,
     positions: &[Vector3<f64>],
-) -> Result<(RawMesh, Option<String>), String> {
+) -> Result<(RawMesh, Option<String>), MeshError> {
     // Positions are finite here (checked by the caller), so the cross products are too.
     let extent = bounding_diagonal(positions);
     // Relative to the mesh size, so that millimetre and kilometre meshes are judged alike.
@@ -259,7 +286,8 @@ fn without_degenerate_faces(
         return Err(format!(
             "every triangle is degenerate (zero area), e.g. {}",
             describe(&skipped[0])
-        ));
+        )
+        .into());
     }
     let warning = (!skipped.is_empty()).then(|| {
         let shown: Vec<String> = skipped.iter().take(5).map(describe).collect();
@@ -298,7 +326,7 @@ pub fn bounding_diagonal(positions: &[Vector3<f64>]) -> f64 {
 fn vertex_temperatures(
     raw: &RawMesh,
     part_temperature: &[Option<f64>],
-) -> Result<Vec<f64>, String> {
+) -> Result<Vec<f64>, MeshError> {
     if let Some(temperatures) = &raw.vertex_temperatures {
         if let Some(i) = temperatures
             .iter()
@@ -309,7 +337,8 @@ fn vertex_temperatures(
                 i + 1,
                 crate::text::number(temperatures[i]),
                 super::MAX_TEMPERATURE_K
-            ));
+            )
+            .into());
         }
         return Ok(temperatures.clone());
     }
@@ -349,7 +378,7 @@ fn corner_normals(
     raw: &RawMesh,
     setup: &ObjectShading,
     face_normals: &[Vector3<f64>],
-) -> Result<Vec<[Vector3<f64>; 3]>, String> {
+) -> Result<Vec<[Vector3<f64>; 3]>, MeshError> {
     let mut faces_at: Vec<Vec<u32>> = vec![Vec::new(); raw.positions.len()];
     for (f, face) in raw.faces.iter().enumerate() {
         if face.normals.is_none() {
@@ -377,7 +406,8 @@ fn corner_normals(
                                 "{}: vertex normal {} is zero or not finite",
                                 face.origin,
                                 indices[corner] + 1
-                            ));
+                            )
+                            .into());
                         }
                         n / length
                     }
@@ -490,13 +520,17 @@ mod tests {
             "{warning}"
         );
         raw.faces.remove(0);
-        let err = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap_err();
+        let err = shade_mesh(&raw, &shading(&temps, &[0, 1]))
+            .unwrap_err()
+            .to_string();
         assert!(
             err.contains("every triangle is degenerate") && err.contains("'b'"),
             "{err}"
         );
         raw.positions[3] = Vector3::new(f64::NAN, 0.5, 0.0);
-        let err = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap_err();
+        let err = shade_mesh(&raw, &shading(&temps, &[0, 1]))
+            .unwrap_err()
+            .to_string();
         assert!(
             err.contains("vertex 4") && err.contains("non-finite"),
             "{err}"
@@ -506,7 +540,9 @@ mod tests {
     #[test]
     fn a_part_without_temperature_is_named() {
         let raw = square_with_two_parts();
-        let err = shade_mesh(&raw, &shading(&[Some(1.0), None], &[0, 1])).unwrap_err();
+        let err = shade_mesh(&raw, &shading(&[Some(1.0), None], &[0, 1]))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("part 'b' has no temperature"), "{err}");
     }
 

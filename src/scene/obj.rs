@@ -8,7 +8,7 @@
 //! its line: `tobj` re-indexes vertices per model and its `LoadError`
 //! variants (`PositionParseError`, `FaceParseError`, …) carry no line or column.
 
-use super::mesh::{FaceOrigin, RawFace, RawMesh};
+use super::mesh::{FaceOrigin, MeshError, RawFace, RawMesh};
 use crate::text::shown;
 use nalgebra::Vector3;
 use std::fmt::Write as _;
@@ -16,7 +16,7 @@ use std::fmt::Write as _;
 /// Statements that carry nothing the renderer uses.
 const IGNORED: &[&str] = &["vt", "vp", "s", "usemtl", "mtllib", "l", "p"];
 
-pub fn parse_obj(text: &str) -> Result<RawMesh, String> {
+pub fn parse_obj(text: &str) -> Result<RawMesh, MeshError> {
     let mut mesh = RawMesh::default();
     let mut part: Option<u32> = None;
     for (number, line) in text.lines().enumerate() {
@@ -26,7 +26,10 @@ pub fn parse_obj(text: &str) -> Result<RawMesh, String> {
         let Some(keyword) = fields.next() else {
             continue;
         };
-        let at = |message: String| format!("line {line_no}: {message}");
+        let at = |error: MeshError| MeshError::Line {
+            line: line_no,
+            message: error.to_string(),
+        };
         match keyword {
             "v" => {
                 let numbers = parse_numbers(fields).map_err(at)?;
@@ -35,14 +38,16 @@ pub fn parse_obj(text: &str) -> Result<RawMesh, String> {
                     return Err(at(format!(
                         "a vertex needs 3 coordinates, got {}",
                         numbers.len()
-                    )));
+                    )
+                    .into()));
                 }
                 let v = Vector3::new(numbers[0], numbers[1], numbers[2]);
                 if !v.iter().all(|c| c.is_finite()) {
                     return Err(at(format!(
                         "vertex {} has a non-finite coordinate",
                         mesh.positions.len() + 1
-                    )));
+                    )
+                    .into()));
                 }
                 mesh.positions.push(v);
             }
@@ -65,7 +70,11 @@ pub fn parse_obj(text: &str) -> Result<RawMesh, String> {
                 part = Some(mesh.part_index(name));
             }
             other if IGNORED.contains(&other) => {}
-            other => return Err(at(format!("unsupported OBJ statement '{}'", shown(other)))),
+            other => {
+                return Err(at(
+                    format!("unsupported OBJ statement '{}'", shown(other)).into()
+                ))
+            }
         }
     }
     if mesh.faces.is_empty() {
@@ -80,15 +89,12 @@ fn push_face<'a>(
     fields: impl Iterator<Item = &'a str>,
     part: u32,
     line_no: usize,
-) -> Result<(), String> {
+) -> Result<(), MeshError> {
     let corners = fields
         .map(|field| parse_corner(field, mesh))
         .collect::<Result<Vec<_>, _>>()?;
     if corners.len() < 3 {
-        return Err(format!(
-            "a face needs at least 3 vertices, got {}",
-            corners.len()
-        ));
+        return Err(format!("a face needs at least 3 vertices, got {}", corners.len()).into());
     }
     let with_normals = corners.iter().filter(|c| c.1.is_some()).count();
     if with_normals != 0 && with_normals != corners.len() {
@@ -111,33 +117,31 @@ const MAX_PART_NAME_CHARS: usize = 256;
 
 /// A group name must be text a scene file can name: no control characters, not a whole line of
 /// binary junk.
-fn check_part_name(name: &str) -> Result<(), String> {
+fn check_part_name(name: &str) -> Result<(), MeshError> {
     if name.chars().any(char::is_control) {
-        return Err(format!(
-            "group name '{}' contains a control character",
-            shown(name)
-        ));
+        return Err(format!("group name '{}' contains a control character", shown(name)).into());
     }
     if name.chars().count() > MAX_PART_NAME_CHARS {
         return Err(format!(
             "group name '{}' is longer than {MAX_PART_NAME_CHARS} characters",
             shown(name)
-        ));
+        )
+        .into());
     }
     Ok(())
 }
 
-fn parse_numbers<'a>(fields: impl Iterator<Item = &'a str>) -> Result<Vec<f64>, String> {
+fn parse_numbers<'a>(fields: impl Iterator<Item = &'a str>) -> Result<Vec<f64>, MeshError> {
     fields
         .map(|f| {
             f.parse::<f64>()
-                .map_err(|_| format!("'{}' is not a number", shown(f)))
+                .map_err(|_| MeshError::from(format!("'{}' is not a number", shown(f))))
         })
         .collect()
 }
 
 /// One `f` corner: (0-based vertex index, 0-based normal index if any).
-fn parse_corner(field: &str, mesh: &RawMesh) -> Result<(u32, Option<u32>), String> {
+fn parse_corner(field: &str, mesh: &RawMesh) -> Result<(u32, Option<u32>), MeshError> {
     let mut pieces = field.split('/');
     let vertex = resolve_index(pieces.next().unwrap_or(""), mesh.positions.len(), "vertex")?;
     let _texture = pieces.next();
@@ -149,19 +153,19 @@ fn parse_corner(field: &str, mesh: &RawMesh) -> Result<(u32, Option<u32>), Strin
 }
 
 /// OBJ indices are 1-based; negative ones count back from the last element defined so far.
-fn resolve_index(text: &str, defined: usize, what: &str) -> Result<u32, String> {
+fn resolve_index(text: &str, defined: usize, what: &str) -> Result<u32, MeshError> {
     let index: i64 = text
         .parse()
-        .map_err(|_| format!("'{}' is not a {what} index", shown(text)))?;
+        .map_err(|_| MeshError::from(format!("'{}' is not a {what} index", shown(text))))?;
     let resolved = if index > 0 {
         index - 1
     } else {
         defined as i64 + index
     };
     if index == 0 || resolved < 0 || resolved >= defined as i64 {
-        return Err(format!(
-            "{what} index {index} is out of range ({defined} defined so far)"
-        ));
+        return Err(
+            format!("{what} index {index} is out of range ({defined} defined so far)").into(),
+        );
     }
     Ok(resolved as u32)
 }
@@ -240,7 +244,7 @@ mod tests {
             ),
         ];
         for (text, expected) in cases {
-            let err = parse_obj(text).unwrap_err();
+            let err = parse_obj(text).unwrap_err().to_string();
             assert!(
                 err.starts_with(expected),
                 "{err:?} should start with {expected:?}"

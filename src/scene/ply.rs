@@ -9,7 +9,7 @@
 //! least its fixed-size properties in binary, a digit and a separator per property in ASCII) and
 //! stay within [`MAX_PLY_ITEMS`].
 
-use super::mesh::{FaceOrigin, RawFace, RawMesh};
+use super::mesh::{FaceOrigin, MeshError, RawFace, RawMesh};
 use crate::text::{shown, shown_at_most};
 use nalgebra::Vector3;
 use ply_rs_bw::parser::{Parser, Reader};
@@ -29,7 +29,7 @@ pub const MAX_PLY_ITEMS: usize = 10_000_000;
 /// Characters of the parser's own message kept in ours (it quotes whole input lines).
 const PARSER_MESSAGE_CHARS: usize = 160;
 
-pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
+pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let payload = read_checked(bytes)?;
     let vertices = payload
         .get("vertex")
@@ -40,6 +40,17 @@ pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
 
     let mut mesh = RawMesh::default();
     let part = mesh.part_index(PLY_PART);
+    let has_normals = read_vertices(vertices, &mut mesh)?;
+    read_faces(faces, part, has_normals, &mut mesh)?;
+    if mesh.faces.is_empty() {
+        return Err("the mesh has no faces".into());
+    }
+    Ok(mesh)
+}
+
+/// The `vertex` element's positions, and normals and temperatures where every vertex has them;
+/// returns whether it has normals.
+fn read_vertices(vertices: &[DefaultElement], mesh: &mut RawMesh) -> Result<bool, MeshError> {
     let has_normals = vertices
         .first()
         .is_some_and(|v| v.contains_key("nx") && v.contains_key("ny") && v.contains_key("nz"));
@@ -61,7 +72,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
     }
     let mut temperatures = Vec::new();
     for (i, vertex) in vertices.iter().enumerate() {
-        let scalar = |key: &str| -> Result<f64, String> {
+        let scalar = |key: &str| -> Result<f64, MeshError> {
             let value = vertex
                 .get(key)
                 .and_then(scalar_value)
@@ -69,7 +80,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
             if value.is_finite() {
                 Ok(value)
             } else {
-                Err(format!("vertex {}: property '{key}' is not finite", i + 1))
+                Err(format!("vertex {}: property '{key}' is not finite", i + 1).into())
             }
         };
         mesh.positions
@@ -86,6 +97,16 @@ pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
         mesh.vertex_temperatures = Some(temperatures);
     }
 
+    Ok(has_normals)
+}
+
+/// The `face` element's polygons, split into triangle fans of part `part`.
+fn read_faces(
+    faces: &[DefaultElement],
+    part: u32,
+    has_normals: bool,
+    mesh: &mut RawMesh,
+) -> Result<(), MeshError> {
     for (f, face) in faces.iter().enumerate() {
         let origin = FaceOrigin::Index(f + 1);
         let indices = face
@@ -94,7 +115,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
             .and_then(list_value)
             .ok_or_else(|| format!("{origin}: no integer list 'vertex_indices'"))?;
         if indices.len() < 3 {
-            return Err(format!("{origin}: a face needs at least 3 vertices"));
+            return Err(format!("{origin}: a face needs at least 3 vertices").into());
         }
         if let Some(bad) = indices
             .iter()
@@ -103,7 +124,8 @@ pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
             return Err(format!(
                 "{origin}: vertex index {bad} is out of range ({} vertices)",
                 mesh.positions.len()
-            ));
+            )
+            .into());
         }
         for i in 1..indices.len() - 1 {
             let vertices = [indices[0], indices[i], indices[i + 1]].map(|v| v as u32);
@@ -115,20 +137,17 @@ pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, String> {
             });
         }
     }
-    if mesh.faces.is_empty() {
-        return Err("the mesh has no faces".into());
-    }
-    Ok(mesh)
+    Ok(())
 }
 
 /// Reads the header, checks it against the bytes that follow ([`check_header`]), then reads the
 /// payload.
-fn read_checked(bytes: &[u8]) -> Result<Payload<DefaultElement>, String> {
+fn read_checked(bytes: &[u8]) -> Result<Payload<DefaultElement>, MeshError> {
     let unreadable = |e: &dyn std::fmt::Display| {
-        format!(
+        MeshError::from(format!(
             "not a readable PLY file: {}",
             shown_at_most(&e.to_string(), PARSER_MESSAGE_CHARS)
-        )
+        ))
     };
     let parser = Parser::<DefaultElement>::new();
     let mut reader = Reader::new(bytes);
@@ -144,12 +163,10 @@ fn read_checked(bytes: &[u8]) -> Result<Payload<DefaultElement>, String> {
 
 /// Refuses versions other than 1.0 (the only PLY standard) and element counts that the payload's
 /// `payload_bytes` cannot hold or that exceed [`MAX_PLY_ITEMS`].
-fn check_header(header: &Header, payload_bytes: usize) -> Result<(), String> {
+fn check_header(header: &Header, payload_bytes: usize) -> Result<(), MeshError> {
     let version = header.version;
     if (version.major, version.minor) != (1, 0) {
-        return Err(format!(
-            "PLY version {version} is not supported (only 1.0 exists)"
-        ));
+        return Err(format!("PLY version {version} is not supported (only 1.0 exists)").into());
     }
     let mut needed: u128 = 0;
     for element in header.elements.values() {
@@ -158,14 +175,16 @@ fn check_header(header: &Header, payload_bytes: usize) -> Result<(), String> {
             return Err(format!(
                 "element '{name}' declares {} items; at most {MAX_PLY_ITEMS} are read",
                 element.count
-            ));
+            )
+            .into());
         }
         let per_item = least_item_bytes(element, header.encoding);
         if per_item == 0 && element.count > 0 {
             return Err(format!(
                 "element '{name}' declares {} items but no properties",
                 element.count
-            ));
+            )
+            .into());
         }
         needed += element.count as u128 * per_item as u128;
     }
@@ -175,7 +194,8 @@ fn check_header(header: &Header, payload_bytes: usize) -> Result<(), String> {
         return Err(format!(
             "the header declares items that need at least {needed} bytes, but only \
              {payload_bytes} bytes follow it (a truncated file or a wrong element count)"
-        ));
+        )
+        .into());
     }
     Ok(())
 }
@@ -277,13 +297,13 @@ mod tests {
     #[test]
     fn bad_faces_and_values_are_named() {
         let out_of_range = TRIANGLE.replace("4 0 1 3 2", "3 0 1 7");
-        let err = parse_ply(out_of_range.as_bytes()).unwrap_err();
+        let err = parse_ply(out_of_range.as_bytes()).unwrap_err().to_string();
         assert!(
             err.starts_with("face 1: vertex index 7 is out of range"),
             "{err}"
         );
         let nan = TRIANGLE.replace("1 0 0 310", "1 nan 0 310");
-        let err = parse_ply(nan.as_bytes()).unwrap_err();
+        let err = parse_ply(nan.as_bytes()).unwrap_err().to_string();
         assert!(err.contains("vertex 2") || err.contains("PLY"), "{err}");
         assert!(parse_ply(b"not a ply").is_err());
     }
@@ -295,16 +315,16 @@ mod tests {
             property list uchar int vertex_indices\nend_header\n";
         let mut bytes = header.as_bytes().to_vec();
         bytes.extend(std::iter::repeat_n(0u8, 36 + 13));
-        let err = parse_ply(&bytes).unwrap_err();
+        let err = parse_ply(&bytes).unwrap_err().to_string();
         assert!(err.contains("at most 10000000"), "{err}");
         let declared = header.replace("4294967295", "1000");
         let mut bytes = declared.as_bytes().to_vec();
         bytes.extend(std::iter::repeat_n(0u8, 36 + 13));
-        let err = parse_ply(&bytes).unwrap_err();
+        let err = parse_ply(&bytes).unwrap_err().to_string();
         assert!(err.contains("only 49 bytes follow"), "{err}");
         let empty_element =
             TRIANGLE.replace("element face 1\n", "element junk 5\nelement face 1\n");
-        let err = parse_ply(empty_element.as_bytes()).unwrap_err();
+        let err = parse_ply(empty_element.as_bytes()).unwrap_err().to_string();
         assert!(
             err.contains("'junk' declares 5 items but no properties"),
             "{err}"
@@ -313,7 +333,9 @@ mod tests {
 
     #[test]
     fn only_version_1_0_is_read_and_a_missing_last_line_break_is_fine() {
-        let err = parse_ply(TRIANGLE.replace("ascii 1.0", "ascii 7.5").as_bytes()).unwrap_err();
+        let err = parse_ply(TRIANGLE.replace("ascii 1.0", "ascii 7.5").as_bytes())
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("PLY version 7.5 is not supported"), "{err}");
         let unterminated = TRIANGLE.trim_end();
         assert_eq!(parse_ply(unterminated.as_bytes()).unwrap().faces.len(), 2);
@@ -325,7 +347,7 @@ mod tests {
             "0 0 0 300",
             &format!("0 0 \u{1b}[31m{} 300", "9".repeat(5000)),
         );
-        let err = parse_ply(bad.as_bytes()).unwrap_err();
+        let err = parse_ply(bad.as_bytes()).unwrap_err().to_string();
         assert!(
             !err.contains('\u{1b}') && !err.contains('\n') && err.len() < 400,
             "{err}"

@@ -5,10 +5,15 @@
 //! - [`layers`]: layer materials and stacks, validated, discretised into finite volumes.
 //! - [`solver`]: implicit stepping with adaptive sub-steps, the non-linear surface balance and
 //!   energy bookkeeping.
+//! - [`config`], [`setup`]: a scene's `[thermal]` keys and their checked form (the run and each
+//!   part's stack); [`convection`]: the front convective coefficient.
 //! - [`weather`]: the weather the surface balance needs, from a CSV or a built-in clear day,
 //!   interpolated in time.
 
+pub mod config;
+pub mod convection;
 pub mod layers;
+pub mod setup;
 pub mod solver;
 pub mod weather;
 

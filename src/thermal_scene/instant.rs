@@ -5,31 +5,48 @@
 use super::ThermalSolution;
 use crate::emitter::format_time_utc;
 use crate::emitter::Sun;
-use crate::scene::environment::Environment;
+use crate::scene::environment::{Environment, EnvironmentError};
 use crate::scene::{Scene, ThermalInstant};
+use std::path::PathBuf;
+
+/// Why a scene cannot be shown at an instant of its thermal run.
+#[derive(Debug, thiserror::Error)]
+pub enum InstantError {
+    #[error("{} has no [thermal] section", path.display())]
+    NoThermal { path: PathBuf },
+    /// The sky at the instant's air temperature.
+    #[error("{0}")]
+    Environment(EnvironmentError),
+}
 
 /// `scene` at recorded instant `index` of `solution`. The sky is rebuilt at the instant's air
 /// temperature, and so are the atmosphere's path temperature and the NETD reference unless the
 /// scene fixes them; the sun is the weather's direction with the scene's band irradiance (none
 /// below the horizon).
-pub fn scene_at(scene: &Scene, solution: &ThermalSolution, index: usize) -> Result<Scene, String> {
-    let setup = scene
-        .thermal
-        .as_deref()
-        .ok_or_else(|| format!("{} has no [thermal] section", scene.path.display()))?;
+pub fn scene_at(
+    scene: &Scene,
+    solution: &ThermalSolution,
+    index: usize,
+) -> Result<Scene, InstantError> {
+    let no_thermal = || InstantError::NoThermal {
+        path: scene.path.clone(),
+    };
+    let setup = scene.thermal.as_deref().ok_or_else(no_thermal)?;
+    let instants = scene.thermal_rebuild.as_ref().ok_or_else(no_thermal)?;
     let w = &solution.weather[index];
     let mut at = scene.clone();
     at.mesh.temperatures = solution.surface_k[index].clone();
     at.air_temperature_k = w.air_k;
-    let mut environment = setup.instants.environment.clone();
+    let mut environment = instants.environment.clone();
     environment.air_temperature_k = w.air_k;
-    at.environment = Environment::new(&environment, &scene.sensor.band)?;
-    if !setup.instants.atmosphere_temperature_given {
+    at.environment =
+        Environment::new(&environment, &scene.sensor.band).map_err(InstantError::Environment)?;
+    if !instants.atmosphere_temperature_given {
         if let Some(a) = &mut at.atmosphere {
             a.temperature_k = w.air_k;
         }
     }
-    if !setup.instants.netd_reference_given {
+    if !instants.netd_reference_given {
         at.sensor.netd_reference_k = w.air_k;
     }
     let time_s = solution.times_s[index];
@@ -41,7 +58,7 @@ pub fn scene_at(scene: &Scene, solution: &ThermalSolution, index: usize) -> Resu
     });
     at.sun = (w.sun_direction.z > 0.0).then_some(Sun {
         direction: w.sun_direction,
-        irradiance: setup.instants.sun_irradiance_w_m2,
+        irradiance: instants.sun_irradiance_w_m2,
     });
     Ok(at)
 }

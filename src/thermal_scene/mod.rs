@@ -12,6 +12,6 @@ pub mod instant;
 pub mod parts;
 pub mod solve;
 
-pub use instant::scene_at;
+pub use instant::{scene_at, InstantError};
 pub use parts::{part_series, PartSeries};
 pub use solve::{solve_scene, vertex_surfaces, SolveStats, ThermalRunError, ThermalSolution};

@@ -16,8 +16,9 @@
 use super::exposure::{sky_view_factors, sun_visibility, VertexFrame};
 use crate::progress::Progress;
 use crate::scene::mesh::{bounding_diagonal, ShadedMesh};
-use crate::scene::thermal::{SurfaceThermal, ThermalSetup};
 use crate::scene::Scene;
+use crate::thermal::convection::mcadams_coefficient;
+use crate::thermal::setup::{SurfaceThermal, ThermalSetup};
 use crate::thermal::{
     Forcing, FrontForcing, Resolution, Solver, SolverControl, ThermalError, ThermalState,
     WeatherSample, STEFAN_BOLTZMANN,
@@ -58,8 +59,12 @@ pub struct SolveStats {
 pub enum ThermalRunError {
     #[error("{0} has no [thermal] section")]
     NotThermal(String),
+    /// The scene's triangles do not make a ray-tracing hierarchy.
     #[error("{0}")]
-    Scene(String),
+    Accel(crate::transport::accel::AccelError),
+    /// The weather has no value at a time the run needs.
+    #[error("{0}")]
+    Weather(crate::thermal::WeatherError),
     #[error("thermal time {time_s} s is outside the run 0…{duration_s} s")]
     OutsideRun { time_s: f64, duration_s: f64 },
     #[error("part '{part}': {source}")]
@@ -146,7 +151,7 @@ impl ThermalVertices {
             .collect();
         progress.begin("sky view and shadows", 2);
         let accel = Accelerator::new(mesh, bounding_diagonal(&mesh.positions))
-            .map_err(ThermalRunError::Scene)?;
+            .map_err(ThermalRunError::Accel)?;
         let sky_view = sky_view_factors(&accel, &frames);
         progress.advance(1);
         let sun = shadow_instants(setup)
@@ -195,10 +200,7 @@ impl ThermalVertices {
 }
 
 fn weather_at(setup: &ThermalSetup, time_s: f64) -> Result<WeatherSample, ThermalRunError> {
-    setup
-        .weather
-        .at(time_s)
-        .map_err(|e| ThermalRunError::Scene(e.to_string()))
+    setup.weather.at(time_s).map_err(ThermalRunError::Weather)
 }
 
 /// Solves the scene's thermal model, recording every output step plus `extra_times_s`.
@@ -376,7 +378,9 @@ impl Run<'_> {
                 longwave_in_w_m2: model.emissivity
                     * (w.longwave_down_w_m2 * f_sky + ground * (1.0 - f_sky)),
                 emissivity: model.emissivity,
-                h_w_m2k: model.convection_w_m2k.unwrap_or(5.7 + 3.8 * w.wind_m_s),
+                h_w_m2k: model
+                    .convection_w_m2k
+                    .unwrap_or(mcadams_coefficient(w.wind_m_s)),
                 air_k: w.air_k,
             },
             back: model.back,

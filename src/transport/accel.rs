@@ -19,21 +19,23 @@ pub struct Accelerator<'a> {
     pub offset: f64,
 }
 
+/// The mesh's triangles do not make a hierarchy (parry refuses the mesh).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot build the ray-tracing hierarchy: {0}")]
+pub struct AccelError(parry3d_f64::shape::TriMeshBuilderError);
+
 fn to_parry(v: &Vector3<f64>) -> ParryVector {
     ParryVector::new(v.x, v.y, v.z)
 }
 
 impl<'a> Accelerator<'a> {
     /// Builds the hierarchy over every triangle of `mesh`; `extent` is the scene's size (m).
-    pub fn new(mesh: &'a ShadedMesh, extent: f64) -> Result<Accelerator<'a>, String> {
+    pub fn new(mesh: &'a ShadedMesh, extent: f64) -> Result<Accelerator<'a>, AccelError> {
         let bvh = if mesh.triangles.is_empty() {
             None
         } else {
             let vertices = mesh.positions.iter().map(to_parry).collect();
-            Some(
-                TriMesh::new(vertices, mesh.triangles.clone())
-                    .map_err(|e| format!("cannot build the ray-tracing hierarchy: {e}"))?,
-            )
+            Some(TriMesh::new(vertices, mesh.triangles.clone()).map_err(AccelError)?)
         };
         Ok(Accelerator {
             mesh,

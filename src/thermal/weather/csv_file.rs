@@ -51,7 +51,7 @@ impl Column {
     }
 
     /// Whether `value` is a valid value of this column; otherwise why not.
-    fn check(self, value: f64, text: &str) -> Result<(), String> {
+    fn check(self, value: f64, text: &str) -> Result<(), FieldProblem> {
         let text = shown(text);
         let problem = match self {
             Column::Time if value.abs() > MAX_TIME_S => {
@@ -69,9 +69,13 @@ impl Column {
             }
             _ => return Ok(()),
         };
-        Err(format!("column '{}': {problem}", self.name()))
+        Err(FieldProblem(format!("column '{}': {problem}", self.name())))
     }
 }
+
+/// What is wrong with one field: the message of a refusal at its line and column.
+#[derive(Debug)]
+struct FieldProblem(String);
 
 /// Where each column is in the records.
 struct Layout {
@@ -338,7 +342,7 @@ fn parse_row(
         let Some(i) = layout.index[column as usize] else {
             return Ok(None);
         };
-        let refuse = |message: String| (line, field_column(raw, i), message);
+        let refuse = |problem: FieldProblem| (line, field_column(raw, i), problem.0);
         let v = parse_number(column.name(), &record[i]).map_err(refuse)?;
         column.check(v, &record[i]).map_err(refuse)?;
         Ok(Some(v))
@@ -348,7 +352,7 @@ fn parse_row(
     let sun_direction = match (value(Column::SunElevation)?, value(Column::SunAzimuth)?) {
         (Some(elevation), Some(azimuth)) => sun_direction(elevation, azimuth),
         _ => spa_direction(site, time)
-            .map_err(|message| at(layout, raw, line, Column::Time, message))?,
+            .map_err(|problem| at(layout, raw, line, Column::Time, problem.0))?,
     };
     let sample = WeatherSample {
         air_k,
@@ -362,34 +366,36 @@ fn parse_row(
 }
 
 /// The SPA's sun direction at the site, `time_s` after its start.
-fn spa_direction(site: &Site, time_s: f64) -> Result<Vector3<f64>, String> {
+fn spa_direction(site: &Site, time_s: f64) -> Result<Vector3<f64>, FieldProblem> {
     let instant = site.instant(time_s).ok_or_else(|| {
-        format!(
+        FieldProblem(format!(
             "time_s {} s after start_utc {} is not an instant irpol can represent",
             number(time_s),
             format_time_utc(&site.start_utc)
-        )
+        ))
     })?;
     sun_position(site.latitude_deg, site.longitude_deg, &instant)
         .map(|p| p.direction())
-        .map_err(|e| e.to_string())
+        .map_err(|e| FieldProblem(e.to_string()))
 }
 
 /// A field as a finite number.
-fn parse_number(column: &str, text: &str) -> Result<f64, String> {
+fn parse_number(column: &str, text: &str) -> Result<f64, FieldProblem> {
     if text.is_empty() {
-        return Err(format!("column '{column}' is empty, expected a number"));
+        return Err(FieldProblem(format!(
+            "column '{column}' is empty, expected a number"
+        )));
     }
     match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(format!(
+        Ok(_) => Err(FieldProblem(format!(
             "column '{column}': '{}' is not a finite number",
             shown(text)
-        )),
-        Err(_) => Err(format!(
+        ))),
+        Err(_) => Err(FieldProblem(format!(
             "column '{column}': '{}' is not a number",
             shown(text)
-        )),
+        ))),
     }
 }
 

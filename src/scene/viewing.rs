@@ -1,0 +1,127 @@
+//! The scene's view of the world (docs/design.md §2.3, §2.4): camera, sensor, environment,
+//! atmosphere and the AoP mask, checked in the order their errors are reported.
+
+use super::camera::Camera;
+use super::config::{AtmosphereConfig, SceneConfig};
+use super::environment::Environment;
+use super::{Atmosphere, SceneError, Sensor};
+use crate::optics::{valid_temperature, Band, MAX_TEMPERATURE_K};
+use crate::text::number;
+use nalgebra::Vector3;
+use std::path::Path;
+
+/// The scene's own sections (camera, sensor, environment, atmosphere, render), checked in the
+/// order their errors are reported.
+pub(super) struct Viewing {
+    pub camera: Camera,
+    pub sensor: Sensor,
+    pub environment: Environment,
+    pub atmosphere: Option<Atmosphere>,
+    pub aop_mask_dolp: f64,
+}
+
+/// Camera, sensor, environment, atmosphere and the AoP mask, checked.
+pub(super) fn resolve_viewing(path: &Path, config: &SceneConfig) -> Result<Viewing, SceneError> {
+    let fail = |message: String| SceneError::new(path, message);
+    let c = &config.camera;
+    let camera = Camera::new(
+        Vector3::from(c.position),
+        Vector3::from(c.look_at),
+        Vector3::from(c.up),
+        c.fov_deg,
+        c.resolution[0],
+        c.resolution[1],
+    )
+    .map_err(|e| fail(e.to_string()))?;
+    let sensor = resolve_sensor(path, config)?;
+    let environment =
+        Environment::new(&config.environment, &sensor.band).map_err(|e| fail(e.to_string()))?;
+    let atmosphere = match &config.atmosphere {
+        None => None,
+        Some(a) => Some(resolve_atmosphere(
+            path,
+            a,
+            config.environment.air_temperature_k,
+        )?),
+    };
+    let mask = config.render.aop_mask_dolp;
+    if !(mask.is_finite() && (0.0..=1.0).contains(&mask)) {
+        return Err(fail(format!(
+            "render.aop_mask_dolp = {mask} must be within [0, 1]"
+        )));
+    }
+    Ok(Viewing {
+        camera,
+        sensor,
+        environment,
+        atmosphere,
+        aop_mask_dolp: mask,
+    })
+}
+
+/// `[sensor]`: the band, NETD and its reference temperature (default the air's).
+fn resolve_sensor(path: &Path, config: &SceneConfig) -> Result<Sensor, SceneError> {
+    let fail = |message: String| SceneError::new(path, message);
+    let s = &config.sensor;
+    let band = Band::new(
+        s.band_um[0],
+        s.band_um[1],
+        s.response
+            .as_ref()
+            .map(|r| r.iter().map(|&[w, v]| (w, v)).collect()),
+    )
+    .map_err(|e| fail(format!("sensor: {e}")))?;
+    let netd_reference_k = s
+        .netd_reference_k
+        .unwrap_or(config.environment.air_temperature_k);
+    if !(s.netd_mk.is_finite() && s.netd_mk >= 0.0) {
+        return Err(fail(format!("sensor.netd_mk = {} must be ≥ 0", s.netd_mk)));
+    }
+    // An explicit reference is checked here; the default (the air) by the environment.
+    if s.netd_reference_k.is_some()
+        && !(valid_temperature(netd_reference_k) && netd_reference_k > 0.0)
+    {
+        return Err(fail(format!(
+            "sensor.netd_reference_k = {} must be within (0, {MAX_TEMPERATURE_K}] K",
+            number(netd_reference_k)
+        )));
+    }
+    Ok(Sensor {
+        band,
+        netd_mk: s.netd_mk,
+        seed: s.seed,
+        netd_reference_k,
+        dofp: s.dofp,
+    })
+}
+
+/// `[atmosphere]`: extinction and path temperature (default the air's).
+fn resolve_atmosphere(
+    path: &Path,
+    a: &AtmosphereConfig,
+    air_k: f64,
+) -> Result<Atmosphere, SceneError> {
+    let temperature_k = a.temperature_k.unwrap_or(air_k);
+    if !(a.extinction_per_km.is_finite() && a.extinction_per_km >= 0.0) {
+        return Err(SceneError::new(
+            path,
+            format!(
+                "atmosphere.extinction_per_km = {} must be finite and ≥ 0",
+                a.extinction_per_km
+            ),
+        ));
+    }
+    if !valid_temperature(temperature_k) {
+        return Err(SceneError::new(
+            path,
+            format!(
+                "atmosphere.temperature_k = {} must be within [0, {MAX_TEMPERATURE_K}] K",
+                number(temperature_k)
+            ),
+        ));
+    }
+    Ok(Atmosphere {
+        extinction_per_m: a.extinction_per_km * 1e-3,
+        temperature_k,
+    })
+}

@@ -1,0 +1,416 @@
+//! The `[thermal]` keys of a scene, checked (docs/design.md §1.8, §2.4): the weather, the site and
+//! the run's time sampling ([`ThermalSetup`]), and a part's layer stack and surface properties
+//! ([`SurfaceThermal`]). Nothing is solved here; `thermal_scene` runs the model. Which parts have
+//! a stack, and their materials' emissivities, are the scene's to say.
+
+use super::config::{
+    BackConfig, InternalHeatConfig, LayerMaterialConfig, PartThermalConfig, ThermalConfig,
+    WeatherConfig,
+};
+use super::{Back, Layer, LayerMaterial, LayerStack, Site, ThermalError, Weather, WeatherError};
+use crate::emitter::{parse_time_utc, SunError};
+use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
+use crate::text::number;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The resolved `[thermal]` section.
+pub struct ThermalSetup {
+    pub site: Site,
+    pub weather: Weather,
+    /// The run covers [0, duration_s] seconds from `site.start_utc`.
+    pub duration_s: f64,
+    pub output_step_s: f64,
+    pub time_step_s: f64,
+    pub shadow_step_s: f64,
+    pub spinup_days: u32,
+    /// What occluded directions and the ground radiate in the long-wave balance (K).
+    pub ground_temperature_k: f64,
+    /// Per scene surface (indexed like `Scene::surfaces`): its thermal model, or `None` for a part
+    /// held at its typed temperature.
+    pub surfaces: Vec<Option<SurfaceThermal>>,
+}
+
+impl std::fmt::Debug for ThermalSetup {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ThermalSetup")
+            .field("start_utc", &self.site.start_utc)
+            .field("duration_s", &self.duration_s)
+            .field("thermal_surfaces", &self.surfaces.iter().flatten().count())
+            .finish_non_exhaustive()
+    }
+}
+
+/// One part's thermal description.
+pub struct SurfaceThermal {
+    pub stack: LayerStack,
+    pub back: Back,
+    pub solar_absorptance: f64,
+    /// Thermal hemispherical emissivity (given, or the material's ε_0 of §1.4).
+    pub emissivity: f64,
+    /// Front convective coefficient; `None` = [`super::convection::mcadams_coefficient`].
+    pub convection_w_m2k: Option<f64>,
+    pub internal_heat: Schedule,
+}
+
+/// A quantity piecewise linear in time (s), constant beyond its first and last points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Schedule {
+    points: Vec<(f64, f64)>,
+}
+
+impl Schedule {
+    pub fn constant(value: f64) -> Schedule {
+        Schedule {
+            points: vec![(0.0, value)],
+        }
+    }
+
+    /// The value at `time_s`. Equal times make a step (the later point wins from then on).
+    pub fn at(&self, time_s: f64) -> f64 {
+        let p = &self.points;
+        let after = p.partition_point(|&(t, _)| t <= time_s);
+        match after {
+            0 => p[0].1,
+            n if n == p.len() => p[n - 1].1,
+            n => {
+                let ((t0, v0), (t1, v1)) = (p[n - 1], p[n]);
+                v0 + (v1 - v0) * (time_s - t0) / (t1 - t0)
+            }
+        }
+    }
+}
+
+/// A `[thermal]` key that cannot be used. The inner errors are part of the message.
+#[derive(Debug, thiserror::Error)]
+pub enum ThermalSetupError {
+    #[error("thermal.start_utc: {0}")]
+    StartUtc(SunError),
+    #[error("thermal.latitude_deg = {0} must be within [-90°, 90°]")]
+    Latitude(f64),
+    #[error("thermal.longitude_deg = {0} must be within [-180°, 360°]")]
+    Longitude(f64),
+    #[error("thermal.duration_h = {0} must be positive")]
+    Duration(f64),
+    /// The weather file cannot be read, or the weather has no value at an instant.
+    #[error("{0}")]
+    Weather(WeatherError),
+    #[error("thermal.weather.clear_day: {0}")]
+    ClearDay(WeatherError),
+    #[error(
+        "thermal: the weather covers {}…{} s but the run needs 0…{} s (duration_h = {})",
+        number(*first_s), number(*last_s), number(*duration_s), number(*duration_s / 3600.0)
+    )]
+    WeatherSpan {
+        first_s: f64,
+        last_s: f64,
+        duration_s: f64,
+    },
+    #[error(
+        "thermal.spinup_days = {spinup_days} repeats the first day, but the weather covers only {} s",
+        number(*last_s)
+    )]
+    SpinupSpan { spinup_days: u32, last_s: f64 },
+    #[error("thermal.{key} = {step} must be positive")]
+    Step { key: &'static str, step: f64 },
+    #[error(
+        "thermal: {} s in steps of {} s is more than {MAX_STEPS} steps; use longer steps",
+        number(*duration_s), number(*step_s)
+    )]
+    TooManySteps { duration_s: f64, step_s: f64 },
+    #[error(
+        "thermal.ground_temperature_k = {} must be within (0, {MAX_TEMPERATURE_K}] K",
+        number(*ground_k)
+    )]
+    Ground { ground_k: f64 },
+    #[error(
+        "[thermal] is given but no part has a thermal stack: add [objects.thermal] or \
+         [objects.parts.NAME.thermal] with a stack"
+    )]
+    NoStack,
+    /// A part's `thermal` table; `part` names it ("objects[0] 'car' part 'hood': thermal").
+    #[error("{part}.{error}")]
+    Part {
+        part: String,
+        error: PartThermalError,
+    },
+}
+
+/// A part's `thermal` key that cannot be used; messages start with the key at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum PartThermalError {
+    #[error("stack is empty: give [[layer name, thickness_m], …] front to back")]
+    EmptyStack,
+    #[error(
+        "stack: layer '{name}' is not defined in [thermal.layers] (defined: {})",
+        if defined.is_empty() { "none".to_owned() } else { defined.join(", ") }
+    )]
+    UnknownLayer { name: String, defined: Vec<String> },
+    #[error("stack: {0}")]
+    Stack(ThermalError),
+    #[error("{key} = {value} must be within [0, 1]")]
+    Fraction { key: &'static str, value: f64 },
+    #[error("convection_w_m2k = {0} must be ≥ 0")]
+    Convection(f64),
+    #[error(
+        "back.temperature_k = {} must be within (0, {MAX_TEMPERATURE_K}] K",
+        number(*temperature_k)
+    )]
+    BackTemperature { temperature_k: f64 },
+    #[error("back.convection_w_m2k = {0} must be ≥ 0")]
+    BackConvection(f64),
+    #[error("internal_heat_w_m2 is an empty schedule: give [[time_h, w_m2], …]")]
+    EmptySchedule,
+    #[error("internal_heat_w_m2 has a non-finite point [{time_h}, {w_m2}]")]
+    NonFinitePoint { time_h: f64, w_m2: f64 },
+    #[error(
+        "internal_heat_w_m2: times must not decrease ({} h after {} h)",
+        number(*later_h), number(*earlier_h)
+    )]
+    Decreasing { later_h: f64, earlier_h: f64 },
+}
+
+/// The weather, site and sampling of `[thermal]`; the surfaces come later (they need the scene's
+/// parts and materials, [`resolve_part`]). `default_ground_k` is the scene's ground temperature.
+pub fn resolve_run(
+    config: &ThermalConfig,
+    dir: &Path,
+    default_ground_k: f64,
+) -> Result<ThermalSetup, ThermalSetupError> {
+    let site = resolve_site(config)?;
+    let requested_s = match config.duration_h {
+        Some(h) if h.is_finite() && h > 0.0 => Some(h * 3600.0),
+        Some(h) => return Err(ThermalSetupError::Duration(h)),
+        None => None,
+    };
+    let weather = resolve_weather(config, dir, &site, requested_s)?;
+    let (first, last) = weather.span_s();
+    let duration_s = requested_s.unwrap_or(last);
+    if first > 0.0 || last < duration_s {
+        return Err(ThermalSetupError::WeatherSpan {
+            first_s: first,
+            last_s: last,
+            duration_s,
+        });
+    }
+    if config.spinup_days > 0 && last < DAY_S {
+        return Err(ThermalSetupError::SpinupSpan {
+            spinup_days: config.spinup_days,
+            last_s: last,
+        });
+    }
+    check_steps(config, duration_s)?;
+    let ground = config.ground_temperature_k.unwrap_or(default_ground_k);
+    if !(valid_temperature(ground) && ground > 0.0) {
+        return Err(ThermalSetupError::Ground { ground_k: ground });
+    }
+    Ok(ThermalSetup {
+        site,
+        weather,
+        duration_s,
+        output_step_s: config.output_step_s,
+        time_step_s: config.time_step_s,
+        shadow_step_s: config.shadow_step_s,
+        spinup_days: config.spinup_days,
+        ground_temperature_k: ground,
+        surfaces: Vec::new(),
+    })
+}
+
+/// Where and when the run is.
+fn resolve_site(config: &ThermalConfig) -> Result<Site, ThermalSetupError> {
+    let start_utc = parse_time_utc(&config.start_utc).map_err(ThermalSetupError::StartUtc)?;
+    let (lat, lon) = (config.latitude_deg, config.longitude_deg);
+    if !(lat.is_finite() && (-90.0..=90.0).contains(&lat)) {
+        return Err(ThermalSetupError::Latitude(lat));
+    }
+    if !(lon.is_finite() && (-180.0..=360.0).contains(&lon)) {
+        return Err(ThermalSetupError::Longitude(lon));
+    }
+    Ok(Site {
+        latitude_deg: lat,
+        longitude_deg: lon,
+        start_utc,
+    })
+}
+
+/// The weather file (relative to `dir`), or a generated clear day long enough for the run and
+/// its spin-up day.
+fn resolve_weather(
+    config: &ThermalConfig,
+    dir: &Path,
+    site: &Site,
+    requested_s: Option<f64>,
+) -> Result<Weather, ThermalSetupError> {
+    match &config.weather {
+        WeatherConfig::File(file) => {
+            Weather::read_csv(&dir.join(file), site).map_err(ThermalSetupError::Weather)
+        }
+        WeatherConfig::Generated(g) => {
+            let days = config.spinup_days as f64 * DAY_S;
+            Weather::clear_day(&g.clear_day, site, requested_s.unwrap_or(DAY_S).max(days))
+                .map_err(ThermalSetupError::ClearDay)
+        }
+    }
+}
+
+/// The three time steps are positive and the run has a sane number of them.
+fn check_steps(config: &ThermalConfig, duration_s: f64) -> Result<(), ThermalSetupError> {
+    let steps = [
+        ("output_step_s", config.output_step_s),
+        ("time_step_s", config.time_step_s),
+        ("shadow_step_s", config.shadow_step_s),
+    ];
+    for (key, step) in steps {
+        if !(step.is_finite() && step > 0.0) {
+            return Err(ThermalSetupError::Step { key, step });
+        }
+    }
+    let step_s = config.time_step_s.min(config.shadow_step_s);
+    if duration_s / step_s > MAX_STEPS {
+        return Err(ThermalSetupError::TooManySteps { duration_s, step_s });
+    }
+    Ok(())
+}
+
+const DAY_S: f64 = 86_400.0;
+/// Longest run in forcing or shadow steps: a 10-year run at 60 s is 5e6, far beyond any use.
+const MAX_STEPS: f64 = 1e7;
+
+/// One part's keys, checked, with its thermal `emissivity` (given, or its material's).
+pub fn resolve_part(
+    part: &PartThermalConfig,
+    layers: &BTreeMap<String, LayerMaterialConfig>,
+    emissivity: f64,
+) -> Result<SurfaceThermal, PartThermalError> {
+    let stack = resolve_stack(&part.stack, layers)?;
+    let fraction = |key: &'static str, value: f64| {
+        if value.is_finite() && (0.0..=1.0).contains(&value) {
+            Ok(value)
+        } else {
+            Err(PartThermalError::Fraction { key, value })
+        }
+    };
+    fraction("solar_absorptance", part.solar_absorptance)?;
+    fraction("emissivity", emissivity)?;
+    if let Some(h) = part.convection_w_m2k {
+        if !(h.is_finite() && h >= 0.0) {
+            return Err(PartThermalError::Convection(h));
+        }
+    }
+    Ok(SurfaceThermal {
+        stack,
+        back: resolve_back(&part.back)?,
+        solar_absorptance: part.solar_absorptance,
+        emissivity,
+        convection_w_m2k: part.convection_w_m2k,
+        internal_heat: resolve_schedule(&part.internal_heat_w_m2)?,
+    })
+}
+
+/// `[[layer name, thickness_m], …]` front to back, each name one of `layers`.
+fn resolve_stack(
+    entries: &[(String, f64)],
+    layers: &BTreeMap<String, LayerMaterialConfig>,
+) -> Result<LayerStack, PartThermalError> {
+    if entries.is_empty() {
+        return Err(PartThermalError::EmptyStack);
+    }
+    let mut stack = Vec::with_capacity(entries.len());
+    for (name, thickness) in entries {
+        let m = layers
+            .get(name)
+            .ok_or_else(|| PartThermalError::UnknownLayer {
+                name: name.clone(),
+                defined: layers.keys().cloned().collect(),
+            })?;
+        let material = LayerMaterial::new(
+            name,
+            m.conductivity_w_mk,
+            m.density_kg_m3,
+            m.heat_capacity_j_kgk,
+        );
+        stack.push(Layer::new(material, *thickness));
+    }
+    LayerStack::new(stack).map_err(PartThermalError::Stack)
+}
+
+fn resolve_back(back: &BackConfig) -> Result<Back, PartThermalError> {
+    match *back {
+        BackConfig::Adiabatic | BackConfig::Keyword(_) => Ok(Back::Adiabatic),
+        BackConfig::Fixed(f) if valid_temperature(f.temperature_k) && f.temperature_k > 0.0 => {
+            Ok(Back::Fixed(f.temperature_k))
+        }
+        BackConfig::Fixed(f) => Err(PartThermalError::BackTemperature {
+            temperature_k: f.temperature_k,
+        }),
+        BackConfig::Convective(c)
+            if c.convection_w_m2k.is_finite() && c.convection_w_m2k >= 0.0 =>
+        {
+            Ok(Back::Convective {
+                h_w_m2k: c.convection_w_m2k,
+                air_k: None,
+            })
+        }
+        BackConfig::Convective(c) => Err(PartThermalError::BackConvection(c.convection_w_m2k)),
+    }
+}
+
+fn resolve_schedule(heat: &InternalHeatConfig) -> Result<Schedule, PartThermalError> {
+    let points: Vec<(f64, f64)> = match heat {
+        InternalHeatConfig::Constant(q) => vec![(0.0, *q)],
+        InternalHeatConfig::Schedule(points) => {
+            points.iter().map(|&(h, q)| (h * 3600.0, q)).collect()
+        }
+    };
+    if points.is_empty() {
+        return Err(PartThermalError::EmptySchedule);
+    }
+    if let Some((t, q)) = points
+        .iter()
+        .find(|(t, q)| !(t.is_finite() && q.is_finite()))
+    {
+        return Err(PartThermalError::NonFinitePoint {
+            time_h: t / 3600.0,
+            w_m2: *q,
+        });
+    }
+    if let Some(w) = points.windows(2).find(|w| w[1].0 < w[0].0) {
+        return Err(PartThermalError::Decreasing {
+            later_h: w[1].0 / 3600.0,
+            earlier_h: w[0].0 / 3600.0,
+        });
+    }
+    Ok(Schedule { points })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn schedules_interpolate_step_and_hold() {
+        let s = resolve_schedule(&InternalHeatConfig::Schedule(vec![
+            (1.0, 0.0),
+            (1.0, 400.0),
+            (2.0, 400.0),
+            (3.0, 0.0),
+        ]))
+        .unwrap();
+        assert_eq!(s.at(0.0), 0.0);
+        assert_eq!(s.at(3599.0), 0.0);
+        assert_eq!(s.at(3600.0), 400.0);
+        assert_eq!(s.at(7200.0), 400.0);
+        assert!((s.at(9000.0) - 200.0).abs() < 1e-12);
+        assert_eq!(s.at(1e6), 0.0);
+        assert_eq!(Schedule::constant(5.0).at(-3.0), 5.0);
+    }
+
+    #[test]
+    fn decreasing_schedules_are_refused() {
+        let e = resolve_schedule(&InternalHeatConfig::Schedule(vec![(2.0, 0.0), (1.0, 1.0)]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("must not decrease (1 h after 2 h)"), "{e}");
+    }
+}
