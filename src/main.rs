@@ -79,42 +79,7 @@ enum Command {
         out: PathBuf,
     },
     /// Fits pBRDF models to measurement CSVs and writes the material library.
-    Fit {
-        /// Measurement CSVs or folders of them.
-        #[arg(required = true)]
-        inputs: Vec<PathBuf>,
-        /// Fit only this distribution (cauchy or gaussian); default: both, keep the preferred.
-        #[arg(long)]
-        distribution: Option<String>,
-        /// Shadowing of the fitted model: none, torrance-sparrow or smith.
-        #[arg(long, default_value = "smith")]
-        shadowing: String,
-        /// Free parameters, e.g. sigma,q,n,k,rho (default: all that are not fixed).
-        #[arg(long)]
-        free: Option<String>,
-        /// Fixed parameter values, e.g. k=0.1,rho=0.
-        #[arg(long)]
-        fix: Option<String>,
-        /// Optimizer stages joined by +: ga, nm, lm (default ga+lm).
-        #[arg(long, default_value = "ga+lm")]
-        optimizer: String,
-        /// Seed of the genetic stage.
-        #[arg(long, default_value_t = FitOptions::default().seed)]
-        seed: u64,
-        /// Robust loss on normalized residuals: huber or cauchy, optionally with a scale (huber:2).
-        #[arg(long)]
-        robust: Option<String>,
-        /// For a material measured at several wavelengths (a spectral set): n, k free at each
-        /// wavelength (table), or from a Lorentz law of N oscillators (lorentz:N).
-        #[arg(long, default_value = "table")]
-        dispersion: String,
-        /// Library folder for the material TOMLs.
-        #[arg(long, default_value = "fits")]
-        out: PathBuf,
-        /// Folder for the fit reports (PNG, SVG) and index.html.
-        #[arg(long, default_value = "reports")]
-        reports: PathBuf,
-    },
+    Fit(FitArgs),
     /// Rebuilds a material's fit report from its library entry and source CSV.
     Report {
         /// The material TOML.
@@ -194,6 +159,45 @@ enum Command {
     /// Runs the main job on shipped defaults (fit the shipped measurements, render the car and
     /// its day) into out/demo/, and prints where everything went.
     Demo,
+}
+
+// The flags of `irpol fit` (the variant's doc comment is the subcommand's help).
+#[derive(Args)]
+struct FitArgs {
+    /// Measurement CSVs or folders of them.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// Fit only this distribution (cauchy or gaussian); default: both, keep the preferred.
+    #[arg(long)]
+    distribution: Option<String>,
+    /// Shadowing of the fitted model: none, torrance-sparrow or smith.
+    #[arg(long, default_value = "smith")]
+    shadowing: String,
+    /// Free parameters, e.g. sigma,q,n,k,rho (default: all that are not fixed).
+    #[arg(long)]
+    free: Option<String>,
+    /// Fixed parameter values, e.g. k=0.1,rho=0.
+    #[arg(long)]
+    fix: Option<String>,
+    /// Optimizer stages joined by +: ga, nm, lm (default ga+lm).
+    #[arg(long, default_value = "ga+lm")]
+    optimizer: String,
+    /// Seed of the genetic stage.
+    #[arg(long, default_value_t = FitOptions::default().seed)]
+    seed: u64,
+    /// Robust loss on normalized residuals: huber or cauchy, optionally with a scale (huber:2).
+    #[arg(long)]
+    robust: Option<String>,
+    /// For a material measured at several wavelengths (a spectral set): n, k free at each
+    /// wavelength (table), or from a Lorentz law of N oscillators (lorentz:N).
+    #[arg(long, default_value = "table")]
+    dispersion: String,
+    /// Library folder for the material TOMLs.
+    #[arg(long, default_value = "fits")]
+    out: PathBuf,
+    /// Folder for the fit reports (PNG, SVG) and index.html.
+    #[arg(long, default_value = "reports")]
+    reports: PathBuf,
 }
 
 #[derive(Subcommand)]
@@ -324,31 +328,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             emissivity(&model, &theta)
         }
         Command::Figure { which, out } => figure(&which, &out),
-        Command::Fit {
-            inputs,
-            distribution,
-            shadowing,
-            free,
-            fix,
-            optimizer,
-            seed,
-            robust,
-            dispersion,
-            out,
-            reports,
-        } => {
-            let flags = FitFlags {
-                distribution,
-                shadowing,
-                free,
-                fix,
-                optimizer,
-                seed,
-                robust,
-                dispersion,
-            };
-            fit_and_summarize(&inputs, &flags.options()?, &out, &reports)
-        }
+        Command::Fit(args) => fit(args),
         Command::Report { material, reports } => report(&material, &reports),
         Command::Render {
             scene,
@@ -372,9 +352,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             clear_sky,
         } => {
             let times = given_times(time_utc.as_deref(), times_file.as_deref())?;
-            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-            write_sun_csv(latitude, longitude, &times, clear_sky, &mut out)?;
-            Ok(out.flush()?)
+            sun(latitude, longitude, &times, clear_sky)
         }
         Command::Library { dir, dir_flag } => print_library(&dir_flag.unwrap_or(dir)),
         Command::Demo => demo(),
@@ -403,6 +381,33 @@ fn emissivity(model: &Pbrdf, theta: &str) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// `irpol fit`: the options checked, then the fit written and summarized.
+fn fit(args: FitArgs) -> anyhow::Result<()> {
+    let flags = FitFlags {
+        distribution: args.distribution,
+        shadowing: args.shadowing,
+        free: args.free,
+        fix: args.fix,
+        optimizer: args.optimizer,
+        seed: args.seed,
+        robust: args.robust,
+        dispersion: args.dispersion,
+    };
+    fit_and_summarize(&args.inputs, &flags.options()?, &args.out, &args.reports)
+}
+
+/// `irpol sun`: the CSV on stdout.
+fn sun(
+    latitude: f64,
+    longitude: f64,
+    times: &[chrono::DateTime<chrono::Utc>],
+    clear_sky: bool,
+) -> anyhow::Result<()> {
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    write_sun_csv(latitude, longitude, times, clear_sky, &mut out)?;
+    Ok(out.flush()?)
 }
 
 fn figure(which: &str, out: &Path) -> anyhow::Result<()> {

@@ -71,7 +71,7 @@ fn apply(
         .iter()
         .map(|(k, v)| Ok((k.clone(), toml_value(v)?)))
         .collect();
-    patched(scene, &text, &values?, missing).map_err(bad_argument)
+    patched(scene, &text, &values?, missing).map_err(|e| bad_argument(e.to_string()))
 }
 
 /// Renders `scene` with `patch` (dotted scene keys, which must exist, → values) and then

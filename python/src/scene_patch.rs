@@ -52,17 +52,49 @@ fn place(parts: &[&str], depth: usize) -> String {
     }
 }
 
-fn index(parts: &[&str], depth: usize, len: usize) -> Result<usize, String> {
+/// Why a dotted key does not name an entry of the scene; `place` is where the walk stopped
+/// ([`place`]).
+#[derive(Debug, thiserror::Error)]
+pub enum KeyError {
+    #[error("'{index}' is not an index of the array {place} ({len} entries)")]
+    NotAnIndex {
+        index: String,
+        place: String,
+        len: usize,
+    },
+    #[error("no '{key}' in {place}")]
+    NoKey { key: String, place: String },
+    #[error("no {0}")]
+    NoEntry(String),
+    #[error("{0} is a table: set its keys one by one")]
+    Table(String),
+    #[error("{0} is a single value, not a table or an array")]
+    SingleValue(String),
+}
+
+/// Why a scene text could not be changed. The key's error is part of the message, which is what
+/// Python's `ValueError` carries.
+#[derive(Debug, thiserror::Error)]
+pub enum PatchError {
+    #[error("{}: not a valid scene: {message}", path.display())]
+    Parse { path: PathBuf, message: String },
+    #[error("{}: scene key '{key}': {error}", path.display())]
+    Key {
+        path: PathBuf,
+        key: String,
+        error: KeyError,
+    },
+}
+
+fn index(parts: &[&str], depth: usize, len: usize) -> Result<usize, KeyError> {
     parts[depth]
         .parse::<usize>()
         .ok()
         .filter(|&i| i < len)
-        .ok_or_else(|| {
-            format!(
-                "'{}' is not an index of the array {} ({len} entries)",
-                parts[depth],
-                place(parts, depth)
-            )
+        .ok_or_else(|| KeyError::NotAnIndex {
+            index: parts[depth].to_owned(),
+            place: place(parts, depth),
+            len,
         })
 }
 
@@ -80,14 +112,15 @@ fn set_in_table(
     depth: usize,
     v: Value,
     missing: Missing,
-) -> Result<(), String> {
+) -> Result<(), KeyError> {
     if missing == Missing::Create && depth + 1 == parts.len() && t.get(parts[depth]).is_none() {
         t.insert(parts[depth], Item::Value(v));
         return Ok(());
     }
-    let child = t
-        .get_mut(parts[depth])
-        .ok_or_else(|| format!("no '{}' in {}", parts[depth], place(parts, depth)))?;
+    let child = t.get_mut(parts[depth]).ok_or_else(|| KeyError::NoKey {
+        key: parts[depth].to_owned(),
+        place: place(parts, depth),
+    })?;
     set_in_item(child, parts, depth + 1, v, missing)
 }
 
@@ -97,13 +130,10 @@ fn set_in_item(
     depth: usize,
     v: Value,
     missing: Missing,
-) -> Result<(), String> {
+) -> Result<(), KeyError> {
     if depth == parts.len() {
         if !item.is_value() {
-            return Err(format!(
-                "{} is a table: set its keys one by one",
-                place(parts, depth)
-            ));
+            return Err(KeyError::Table(place(parts, depth)));
         }
         *item = Item::Value(v);
         return Ok(());
@@ -114,15 +144,12 @@ fn set_in_item(
             let i = index(parts, depth, a.len())?;
             let table = a.get_mut(i).expect("index checked");
             if depth + 1 == parts.len() {
-                return Err(format!(
-                    "{} is a table: set its keys one by one",
-                    place(parts, depth + 1)
-                ));
+                return Err(KeyError::Table(place(parts, depth + 1)));
             }
             set_in_table(table, parts, depth + 1, v, missing)
         }
         Item::Value(value) => set_in_value(value, parts, depth, v, missing),
-        Item::None => Err(format!("no {}", place(parts, depth))),
+        Item::None => Err(KeyError::NoEntry(place(parts, depth))),
     }
 }
 
@@ -132,7 +159,7 @@ fn set_in_value(
     depth: usize,
     v: Value,
     missing: Missing,
-) -> Result<(), String> {
+) -> Result<(), KeyError> {
     if depth == parts.len() {
         *value = v;
         return Ok(());
@@ -144,10 +171,7 @@ fn set_in_value(
             set_in_value(element, parts, depth + 1, v, missing)
         }
         Value::InlineTable(t) => set_in_table(t, parts, depth, v, missing),
-        _ => Err(format!(
-            "{} is a single value, not a table or an array",
-            place(parts, depth)
-        )),
+        _ => Err(KeyError::SingleValue(place(parts, depth))),
     }
 }
 
@@ -158,14 +182,22 @@ pub fn patched(
     text: &str,
     patch: &[(String, Value)],
     missing: Missing,
-) -> Result<String, String> {
-    let mut doc: DocumentMut = text
-        .parse()
-        .map_err(|e| format!("{}: not a valid scene: {e}", path.display()))?;
+) -> Result<String, PatchError> {
+    let mut doc: DocumentMut =
+        text.parse()
+            .map_err(|e: toml_edit::TomlError| PatchError::Parse {
+                path: path.to_owned(),
+                message: e.to_string(),
+            })?;
     for (key, value) in patch {
         let parts: Vec<&str> = key.split('.').collect();
-        set_in_item(doc.as_item_mut(), &parts, 0, value.clone(), missing)
-            .map_err(|e| format!("{}: scene key '{key}': {e}", path.display()))?;
+        set_in_item(doc.as_item_mut(), &parts, 0, value.clone(), missing).map_err(|error| {
+            PatchError::Key {
+                path: path.to_owned(),
+                key: key.clone(),
+                error,
+            }
+        })?;
     }
     Ok(doc.to_string())
 }
@@ -183,5 +215,5 @@ pub fn check_scene_keys(scene: PathBuf, keys: Vec<String>) -> PyResult<()> {
     let patch: Vec<(String, Value)> = keys.into_iter().map(|k| (k, Value::from(0))).collect();
     patched(&scene, &text, &patch, Missing::Refuse)
         .map(drop)
-        .map_err(bad_argument)
+        .map_err(|e| bad_argument(e.to_string()))
 }
