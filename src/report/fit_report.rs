@@ -503,6 +503,7 @@ fn header_legend(data: &ReportData) -> Vec<LegendEntry> {
     entries
 }
 
+/// Panel (a): m00 against the signed detector zenith in the plane of incidence.
 fn draw_in_plane_m00<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     data: &ReportData,

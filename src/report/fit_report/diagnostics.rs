@@ -4,8 +4,8 @@
 use super::data::{EmissivityCurves, ReportData, Residual};
 use super::style::{
     draw_legend_column, draw_legend_top_right, draw_note, log_tick, panel_chart, report_mesh_style,
-    sane_log_range, DrawResult, LegendEntry, LineKind, Marker, AXIS_DESC_SIZE, GREY, LEGEND_SIZE,
-    TICK_SIZE,
+    sane_log_range, Chart2d, DrawResult, LegendEntry, LineKind, Marker, AXIS_DESC_SIZE, GREY,
+    LEGEND_SIZE, TICK_SIZE,
 };
 use crate::material::FitRecord;
 use crate::plot_style::FONT;
@@ -98,8 +98,6 @@ pub fn draw_residuals<DB: DrawingBackend>(
 /// Most residuals a vector figure's panel (g) draws as elements; beyond it, the scatter (with its
 /// grid and guides) is one embedded PNG: 10⁴ SVG circles cost ~1 MB, the image ~0.1 MB.
 pub const RASTER_SCATTER_POINTS: usize = 2_000;
-
-type Chart2d<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// The residuals within ±`bound` as dots, the polarization classes first so that m00 stays
 /// visible on top.

@@ -213,29 +213,7 @@ pub fn profile_series(
     quantity: Quantity,
     domain: Domain,
 ) -> (Vec<ProfileSeries>, bool) {
-    let measured = |p: &PointView, x: f64| {
-        quantity.of_point(p).map(|(value, sigma)| ProfilePoint {
-            x,
-            value,
-            sigma,
-            model: quantity.of_model(&p.model),
-        })
-    };
-    // One pass over the points into their series: a file may hold as many groups as points.
-    let groups = match domain {
-        Domain::InPlane => data.in_plane.len(),
-        Domain::Rings => data.rings.len(),
-    };
-    let mut buckets: Vec<Vec<ProfilePoint>> = vec![Vec::new(); groups];
-    for p in &data.points {
-        let placed = match domain {
-            Domain::InPlane => data.slot[p.incidence].zip(p.signed_zenith),
-            Domain::Rings => p.ring.map(|ring| (ring, p.relative_azimuth)),
-        };
-        if let Some(point) = placed.and_then(|(group, x)| Some((group, measured(p, x)?))) {
-            buckets[point.0].push(point.1);
-        }
-    }
+    let mut buckets = profile_points(data, quantity, domain);
     let binned = buckets.iter().map(Vec::len).sum::<usize>() > MAX_PROFILE_POINTS;
     if binned {
         for bucket in &mut buckets {
@@ -276,6 +254,35 @@ pub fn profile_series(
             .collect(),
     };
     (series, binned)
+}
+
+/// The measured points of `quantity` along `domain`, one bucket per entry of
+/// [`ReportData::in_plane`] or per ring, in one pass over the points (a file may hold as many
+/// groups as points).
+fn profile_points(data: &ReportData, quantity: Quantity, domain: Domain) -> Vec<Vec<ProfilePoint>> {
+    let measured = |p: &PointView, x: f64| {
+        quantity.of_point(p).map(|(value, sigma)| ProfilePoint {
+            x,
+            value,
+            sigma,
+            model: quantity.of_model(&p.model),
+        })
+    };
+    let groups = match domain {
+        Domain::InPlane => data.in_plane.len(),
+        Domain::Rings => data.rings.len(),
+    };
+    let mut buckets: Vec<Vec<ProfilePoint>> = vec![Vec::new(); groups];
+    for p in &data.points {
+        let placed = match domain {
+            Domain::InPlane => data.slot[p.incidence].zip(p.signed_zenith),
+            Domain::Rings => p.ring.map(|ring| (ring, p.relative_azimuth)),
+        };
+        if let Some(point) = placed.and_then(|(group, x)| Some((group, measured(p, x)?))) {
+            buckets[point.0].push(point.1);
+        }
+    }
+    buckets
 }
 
 /// The median value (and median model) of the points in each [`BIN_DEGREES`]-wide bin of x,

@@ -2,12 +2,16 @@
 //! embedded font ([`FONT`]) so that the figure renders without system fonts.
 
 use crate::plot_style::FONT;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::Drawable;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 pub type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+/// A chart with linear x and y axes, as most panels draw.
+pub type Chart2d<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Font sizes in pixels for the 2400 × 1800 figure. All even: plotters places each glyph at
 /// size/2 + its top, truncated, so odd sizes put some letters (the z of "zenith") a pixel high.

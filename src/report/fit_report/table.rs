@@ -105,6 +105,7 @@ pub fn at_bound(fit: &FitRecord, name: &str) -> bool {
         .any(|p| p == name || (name == "rho_d" && p == "rho"))
 }
 
+/// Whether the fit varied parameter `name` (rather than holding it fixed).
 pub fn is_free(fit: &FitRecord, name: &str) -> bool {
     fit.free_parameters
         .iter()
@@ -143,6 +144,7 @@ pub fn robust_loss(fit: &FitRecord) -> Option<&str> {
         .filter(|loss| *loss != "none")
 }
 
+/// The first [`SHA_PREFIX`] characters of a SHA-256, with "…" when it is longer.
 pub fn sha_prefix(sha: &str) -> String {
     let prefix: String = sha.chars().take(SHA_PREFIX).collect();
     if sha.chars().count() > SHA_PREFIX {

@@ -2,13 +2,12 @@
 
 use super::super::fit_report::format_plain;
 use super::super::fit_report::style::{
-    draw_legend_top_right, panel_chart, report_mesh_style, sane_linear_range, DrawResult,
+    draw_legend_top_right, panel_chart, report_mesh_style, sane_linear_range, Chart2d, DrawResult,
     LegendEntry, LineKind, Marker, AXIS_DESC_SIZE, GREY, TICK_SIZE,
 };
 use crate::fit::SpectralFitOutcome;
 use crate::material::SpectralModel;
 use crate::plot_style::{FONT, TABLEAU20};
-use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -154,8 +153,6 @@ pub fn draw_index<DB: DrawingBackend>(
     });
     draw_legend_top_right(area, chart.plotting_area().get_pixel_range(), &entries, 10)
 }
-
-type Chart2d<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// A chart over wavelength `x0`…`x1` (µm) and `low`…`high`, its grid, ticks and axis titles
 /// drawn: the frame of panels (a), (b) and (d).
