@@ -17,7 +17,7 @@ const CHUNK: usize = 4096;
 /// The material's pBRDF as `irpol eval --material` builds it (at `wavelength_um` for a spectral
 /// material).
 fn pbrdf(material: &PyMaterial, wavelength_um: Option<f64>) -> PyResult<Pbrdf> {
-    material_pbrdf(&material.inner, wavelength_um, None).map_err(|e| raised(e, &[]))
+    material_pbrdf(&material.inner, wavelength_um, None).map_err(|e| raised(e.into(), &[]))
 }
 
 /// One geometry's directions, checked as `irpol eval` checks a row (θ_r signed).

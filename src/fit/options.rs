@@ -1,7 +1,9 @@
 //! What a fit is asked to do (the options of `irpol fit`, docs/design.md §4).
 
 use super::optimize::OptimizerSettings;
-use super::parameters::{DistributionKind, Parameter, ParameterBounds, ParameterValues};
+use super::parameters::{
+    DistributionKind, OutsideDomain, Parameter, ParameterBounds, ParameterValues,
+};
 use super::robust::RobustLoss;
 use super::stages::Optimizer;
 use super::FitError;
@@ -56,11 +58,12 @@ impl Default for FitOptions {
 }
 
 impl FitOptions {
-    /// The distributions to fit, the requested (or first) one first.
+    /// The distributions to fit: the requested one, or every family in
+    /// [`DistributionKind::ALL`] order.
     pub fn distributions(&self) -> Vec<DistributionKind> {
         match self.distribution {
             Some(kind) => vec![kind],
-            None => vec![DistributionKind::Cauchy, DistributionKind::Gaussian],
+            None => DistributionKind::ALL.to_vec(),
         }
     }
 
@@ -92,58 +95,77 @@ impl FitOptions {
     }
 }
 
+/// Why a `--free` list or `--fix` values are refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ParameterListError {
+    #[error("unknown parameter '{}' (use {})", shown(.0), parameter_names())]
+    Unknown(String),
+    #[error("parameter '{}' is listed twice", shown(.0))]
+    ListedTwice(String),
+    #[error("the parameter list is empty")]
+    EmptyList,
+    #[error("'{}' is not name=value (e.g. k=0.1)", shown(.0))]
+    NotAPair(String),
+    #[error("the value of {parameter} in '{}' is not a finite number", shown(.pair))]
+    NotANumber { parameter: Parameter, pair: String },
+    #[error(transparent)]
+    Outside(#[from] OutsideDomain),
+    #[error("{0} is given twice")]
+    GivenTwice(Parameter),
+    #[error("no name=value pair given")]
+    NoPair,
+}
+
+/// "sigma, q, n, k, rho_d".
+fn parameter_names() -> String {
+    Parameter::ALL.map(|p| p.name()).join(", ")
+}
+
+/// The parameter named `name`.
+fn named(name: &str) -> Result<Parameter, ParameterListError> {
+    Parameter::parse(name).ok_or_else(|| ParameterListError::Unknown(name.trim().to_owned()))
+}
+
 /// Parses a comma-separated parameter list such as `sigma,q,n` (`--free`).
-pub fn parse_parameter_list(text: &str) -> Result<Vec<Parameter>, String> {
+pub fn parse_parameter_list(text: &str) -> Result<Vec<Parameter>, ParameterListError> {
     let mut list = Vec::new();
     for name in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let parameter = Parameter::parse(name).ok_or_else(|| {
-            format!(
-                "unknown parameter '{}' (use sigma, q, n, k, rho_d)",
-                shown(name)
-            )
-        })?;
+        let parameter = named(name)?;
         if list.contains(&parameter) {
-            return Err(format!("parameter '{}' is listed twice", shown(name)));
+            return Err(ParameterListError::ListedTwice(name.to_owned()));
         }
         list.push(parameter);
     }
     if list.is_empty() {
-        return Err("the parameter list is empty".into());
+        return Err(ParameterListError::EmptyList);
     }
     Ok(list)
 }
 
 /// Parses comma-separated `name=value` pairs such as `k=0.1,rho=0` (`--fix`).
-pub fn parse_parameter_values(text: &str) -> Result<BTreeMap<Parameter, f64>, String> {
+pub fn parse_parameter_values(text: &str) -> Result<BTreeMap<Parameter, f64>, ParameterListError> {
     let mut values = BTreeMap::new();
     for pair in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let (name, value) = pair
             .split_once('=')
-            .ok_or_else(|| format!("'{}' is not name=value (e.g. k=0.1)", shown(pair)))?;
-        let parameter = Parameter::parse(name).ok_or_else(|| {
-            format!(
-                "unknown parameter '{}' (use sigma, q, n, k, rho_d)",
-                shown(name.trim())
-            )
-        })?;
+            .ok_or_else(|| ParameterListError::NotAPair(pair.to_owned()))?;
+        let parameter = named(name)?;
         let value: f64 = value
             .trim()
             .parse()
             .ok()
             .filter(|v: &f64| v.is_finite())
-            .ok_or_else(|| {
-                format!(
-                    "the value of {parameter} in '{}' is not a finite number",
-                    shown(pair)
-                )
+            .ok_or_else(|| ParameterListError::NotANumber {
+                parameter,
+                pair: pair.to_owned(),
             })?;
         parameter.check(value)?;
         if values.insert(parameter, value).is_some() {
-            return Err(format!("{parameter} is given twice"));
+            return Err(ParameterListError::GivenTwice(parameter));
         }
     }
     if values.is_empty() {
-        return Err("no name=value pair given".into());
+        return Err(ParameterListError::NoPair);
     }
     Ok(values)
 }
@@ -175,9 +197,10 @@ mod tests {
     #[test]
     fn lists_and_values_are_checked() {
         assert!(parse_parameter_list("sigma,sigma").is_err());
-        assert!(parse_parameter_list("sigma,alpha")
-            .unwrap_err()
-            .contains("alpha"));
+        assert_eq!(
+            parse_parameter_list("sigma,alpha").unwrap_err().to_string(),
+            "unknown parameter 'alpha' (use sigma, q, n, k, rho_d)"
+        );
         assert!(parse_parameter_list("").is_err());
         assert!(parse_parameter_values("k:0.1").is_err());
         assert!(parse_parameter_values("k=abc").is_err());
@@ -185,6 +208,7 @@ mod tests {
         assert!(parse_parameter_values("k=1,k=2").is_err());
         assert!(parse_parameter_values("sigma=1e308")
             .unwrap_err()
+            .to_string()
             .contains("sigma = 1e308 is outside"));
         assert!(parse_parameter_values("q=0.5").is_err());
         assert_eq!(parse_parameter_values("n=2.2").unwrap()[&Parameter::N], 2.2);

@@ -340,7 +340,7 @@ fn solve(
         linearized_errors(&(physical.transpose() * &physical), reduced_chi2);
     let law = problem.law(&best);
     let model = SpectralModel {
-        distribution: kind.distribution(&values[0]),
+        distribution: kind.with_parameters(|p| values[0].get(p)),
         shadowing: options.shadowing,
         wavelength_um: sets.iter().map(|s| s.wavelength_um).collect(),
         n: values.iter().map(|v| v.get(Parameter::N)).collect(),
