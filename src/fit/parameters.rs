@@ -1,5 +1,7 @@
 //! The fitted pBRDF parameters (σ, q, n, k, ρ_d of docs/design.md §1.2–1.3), their bounds, and the search
-//! coordinates the optimizers work in.
+//! coordinates the optimizers work in. The parameters themselves (names, domains, default
+//! bounds) are declared in [`crate::pbrdf::terms`]; the table below repeats the bounds to
+//! explain the search coordinates.
 //!
 //! Every optimizer sees a parameter through a smooth, monotone map from the physical value to a
 //! *search coordinate* that spreads the parameter's plausible range evenly over a finite box:

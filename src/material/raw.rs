@@ -186,3 +186,40 @@ fn check_table(model: &SpectralModel) -> Result<(), ModelTableError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_schema_reads_grey_and_spectral_models() {
+        let grey = "distribution = \"cauchy\"\nsigma = 0.1\nq = 2.0\nshadowing = \"smith\"\n\
+                    n = 1.5\nk = 0.1\nwavelength_um = 10.0\n";
+        let spec: ModelSpec = toml::from_str(grey).unwrap();
+        let model: MaterialModel = toml::from_str(grey).unwrap();
+        assert_eq!(model, MaterialModel::Grey(spec));
+        let spectral = grey
+            .replace("n = 1.5", "n = [1.5, 1.6]")
+            .replace("k = 0.1", "k = [0.1, 0.2]")
+            .replace("wavelength_um = 10.0", "wavelength_um = [9.0, 10.0]");
+        let model: MaterialModel = toml::from_str(&spectral).unwrap();
+        assert!(matches!(model, MaterialModel::Spectral(_)));
+        assert!(toml::from_str::<ModelSpec>(&spectral).is_err());
+        let message = |text: &str| {
+            toml::from_str::<MaterialModel>(text)
+                .unwrap_err()
+                .to_string()
+        };
+        let mixed = message(&grey.replace("n = 1.5", "n = [1.5, 1.6]"));
+        assert!(mixed.contains("must be all numbers"), "{mixed}");
+        let stray_q = message(&grey.replace("\"cauchy\"", "\"gaussian\""));
+        assert!(stray_q.contains("q applies to the cauchy distribution only"));
+        let dispersion = message(&format!(
+            "{grey}[dispersion]\neps_inf = 2.0\noscillators = []\n"
+        ));
+        assert!(
+            dispersion.contains("a dispersion law needs tables"),
+            "{dispersion}"
+        );
+    }
+}
