@@ -45,7 +45,7 @@ enum Command {
     /// Mueller BRDF (m00…m33, sr⁻¹, psps frames) of a model at given geometries, as CSV on stdout.
     Eval {
         #[command(flatten)]
-        model: ModelFlags,
+        model: ModelArgs,
         /// CSV with theta_i_deg, theta_r_deg [, phi_i_deg (0), phi_r_deg (180), other columns kept].
         #[arg(long, conflicts_with_all = ["theta_i", "theta_r"])]
         geometry: Option<PathBuf>,
@@ -66,7 +66,7 @@ enum Command {
     /// Polarized emissivity ε0…ε3 against emission angle, as CSV on stdout.
     Emissivity {
         #[command(flatten)]
-        model: ModelFlags,
+        model: ModelArgs,
         /// Emission zenith (°), a value or START:STOP:STEP.
         #[arg(long, default_value = "0:89:1")]
         theta: String,
@@ -211,55 +211,6 @@ enum SceneCommand {
     },
 }
 
-#[derive(Args)]
-struct ModelFlags {
-    /// A material TOML from the library (instead of the parameters below).
-    #[arg(long)]
-    material: Option<PathBuf>,
-    /// Slope distribution: cauchy or gaussian.
-    #[arg(long)]
-    distribution: Option<String>,
-    /// Slope parameter σ (rms slope per axis for the Gaussian; a = 2σ² for the Cauchy).
-    #[arg(long, allow_negative_numbers = true)]
-    sigma: Option<f64>,
-    /// Cauchy exponent q (> 1).
-    #[arg(long, allow_negative_numbers = true)]
-    q: Option<f64>,
-    /// Real part of the refractive index.
-    #[arg(long, allow_negative_numbers = true)]
-    n: Option<f64>,
-    /// Extinction coefficient (≥ 0).
-    #[arg(long, allow_negative_numbers = true)]
-    k: Option<f64>,
-    /// Diffuse (unpolarized) reflectance ρ_d.
-    #[arg(long, allow_negative_numbers = true)]
-    rho: Option<f64>,
-    /// Shadowing: none, torrance-sparrow or smith (default smith, as `fit`; with --material,
-    /// the material's own).
-    #[arg(long)]
-    shadowing: Option<String>,
-    /// Wavelength (µm) at which to evaluate a spectral --material (n, k, ρ_d interpolated in its
-    /// table; outside it is refused). A grey material is the same at every wavelength.
-    #[arg(long, value_name = "UM")]
-    wavelength: Option<f64>,
-}
-
-impl ModelFlags {
-    fn model_args(&self) -> ModelArgs {
-        ModelArgs {
-            material: self.material.clone(),
-            distribution: self.distribution.clone(),
-            sigma: self.sigma,
-            q: self.q,
-            n: self.n,
-            k: self.k,
-            rho: self.rho,
-            shadowing: self.shadowing.clone(),
-            wavelength_um: self.wavelength,
-        }
-    }
-}
-
 /// `println!` that treats a closed stdout (`irpol … | head`) as the reader being done, not as a
 /// panic.
 macro_rules! say {
@@ -313,7 +264,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             phi_i,
             phi_r,
         } => {
-            let model = model.model_args().build()?;
+            let model = model.build()?;
             let table = geometry_table(
                 geometry.as_deref(),
                 theta_i.as_deref(),
@@ -324,7 +275,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             eval(&model, &table)
         }
         Command::Emissivity { model, theta } => {
-            let model = model.model_args().build()?;
+            let model = model.build()?;
             emissivity(&model, &theta)
         }
         Command::Figure { which, out } => figure(&which, &out),

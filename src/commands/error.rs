@@ -19,25 +19,32 @@ use std::error::Error;
 use std::io;
 use std::path::PathBuf;
 
+/// The library's larger errors are boxed (their `From` below), so that a `Result<_, AppError>`
+/// stays small on the success path.
 #[derive(Debug, thiserror::Error)]
 pub enum AppError {
     // --- library errors, as the library words them ---
     #[error(transparent)]
-    Scene(#[from] SceneError),
+    Scene(Box<SceneError>),
     #[error(transparent)]
-    Render(#[from] RenderError),
+    Render(Box<RenderError>),
     #[error(transparent)]
     Material(#[from] MaterialError),
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// A model chosen by `--material` or by parameter flags ([`super::ModelArgs`]).
     #[error(transparent)]
-    Measure(#[from] MeasureError),
+    ModelArgs(#[from] super::ModelArgsError),
     #[error(transparent)]
-    Fit(#[from] FitError),
+    Distribution(#[from] crate::pbrdf::DistributionError),
+    #[error(transparent)]
+    Measure(Box<MeasureError>),
+    #[error(transparent)]
+    Fit(Box<FitError>),
     #[error(transparent)]
     FitOption(#[from] OptionError),
     #[error(transparent)]
-    Report(#[from] ReportError),
+    Report(Box<ReportError>),
     #[error(transparent)]
     Sun(#[from] crate::emitter::SunError),
     /// Writing a table to the output stream (stdout for the CLI); kept as the bare I/O error so
@@ -117,23 +124,13 @@ pub enum AppError {
     NoTimes(PathBuf),
     #[error("--time-utc")]
     TimeFlag(#[source] crate::emitter::SunError),
-    #[error(
-        "material '{name}' is spectral ({first}–{last} µm): give --wavelength UM",
-        first = crate::text::number(*.first_um),
-        last = crate::text::number(*.last_um)
-    )]
-    SpectralNeedsWavelength {
-        name: String,
-        first_um: f64,
-        last_um: f64,
-    },
 
     // --- thermal scenes ---
     #[error("{}: thermal run", path.display())]
     ThermalRun {
         path: PathBuf,
         #[source]
-        source: ThermalRunError,
+        source: Box<ThermalRunError>,
     },
     #[error(
         "{}: has a [thermal] section: say when to render it with --time SECONDS, --time-utc \
@@ -153,6 +150,25 @@ pub enum AppError {
     #[error("{}: {message}", path.display())]
     SceneAt { path: PathBuf, message: String },
 }
+
+/// `From` for the boxed library errors, so that `?` converts them as it does the others.
+macro_rules! from_boxed {
+    ($($variant:ident($error:ty)),* $(,)?) => {
+        $(impl From<$error> for AppError {
+            fn from(error: $error) -> AppError {
+                AppError::$variant(Box::new(error))
+            }
+        })*
+    };
+}
+
+from_boxed!(
+    Scene(SceneError),
+    Render(RenderError),
+    Measure(MeasureError),
+    Fit(FitError),
+    Report(ReportError),
+);
 
 impl AppError {
     /// A refused argument.
@@ -187,11 +203,20 @@ impl AppError {
     /// The measurement error inside, however it is wrapped (a wrapped error displays as its own
     /// message, so it does not appear among the causes).
     fn measure_error(&self) -> Option<&MeasureError> {
+        fn in_fit(error: &FitError) -> Option<&MeasureError> {
+            match error {
+                FitError::Read(e) => Some(e),
+                _ => None,
+            }
+        }
         match self {
-            AppError::Measure(e)
-            | AppError::Fit(FitError::Read(e))
-            | AppError::Report(ReportError::Measure(e))
-            | AppError::Report(ReportError::Fit(FitError::Read(e))) => Some(e),
+            AppError::Measure(e) => Some(e),
+            AppError::Fit(e) => in_fit(e),
+            AppError::Report(e) => match &**e {
+                ReportError::Measure(e) => Some(e),
+                ReportError::Fit(e) => in_fit(e),
+                _ => None,
+            },
             _ => None,
         }
     }

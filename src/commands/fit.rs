@@ -70,11 +70,7 @@ impl FitFlags {
             ..FitOptions::default()
         };
         if let Some(name) = &self.distribution {
-            options.distribution = Some(DistributionKind::parse(name).ok_or_else(|| {
-                AppError::invalid(format!(
-                    "unknown distribution '{name}': use cauchy or gaussian"
-                ))
-            })?);
+            options.distribution = Some(DistributionKind::parse(name)?);
         }
         if let Some(list) = &self.free {
             options.free = Some(parse_parameter_list(list)?);

@@ -11,83 +11,120 @@ pub mod thermal;
 
 pub use error::{one_line, AppError};
 
-use crate::material::Material;
+use crate::material::{Material, MaterialError};
 use crate::optics::RefractiveIndex;
-use crate::pbrdf::{Pbrdf, Shadowing, SlopeDistribution};
+use crate::pbrdf::{DistributionError, DistributionKind, ModelError, Pbrdf, Shadowing};
 use std::path::PathBuf;
 
-/// A pBRDF chosen on the command line: a material file, or parameters.
-#[derive(Clone, Debug, Default)]
+/// A pBRDF chosen on the command line: a material file, or parameters (the flags of `eval` and
+/// `emissivity`).
+#[derive(Clone, Debug, Default, clap::Args)]
 pub struct ModelArgs {
+    /// A material TOML from the library (instead of the parameters below).
+    #[arg(long)]
     pub material: Option<PathBuf>,
+    /// Slope distribution: cauchy or gaussian.
+    #[arg(long)]
     pub distribution: Option<String>,
+    /// Slope parameter σ (rms slope per axis for the Gaussian; a = 2σ² for the Cauchy).
+    #[arg(long, allow_negative_numbers = true)]
     pub sigma: Option<f64>,
+    /// Cauchy exponent q (> 1).
+    #[arg(long, allow_negative_numbers = true)]
     pub q: Option<f64>,
+    /// Real part of the refractive index.
+    #[arg(long, allow_negative_numbers = true)]
     pub n: Option<f64>,
+    /// Extinction coefficient (≥ 0).
+    #[arg(long, allow_negative_numbers = true)]
     pub k: Option<f64>,
+    /// Diffuse (unpolarized) reflectance ρ_d.
+    #[arg(long, allow_negative_numbers = true)]
     pub rho: Option<f64>,
+    /// Shadowing: none, torrance-sparrow or smith (default smith, as `fit`; with --material,
+    /// the material's own).
+    #[arg(long)]
     pub shadowing: Option<String>,
-    /// Where to evaluate a spectral material (µm); required for one, optional for a grey one.
+    /// Wavelength (µm) at which to evaluate a spectral --material (n, k, ρ_d interpolated in its
+    /// table; outside it is refused). A grey material is the same at every wavelength.
+    #[arg(long = "wavelength", value_name = "UM")]
     pub wavelength_um: Option<f64>,
+}
+
+/// Why the model of [`ModelArgs`] or of a material cannot be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelArgsError {
+    #[error("unknown shadowing '{0}': use none, torrance-sparrow or smith")]
+    UnknownShadowing(String),
+    #[error(
+        "give either --material or model parameters (--distribution --sigma --q --n --k \
+         --rho), not both (got {0} with --material)"
+    )]
+    MaterialAndParameters(String),
+    #[error(
+        "--wavelength selects where a --material is evaluated; model parameters are one \
+         wavelength's already"
+    )]
+    WavelengthWithoutMaterial,
+    #[error("missing --{0} (or give --material FILE)")]
+    Missing(&'static str),
+    /// A distribution name or q that does not fit (`--q` for the Gaussian).
+    #[error("{}", flag_message(.0))]
+    Distribution(DistributionError),
+    #[error(
+        "material '{name}' is spectral ({}–{} µm): give --wavelength UM",
+        crate::text::number(*.first_um),
+        crate::text::number(*.last_um)
+    )]
+    SpectralNeedsWavelength {
+        name: String,
+        first_um: f64,
+        last_um: f64,
+    },
+    #[error(transparent)]
+    Material(#[from] MaterialError),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+}
+
+/// A distribution error as the command line says it: of `--q`, not of the file key `q`.
+fn flag_message(error: &DistributionError) -> String {
+    match error {
+        DistributionError::StrayQ(_) => format!("--{error}"),
+        other => other.to_string(),
+    }
 }
 
 impl ModelArgs {
     /// The model: the material's, with `--shadowing` overriding it, or one built from the flags.
-    pub fn build(&self) -> anyhow::Result<Pbrdf> {
+    pub fn build(&self) -> Result<Pbrdf, ModelArgsError> {
         let shadowing = match &self.shadowing {
-            Some(name) => Some(Shadowing::parse(name).ok_or_else(|| {
-                anyhow::anyhow!("unknown shadowing '{name}': use none, torrance-sparrow or smith")
-            })?),
+            Some(name) => Some(
+                Shadowing::parse(name)
+                    .ok_or_else(|| ModelArgsError::UnknownShadowing(name.clone()))?,
+            ),
             None => None,
         };
         if let Some(path) = &self.material {
-            // The material defines every model parameter: a flag beside it would be silently
-            // ignored (only --shadowing overrides the material's, by design).
-            let given: Vec<&str> = [
-                ("--distribution", self.distribution.is_some()),
-                ("--sigma", self.sigma.is_some()),
-                ("--q", self.q.is_some()),
-                ("--n", self.n.is_some()),
-                ("--k", self.k.is_some()),
-                ("--rho", self.rho.is_some()),
-            ]
-            .into_iter()
-            .filter_map(|(flag, set)| set.then_some(flag))
-            .collect();
-            if !given.is_empty() {
-                anyhow::bail!(
-                    "give either --material or model parameters (--distribution --sigma --q --n --k \
-                     --rho), not both (got {} with --material)",
-                    given.join(" ")
-                );
-            }
+            self.refuse_parameters()?;
             let material = Material::load(path)?;
-            return Ok(material_pbrdf(&material, self.wavelength_um, shadowing)?);
+            return material_pbrdf(&material, self.wavelength_um, shadowing);
         }
         if self.wavelength_um.is_some() {
-            anyhow::bail!(
-                "--wavelength selects where a --material is evaluated; model parameters are \
-                 one wavelength's already"
-            );
+            return Err(ModelArgsError::WavelengthWithoutMaterial);
         }
-        let missing = |flag: &str| anyhow::anyhow!("missing --{flag} (or give --material FILE)");
-        let sigma = self.sigma.ok_or_else(|| missing("sigma"))?;
-        let distribution = match self.distribution.as_deref().unwrap_or("cauchy") {
-            "cauchy" => SlopeDistribution::Cauchy {
-                sigma,
-                q: self.q.ok_or_else(|| missing("q"))?,
-            },
-            "gaussian" => {
-                if self.q.is_some() {
-                    anyhow::bail!("--q applies to the cauchy distribution only");
-                }
-                SlopeDistribution::Gaussian { sigma }
-            }
-            other => anyhow::bail!("unknown distribution '{other}': use cauchy or gaussian"),
+        let sigma = self.sigma.ok_or(ModelArgsError::Missing("sigma"))?;
+        let kind = match &self.distribution {
+            Some(name) => DistributionKind::parse(name).map_err(ModelArgsError::Distribution)?,
+            None => DistributionKind::Cauchy,
         };
+        let distribution = kind.with(sigma, self.q).map_err(|error| match error {
+            DistributionError::NeedsQ(_) => ModelArgsError::Missing("q"),
+            other => ModelArgsError::Distribution(other),
+        })?;
         let index = RefractiveIndex::new(
-            self.n.ok_or_else(|| missing("n"))?,
-            self.k.ok_or_else(|| missing("k"))?,
+            self.n.ok_or(ModelArgsError::Missing("n"))?,
+            self.k.ok_or(ModelArgsError::Missing("k"))?,
         );
         Ok(Pbrdf::new(
             distribution,
@@ -98,6 +135,27 @@ impl ModelArgs {
             self.rho.unwrap_or(0.0),
         )?)
     }
+
+    /// The material defines every model parameter: a flag beside it would be silently ignored
+    /// (only --shadowing overrides the material's, by design).
+    fn refuse_parameters(&self) -> Result<(), ModelArgsError> {
+        let given: Vec<&str> = [
+            ("--distribution", self.distribution.is_some()),
+            ("--sigma", self.sigma.is_some()),
+            ("--q", self.q.is_some()),
+            ("--n", self.n.is_some()),
+            ("--k", self.k.is_some()),
+            ("--rho", self.rho.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(flag, set)| set.then_some(flag))
+        .collect();
+        if given.is_empty() {
+            Ok(())
+        } else {
+            Err(ModelArgsError::MaterialAndParameters(given.join(" ")))
+        }
+    }
 }
 
 /// The pBRDF of a loaded material as `eval` and `emissivity` use it: at `wavelength_um` (required
@@ -107,13 +165,13 @@ pub fn material_pbrdf(
     material: &Material,
     wavelength_um: Option<f64>,
     shadowing: Option<Shadowing>,
-) -> Result<Pbrdf, AppError> {
+) -> Result<Pbrdf, ModelArgsError> {
     let mut spec = match (wavelength_um, material.model.spectral()) {
         (Some(wavelength), _) => material.at(wavelength)?,
         (None, None) => material.grey_model()?.clone(),
         (None, Some(table)) => {
             let (first_um, last_um) = table.range_um();
-            return Err(AppError::SpectralNeedsWavelength {
+            return Err(ModelArgsError::SpectralNeedsWavelength {
                 name: material.name.clone(),
                 first_um,
                 last_um,
@@ -129,12 +187,13 @@ pub fn material_pbrdf(
 /// `#` lines stating the model a table was computed with (`eval`, `emissivity` output): the
 /// distribution and its parameters, the index, ρ_d and the shadowing.
 pub fn model_header(model: &Pbrdf) -> String {
-    let distribution = match model.distribution() {
-        SlopeDistribution::Cauchy { sigma, q } => {
-            format!("cauchy slopes, sigma = {sigma}, q = {q}")
+    let slopes = model.distribution();
+    let mut distribution = format!("{} slopes", slopes.kind());
+    for &parameter in slopes.kind().parameters() {
+        if let Some(value) = slopes.parameter(parameter) {
+            distribution.push_str(&format!(", {parameter} = {value}"));
         }
-        SlopeDistribution::Gaussian { sigma } => format!("gaussian slopes, sigma = {sigma}"),
-    };
+    }
     let index = model.index();
     format!(
         "# irpol {}: {distribution}\n# N = n + ik: n = {}, k = {}; rho_d = {}; shadowing = {}\n",

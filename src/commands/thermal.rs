@@ -50,7 +50,7 @@ pub(crate) fn solve(
 ) -> Result<ThermalSolution, AppError> {
     solve_scene(scene, times, progress).map_err(|source| AppError::ThermalRun {
         path: scene_path.to_owned(),
-        source,
+        source: Box::new(source),
     })
 }
 

@@ -1,11 +1,12 @@
 //! Model comparison between the slope distributions by information criteria on the χ² of the
 //! weighted fit (Gaussian errors with the stated uncertainties, so −2 ln L = χ² + const):
 //! AIC = χ² + 2p, BIC = χ² + p ln N (N observations, p free parameters). The model with the
-//! lower AIC is preferred; on a tie the one with fewer parameters. The χ² is the plain one even
-//! when the fit used a robust loss.
+//! lowest AIC is preferred; on a tie the one with fewer parameters, then the one fitted first.
+//! The χ² is the plain one even when the fit used a robust loss.
 
 use super::parameters::DistributionKind;
 use serde::{Deserialize, Serialize};
+use std::cmp::Ordering;
 
 pub fn aic(chi2: f64, free_parameters: usize) -> f64 {
     chi2 + 2.0 * free_parameters as f64
@@ -15,10 +16,31 @@ pub fn bic(chi2: f64, free_parameters: usize, observations: usize) -> f64 {
     chi2 + free_parameters as f64 * (observations as f64).ln()
 }
 
+/// One fitted distribution as the comparison sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Candidate {
+    pub distribution: DistributionKind,
+    pub aic: f64,
+    pub bic: f64,
+    pub free_parameters: usize,
+}
+
+impl Candidate {
+    /// Whether `self` is preferred over `other` (lower AIC; on a tie no more parameters).
+    fn beats(&self, other: &Candidate) -> bool {
+        match self.aic.partial_cmp(&other.aic) {
+            Some(Ordering::Less) => true,
+            Some(Ordering::Equal) => self.free_parameters <= other.free_parameters,
+            _ => false,
+        }
+    }
+}
+
 /// Which distribution the data prefer and by how much.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ModelComparison {
     pub preferred: DistributionKind,
+    /// The runner-up (the other one of two).
     pub rejected: DistributionKind,
     /// AIC(rejected) − AIC(preferred) ≥ 0; above ~10 the rejected model has essentially no
     /// support (Burnham & Anderson).
@@ -28,19 +50,23 @@ pub struct ModelComparison {
 }
 
 impl ModelComparison {
-    /// Compares two fits given as (distribution, AIC, BIC, free parameters).
-    pub fn new(
-        a: (DistributionKind, f64, f64, usize),
-        b: (DistributionKind, f64, f64, usize),
-    ) -> ModelComparison {
-        let a_first = a.1 < b.1 || (a.1 == b.1 && a.3 <= b.3);
-        let (preferred, rejected) = if a_first { (a, b) } else { (b, a) };
-        ModelComparison {
-            preferred: preferred.0,
-            rejected: rejected.0,
-            delta_aic: rejected.1 - preferred.1,
-            delta_bic: rejected.2 - preferred.2,
+    /// Compares the fits of several distributions, in the order they were fitted; `None` for
+    /// fewer than two.
+    pub fn among(candidates: &[Candidate]) -> Option<ModelComparison> {
+        fn best<'a>(among: impl Iterator<Item = &'a Candidate>) -> Option<&'a Candidate> {
+            among.fold(None, |best, c| match best {
+                Some(b) if b.beats(c) => Some(b),
+                _ => Some(c),
+            })
         }
+        let preferred = best(candidates.iter())?;
+        let rejected = best(candidates.iter().filter(|c| !std::ptr::eq(*c, preferred)))?;
+        Some(ModelComparison {
+            preferred: preferred.distribution,
+            rejected: rejected.distribution,
+            delta_aic: rejected.aic - preferred.aic,
+            delta_bic: rejected.bic - preferred.bic,
+        })
     }
 
     /// One line for the material file and the report.
@@ -58,30 +84,39 @@ mod tests {
 
     #[test]
     fn lower_aic_wins_and_ties_go_to_the_simpler_model() {
-        let cauchy = (
+        let candidate = |distribution, aic, bic, free_parameters| Candidate {
+            distribution,
+            aic,
+            bic,
+            free_parameters,
+        };
+        let cauchy = candidate(
             DistributionKind::Cauchy,
             aic(100.0, 5),
             bic(100.0, 5, 1000),
             5,
         );
-        let gauss = (
+        let gauss = candidate(
             DistributionKind::Gaussian,
             aic(103.0, 4),
             bic(103.0, 4, 1000),
             4,
         );
-        let c = ModelComparison::new(cauchy, gauss);
+        let c = ModelComparison::among(&[cauchy, gauss]).unwrap();
         assert_eq!(c.preferred, DistributionKind::Cauchy);
+        assert_eq!(ModelComparison::among(&[gauss, cauchy]).unwrap(), c);
         assert!((c.delta_aic - 1.0).abs() < 1e-12);
         // BIC penalizes the extra parameter by ln 1000 = 6.9 > 3: it prefers the Gaussian.
         assert!(c.delta_bic < 0.0);
-        let tie = ModelComparison::new(
-            (DistributionKind::Cauchy, 10.0, 10.0, 5),
-            (DistributionKind::Gaussian, 10.0, 10.0, 4),
-        );
+        let tie = ModelComparison::among(&[
+            candidate(DistributionKind::Cauchy, 10.0, 10.0, 5),
+            candidate(DistributionKind::Gaussian, 10.0, 10.0, 4),
+        ])
+        .unwrap();
         assert_eq!(tie.preferred, DistributionKind::Gaussian);
         assert!(c
             .summary()
             .starts_with("cauchy preferred over gaussian: ΔAIC = 1.0"));
+        assert_eq!(ModelComparison::among(&[cauchy]), None);
     }
 }

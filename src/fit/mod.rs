@@ -34,7 +34,7 @@ mod spectral;
 mod stages;
 mod uncertainty;
 
-pub use comparison::{aic, bic, ModelComparison};
+pub use comparison::{aic, bic, Candidate, ModelComparison};
 pub use data::{
     ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00,
 };
@@ -49,7 +49,8 @@ pub use optimize::OptimizerSettings;
 pub use options::{parse_parameter_list, parse_parameter_values, FitOptions, OptionError};
 pub use outcome::{fit_measurement, FitOutcome};
 pub use parameters::{
-    DistributionKind, Interval, Parameter, ParameterBounds, ParameterValues, SMITH_MIN_Q,
+    DistributionKind, Interval, InvalidBounds, Parameter, ParameterBounds, ParameterValues,
+    SMITH_MIN_Q,
 };
 pub use profile::{CONFIDENCE, ONE_SIDED_95_DELTA_CHI2};
 pub use robust::RobustLoss;

@@ -1,6 +1,6 @@
 //! One model family fitted to one measurement: optimization, goodness of fit and uncertainties.
 
-use super::comparison::{aic, bic};
+use super::comparison::{aic, bic, Candidate};
 use super::data::MeasurementData;
 use super::objective::Objective;
 use super::optimize::minimize;
@@ -48,17 +48,19 @@ pub struct ModelFit {
 }
 
 impl ModelFit {
-    /// The fitted value of `parameter` (free or fixed).
+    /// The fitted value of `parameter` (free or fixed); NaN for a slope parameter the
+    /// distribution does not have (q of the Gaussian).
     pub fn value(&self, parameter: Parameter) -> f64 {
-        match parameter {
-            Parameter::Sigma => self.model.distribution.sigma(),
-            Parameter::Q => match self.model.distribution {
-                crate::pbrdf::SlopeDistribution::Cauchy { q, .. } => q,
-                crate::pbrdf::SlopeDistribution::Gaussian { .. } => f64::NAN,
-            },
-            Parameter::N => self.model.n,
-            Parameter::K => self.model.k,
-            Parameter::RhoD => self.model.rho_d,
+        self.model.parameter(parameter).unwrap_or(f64::NAN)
+    }
+
+    /// The fit as a model comparison sees it.
+    pub fn candidate(&self) -> Candidate {
+        Candidate {
+            distribution: self.distribution,
+            aic: self.aic,
+            bic: self.bic,
+            free_parameters: self.free.len(),
         }
     }
 

@@ -1,7 +1,9 @@
 //! What a fit is asked to do (the options of `irpol fit`, docs/design.md §4).
 
 use super::optimize::OptimizerSettings;
-use super::parameters::{DistributionKind, Parameter, ParameterBounds, ParameterValues};
+use super::parameters::{
+    DistributionKind, OutsideDomain, Parameter, ParameterBounds, ParameterValues,
+};
 use super::robust::RobustLoss;
 use super::stages::Optimizer;
 use super::FitError;
@@ -56,11 +58,12 @@ impl Default for FitOptions {
 }
 
 impl FitOptions {
-    /// The distributions to fit, the requested (or first) one first.
+    /// The distributions to fit: the requested one, or every family in
+    /// [`DistributionKind::ALL`] order.
     pub fn distributions(&self) -> Vec<DistributionKind> {
         match self.distribution {
             Some(kind) => vec![kind],
-            None => vec![DistributionKind::Cauchy, DistributionKind::Gaussian],
+            None => DistributionKind::ALL.to_vec(),
         }
     }
 
@@ -107,9 +110,9 @@ pub enum OptionError {
     NotNameValue(String),
     #[error("the value of {parameter} in '{}' is not a finite number", shown(.pair))]
     NotFinite { parameter: Parameter, pair: String },
-    /// A value outside the parameter's domain ([`Parameter::check`]'s message).
-    #[error("{0}")]
-    OutsideDomain(String),
+    /// A value outside the parameter's domain ([`Parameter::check`]).
+    #[error(transparent)]
+    OutsideDomain(#[from] OutsideDomain),
     #[error("{0} is given twice")]
     GivenTwice(Parameter),
     #[error("no name=value pair given")]
@@ -208,10 +211,10 @@ mod tests {
     #[test]
     fn lists_and_values_are_checked() {
         assert!(parse_parameter_list("sigma,sigma").is_err());
-        assert!(parse_parameter_list("sigma,alpha")
-            .unwrap_err()
-            .to_string()
-            .contains("alpha"));
+        assert_eq!(
+            parse_parameter_list("sigma,alpha").unwrap_err().to_string(),
+            "unknown parameter 'alpha' (use sigma, q, n, k, rho_d)"
+        );
         assert!(parse_parameter_list("").is_err());
         assert!(parse_parameter_values("k:0.1").is_err());
         assert!(parse_parameter_values("k=abc").is_err());

@@ -43,15 +43,8 @@ pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<Fit
     let (chosen, alternative, comparison) = match second {
         None => (first, None, None),
         Some(second) => {
-            let comparison = ModelComparison::new(
-                (first.distribution, first.aic, first.bic, first.free.len()),
-                (
-                    second.distribution,
-                    second.aic,
-                    second.bic,
-                    second.free.len(),
-                ),
-            );
+            let comparison = ModelComparison::among(&[first.candidate(), second.candidate()])
+                .expect("two fits compare");
             if comparison.preferred == first.distribution {
                 (first, Some(second), Some(comparison))
             } else {

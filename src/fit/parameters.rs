@@ -1,5 +1,7 @@
 //! The fitted pBRDF parameters (σ, q, n, k, ρ_d of docs/design.md §1.2–1.3), their bounds, and the search
-//! coordinates the optimizers work in.
+//! coordinates the optimizers work in. The parameters themselves (names, domains, default
+//! bounds) are declared in [`crate::pbrdf::terms`]; the table below repeats the bounds to
+//! explain the search coordinates.
 //!
 //! Every optimizer sees a parameter through a smooth, monotone map from the physical value to a
 //! *search coordinate* that spreads the parameter's plausible range evenly over a finite box:
@@ -17,94 +19,13 @@
 //! a bound. The Smith Λ of the Cauchy distribution diverges for q ≤ 3/2 (docs/design.md §1.3), hence the
 //! raised lower bound of q with Smith shadowing.
 
-use crate::pbrdf::{limits, Shadowing, SlopeDistribution};
-use crate::text::number;
+use crate::pbrdf::Shadowing;
+pub use crate::pbrdf::{DistributionKind, OutsideDomain, Parameter};
 use serde::{Deserialize, Serialize};
-use std::fmt;
 
-/// A pBRDF parameter that a fit can adjust or hold fixed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Parameter {
-    /// Slope parameter σ of either distribution (docs/design.md §1.2).
-    Sigma,
-    /// Cauchy exponent q (not a parameter of the Gaussian).
-    Q,
-    /// Real part n of the refractive index.
-    N,
-    /// Extinction coefficient k.
-    K,
-    /// Diffuse reflectance ρ_d.
-    RhoD,
-}
-
+/// The fit's own values of each parameter (its name, domain and bounds are in
+/// [`crate::pbrdf::terms`]).
 impl Parameter {
-    /// All parameters in their canonical order (the order of vectors and matrices in a fit).
-    pub const ALL: [Parameter; 5] = [
-        Parameter::Sigma,
-        Parameter::Q,
-        Parameter::N,
-        Parameter::K,
-        Parameter::RhoD,
-    ];
-
-    /// The name used on the command line and in material files.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Parameter::Sigma => "sigma",
-            Parameter::Q => "q",
-            Parameter::N => "n",
-            Parameter::K => "k",
-            Parameter::RhoD => "rho_d",
-        }
-    }
-
-    /// Parses a name of [`Parameter::name`]; `rho` is accepted for ρ_d (docs/design.md §4).
-    pub fn parse(text: &str) -> Option<Parameter> {
-        match text.trim() {
-            "sigma" => Some(Parameter::Sigma),
-            "q" => Some(Parameter::Q),
-            "n" => Some(Parameter::N),
-            "k" => Some(Parameter::K),
-            "rho" | "rho_d" => Some(Parameter::RhoD),
-            _ => None,
-        }
-    }
-
-    /// Position in [`Parameter::ALL`].
-    pub fn index(&self) -> usize {
-        *self as usize
-    }
-
-    /// The values a model accepts ([`crate::pbrdf::limits`]): (lowest, highest, whether the
-    /// lowest itself is excluded). q > 1 is open: the distribution is not normalizable at 1.
-    pub fn domain(&self) -> (f64, f64, bool) {
-        match self {
-            Parameter::Sigma => (limits::MIN_SIGMA, limits::MAX_SIGMA, false),
-            Parameter::Q => (1.0, limits::MAX_Q, true),
-            Parameter::N => (limits::MIN_N, limits::MAX_N, false),
-            Parameter::K => (0.0, limits::MAX_K, false),
-            Parameter::RhoD => (0.0, 1.0, false),
-        }
-    }
-
-    /// Refuses a value outside [`Parameter::domain`] (or not finite), naming the range.
-    pub fn check(&self, value: f64) -> Result<(), String> {
-        let (low, high, open) = self.domain();
-        let above_low = if open { value > low } else { value >= low };
-        if value.is_finite() && above_low && value <= high {
-            Ok(())
-        } else {
-            let bracket = if open { '(' } else { '[' };
-            Err(format!(
-                "{self} = {} is outside {bracket}{}, {}], the values a model accepts",
-                number(value),
-                number(low),
-                number(high)
-            ))
-        }
-    }
-
     /// Value used when the parameter is neither free nor given a value: a moderately rough
     /// dielectric without absorption or diffuse part.
     pub fn default_value(&self) -> f64 {
@@ -127,68 +48,6 @@ impl Parameter {
             Parameter::K => 0.1,
             Parameter::RhoD => 0.02,
         }
-    }
-}
-
-impl fmt::Display for Parameter {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// The slope distribution family being fitted, without its parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum DistributionKind {
-    Cauchy,
-    Gaussian,
-}
-
-impl DistributionKind {
-    pub fn name(&self) -> &'static str {
-        match self {
-            DistributionKind::Cauchy => "cauchy",
-            DistributionKind::Gaussian => "gaussian",
-        }
-    }
-
-    pub fn parse(text: &str) -> Option<DistributionKind> {
-        match text.trim() {
-            "cauchy" => Some(DistributionKind::Cauchy),
-            "gaussian" => Some(DistributionKind::Gaussian),
-            _ => None,
-        }
-    }
-
-    /// The other family (the alternative of a model comparison).
-    pub fn other(&self) -> DistributionKind {
-        match self {
-            DistributionKind::Cauchy => DistributionKind::Gaussian,
-            DistributionKind::Gaussian => DistributionKind::Cauchy,
-        }
-    }
-
-    /// Whether `parameter` belongs to this family's model (q is Cauchy-only).
-    pub fn has(&self, parameter: Parameter) -> bool {
-        !(parameter == Parameter::Q && *self == DistributionKind::Gaussian)
-    }
-
-    /// The distribution with σ and q taken from a full parameter vector.
-    pub fn distribution(&self, values: &ParameterValues) -> SlopeDistribution {
-        let sigma = values.get(Parameter::Sigma);
-        match self {
-            DistributionKind::Cauchy => SlopeDistribution::Cauchy {
-                sigma,
-                q: values.get(Parameter::Q),
-            },
-            DistributionKind::Gaussian => SlopeDistribution::Gaussian { sigma },
-        }
-    }
-}
-
-impl fmt::Display for DistributionKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
     }
 }
 
@@ -237,13 +96,18 @@ pub struct ParameterBounds {
 pub const SMITH_MIN_Q: f64 = 1.51;
 
 impl Default for ParameterBounds {
+    /// The registry's default bounds ([`crate::pbrdf::ParameterInfo::default_bounds`]).
     fn default() -> Self {
+        let interval = |p: Parameter| {
+            let (lower, upper) = p.info().default_bounds;
+            Interval::new(lower, upper)
+        };
         ParameterBounds {
-            sigma: Interval::new(0.005, 1.5),
-            q: Interval::new(1.05, 50.0),
-            n: Interval::new(0.05, 10.0),
-            k: Interval::new(0.0, 50.0),
-            rho_d: Interval::new(0.0, 1.0),
+            sigma: interval(Parameter::Sigma),
+            q: interval(Parameter::Q),
+            n: interval(Parameter::N),
+            k: interval(Parameter::K),
+            rho_d: interval(Parameter::RhoD),
         }
     }
 }
@@ -270,18 +134,29 @@ impl ParameterBounds {
 
     /// Checks that every interval is finite, ordered and inside the parameter's
     /// [`Parameter::domain`].
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidBounds> {
         for parameter in Parameter::ALL {
             let Interval { lower, upper } = self.get(parameter);
             let domain_ok = parameter.check(lower).is_ok() && parameter.check(upper).is_ok();
             if !(lower < upper && domain_ok) {
-                return Err(format!(
-                    "the bounds [{lower}, {upper}] of {parameter} are invalid (finite, lower < upper, inside the parameter's domain)"
-                ));
+                return Err(InvalidBounds {
+                    parameter,
+                    lower,
+                    upper,
+                });
             }
         }
         Ok(())
     }
+}
+
+/// A search interval that is not finite, not ordered or outside the parameter's domain.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("the bounds [{lower}, {upper}] of {parameter} are invalid (finite, lower < upper, inside the parameter's domain)")]
+pub struct InvalidBounds {
+    pub parameter: Parameter,
+    pub lower: f64,
+    pub upper: f64,
 }
 
 /// Scale of the asinh map of k: below ~0.1 the search coordinate is linear in k (k = 0 is an
@@ -352,7 +227,7 @@ mod tests {
         assert!(bounds.validate().is_ok());
         let mut bad = bounds;
         bad.q = Interval::new(0.9, 10.0);
-        assert!(bad.validate().unwrap_err().contains("q"));
+        assert!(bad.validate().unwrap_err().to_string().contains("q"));
         bad = bounds;
         bad.rho_d = Interval::new(0.0, 1.5);
         assert!(bad.validate().is_err());
@@ -362,8 +237,13 @@ mod tests {
         assert!(Parameter::Sigma
             .check(1e308)
             .unwrap_err()
+            .to_string()
             .contains("[0.0001, 10]"));
-        assert!(Parameter::Q.check(1.0).unwrap_err().contains("(1, 100]"));
+        assert!(Parameter::Q
+            .check(1.0)
+            .unwrap_err()
+            .to_string()
+            .contains("(1, 100]"));
         assert!(Parameter::Q.check(100.0).is_ok() && Parameter::K.check(0.0).is_ok());
     }
 

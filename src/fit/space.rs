@@ -33,7 +33,9 @@ impl ModelSpace {
         base: ParameterValues,
         bounds: &ParameterBounds,
     ) -> Result<ModelSpace, FitError> {
-        bounds.validate().map_err(FitError::Options)?;
+        bounds
+            .validate()
+            .map_err(|e| FitError::Options(e.to_string()))?;
         let bounds = bounds.effective(shadowing);
         let free: Vec<Parameter> = Parameter::ALL
             .into_iter()
@@ -129,7 +131,7 @@ impl ModelSpace {
 
     pub fn pbrdf(&self, values: &ParameterValues) -> Result<Pbrdf, ModelError> {
         Pbrdf::new(
-            self.kind.distribution(values),
+            self.kind.with_parameters(|p| values.get(p)),
             self.shadowing,
             RefractiveIndex::new(values.get(Parameter::N), values.get(Parameter::K)),
             values.get(Parameter::RhoD),
@@ -138,7 +140,7 @@ impl ModelSpace {
 
     pub fn model_spec(&self, values: &ParameterValues, wavelength_um: f64) -> ModelSpec {
         ModelSpec {
-            distribution: self.kind.distribution(values),
+            distribution: self.kind.with_parameters(|p| values.get(p)),
             shadowing: self.shadowing,
             n: values.get(Parameter::N),
             k: values.get(Parameter::K),

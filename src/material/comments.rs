@@ -4,6 +4,8 @@
 //! comments are added to the serialized document with `toml_edit`, so the values are exactly
 //! what serde wrote; docs/materials.md has the longer explanations.
 
+use crate::pbrdf::{DistributionKind, Parameter};
+use std::borrow::Cow;
 use toml_edit::{DocumentMut, Item, Table};
 
 /// Above the first key of the file.
@@ -98,16 +100,29 @@ const TABLES: &[(&str, &str)] = &[
     ),
 ];
 
+/// The keys of `[model]` that are not model parameters (those explain themselves in
+/// [`crate::pbrdf::terms`]); `distribution` lists the laws of [`DistributionKind`].
 const MODEL: &[(&str, &str)] = &[
-    ("distribution", "facet slope distribution P(θ): \"cauchy\" (Student-t, Wellems 2006) or \"gaussian\" (Beckmann)"),
-    ("sigma", "slope parameter σ (dimensionless): Gaussian rms slope per axis; Cauchy a = 2σ² (q = 2 is GGX, α = √2σ)"),
-    ("q", "Cauchy tail exponent q (> 1; > 1.5 with Smith): small q puts more facets at steep tilts"),
     ("shadowing", "shadowing/masking G: \"none\" (G = 1), \"torrance-sparrow\" or \"smith\" (energy conserving)"),
-    ("n", "real part n of the complex refractive index N = n + ik at wavelength_um"),
-    ("k", "extinction coefficient k (imaginary part of N, ≥ 0): absorption"),
-    ("rho_d", "unpolarized diffuse reflectance ρ_d (0–1): adds ρ_d/π to m00 only"),
     ("wavelength_um", "wavelength of the measurement the model was fitted to, µm"),
 ];
+
+/// Every key of `[model]` with its comment.
+fn model_keys() -> Vec<(&'static str, Cow<'static, str>)> {
+    let laws: Vec<String> = DistributionKind::ALL
+        .iter()
+        .map(|kind| format!("\"{kind}\" ({})", kind.description()))
+        .collect();
+    let distribution = format!("facet slope distribution P(θ): {}", laws.join(" or "));
+    let parameters = Parameter::ALL
+        .iter()
+        .map(|p| (p.name(), Cow::Borrowed(p.info().comment)));
+    let others = MODEL.iter().map(|&(key, text)| (key, Cow::Borrowed(text)));
+    std::iter::once(("distribution", Cow::Owned(distribution)))
+        .chain(parameters)
+        .chain(others)
+        .collect()
+}
 
 const FIT: &[(&str, &str)] = &[
     ("source", "the measurement CSV as given to `irpol fit` (relative to where it ran)"),
@@ -161,15 +176,35 @@ const PROFILE_BOUND: &[(&str, &str)] = &[
     ("confidence", "the confidence of each side's bound"),
 ];
 
+/// The keys of one table explained line by line.
+#[derive(Clone, Copy)]
+enum Keys {
+    Fixed(&'static [(&'static str, &'static str)]),
+    /// `[model]` and its copies: [`model_keys`].
+    Model,
+}
+
+impl Keys {
+    fn comments(self) -> Vec<(&'static str, Cow<'static, str>)> {
+        match self {
+            Keys::Fixed(keys) => keys
+                .iter()
+                .map(|&(key, text)| (key, Cow::Borrowed(text)))
+                .collect(),
+            Keys::Model => model_keys(),
+        }
+    }
+}
+
 /// The keys explained line by line, by table path; other tables get only their block. A path
 /// ending in `.*` stands for every subtable of its parent (one per parameter).
-const KEYED: &[(&str, &[(&str, &str)])] = &[
-    ("model", MODEL),
-    ("fit", FIT),
-    ("fit.merged_sources", MERGED_SOURCE),
-    ("fit.alternative", ALTERNATIVE),
-    ("fit.alternative.model", MODEL),
-    ("fit.profile_bounds.*", PROFILE_BOUND),
+const KEYED: &[(&str, Keys)] = &[
+    ("model", Keys::Model),
+    ("fit", Keys::Fixed(FIT)),
+    ("fit.merged_sources", Keys::Fixed(MERGED_SOURCE)),
+    ("fit.alternative", Keys::Fixed(ALTERNATIVE)),
+    ("fit.alternative.model", Keys::Model),
+    ("fit.profile_bounds.*", Keys::Fixed(PROFILE_BOUND)),
 ];
 
 /// The entry of `entries` for the table at `path`: its own, or its parent's `.*` entry.
@@ -187,7 +222,7 @@ fn entry_for<'e, T>(entries: &'e [(&str, T)], path: &str) -> Option<&'e T> {
 pub(super) fn commented(text: &str) -> Result<String, toml_edit::TomlError> {
     let mut document: DocumentMut = text.parse()?;
     let root = document.as_table_mut();
-    explain_keys(root, TOP);
+    explain_keys(root, &Keys::Fixed(TOP).comments());
     if let Some(mut name) = root.key_mut(TOP[0].0) {
         let explained = comment_lines(TOP[0].1);
         name.leaf_decor_mut()
@@ -217,7 +252,7 @@ fn decorate_tables(table: &mut Table, path: &str) {
                     .set_prefix(format!("\n{}", comment_lines(block)));
             }
             if let Some(keys) = entry_for(KEYED, &path) {
-                explain_keys(table, keys);
+                explain_keys(table, &keys.comments());
             }
             decorate_tables(table, &path);
         }
@@ -225,7 +260,7 @@ fn decorate_tables(table: &mut Table, path: &str) {
 }
 
 /// A comment line above each key of `table` that `comments` explains.
-fn explain_keys(table: &mut Table, comments: &[(&str, &str)]) {
+fn explain_keys(table: &mut Table, comments: &[(&str, Cow<'static, str>)]) {
     for (key, comment) in comments {
         if let Some(mut key) = table.key_mut(key) {
             key.leaf_decor_mut().set_prefix(comment_lines(comment));
@@ -243,11 +278,11 @@ fn comment_lines(text: &str) -> String {
 #[cfg(test)]
 pub(super) fn explained_keys(path: &str) -> Option<Vec<&'static str>> {
     let keys = if path.is_empty() {
-        Some(TOP)
+        Some(Keys::Fixed(TOP))
     } else {
         entry_for(KEYED, path).copied()
     };
-    keys.map(|keys| keys.iter().map(|(key, _)| *key).collect())
+    keys.map(|keys| keys.comments().iter().map(|(key, _)| *key).collect())
 }
 
 #[cfg(test)]

@@ -2,21 +2,22 @@
 //! was fitted, and its uncertainties. Written atomically; read by `render` and `report`.
 
 mod comments;
+mod raw;
 mod scene_materials;
 mod spectral;
 
+pub use raw::ModelTableError;
 pub use scene_materials::{
     inline_pbrdf, share_wavelength_nodes, InlineMaterialConfig, InlineMaterialError,
     MaterialResolver, SceneMaterial, SceneMaterialError,
 };
-use spectral::{check_wavelength, DistributionName};
 pub use spectral::{
     BandModelError, MaterialModel, OutsideTable, SpectralModel, THERMAL_EMISSIVITY_REFERENCE_K,
 };
 
 use crate::atomic::write_atomically;
 use crate::optics::RefractiveIndex;
-use crate::pbrdf::{ModelError, Pbrdf, Shadowing, SlopeDistribution};
+use crate::pbrdf::{ModelError, Parameter, Pbrdf, Shadowing, SlopeDistribution};
 use crate::text::{number, shown, shown_at_most, significant};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -48,10 +49,10 @@ pub enum MaterialError {
 }
 
 /// The pBRDF parameters of a material (docs/design.md §1.3) at one wavelength. Read through
-/// `RawModelSpec`, which refuses unknown keys: serde cannot deny them on a struct with a
+/// [`raw::RawModel`], which refuses unknown keys: serde cannot deny them on a struct with a
 /// flattened field, and a typo such as `rho = 0.5` must not silently give ρ_d = 0.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "RawModelSpec")]
+#[serde(try_from = "raw::RawModel<f64>")]
 pub struct ModelSpec {
     #[serde(flatten)]
     pub distribution: SlopeDistribution,
@@ -63,39 +64,18 @@ pub struct ModelSpec {
     pub wavelength_um: f64,
 }
 
-/// [`ModelSpec`] as written in a material file: flat, every key known.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawModelSpec {
-    distribution: DistributionName,
-    sigma: f64,
-    q: Option<f64>,
-    shadowing: Shadowing,
-    n: f64,
-    k: f64,
-    #[serde(default)]
-    rho_d: f64,
-    wavelength_um: f64,
-}
-
-impl TryFrom<RawModelSpec> for ModelSpec {
-    type Error = String;
-
-    fn try_from(raw: RawModelSpec) -> Result<ModelSpec, String> {
-        let distribution = raw.distribution.with(raw.sigma, raw.q)?;
-        let lambda = check_wavelength(raw.wavelength_um)?;
-        Ok(ModelSpec {
-            distribution,
-            shadowing: raw.shadowing,
-            n: raw.n,
-            k: raw.k,
-            rho_d: raw.rho_d,
-            wavelength_um: lambda,
-        })
-    }
-}
-
 impl ModelSpec {
+    /// The value of a model parameter; `None` for a slope parameter the distribution does not
+    /// have (q of the Gaussian).
+    pub fn parameter(&self, parameter: Parameter) -> Option<f64> {
+        match parameter {
+            Parameter::N => Some(self.n),
+            Parameter::K => Some(self.k),
+            Parameter::RhoD => Some(self.rho_d),
+            slope => self.distribution.parameter(slope),
+        }
+    }
+
     pub fn pbrdf(&self) -> Result<Pbrdf, ModelError> {
         Pbrdf::new(
             self.distribution,
@@ -510,6 +490,17 @@ mod tests {
         );
         let document: toml_edit::DocumentMut = text.parse().unwrap();
         assert_every_field_explained(document.as_table(), "");
+    }
+
+    /// The shipped fits were written by `irpol fit`: read and written again, they keep every
+    /// byte, comments included (the comments come from the model's registry).
+    #[test]
+    fn shipped_fits_are_written_back_byte_for_byte() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fits");
+        for (path, material) in list_library(&dir).unwrap() {
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert_eq!(material.to_toml(&path).unwrap(), text, "{}", path.display());
+        }
     }
 
     fn is_comment(decor: &toml_edit::Decor) -> bool {

@@ -5,18 +5,14 @@
 //! A grey model is the same at every wavelength.
 
 use super::ModelSpec;
-use crate::optics::{
-    Band, LorentzDispersion, TableMissesBand, WavelengthNodes, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM,
-};
+use crate::optics::{Band, LorentzDispersion, TableMissesBand, WavelengthNodes};
 use crate::pbrdf::{BandPbrdf, ModelError, Shadowing, SlopeDistribution};
 use crate::text::number;
 use serde::{Deserialize, Serialize};
 
-use crate::measure::SAME_WAVELENGTH_UM;
-
 /// A material's model over wavelength.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged, try_from = "RawModel")]
+#[serde(untagged, try_from = "super::raw::RawModel<super::raw::OneOrMany>")]
 pub enum MaterialModel {
     /// One N = n + ik and ρ_d, used at every wavelength (`wavelength_um` is where it was measured).
     Grey(ModelSpec),
@@ -221,152 +217,6 @@ impl MaterialModel {
             MaterialModel::Spectral(m) => m.nodes().try_for_each(|node| node.pbrdf().map(drop)),
         }
     }
-}
-
-/// A number or a list of numbers (a grey or a spectral key of `[model]`).
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum OneOrMany {
-    One(f64),
-    Many(Vec<f64>),
-}
-
-/// `[model]` as written in a material file: flat, every key known.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawModel {
-    distribution: DistributionName,
-    sigma: f64,
-    q: Option<f64>,
-    shadowing: Shadowing,
-    n: OneOrMany,
-    k: OneOrMany,
-    rho_d: Option<OneOrMany>,
-    wavelength_um: OneOrMany,
-    dispersion: Option<LorentzDispersion>,
-}
-
-/// The distribution names of [`SlopeDistribution`] as written in a material file.
-#[derive(Clone, Copy, Debug, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub(super) enum DistributionName {
-    Cauchy,
-    Gaussian,
-}
-
-impl DistributionName {
-    /// The distribution of a name, σ and q (which only the Cauchy one has).
-    pub(super) fn with(self, sigma: f64, q: Option<f64>) -> Result<SlopeDistribution, String> {
-        match (self, q) {
-            (DistributionName::Cauchy, Some(q)) => Ok(SlopeDistribution::Cauchy { sigma, q }),
-            (DistributionName::Cauchy, None) => Err("the cauchy distribution needs q".into()),
-            (DistributionName::Gaussian, None) => Ok(SlopeDistribution::Gaussian { sigma }),
-            (DistributionName::Gaussian, Some(_)) => {
-                Err("q applies to the cauchy distribution only".into())
-            }
-        }
-    }
-}
-
-/// Refuses a wavelength irpol does not model.
-pub(super) fn check_wavelength(lambda: f64) -> Result<f64, String> {
-    if lambda.is_finite() && (MIN_WAVELENGTH_UM..=MAX_WAVELENGTH_UM).contains(&lambda) {
-        Ok(lambda)
-    } else {
-        Err(format!(
-            "wavelength_um = {} is outside 0.1–1000 µm, the wavelengths irpol models",
-            number(lambda)
-        ))
-    }
-}
-
-impl TryFrom<RawModel> for MaterialModel {
-    type Error = String;
-
-    fn try_from(raw: RawModel) -> Result<MaterialModel, String> {
-        let distribution = raw.distribution.with(raw.sigma, raw.q)?;
-        let rho_d = raw.rho_d.unwrap_or(OneOrMany::One(0.0));
-        match (raw.wavelength_um, raw.n, raw.k, rho_d) {
-            (OneOrMany::One(w), OneOrMany::One(n), OneOrMany::One(k), OneOrMany::One(rho_d)) => {
-                if raw.dispersion.is_some() {
-                    return Err("a dispersion law needs tables: wavelength_um, n and k as \
-                                arrays"
-                        .into());
-                }
-                Ok(MaterialModel::Grey(ModelSpec {
-                    distribution,
-                    shadowing: raw.shadowing,
-                    n,
-                    k,
-                    rho_d,
-                    wavelength_um: check_wavelength(w)?,
-                }))
-            }
-            (OneOrMany::Many(wavelength_um), OneOrMany::Many(n), OneOrMany::Many(k), rho_d) => {
-                let rho_d = match rho_d {
-                    OneOrMany::One(r) => vec![r; wavelength_um.len()],
-                    OneOrMany::Many(r) => r,
-                };
-                let model = SpectralModel {
-                    distribution,
-                    shadowing: raw.shadowing,
-                    wavelength_um,
-                    n,
-                    k,
-                    rho_d,
-                    dispersion: raw.dispersion,
-                };
-                check_table(&model)?;
-                Ok(MaterialModel::Spectral(model))
-            }
-            _ => Err(
-                "wavelength_um, n and k must be all numbers (a grey material) or all \
-                      arrays of equal length (a spectral one)"
-                    .into(),
-            ),
-        }
-    }
-}
-
-/// Refuses a table that is not one: fewer than two nodes, unequal lengths, wavelengths out of
-/// range or not strictly ascending, an unphysical dispersion law.
-fn check_table(model: &SpectralModel) -> Result<(), String> {
-    let count = model.wavelength_um.len();
-    if count < 2 {
-        return Err(
-            "a spectral table needs at least two wavelengths (write numbers for a grey material)"
-                .into(),
-        );
-    }
-    for (name, len) in [
-        ("n", model.n.len()),
-        ("k", model.k.len()),
-        ("rho_d", model.rho_d.len()),
-    ] {
-        if len != count {
-            return Err(format!(
-                "{name} has {len} values for {count} wavelengths (wavelength_um)"
-            ));
-        }
-    }
-    for &w in &model.wavelength_um {
-        check_wavelength(w)?;
-    }
-    if let Some(pair) = model
-        .wavelength_um
-        .windows(2)
-        .find(|p| p[1] - p[0] <= SAME_WAVELENGTH_UM)
-    {
-        return Err(format!(
-            "wavelength_um must be strictly ascending ({} µm then {} µm)",
-            number(pair[0]),
-            number(pair[1])
-        ));
-    }
-    if let Some(law) = &model.dispersion {
-        law.validate().map_err(|e| format!("dispersion: {e}"))?;
-    }
-    Ok(())
 }
 
 #[cfg(test)]

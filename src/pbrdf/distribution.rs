@@ -1,11 +1,13 @@
 //! Facet slope distributions (docs/design.md §1.2) and their Smith Λ functions (docs/design.md §1.3).
 
 use super::limits::{within, MAX_Q, MAX_SIGMA, MIN_SIGMA};
+use super::terms::Parameter;
 use super::ModelError;
 use crate::elementary::inline_exp;
 use serde::{Deserialize, Serialize};
 use statrs::function::{beta::beta_reg, erf::erfc, gamma::ln_gamma};
 use std::f64::consts::PI;
+use std::fmt;
 
 /// Distribution of facet slopes m = tan θ, normalized over the hemisphere (∫ P(θ) dΩ = 1).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -28,10 +30,26 @@ impl SlopeDistribution {
         }
     }
 
-    pub fn name(&self) -> &'static str {
+    /// The family of the distribution, without its parameters.
+    pub fn kind(&self) -> DistributionKind {
         match self {
-            SlopeDistribution::Cauchy { .. } => "cauchy",
-            SlopeDistribution::Gaussian { .. } => "gaussian",
+            SlopeDistribution::Cauchy { .. } => DistributionKind::Cauchy,
+            SlopeDistribution::Gaussian { .. } => DistributionKind::Gaussian,
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        self.kind().name()
+    }
+
+    /// The value of one of the distribution's [`DistributionKind::parameters`]; `None` for any
+    /// other parameter.
+    pub fn parameter(&self, parameter: Parameter) -> Option<f64> {
+        match (*self, parameter) {
+            (SlopeDistribution::Cauchy { sigma, .. }, Parameter::Sigma)
+            | (SlopeDistribution::Gaussian { sigma }, Parameter::Sigma) => Some(sigma),
+            (SlopeDistribution::Cauchy { q, .. }, Parameter::Q) => Some(q),
+            _ => None,
         }
     }
 
@@ -86,6 +104,163 @@ impl SlopeDistribution {
             },
         }
     }
+}
+
+/// A slope distribution family without its parameters: the one vocabulary of distribution names
+/// (material files, scene files, the command line, fits and reports all parse and print them
+/// here). A new slope law is a variant here, its arms in [`SlopeDistribution`], and its
+/// parameters in [`super::terms`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DistributionKind {
+    Cauchy,
+    Gaussian,
+}
+
+/// Why a distribution name or a distribution's parameters are refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DistributionError {
+    #[error("unknown distribution '{0}': use {names}", names = DistributionKind::names())]
+    Unknown(String),
+    #[error("the {0} distribution needs q")]
+    NeedsQ(DistributionKind),
+    #[error(
+        "q applies to the {} distribution only",
+        DistributionKind::names_with(Parameter::Q)
+    )]
+    StrayQ(DistributionKind),
+}
+
+impl DistributionKind {
+    /// Every family, in the order fits try them (the first wins a tie of equal complexity).
+    pub const ALL: [DistributionKind; 2] = [DistributionKind::Cauchy, DistributionKind::Gaussian];
+
+    /// The name in files and on the command line (serde writes the same, lowercased).
+    pub fn name(&self) -> &'static str {
+        match self {
+            DistributionKind::Cauchy => "cauchy",
+            DistributionKind::Gaussian => "gaussian",
+        }
+    }
+
+    /// Who the law is known by, for the material file's comment.
+    pub fn description(&self) -> &'static str {
+        match self {
+            DistributionKind::Cauchy => "Student-t, Wellems 2006",
+            DistributionKind::Gaussian => "Beckmann",
+        }
+    }
+
+    /// The slope parameters of the family, in canonical order.
+    pub fn parameters(&self) -> &'static [Parameter] {
+        match self {
+            DistributionKind::Cauchy => &[Parameter::Sigma, Parameter::Q],
+            DistributionKind::Gaussian => &[Parameter::Sigma],
+        }
+    }
+
+    /// Parses a name of [`DistributionKind::name`] (surrounding blanks ignored).
+    pub fn parse(text: &str) -> Result<DistributionKind, DistributionError> {
+        let name = text.trim();
+        DistributionKind::ALL
+            .into_iter()
+            .find(|kind| kind.name() == name)
+            .ok_or_else(|| DistributionError::Unknown(text.to_owned()))
+    }
+
+    /// "cauchy or gaussian": every name, for messages and help.
+    pub fn names() -> String {
+        Self::listed(DistributionKind::ALL.iter())
+    }
+
+    /// The names of the families that have `parameter` ("cauchy" for q).
+    fn names_with(parameter: Parameter) -> String {
+        Self::listed(
+            DistributionKind::ALL
+                .iter()
+                .filter(|kind| kind.parameters().contains(&parameter)),
+        )
+    }
+
+    fn listed<'a>(kinds: impl Iterator<Item = &'a DistributionKind>) -> String {
+        kinds
+            .map(|kind| kind.name())
+            .collect::<Vec<_>>()
+            .join(" or ")
+    }
+
+    /// Whether `parameter` belongs to this family's model: every parameter but the slope
+    /// parameters of the other families (q is Cauchy-only).
+    pub fn has(&self, parameter: Parameter) -> bool {
+        self.parameters().contains(&parameter)
+            || !DistributionKind::ALL
+                .iter()
+                .any(|kind| kind.parameters().contains(&parameter))
+    }
+
+    /// The first other family (the alternative of a model comparison between two).
+    pub fn other(&self) -> DistributionKind {
+        DistributionKind::ALL
+            .into_iter()
+            .find(|kind| kind != self)
+            .expect("there is more than one family")
+    }
+
+    /// The distribution of this family with σ and q, refused when q is missing for a family
+    /// that has it or given for one that has not.
+    pub fn with(self, sigma: f64, q: Option<f64>) -> Result<SlopeDistribution, DistributionError> {
+        match (self.has(Parameter::Q), q) {
+            (true, None) => Err(DistributionError::NeedsQ(self)),
+            (false, Some(_)) => Err(DistributionError::StrayQ(self)),
+            (_, q) => Ok(self.with_parameters(|p| match p {
+                Parameter::Q => q.unwrap_or(f64::NAN),
+                _ => sigma,
+            })),
+        }
+    }
+
+    /// The distribution of this family with each of its [`DistributionKind::parameters`] taken
+    /// from `value` (e.g. a fit's full parameter vector).
+    pub fn with_parameters(self, value: impl Fn(Parameter) -> f64) -> SlopeDistribution {
+        let sigma = value(Parameter::Sigma);
+        match self {
+            DistributionKind::Cauchy => SlopeDistribution::Cauchy {
+                sigma,
+                q: value(Parameter::Q),
+            },
+            DistributionKind::Gaussian => SlopeDistribution::Gaussian { sigma },
+        }
+    }
+}
+
+impl fmt::Display for DistributionKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for DistributionKind {
+    type Err = DistributionError;
+
+    fn from_str(text: &str) -> Result<DistributionKind, DistributionError> {
+        DistributionKind::parse(text)
+    }
+}
+
+/// [`DistributionKind::parse`] as a function: what scene files, material files and the command
+/// line call to read a distribution name.
+pub fn parse_distribution(text: &str) -> Result<DistributionKind, DistributionError> {
+    DistributionKind::parse(text)
+}
+
+/// The distribution named `name` with σ and q ([`DistributionKind::with`]): a model written as
+/// a name and its parameters (e.g. a scene's inline material) in one call.
+pub fn slope_distribution(
+    name: &str,
+    sigma: f64,
+    q: Option<f64>,
+) -> Result<SlopeDistribution, DistributionError> {
+    parse_distribution(name)?.with(sigma, q)
 }
 
 /// A validated distribution with its constants computed once.
@@ -335,6 +510,39 @@ impl HalfBetaRatio {
 mod tests {
     use super::*;
     use gauss_quad::legendre::GaussLegendre;
+
+    #[test]
+    fn kinds_name_parse_and_build_their_distributions() {
+        for kind in DistributionKind::ALL {
+            assert_eq!(DistributionKind::parse(kind.name()), Ok(kind));
+            assert_eq!(parse_distribution(&format!(" {kind} ")), Ok(kind));
+            // serde reads and writes the same names.
+            let json = serde_json::to_string(&kind).unwrap();
+            assert_eq!(json, format!("\"{}\"", kind.name()));
+            let q = kind.has(Parameter::Q).then_some(2.5);
+            let distribution = kind.with(0.1, q).unwrap();
+            assert_eq!(
+                (distribution.kind(), distribution.name()),
+                (kind, kind.name())
+            );
+        }
+        let message = |e: DistributionError| e.to_string();
+        assert_eq!(
+            message(DistributionKind::parse("beckmann").unwrap_err()),
+            "unknown distribution 'beckmann': use cauchy or gaussian"
+        );
+        assert_eq!(
+            message(DistributionKind::Cauchy.with(0.1, None).unwrap_err()),
+            "the cauchy distribution needs q"
+        );
+        assert_eq!(
+            message(DistributionKind::Gaussian.with(0.1, Some(2.0)).unwrap_err()),
+            "q applies to the cauchy distribution only"
+        );
+        assert!(!DistributionKind::Gaussian.has(Parameter::Q));
+        assert!(DistributionKind::Gaussian.has(Parameter::RhoD));
+        assert_eq!(DistributionKind::Cauchy.other(), DistributionKind::Gaussian);
+    }
 
     fn gl(n: usize) -> GaussLegendre {
         GaussLegendre::new(n.try_into().unwrap())

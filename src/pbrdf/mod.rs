@@ -12,13 +12,17 @@ pub mod limits;
 mod model;
 mod sample;
 mod shadowing;
+pub mod terms;
 mod visible_slopes;
 
 pub use crate::optics::Direction;
 pub use band::{BandPbrdf, MaterialOptics};
-pub use distribution::SlopeDistribution;
+pub use distribution::{
+    parse_distribution, slope_distribution, DistributionError, DistributionKind, SlopeDistribution,
+};
 pub use error::ModelError;
 pub use geometry::{fold_signed_zenith, signed_zenith_note};
 pub use hemisphere::{cosine_hemisphere_rule, HemisphereQuadrature};
 pub use model::{Pbrdf, ScatteringGeometry};
 pub use shadowing::Shadowing;
+pub use terms::{OutsideDomain, Parameter, ParameterInfo, Term};

@@ -405,7 +405,7 @@ fn spectral_model(
     law: Option<LorentzDispersion>,
 ) -> SpectralModel {
     SpectralModel {
-        distribution: kind.distribution(&values[0]),
+        distribution: kind.with_parameters(|p| values[0].get(p)),
         shadowing: options.shadowing,
         wavelength_um: sets.iter().map(|s| s.wavelength_um).collect(),
         n: values.iter().map(|v| v.get(Parameter::N)).collect(),

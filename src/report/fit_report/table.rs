@@ -4,7 +4,7 @@
 
 use super::style::{draw_caption, DrawResult, LEGEND_SIZE};
 use crate::material::{ConfidenceBound, FitRecord, Material, ModelSpec};
-use crate::pbrdf::SlopeDistribution;
+use crate::pbrdf::Parameter;
 use crate::plot_style::FONT;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -80,17 +80,9 @@ pub fn format_angle(degrees: f64) -> String {
 
 /// The model parameters: (symbol, name in `FitRecord` maps, value).
 pub fn parameters(model: &ModelSpec) -> Vec<(&'static str, &'static str, Option<f64>)> {
-    let q = match model.distribution {
-        SlopeDistribution::Cauchy { q, .. } => Some(q),
-        SlopeDistribution::Gaussian { .. } => None,
-    };
-    vec![
-        ("σ", "sigma", Some(model.distribution.sigma())),
-        ("q", "q", q),
-        ("n", "n", Some(model.n)),
-        ("k", "k", Some(model.k)),
-        ("ρd", "rho_d", Some(model.rho_d)),
-    ]
+    Parameter::ALL
+        .map(|p| (p.label(), p.name(), model.parameter(p)))
+        .to_vec()
 }
 
 /// A fit map entry under the parameter's name, accepting `rho` for `rho_d` (docs/design.md §4 spelling).
@@ -380,11 +372,7 @@ fn provenance_rows(fit: &FitRecord) -> Vec<Row> {
 
 /// The table's symbol of a parameter name ("sigma" → "σ").
 pub fn symbol(name: &str) -> &str {
-    match name {
-        "sigma" => "σ",
-        "rho_d" | "rho" => "ρd",
-        other => other,
-    }
+    Parameter::parse(name).map_or(name, |p| p.label())
 }
 
 fn element_span(elements: &[String]) -> String {
@@ -621,7 +609,7 @@ fn wrap<DB: DrawingBackend>(
 mod tests {
     use super::*;
     use crate::material::AlternativeFit;
-    use crate::pbrdf::Shadowing;
+    use crate::pbrdf::{Shadowing, SlopeDistribution};
     use crate::report::fit_report::test_records::fit_record;
     use serde_json::json;
 

@@ -1,0 +1,232 @@
+//! The vocabulary of the pBRDF model (docs/design.md §1.2–1.3), declared once: its parameters
+//! (σ, q, n, k, ρ_d) with their key in files and on the command line, report label, unit, the
+//! values a model accepts, the default search bounds of a fit and the `#` comment a material file
+//! carries above the key; and its terms (the facet term and the ideal depolarizer) with the
+//! parameters each one owns. The fit, the material files and the reports read this table instead
+//! of repeating it; a new parameter or term is added here (and in the physics that uses it).
+
+use super::limits;
+use crate::text::number;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// A parameter of the pBRDF model, which a fit can adjust or hold fixed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Parameter {
+    /// Slope parameter σ of every slope distribution (docs/design.md §1.2).
+    Sigma,
+    /// Cauchy exponent q (not a parameter of the Gaussian).
+    Q,
+    /// Real part n of the refractive index.
+    N,
+    /// Extinction coefficient k.
+    K,
+    /// Diffuse reflectance ρ_d.
+    RhoD,
+}
+
+/// A term of the model: F = facet term + ideal depolarizer (docs/design.md §1.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Term {
+    /// P(θ) G M(β) / (4 cosθ cosθ_i cosθ_r): the slope distribution's parameters and N = n + ik.
+    Facet,
+    /// (ρ_d/π) diag(1, 0, 0, 0): unpolarized diffuse reflection.
+    IdealDepolarizer,
+}
+
+/// What the crate knows about one [`Parameter`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParameterInfo {
+    /// The name on the command line, in material files and in fit records.
+    pub key: &'static str,
+    /// Further names the command line accepts (`rho` for ρ_d, docs/design.md §4).
+    pub aliases: &'static [&'static str],
+    /// The symbol in report tables.
+    pub label: &'static str,
+    pub unit: &'static str,
+    /// The term of the model the parameter belongs to.
+    pub term: Term,
+    /// The values a model accepts ([`limits`]): (lowest, highest, whether the lowest itself is
+    /// excluded).
+    pub domain: (f64, f64, bool),
+    /// The search interval of a fit unless `--bounds` says otherwise.
+    pub default_bounds: (f64, f64),
+    /// The `#` line above the key in a material file's `[model]`.
+    pub comment: &'static str,
+}
+
+/// Every parameter's entry, in [`Parameter::ALL`] order.
+const REGISTRY: [ParameterInfo; 5] = [
+    ParameterInfo {
+        key: "sigma",
+        aliases: &[],
+        label: "σ",
+        unit: "dimensionless",
+        term: Term::Facet,
+        domain: (limits::MIN_SIGMA, limits::MAX_SIGMA, false),
+        default_bounds: (0.005, 1.5),
+        comment: "slope parameter σ (dimensionless): Gaussian rms slope per axis; Cauchy a = 2σ² (q = 2 is GGX, α = √2σ)",
+    },
+    ParameterInfo {
+        key: "q",
+        aliases: &[],
+        label: "q",
+        unit: "dimensionless",
+        term: Term::Facet,
+        // q > 1 is open: the distribution is not normalizable at 1.
+        domain: (1.0, limits::MAX_Q, true),
+        default_bounds: (1.05, 50.0),
+        comment: "Cauchy tail exponent q (> 1; > 1.5 with Smith): small q puts more facets at steep tilts",
+    },
+    ParameterInfo {
+        key: "n",
+        aliases: &[],
+        label: "n",
+        unit: "dimensionless",
+        term: Term::Facet,
+        domain: (limits::MIN_N, limits::MAX_N, false),
+        default_bounds: (0.05, 10.0),
+        comment: "real part n of the complex refractive index N = n + ik at wavelength_um",
+    },
+    ParameterInfo {
+        key: "k",
+        aliases: &[],
+        label: "k",
+        unit: "dimensionless",
+        term: Term::Facet,
+        domain: (0.0, limits::MAX_K, false),
+        default_bounds: (0.0, 50.0),
+        comment: "extinction coefficient k (imaginary part of N, ≥ 0): absorption",
+    },
+    ParameterInfo {
+        key: "rho_d",
+        aliases: &["rho"],
+        label: "ρd",
+        unit: "dimensionless",
+        term: Term::IdealDepolarizer,
+        domain: (0.0, 1.0, false),
+        default_bounds: (0.0, 1.0),
+        comment: "unpolarized diffuse reflectance ρ_d (0–1): adds ρ_d/π to m00 only",
+    },
+];
+
+/// A parameter value outside the values a model accepts.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("{parameter} = {} is outside {}, the values a model accepts", number(*.value), range(*.parameter))]
+pub struct OutsideDomain {
+    pub parameter: Parameter,
+    pub value: f64,
+}
+
+/// "[0.0001, 10]" or "(1, 100]": a parameter's domain as an interval.
+fn range(parameter: Parameter) -> String {
+    let (low, high, open) = parameter.domain();
+    let bracket = if open { '(' } else { '[' };
+    format!("{bracket}{}, {}]", number(low), number(high))
+}
+
+impl Parameter {
+    /// All parameters in their canonical order (the order of vectors and matrices in a fit).
+    pub const ALL: [Parameter; 5] = [
+        Parameter::Sigma,
+        Parameter::Q,
+        Parameter::N,
+        Parameter::K,
+        Parameter::RhoD,
+    ];
+
+    /// The parameter's entry in the registry.
+    pub fn info(&self) -> &'static ParameterInfo {
+        &REGISTRY[self.index()]
+    }
+
+    /// The name used on the command line and in material files.
+    pub fn name(&self) -> &'static str {
+        self.info().key
+    }
+
+    /// The symbol of report tables ("σ", "ρd").
+    pub fn label(&self) -> &'static str {
+        self.info().label
+    }
+
+    /// Parses a name of [`Parameter::name`] or one of its aliases (`rho` for ρ_d).
+    pub fn parse(text: &str) -> Option<Parameter> {
+        let text = text.trim();
+        Parameter::ALL.into_iter().find(|p| {
+            let info = p.info();
+            info.key == text || info.aliases.contains(&text)
+        })
+    }
+
+    /// Position in [`Parameter::ALL`].
+    pub fn index(&self) -> usize {
+        *self as usize
+    }
+
+    /// The values a model accepts ([`limits`]): (lowest, highest, whether the lowest itself is
+    /// excluded).
+    pub fn domain(&self) -> (f64, f64, bool) {
+        self.info().domain
+    }
+
+    /// Refuses a value outside [`Parameter::domain`] (or not finite), naming the range.
+    pub fn check(&self, value: f64) -> Result<(), OutsideDomain> {
+        let (low, high, open) = self.domain();
+        let above_low = if open { value > low } else { value >= low };
+        if value.is_finite() && above_low && value <= high {
+            Ok(())
+        } else {
+            Err(OutsideDomain {
+                parameter: *self,
+                value,
+            })
+        }
+    }
+}
+
+impl fmt::Display for Parameter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Term {
+    pub const ALL: [Term; 2] = [Term::Facet, Term::IdealDepolarizer];
+
+    /// The parameters of the term, in canonical order (the facet term's slope parameters are
+    /// those of every distribution: [`super::DistributionKind::parameters`] says which one has
+    /// which).
+    pub fn parameters(self) -> impl Iterator<Item = Parameter> {
+        Parameter::ALL
+            .into_iter()
+            .filter(move |p| p.info().term == self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_parse_back_and_every_parameter_has_one_term() {
+        for parameter in Parameter::ALL {
+            assert_eq!(Parameter::parse(parameter.name()), Some(parameter));
+            let owners = Term::ALL
+                .iter()
+                .filter(|t| t.parameters().any(|p| p == parameter))
+                .count();
+            assert_eq!(owners, 1, "{parameter}");
+            let (low, high) = parameter.info().default_bounds;
+            assert!(parameter.check(low).is_ok() && parameter.check(high).is_ok());
+        }
+        assert_eq!(Parameter::parse(" rho "), Some(Parameter::RhoD));
+        assert_eq!(Parameter::parse("alpha"), None);
+        // serde's names are the registry's keys.
+        for parameter in Parameter::ALL {
+            let json = serde_json::to_string(&parameter).unwrap();
+            assert_eq!(json, format!("\"{}\"", parameter.name()));
+        }
+    }
+}
