@@ -2,14 +2,13 @@
 //! its thermal run (docs/design.md §2.6).
 
 use super::error::single_line;
-use super::thermal::solve;
 use super::AppError;
 use crate::atomic::write_atomically;
 use crate::output::{write_outputs, RenderSummary};
 use crate::progress::Progress;
 use crate::render::render;
 use crate::scene::{load_scene, load_scene_text, Scene};
-use crate::thermal_scene::{scene_at, ThermalSolution};
+use crate::thermal_scene::{scene_at, solve_scene, ThermalSolution};
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbaImage};
 use std::path::{Path, PathBuf};
@@ -257,4 +256,17 @@ fn caption_strip(text: &str, width: u32) -> Result<RgbaImage, AppError> {
     let strip = image::RgbImage::from_raw(width, HEIGHT, rgb)
         .ok_or_else(|| AppError::invalid("caption buffer has the wrong size"))?;
     Ok(image::DynamicImage::ImageRgb8(strip).to_rgba8())
+}
+
+/// The scene's thermal run (recording `times` too), its failure naming the scene file.
+pub(crate) fn solve(
+    scene: &Scene,
+    scene_path: &Path,
+    times: &[f64],
+    progress: &dyn Progress,
+) -> Result<ThermalSolution, AppError> {
+    solve_scene(scene, times, progress).map_err(|source| AppError::ThermalRun {
+        path: scene_path.to_owned(),
+        source: Box::new(source),
+    })
 }

@@ -1,11 +1,11 @@
 //! `irpol thermal`: a scene's temperatures over its `[thermal]` run (docs/design.md §1.8, §2.6).
 
-use super::render::{render_solution_at, TimedRender};
+use super::render::{render_solution_at, solve, TimedRender};
 use super::AppError;
 use crate::output::thermal::{write_thermal_outputs, ThermalSummary};
 use crate::progress::Progress;
 use crate::scene::{load_scene, Scene};
-use crate::thermal_scene::{solve_scene, ThermalSolution};
+use crate::thermal_scene::ThermalSolution;
 use std::path::Path;
 use std::time::Instant;
 
@@ -39,19 +39,6 @@ pub fn run_thermal_and_render(
     let summary = write_thermal(&scene, &solution, thermal_out, seconds)?;
     let renders = render_solution_at(&scene, &solution, times, render_out, progress)?;
     Ok((summary, renders))
-}
-
-/// The scene's thermal run (recording `times` too), its failure naming the scene file.
-pub(crate) fn solve(
-    scene: &Scene,
-    scene_path: &Path,
-    times: &[f64],
-    progress: &dyn Progress,
-) -> Result<ThermalSolution, AppError> {
-    solve_scene(scene, times, progress).map_err(|source| AppError::ThermalRun {
-        path: scene_path.to_owned(),
-        source: Box::new(source),
-    })
 }
 
 fn write_thermal(

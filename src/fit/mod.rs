@@ -24,6 +24,7 @@ mod model_fit;
 mod nelder_mead;
 mod objective;
 mod optimize;
+mod option_error;
 mod options;
 mod outcome;
 pub mod parameters;
@@ -46,7 +47,8 @@ pub use model_fit::ModelFit;
 pub use nelder_mead::NelderMeadSettings;
 pub use objective::{BoxCost, Objective};
 pub use optimize::OptimizerSettings;
-pub use options::{parse_parameter_list, parse_parameter_values, FitOptions, OptionError};
+pub use option_error::OptionError;
+pub use options::{parse_parameter_list, parse_parameter_values, FitOptions};
 pub use outcome::{fit_measurement, FitOutcome};
 pub use parameters::{
     DistributionKind, Interval, InvalidBounds, Parameter, ParameterBounds, ParameterValues,

@@ -2,7 +2,7 @@
 //! detector spike) from pulling the fit. Off by default: with honest uncertainties plain least
 //! squares is the maximum-likelihood estimate and its χ² is what the statistics assume.
 
-use super::options::OptionError;
+use super::option_error::OptionError;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 

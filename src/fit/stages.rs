@@ -1,6 +1,6 @@
 //! The optimizer stages of a fit and the record each leaves behind (its convergence history).
 
-use super::options::OptionError;
+use super::option_error::OptionError;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 

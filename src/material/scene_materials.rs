@@ -3,7 +3,7 @@
 
 use super::{find_material, BandModelError, Material, MaterialError, MaterialModel, SpectralModel};
 use crate::optics::{Band, RefractiveIndex, TableMissesBand};
-use crate::pbrdf::{MaterialOptics, ModelError, Pbrdf, SlopeDistribution};
+use crate::pbrdf::{slope_distribution, DistributionError, MaterialOptics, ModelError, Pbrdf};
 use serde::Deserialize;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -48,23 +48,11 @@ pub struct SceneMaterial {
 /// An inline material's keys do not make a pBRDF.
 #[derive(Debug, thiserror::Error)]
 pub enum InlineMaterialError {
-    /// The distribution name, or its `q`, is wrong.
+    /// The distribution name, or its `q`, is wrong (the material file's words for it).
     #[error("{0}")]
-    Distribution(String),
+    Distribution(#[from] DistributionError),
     #[error("{0}")]
     Model(ModelError),
-}
-
-impl From<&str> for InlineMaterialError {
-    fn from(message: &str) -> Self {
-        InlineMaterialError::Distribution(message.to_owned())
-    }
-}
-
-impl From<String> for InlineMaterialError {
-    fn from(message: String) -> Self {
-        InlineMaterialError::Distribution(message)
-    }
 }
 
 /// A material of a scene cannot be used. The inner errors are part of the message (not a
@@ -290,15 +278,7 @@ pub fn share_wavelength_nodes(
 }
 
 pub fn inline_pbrdf(m: &InlineMaterialConfig) -> Result<Pbrdf, InlineMaterialError> {
-    let distribution = match (m.distribution.as_str(), m.q) {
-        ("cauchy", Some(q)) => SlopeDistribution::Cauchy { sigma: m.sigma, q },
-        ("cauchy", None) => return Err("distribution cauchy needs q".into()),
-        ("gaussian", None) => SlopeDistribution::Gaussian { sigma: m.sigma },
-        ("gaussian", Some(_)) => return Err("distribution gaussian takes no q".into()),
-        (other, _) => {
-            return Err(format!("distribution '{other}' is unknown (cauchy or gaussian)").into())
-        }
-    };
+    let distribution = slope_distribution(&m.distribution, m.sigma, m.q)?;
     Pbrdf::new(
         distribution,
         m.shadowing,
