@@ -5,18 +5,18 @@ mod cli;
 
 use clap::{Args, Parser, Subcommand};
 use cli::progress::TerminalProgress;
-use irpol::atomic::staging_folder;
-use irpol::commands::evaluate::{
+use irpol::app::evaluate::{
     geometry_table, write_emissivity_csv, write_mueller_csv, GeometryTable,
 };
-use irpol::commands::fit::{fit_and_write, FitFlags};
-use irpol::commands::render::{
+use irpol::app::fit::{fit_and_write, FitFlags};
+use irpol::app::render::{
     default_output_dir, instant_folder, render_scene, render_scene_at, Instants, TimedRender,
 };
-use irpol::commands::scene_init::write_starter_scene;
-use irpol::commands::sun::{given_times, write_sun_csv};
-use irpol::commands::thermal::{run_thermal, run_thermal_and_render};
-use irpol::commands::{parse_sweep, AppError, ModelArgs};
+use irpol::app::scene_init::write_starter_scene;
+use irpol::app::sun::{given_times, write_sun_csv};
+use irpol::app::thermal::{run_thermal, run_thermal_and_render};
+use irpol::app::{parse_sweep, AppError, ModelArgs};
+use irpol::atomic::staging_folder;
 use irpol::fit::{FitOptions, MaterialFit};
 use irpol::material::MaterialModel;
 use irpol::output::thermal::ThermalSummary;

@@ -7,7 +7,7 @@
 //! scene), `<!-- check: file NAME -->` (a file the scenes on the page may use, written next to
 //! them as NAME) and `<!-- check: material -->` (a material TOML).
 
-use irpol::commands::render::render_scene;
+use irpol::app::render::render_scene;
 use irpol::material::Material;
 use irpol::progress::Silent;
 use irpol::scene::load_scene;

@@ -9,7 +9,7 @@
 //! together they take well under 20 s in a release build. Raise `FUZZ_CASES` (environment) to
 //! fuzz longer, e.g. `FUZZ_CASES=100000 cargo test --release --test fuzz_readers`.
 
-use irpol::commands::evaluate::{parse_geometry_csv, write_mueller_csv};
+use irpol::app::evaluate::{parse_geometry_csv, write_mueller_csv};
 use irpol::material::Material;
 use irpol::measure::parse_measurement_csv;
 use irpol::optics::RefractiveIndex;

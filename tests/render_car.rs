@@ -3,7 +3,7 @@
 
 mod common;
 
-use irpol::commands::render::render_scene;
+use irpol::app::render::render_scene;
 use irpol::optics::Band;
 use irpol::progress::Silent;
 use irpol::render::{render, BACKGROUND};

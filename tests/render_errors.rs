@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use irpol::commands::render::render_scene;
+use irpol::app::render::render_scene;
 use irpol::progress::Silent;
 use std::path::Path;
 

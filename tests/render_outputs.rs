@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use irpol::commands::render::render_scene;
+use irpol::app::render::render_scene;
 use irpol::optics::{Band, RefractiveIndex};
 use irpol::output::Channel;
 use irpol::pbrdf::{HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};

@@ -3,7 +3,7 @@
 //! the error's type: `OSError` when a file could not be read or written (an I/O error among its
 //! causes, [`AppError::is_io`]), `ValueError` for everything else (bad input).
 
-use irpol::commands::{one_line, AppError};
+use irpol::app::{one_line, AppError};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::PyErr;
 

@@ -4,7 +4,7 @@
 use crate::errors::raised;
 use crate::material::PyMaterial;
 use crate::measurements::set_dict;
-use irpol::commands::fit::FitFlags;
+use irpol::app::fit::FitFlags;
 use irpol::fit::{fit_inputs, MaterialFit};
 use irpol::measure::MeasurementSet;
 use irpol::optics::Mueller;

@@ -4,7 +4,7 @@
 
 use crate::errors::{bad_argument, raised};
 use crate::material::PyMaterial;
-use irpol::commands::material_pbrdf;
+use irpol::app::material_pbrdf;
 use irpol::optics::{Direction, Mueller};
 use irpol::pbrdf::{HemisphereQuadrature, ModelError, Pbrdf, ScatteringGeometry};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};

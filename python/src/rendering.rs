@@ -3,8 +3,8 @@
 
 use crate::errors::{bad_argument, raised};
 use crate::scene_patch::{patched, scene_text, toml_value, Missing};
-use irpol::commands::render::scene_to_render;
-use irpol::commands::AppError;
+use irpol::app::render::scene_to_render;
+use irpol::app::AppError;
 use irpol::output::{write_outputs, Channel};
 use irpol::progress::Silent;
 use irpol::render::render;

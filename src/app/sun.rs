@@ -187,7 +187,7 @@ mod tests {
         assert_eq!(read_times_file(&good).unwrap().len(), 2);
         let bad = dir.path().join("bad.txt");
         std::fs::write(&bad, "2026-06-21T10:00:00Z\n2026-06-21 11:00\n").unwrap();
-        let error = crate::commands::one_line(&read_times_file(&bad).unwrap_err());
+        let error = crate::app::one_line(&read_times_file(&bad).unwrap_err());
         assert!(
             error.contains("bad.txt:2:") && error.contains("RFC 3339"),
             "{error}"
