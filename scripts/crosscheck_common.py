@@ -384,7 +384,6 @@ def find_irpol(explicit: str | None) -> str:
         os.environ.get("IRPOL", ""),
         os.path.join(os.environ.get("CARGO_TARGET_DIR", ""), "release", "irpol") if os.environ.get("CARGO_TARGET_DIR") else "",
         os.path.join(REPO, "target", "release", "irpol"),
-        "/work/target-shared/release/irpol",
         shutil.which("irpol") or "",
     ]
     for c in candidates:
