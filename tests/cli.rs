@@ -228,7 +228,7 @@ fn demo_outside_the_repository_says_what_it_needs() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains("must be started from its root folder")
-            && stderr.contains("missing here: measurements, scenes/car.toml"),
+            && stderr.contains("missing here: measurements, fits, scenes/car.toml"),
         "{stderr}"
     );
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
