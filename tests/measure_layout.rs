@@ -147,6 +147,8 @@ fn the_shipped_ptfe_table_equals_an_independent_conversion() {
                 .all(|u| u.is_some_and(|u| u > 0.0)));
         }
         assert_eq!(set.metadata["uncertainty_model"], "estimate (mirror pairs)");
+        // The fit takes the set as it takes a file of docs/design.md §2.1.
+        irpol::fit::MeasurementData::new(set).unwrap();
         eprintln!("{}", set.notes.join("\n"));
         let note = set.notes.last().unwrap();
         assert!(note.contains("mirror pairs"), "{note}");
@@ -296,14 +298,14 @@ fn tables_that_do_not_fit_the_layout_are_refused_with_line_and_column() {
             &table("ti,tr,pr,M11,M12", "30,120,180,0.5,0.1")
         ),
         "mem/table.csv:3:4: column 'tr': 120° is not a zenith angle within (−90°, 90°): the \
-         layout says angle_unit = \"deg\"; if the file's angles are in the other unit, set \
+         layout says angle_unit = \"deg\"; if the file's angles are in radians, set \
          angle_unit = \"rad\""
     );
     let radians = GOOD_LAYOUT.replace("index_base = 1", "index_base = 1\nangle_unit = \"rad\"");
     assert_eq!(
         table_message(&radians, &table("ti,tr,pr,M11,M12", "30,0.2,3.14,0.5,0.1")),
         "mem/table.csv:3:1: column 'ti': 30 rad is not a zenith angle within (−π/2, π/2): the \
-         layout says angle_unit = \"rad\"; if the file's angles are in the other unit, set \
+         layout says angle_unit = \"rad\"; if the file's angles are in degrees, set \
          angle_unit = \"deg\""
     );
     let unsigned = GOOD_LAYOUT.replace("index_base = 1", "index_base = 1\nsigned_angles = false");

@@ -5,8 +5,6 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use super::layout::AngleUnit;
-
 /// A refused measurement input. Displays exactly as `file:line:column: what is wrong`, with the
 /// file as the caller gave it. Whole-file problems point at line 1 column 1 (or at the header
 /// row when they concern the columns).
@@ -147,11 +145,16 @@ pub enum MeasureErrorKind {
         present: &'static str,
         missing: &'static str,
     },
-    #[error("column '{column}': {value}{} is not a zenith angle within {}: the layout says angle_unit = \"{}\"; if the file's angles are in the other unit, set angle_unit = \"{}\"", .unit.symbol(), .unit.zenith_range(*.signed), .unit.name(), .unit.other().name())]
-    LayoutAngleOutOfRange {
+    #[error("column '{column}': {value}° is not a zenith angle within {}: the layout says angle_unit = \"deg\"; if the file's angles are in radians, set angle_unit = \"rad\"", if *.signed { "(−90°, 90°)" } else { "[0°, 90°)" })]
+    LayoutDegreesOutOfRange {
         column: String,
         value: String,
-        unit: AngleUnit,
+        signed: bool,
+    },
+    #[error("column '{column}': {value} rad is not a zenith angle within {}: the layout says angle_unit = \"rad\"; if the file's angles are in degrees, set angle_unit = \"deg\"", if *.signed { "(−π/2, π/2)" } else { "[0, π/2)" })]
+    LayoutRadiansOutOfRange {
+        column: String,
+        value: String,
         signed: bool,
     },
     #[error("column '{column}': {value} is negative, but the layout says signed_angles = false: set signed_angles = true if θ < 0 is the direction across the normal")]

@@ -110,41 +110,6 @@ pub enum AngleUnit {
     Radians,
 }
 
-impl AngleUnit {
-    /// The name a layout uses.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Degrees => "deg",
-            Self::Radians => "rad",
-        }
-    }
-
-    pub fn other(self) -> Self {
-        match self {
-            Self::Degrees => Self::Radians,
-            Self::Radians => Self::Degrees,
-        }
-    }
-
-    /// The unit after a number in messages (`30°`, `30 rad`).
-    pub fn symbol(self) -> &'static str {
-        match self {
-            Self::Degrees => "°",
-            Self::Radians => " rad",
-        }
-    }
-
-    /// The zenith angles a file may hold, signed or not, in this unit (for messages).
-    pub fn zenith_range(self, signed: bool) -> &'static str {
-        match (self, signed) {
-            (Self::Degrees, true) => "(−90°, 90°)",
-            (Self::Degrees, false) => "[0°, 90°)",
-            (Self::Radians, true) => "(−π/2, π/2)",
-            (Self::Radians, false) => "[0, π/2)",
-        }
-    }
-}
-
 /// The Stokes bases the file's Mueller matrices are written in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MuellerBasis {

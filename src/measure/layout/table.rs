@@ -431,11 +431,18 @@ impl Cells<'_> {
             return Err(self.refusal(field, kind));
         }
         if degrees.abs() >= 90.0 {
-            let kind = MeasureErrorKind::LayoutAngleOutOfRange {
-                column,
-                value: text,
-                unit: conventions.angle_unit,
-                signed: conventions.signed_angles,
+            let signed = conventions.signed_angles;
+            let kind = match conventions.angle_unit {
+                AngleUnit::Degrees => MeasureErrorKind::LayoutDegreesOutOfRange {
+                    column,
+                    value: text,
+                    signed,
+                },
+                AngleUnit::Radians => MeasureErrorKind::LayoutRadiansOutOfRange {
+                    column,
+                    value: text,
+                    signed,
+                },
             };
             return Err(self.refusal(field, kind));
         }
