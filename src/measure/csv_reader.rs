@@ -33,7 +33,7 @@ pub fn read_measurement_csv(path: &Path) -> Result<MeasurementSet, MeasureError>
 }
 
 /// The bytes of a measurement file, refused with a message if it cannot be read.
-fn read_bytes(path: &Path) -> Result<Vec<u8>, MeasureError> {
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, MeasureError> {
     let whole_file = |kind| Refusal::new(1, 1, kind).in_file(path);
     match std::fs::metadata(path) {
         Ok(meta) if meta.is_dir() => return Err(whole_file(MeasureErrorKind::IsDirectory)),
@@ -151,7 +151,7 @@ fn wavelength_groups(
         .collect())
 }
 
-fn same_wavelength(a: f64, b: f64) -> bool {
+pub(crate) fn same_wavelength(a: f64, b: f64) -> bool {
     (a - b).abs() <= WAVELENGTH_RELATIVE_TOLERANCE * a.max(b)
 }
 
@@ -160,7 +160,7 @@ pub(crate) fn hex(bytes: &[u8]) -> String {
 }
 
 /// The text of the file without a leading byte-order mark (spreadsheets write one).
-fn decode_utf8(bytes: &[u8]) -> Result<&str, Refusal> {
+pub(crate) fn decode_utf8(bytes: &[u8]) -> Result<&str, Refusal> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         // The valid prefix is UTF-8 by construction, so the lossy decode is exact.
         let before = String::from_utf8_lossy(&bytes[..e.valid_up_to()]);
@@ -183,13 +183,13 @@ fn without_bom(text: &str) -> &str {
 }
 
 /// The column just after the end of `line`.
-fn last_column(line: &str) -> u64 {
+pub(crate) fn last_column(line: &str) -> u64 {
     line.chars().count() as u64 + 1
 }
 
 /// The lines of a text without their terminators: "\r\n", "\n", or a bare "\r" (old Mac
 /// spreadsheet exports) each end a line.
-fn text_lines(text: &str) -> impl Iterator<Item = &str> {
+pub(crate) fn text_lines(text: &str) -> impl Iterator<Item = &str> {
     text.split('\n')
         .flat_map(|line| line.strip_suffix('\r').unwrap_or(line).split('\r'))
 }
@@ -468,7 +468,7 @@ fn store_value(
 }
 
 /// Why a wavelength_um field's (finite) value is not a wavelength irpol models, if it is not.
-fn wavelength_refusal(value: f64, text: &str) -> Option<MeasureErrorKind> {
+pub(crate) fn wavelength_refusal(value: f64, text: &str) -> Option<MeasureErrorKind> {
     if value <= 0.0 {
         Some(MeasureErrorKind::NonPositiveWavelength { value: shown(text) })
     } else if !wavelength_in_range(value) {
@@ -482,7 +482,7 @@ fn wavelength_refusal(value: f64, text: &str) -> Option<MeasureErrorKind> {
 }
 
 /// A finite number, or why the field is not one.
-fn parse_number(column: &str, text: &str) -> Result<f64, MeasureErrorKind> {
+pub(crate) fn parse_number(column: &str, text: &str) -> Result<f64, MeasureErrorKind> {
     if text.is_empty() {
         return Err(MeasureErrorKind::EmptyField {
             column: column.to_string(),

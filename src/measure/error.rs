@@ -122,6 +122,50 @@ pub enum MeasureErrorKind {
         first: String,
         first_line: u64,
     },
+
+    // --- instrument layouts (docs/design.md §2.8) ---
+    #[error("not a valid layout: {message}")]
+    LayoutSyntax { message: String },
+    #[error("layout key {key}: {message}")]
+    LayoutValue { key: &'static str, message: String },
+    #[error("column '{column}', which the layout {layout} names for {role}, is not in the header row: fix [columns] {role} (names are case-sensitive)")]
+    LayoutColumnMissing {
+        column: String,
+        role: &'static str,
+        layout: String,
+    },
+    #[error("the element pattern '{pattern}' of the layout {layout} matches no column of the header row (it names {names}): fix the pattern or index_base")]
+    ElementPatternMatchesNothing {
+        pattern: String,
+        layout: String,
+        names: String,
+    },
+    #[error("the layout's mueller_convention = \"xyxy\" is rotated into psps, which mixes {present} with {missing}, but the file has no column for {missing}: add it, or say mueller_convention = \"psps\" if the file already is psps")]
+    BasisNeedsElement {
+        present: &'static str,
+        missing: &'static str,
+    },
+    #[error("column '{column}': {value}° is not a zenith angle within {}: the layout says angle_unit = \"deg\"; if the file's angles are in radians, set angle_unit = \"rad\"", if *.signed { "(−90°, 90°)" } else { "[0°, 90°)" })]
+    LayoutDegreesOutOfRange {
+        column: String,
+        value: String,
+        signed: bool,
+    },
+    #[error("column '{column}': {value} rad is not a zenith angle within {}: the layout says angle_unit = \"rad\"; if the file's angles are in degrees, set angle_unit = \"deg\"", if *.signed { "(−π/2, π/2)" } else { "[0, π/2)" })]
+    LayoutRadiansOutOfRange {
+        column: String,
+        value: String,
+        signed: bool,
+    },
+    #[error("column '{column}': {value} is negative, but the layout says signed_angles = false: set signed_angles = true if θ < 0 is the direction across the normal")]
+    LayoutNegativeAngle { column: String, value: String },
+    #[error("column '{column}' (the layout's m00): {value} is negative, but m00 (the unpolarized BRDF, sr⁻¹) is ≥ 0")]
+    LayoutNegativeM00 { column: String, value: String },
+    #[error("header 'mueller_convention': '{value}' disagrees with the layout's mueller_convention = \"{layout_value}\"")]
+    ConventionDisagreesWithLayout {
+        value: String,
+        layout_value: &'static str,
+    },
 }
 
 /// A field separator found where ',' was expected.

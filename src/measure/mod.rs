@@ -24,6 +24,7 @@ mod error;
 mod fields;
 mod files;
 mod fingerprint;
+mod layout;
 mod merge;
 mod metadata;
 
@@ -37,6 +38,10 @@ pub use csv_reader::{
 pub use error::{Delimiter, MeasureError, MeasureErrorKind};
 pub use files::collect_measurement_files;
 pub use fingerprint::SourceData;
+pub use layout::{
+    parse_with_layout, read_with_layout, xyxy_to_psps, AngleUnit, ColumnRoles, Conventions, Layout,
+    MuellerBasis, SpecularAzimuth, UncertaintyModel,
+};
 pub use merge::{merge_repeat_measurements, MergeError, SAME_WAVELENGTH_UM};
 
 /// Column names of the 16 Mueller elements; element (r, c) has index r*4 + c (row-major).

@@ -1,0 +1,623 @@
+//! Reading a table through a [`Layout`] (docs/design.md §2.8): the header row resolved to
+//! roles, each row converted to docs/design.md §2.1's meaning, the rows split by wavelength.
+//! Refusals point at `file:line:column` like the §2.1 reader's, and say what to fix.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use sha2::{Digest, Sha256};
+
+use super::basis::{mixed_with, xyxy_to_psps};
+use super::uncertainty::apply_uncertainty_model;
+use super::{AngleUnit, Layout, MuellerBasis, SpecularAzimuth};
+use crate::measure::columns::wrong_delimiter;
+use crate::measure::csv_reader::{
+    decode_utf8, hex, last_column, parse_number, same_wavelength, text_lines, wavelength_refusal,
+};
+use crate::measure::error::{MeasureError, MeasureErrorKind, Refusal};
+use crate::measure::fields::{split_fields, Field};
+use crate::measure::metadata::{split_metadata_line, HeaderWavelength, Metadata};
+use crate::measure::{MeasurementPoint, MeasurementSet, MUELLER_ELEMENT_NAMES};
+use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
+use crate::text::shown;
+
+/// irpol's azimuths when the layout names no column for them (docs/design.md §2.1).
+const DEFAULT_PHI_I_DEG: f64 = 0.0;
+const DEFAULT_PHI_R_DEG: f64 = 180.0;
+
+/// The field index of each role in the header row.
+struct Resolved {
+    theta_i: usize,
+    phi_i: Option<usize>,
+    theta_r: usize,
+    phi_r: Option<usize>,
+    wavelength: Option<usize>,
+    /// (Mueller index, field index), ascending by Mueller index, m00 first.
+    elements: Vec<(usize, usize)>,
+    /// The header's names, by field index.
+    names: Vec<String>,
+}
+
+/// The rows' wavelengths: the `# wavelength_um:` line's for all, or each row's own column value.
+enum Wavelengths {
+    Header(f64),
+    PerRow(Vec<HeaderWavelength>),
+}
+
+/// Everything read from the table, before it is split by wavelength.
+struct ParsedTable {
+    metadata: Metadata,
+    elements: Vec<usize>,
+    points: Vec<MeasurementPoint>,
+    wavelengths: Wavelengths,
+    folded_incident: usize,
+    folded_detector: usize,
+    unused_columns: Vec<String>,
+}
+
+pub(super) fn parse_table(
+    source: &Path,
+    bytes: &[u8],
+    layout: &Layout,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    let sha256 = hex(&Sha256::digest(bytes));
+    let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
+    let parsed = parse_text(text, layout).map_err(|r| r.in_file(source))?;
+    Ok(build_sets(source, sha256, parsed, layout))
+}
+
+fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
+    let lines: Vec<(u64, &str)> = text_lines(text)
+        .zip(1..)
+        .map(|(line, number)| (number, line))
+        .filter(|(_, line)| !line.trim().is_empty())
+        .collect();
+    if lines.is_empty() {
+        return Err(Refusal::new(1, 1, MeasureErrorKind::EmptyFile));
+    }
+    let is_hash_line = |line: &str| line.trim_start().starts_with('#');
+    let mut metadata = Metadata::default();
+    for &(number, line) in lines.iter().filter(|(_, line)| is_hash_line(line)) {
+        add_metadata(&mut metadata, number, line, layout)?;
+    }
+    let mut content = lines.iter().filter(|(_, line)| !is_hash_line(line));
+    let &(header_line, header) = content
+        .next()
+        .ok_or_else(|| Refusal::new(1, 1, MeasureErrorKind::NoHeader))?;
+    let header_fields = fields_of(header_line, header)?;
+    let resolved = resolve_header(header_line, &header_fields, layout)?;
+    if resolved.wavelength.is_none() && metadata.wavelength.is_none() {
+        return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength));
+    }
+    let mut points = Vec::new();
+    let mut row_wavelengths = Vec::new();
+    let (mut folded_incident, mut folded_detector) = (0, 0);
+    for &(number, line) in content {
+        let row = parse_row(number, line, &resolved, layout, &metadata.wavelength)?;
+        folded_incident += usize::from(row.folded.0);
+        folded_detector += usize::from(row.folded.1);
+        points.push(row.point);
+        row_wavelengths.extend(row.wavelength);
+    }
+    if points.is_empty() {
+        return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
+    }
+    if points.iter().all(|p| p.values[0] == 0.0) {
+        let m00_column = header_fields[resolved.elements[0].1].column;
+        return Err(Refusal::new(
+            header_line,
+            m00_column,
+            MeasureErrorKind::AllM00Zero,
+        ));
+    }
+    let used = used_fields(&resolved);
+    let unused_columns = (0..resolved.names.len())
+        .filter(|i| !used.contains(i))
+        .map(|i| resolved.names[i].clone())
+        .collect();
+    let wavelengths = match &metadata.wavelength {
+        Some(header) => Wavelengths::Header(header.um),
+        None => Wavelengths::PerRow(row_wavelengths),
+    };
+    Ok(ParsedTable {
+        metadata,
+        elements: resolved.elements.iter().map(|&(index, _)| index).collect(),
+        points,
+        wavelengths,
+        folded_incident,
+        folded_detector,
+        unused_columns,
+    })
+}
+
+/// Records a `# key: value` line. A `# mueller_convention:` line must agree with the layout (the
+/// §2.1 reader accepts only psps; through a layout the file may say xyxy).
+fn add_metadata(
+    metadata: &mut Metadata,
+    number: u64,
+    line: &str,
+    layout: &Layout,
+) -> Result<(), Refusal> {
+    let Some((key, value, column)) = split_metadata_line(line) else {
+        return Ok(());
+    };
+    let basis = layout.conventions.mueller_convention;
+    if key == "mueller_convention" && !value.eq_ignore_ascii_case(basis.name()) {
+        return Err(Refusal::new(
+            number,
+            column,
+            MeasureErrorKind::ConventionDisagreesWithLayout {
+                value: shown(value),
+                layout_value: basis.name(),
+            },
+        ));
+    }
+    if key == "mueller_convention" && basis != MuellerBasis::Psps {
+        // Agrees with the layout; the set's own convention is psps once converted.
+        metadata.entries.insert(key.to_string(), value.to_string());
+        return Ok(());
+    }
+    metadata.add(number, key, value, column)
+}
+
+fn fields_of(line_number: u64, line: &str) -> Result<Vec<Field<'_>>, Refusal> {
+    split_fields(line).map_err(|(column, kind)| Refusal::new(line_number, column, kind))
+}
+
+/// The field index of every role, refusing a named column the header lacks (or holds twice), an
+/// element pattern that matches nothing, and an element set the basis rotation cannot convert.
+fn resolve_header(line: u64, fields: &[Field<'_>], layout: &Layout) -> Result<Resolved, Refusal> {
+    let names: Vec<String> = fields.iter().map(|f| f.text.to_string()).collect();
+    let roles = &layout.columns;
+    let find = |column: &str, role: &'static str| find_column(line, fields, layout, column, role);
+    let find_optional = |column: &Option<String>, role: &'static str| {
+        column.as_deref().map(|c| find(c, role)).transpose()
+    };
+    let mut elements = vec![(0, find(&roles.m00, "m00")?)];
+    for (&index, column) in &roles.elements {
+        match (&roles.pattern, names.iter().position(|n| n == column)) {
+            (_, Some(_)) | (None, None) => {
+                elements.push((index, find(column, MUELLER_ELEMENT_NAMES[index])?))
+            }
+            (Some(_), None) => {} // a pattern names all fifteen; the file holds a subset
+        }
+    }
+    if let (Some(pattern), 1) = (&roles.pattern, elements.len()) {
+        return Err(Refusal::new(
+            line,
+            1,
+            MeasureErrorKind::ElementPatternMatchesNothing {
+                pattern: shown(pattern),
+                layout: layout.source.display().to_string(),
+                names: pattern_names(&roles.elements),
+            },
+        ));
+    }
+    if layout.conventions.mueller_convention == MuellerBasis::Xyxy {
+        check_rotation_closure(line, &elements)?;
+    }
+    Ok(Resolved {
+        theta_i: find(&roles.theta_i, "theta_i_deg")?,
+        phi_i: find_optional(&roles.phi_i, "phi_i_deg")?,
+        theta_r: find(&roles.theta_r, "theta_r_deg")?,
+        phi_r: find_optional(&roles.phi_r, "phi_r_deg")?,
+        wavelength: find_optional(&roles.wavelength, "wavelength_um")?,
+        elements,
+        names,
+    })
+}
+
+/// The field index of `column`, which the layout names for `role`.
+fn find_column(
+    line: u64,
+    fields: &[Field<'_>],
+    layout: &Layout,
+    column: &str,
+    role: &'static str,
+) -> Result<usize, Refusal> {
+    let mut matches = fields.iter().enumerate().filter(|(_, f)| f.text == column);
+    let Some((index, first)) = matches.next() else {
+        if let Some(refusal) = fields
+            .iter()
+            .filter(|f| !f.quoted)
+            .find_map(|f| wrong_delimiter(line, f))
+        {
+            return Err(refusal);
+        }
+        return Err(Refusal::new(
+            line,
+            1,
+            MeasureErrorKind::LayoutColumnMissing {
+                column: shown(column),
+                role,
+                layout: layout.source.display().to_string(),
+            },
+        ));
+    };
+    if let Some((_, second)) = matches.next() {
+        return Err(Refusal::new(
+            line,
+            second.column,
+            MeasureErrorKind::DuplicateColumn {
+                name: shown(column),
+                first_column: first.column,
+            },
+        ));
+    }
+    Ok(index)
+}
+
+/// The xyxy → psps rotation mixes rows 1 and 2 and columns 1 and 2: every element it mixes with
+/// a present one must be present too, or the converted value would be wrong.
+fn check_rotation_closure(line: u64, elements: &[(usize, usize)]) -> Result<(), Refusal> {
+    let present: Vec<usize> = elements.iter().map(|&(index, _)| index).collect();
+    for &index in &present {
+        if let Some(missing) = mixed_with(index).into_iter().find(|m| !present.contains(m)) {
+            return Err(Refusal::new(
+                line,
+                1,
+                MeasureErrorKind::BasisNeedsElement {
+                    present: MUELLER_ELEMENT_NAMES[index],
+                    missing: MUELLER_ELEMENT_NAMES[missing],
+                },
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The first and last names of an element pattern, quoted, for messages.
+fn pattern_names(names: &BTreeMap<usize, String>) -> String {
+    let quoted = |name: Option<&String>| format!("'{}'", shown(name.map_or("", |n| n.as_str())));
+    format!(
+        "{} … {}",
+        quoted(names.values().next()),
+        quoted(names.values().last())
+    )
+}
+
+fn used_fields(resolved: &Resolved) -> Vec<usize> {
+    let mut used = vec![resolved.theta_i, resolved.theta_r];
+    used.extend(resolved.phi_i);
+    used.extend(resolved.phi_r);
+    used.extend(resolved.wavelength);
+    used.extend(resolved.elements.iter().map(|&(_, field)| field));
+    used
+}
+
+/// One converted row.
+struct Row {
+    point: MeasurementPoint,
+    wavelength: Option<HeaderWavelength>,
+    /// Whether θ_i and θ_r were negative (read across the normal).
+    folded: (bool, bool),
+}
+
+fn parse_row(
+    number: u64,
+    line: &str,
+    resolved: &Resolved,
+    layout: &Layout,
+    header_wavelength: &Option<HeaderWavelength>,
+) -> Result<Row, Refusal> {
+    let fields = fields_of(number, line)?;
+    let expected = resolved.names.len();
+    if fields.len() != expected {
+        let column = fields.get(expected).map_or(last_column(line), |f| f.column);
+        return Err(Refusal::new(
+            number,
+            column,
+            MeasureErrorKind::FieldCount {
+                found: fields.len(),
+                expected,
+            },
+        ));
+    }
+    let cells = Cells {
+        number,
+        fields: &fields,
+        names: &resolved.names,
+    };
+    let wavelength = match resolved.wavelength {
+        Some(field) => row_wavelength(&cells, field, header_wavelength)?,
+        None => None,
+    };
+    let conventions = &layout.conventions;
+    let azimuth = |field: Option<usize>, default: f64| -> Result<f64, Refusal> {
+        field.map_or(Ok(default), |f| {
+            cells
+                .number(f)
+                .map(|v| in_degrees(v, conventions.angle_unit))
+        })
+    };
+    let theta_i = cells.zenith(resolved.theta_i, layout)?;
+    let phi_i = azimuth(resolved.phi_i, DEFAULT_PHI_I_DEG)?;
+    let theta_r = cells.zenith(resolved.theta_r, layout)?;
+    let mut phi_r = azimuth(resolved.phi_r, DEFAULT_PHI_R_DEG)?;
+    if resolved.phi_r.is_some() && conventions.specular_phi_r == SpecularAzimuth::SameAsIncidence {
+        phi_r = (phi_r + 180.0).rem_euclid(360.0);
+    }
+    let (theta_i_deg, phi_i_deg) = fold_signed_zenith(theta_i, phi_i);
+    let (theta_r_deg, phi_r_deg) = fold_signed_zenith(theta_r, phi_r);
+    let values = cells.elements(resolved, layout, phi_i_deg, phi_r_deg)?;
+    let width = values.len();
+    Ok(Row {
+        point: MeasurementPoint {
+            theta_i_deg,
+            phi_i_deg,
+            theta_r_deg,
+            phi_r_deg,
+            values,
+            uncertainties: vec![None; width],
+            line: number,
+        },
+        wavelength,
+        folded: (theta_i < 0.0, theta_r < 0.0),
+    })
+}
+
+fn in_degrees(value: f64, unit: AngleUnit) -> f64 {
+    match unit {
+        AngleUnit::Degrees => value,
+        AngleUnit::Radians => value.to_degrees(),
+    }
+}
+
+/// A row's wavelength: checked against the `# wavelength_um:` line if there is one (then `None`),
+/// else the row's own.
+fn row_wavelength(
+    cells: &Cells<'_>,
+    field: usize,
+    header: &Option<HeaderWavelength>,
+) -> Result<Option<HeaderWavelength>, Refusal> {
+    let um = cells.number(field)?;
+    let (text, column) = (
+        cells.fields[field].text.as_ref(),
+        cells.fields[field].column,
+    );
+    if let Some(kind) = wavelength_refusal(um, text) {
+        return Err(Refusal::new(cells.number, column, kind));
+    }
+    match header {
+        Some(header) if !same_wavelength(header.um, um) => Err(Refusal::new(
+            cells.number,
+            column,
+            MeasureErrorKind::WavelengthDisagrees {
+                value: shown(text),
+                header: shown(&header.text),
+                header_line: header.line,
+            },
+        )),
+        Some(_) => Ok(None),
+        None => Ok(Some(HeaderWavelength {
+            um,
+            text: text.to_string(),
+            line: cells.number,
+        })),
+    }
+}
+
+/// The fields of one data row, with what messages need to point at them.
+struct Cells<'a> {
+    number: u64,
+    fields: &'a [Field<'a>],
+    names: &'a [String],
+}
+
+impl Cells<'_> {
+    fn refusal(&self, field: usize, kind: MeasureErrorKind) -> Refusal {
+        Refusal::new(self.number, self.fields[field].column, kind)
+    }
+
+    fn number(&self, field: usize) -> Result<f64, Refusal> {
+        parse_number(&self.names[field], &self.fields[field].text)
+            .map_err(|kind| self.refusal(field, kind))
+    }
+
+    /// A zenith angle in degrees, still signed; refused beyond the hemisphere in the layout's
+    /// unit (the usual sign of an angle column in another unit than the layout says) or, without
+    /// signed angles, below 0.
+    fn zenith(&self, field: usize, layout: &Layout) -> Result<f64, Refusal> {
+        let value = self.number(field)?;
+        let conventions = &layout.conventions;
+        let degrees = in_degrees(value, conventions.angle_unit);
+        let column = self.names[field].clone();
+        let text = shown(&self.fields[field].text);
+        if degrees < 0.0 && !conventions.signed_angles {
+            let kind = MeasureErrorKind::LayoutNegativeAngle {
+                column,
+                value: text,
+            };
+            return Err(self.refusal(field, kind));
+        }
+        if degrees.abs() >= 90.0 {
+            let signed = conventions.signed_angles;
+            let kind = match conventions.angle_unit {
+                AngleUnit::Degrees => MeasureErrorKind::LayoutDegreesOutOfRange {
+                    column,
+                    value: text,
+                    signed,
+                },
+                AngleUnit::Radians => MeasureErrorKind::LayoutRadiansOutOfRange {
+                    column,
+                    value: text,
+                    signed,
+                },
+            };
+            return Err(self.refusal(field, kind));
+        }
+        Ok(degrees)
+    }
+
+    /// The row's Mueller elements in sr⁻¹, psps, aligned with the resolved elements.
+    fn elements(
+        &self,
+        resolved: &Resolved,
+        layout: &Layout,
+        phi_i_deg: f64,
+        phi_r_deg: f64,
+    ) -> Result<Vec<f64>, Refusal> {
+        let m00_field = resolved.elements[0].1;
+        let m00 = self.number(m00_field)?;
+        if m00 < 0.0 {
+            let kind = MeasureErrorKind::LayoutNegativeM00 {
+                column: self.names[m00_field].clone(),
+                value: shown(&self.fields[m00_field].text),
+            };
+            return Err(self.refusal(m00_field, kind));
+        }
+        let mut matrix = [0.0; 16];
+        for &(index, field) in &resolved.elements {
+            let value = self.number(field)?;
+            matrix[index] = match index {
+                0 => m00,
+                _ if layout.conventions.normalized => value * m00,
+                _ => value,
+            };
+        }
+        if layout.conventions.mueller_convention == MuellerBasis::Xyxy {
+            xyxy_to_psps(&mut matrix, phi_i_deg, phi_r_deg);
+        }
+        Ok(resolved
+            .elements
+            .iter()
+            .map(|&(index, _)| matrix[index])
+            .collect())
+    }
+}
+
+/// The table's rows as one set per wavelength, ascending, each with its uncertainties and the
+/// notes that tell the user what the conversion did.
+fn build_sets(
+    source: &Path,
+    sha256: String,
+    parsed: ParsedTable,
+    layout: &Layout,
+) -> Vec<MeasurementSet> {
+    let file = source.display().to_string();
+    let material = match &parsed.metadata.material {
+        Some(material) => material.clone(),
+        None => source
+            .file_stem()
+            .map(|stem| stem.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+    };
+    let mut file_notes = file_notes(&file, &parsed, layout);
+    let mut metadata = parsed.metadata.entries.clone();
+    metadata.insert("layout".to_string(), layout.source.display().to_string());
+    let groups = wavelength_groups(parsed.points, parsed.wavelengths);
+    groups
+        .into_iter()
+        .map(|(wavelength_um, mut points)| {
+            let applied =
+                apply_uncertainty_model(layout.uncertainty, &mut points, &parsed.elements);
+            let mut metadata = metadata.clone();
+            metadata.insert("uncertainty_model".to_string(), applied.label.clone());
+            // The file's notes go with its first set, as read_measurement_sets does.
+            let mut notes = std::mem::take(&mut file_notes);
+            notes.push(format!("{file} at {wavelength_um} µm: {}", applied.note));
+            MeasurementSet {
+                source: source.to_path_buf(),
+                sha256: sha256.clone(),
+                material: material.clone(),
+                wavelength_um,
+                metadata,
+                elements: parsed.elements.clone(),
+                points,
+                merged: Vec::new(),
+                notes,
+            }
+        })
+        .collect()
+}
+
+/// What the layout changed, said once per file.
+fn file_notes(file: &str, parsed: &ParsedTable, layout: &Layout) -> Vec<String> {
+    let conventions = &layout.conventions;
+    let mut done = Vec::new();
+    if conventions.angle_unit == AngleUnit::Radians {
+        done.push("angles in radians converted to degrees".to_string());
+    }
+    if conventions.specular_phi_r == SpecularAzimuth::SameAsIncidence {
+        done.push("φ_r turned by 180° (the file's specular azimuth is φ_i)".to_string());
+    }
+    if conventions.normalized {
+        done.push(format!(
+            "elements normalized by m00 multiplied by '{}'",
+            layout.columns.m00
+        ));
+    }
+    if conventions.mueller_convention == MuellerBasis::Xyxy {
+        done.push("Mueller matrices rotated from the sample's xyxy basis into psps".to_string());
+    }
+    let mut notes = Vec::new();
+    if !done.is_empty() {
+        notes.push(format!(
+            "{file}: read through the layout {}: {}",
+            layout.source.display(),
+            done.join("; ")
+        ));
+    }
+    if let Some(note) = radians_note(file, &parsed.points, conventions.angle_unit) {
+        notes.push(note);
+    }
+    if parsed.folded_incident > 0 {
+        notes.push(format!(
+            "{file}: {} with θ_i < 0 read as (|θ_i|, φ_i + 180°)",
+            crate::text::counted(parsed.folded_incident, "row")
+        ));
+    }
+    notes.extend(signed_zenith_note(file, parsed.folded_detector));
+    if !parsed.unused_columns.is_empty() {
+        notes.push(format!(
+            "{file}: columns the layout does not name, not read: {}",
+            parsed.unused_columns.join(", ")
+        ));
+    }
+    notes
+}
+
+/// A warning when degrees are declared but every zenith angle is within π/2 (and some is not 0):
+/// most likely radians. Not refused, since a narrow scan near the normal can look the same.
+fn radians_note(file: &str, points: &[MeasurementPoint], unit: AngleUnit) -> Option<String> {
+    let largest = points
+        .iter()
+        .map(|p| p.theta_i_deg.max(p.theta_r_deg))
+        .fold(0.0, f64::max);
+    (unit == AngleUnit::Degrees && largest > 0.0 && largest <= std::f64::consts::FRAC_PI_2).then(
+        || {
+            format!(
+                "{file}: every zenith angle is within {largest}° ≤ π/2: if the angles are in \
+                 radians, the layout needs angle_unit = \"rad\""
+            )
+        },
+    )
+}
+
+/// The points by wavelength, ascending: all at the header's, or one group per distinct row
+/// wavelength (equal within 1 ppm, the group keeping its first row's value).
+fn wavelength_groups(
+    points: Vec<MeasurementPoint>,
+    wavelengths: Wavelengths,
+) -> Vec<(f64, Vec<MeasurementPoint>)> {
+    let rows = match wavelengths {
+        Wavelengths::Header(um) => return vec![(um, points)],
+        Wavelengths::PerRow(rows) => rows,
+    };
+    let mut groups: BTreeMap<usize, (f64, Vec<MeasurementPoint>)> = BTreeMap::new();
+    let mut firsts: Vec<f64> = Vec::new();
+    for (point, row) in points.into_iter().zip(rows) {
+        let um = row.um;
+        let slot = match firsts.iter().position(|&w| same_wavelength(w, um)) {
+            Some(slot) => slot,
+            None => {
+                firsts.push(um);
+                firsts.len() - 1
+            }
+        };
+        groups.entry(slot).or_insert((um, Vec::new())).1.push(point);
+    }
+    let mut groups: Vec<_> = groups.into_values().collect();
+    groups.sort_by(|a, b| a.0.total_cmp(&b.0));
+    groups
+}
