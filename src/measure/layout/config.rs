@@ -184,13 +184,16 @@ fn column_roles(
     })
 }
 
+/// The file's column name of each Mueller element, by row-major element index.
+type ElementColumns = BTreeMap<usize, String>;
+
 /// The column of each element named by `[columns] elements`: a pattern over `{i}` and `{j}`
 /// (counted from `index_base`), or a table keyed by irpol's names m00…m33.
 fn element_columns(
     text: &str,
     value: &Spanned<toml::Value>,
     index_base: u8,
-) -> Result<(BTreeMap<usize, String>, Option<String>), Refusal> {
+) -> Result<(ElementColumns, Option<String>), Refusal> {
     let refuse = |message: String| value_refusal(text, value.span(), "[columns] elements", message);
     match value.get_ref() {
         toml::Value::String(pattern) => {
