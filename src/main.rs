@@ -666,10 +666,11 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
                 s.rho_d.clone(),
             ),
         };
-        let q = match m.model.distribution() {
-            irpol::pbrdf::SlopeDistribution::Cauchy { q, .. } => format!("{q:.3}"),
-            irpol::pbrdf::SlopeDistribution::Gaussian { .. } => "—".into(),
-        };
+        let q = m
+            .model
+            .distribution()
+            .parameter(irpol::pbrdf::Parameter::Q)
+            .map_or("—".into(), |q| format!("{q:.3}"));
         let chi2 = m
             .fit
             .as_ref()

@@ -158,10 +158,10 @@ impl PyMaterial {
     /// Cauchy exponent q, or None for the Gaussian distribution.
     #[getter]
     fn q(&self) -> Option<f64> {
-        match self.inner.model.distribution() {
-            irpol::pbrdf::SlopeDistribution::Cauchy { q, .. } => Some(q),
-            irpol::pbrdf::SlopeDistribution::Gaussian { .. } => None,
-        }
+        self.inner
+            .model
+            .distribution()
+            .parameter(irpol::pbrdf::Parameter::Q)
     }
 
     #[getter]

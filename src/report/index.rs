@@ -10,7 +10,7 @@ use super::fit_report::{
 use super::ReportError;
 use crate::atomic::write_atomically;
 use crate::material::{list_library, FitRecord, Material, MaterialModel};
-use crate::pbrdf::SlopeDistribution;
+use crate::pbrdf::Parameter;
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
 
@@ -265,10 +265,7 @@ fn model_cells(material: &Material) -> (String, Vec<String>) {
         ),
         MaterialModel::Spectral(model) => {
             let (first, last) = model.range_um();
-            let q = match model.distribution {
-                SlopeDistribution::Cauchy { q, .. } => Some(q),
-                SlopeDistribution::Gaussian { .. } => None,
-            };
+            let q = model.distribution.parameter(Parameter::Q);
             (
                 format!("{}–{}", format_plain(first), format_plain(last)),
                 vec![
@@ -319,7 +316,7 @@ fn parameter_table(html: &mut String, material: &Material) {
                 "σ",
                 parameter_text(material, "sigma", model.distribution.sigma()),
             );
-            if let SlopeDistribution::Cauchy { q, .. } = model.distribution {
+            if let Some(q) = model.distribution.parameter(Parameter::Q) {
                 row("q", parameter_text(material, "q", q));
             }
             for node in model.nodes() {
