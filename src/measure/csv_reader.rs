@@ -189,7 +189,7 @@ pub(crate) fn last_column(line: &str) -> u64 {
 
 /// The lines of a text without their terminators: "\r\n", "\n", or a bare "\r" (old Mac
 /// spreadsheet exports) each end a line.
-pub(crate) fn text_lines(text: &str) -> impl Iterator<Item = &str> {
+fn text_lines(text: &str) -> impl Iterator<Item = &str> {
     text.split('\n')
         .flat_map(|line| line.strip_suffix('\r').unwrap_or(line).split('\r'))
 }
@@ -210,7 +210,8 @@ struct ParsedText {
 /// A line of the file, numbered from 1, without its terminator.
 type NumberedLine<'a> = (u64, &'a str);
 
-fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
+/// The file's non-blank lines, numbered from 1; a file without one is refused as empty.
+pub(crate) fn numbered_lines(text: &str) -> Result<Vec<NumberedLine<'_>>, Refusal> {
     let lines: Vec<NumberedLine<'_>> = text_lines(text)
         .zip(1..)
         .map(|(line, number)| (number, line))
@@ -219,6 +220,11 @@ fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
     if lines.is_empty() {
         return Err(Refusal::new(1, 1, MeasureErrorKind::EmptyFile));
     }
+    Ok(lines)
+}
+
+fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
+    let lines = numbered_lines(text)?;
     let is_hash_line = |line: &str| line.trim_start().starts_with('#');
 
     let mut metadata = Metadata::default();

@@ -12,7 +12,8 @@ use super::uncertainty::apply_uncertainty_model;
 use super::{AngleUnit, Layout, MuellerBasis, SpecularAzimuth};
 use crate::measure::columns::wrong_delimiter;
 use crate::measure::csv_reader::{
-    decode_utf8, hex, last_column, parse_number, same_wavelength, text_lines, wavelength_refusal,
+    decode_utf8, hex, last_column, numbered_lines, parse_number, same_wavelength,
+    wavelength_refusal,
 };
 use crate::measure::error::{MeasureError, MeasureErrorKind, Refusal};
 use crate::measure::fields::{split_fields, Field};
@@ -67,14 +68,7 @@ pub(super) fn parse_table(
 }
 
 fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
-    let lines: Vec<(u64, &str)> = text_lines(text)
-        .zip(1..)
-        .map(|(line, number)| (number, line))
-        .filter(|(_, line)| !line.trim().is_empty())
-        .collect();
-    if lines.is_empty() {
-        return Err(Refusal::new(1, 1, MeasureErrorKind::EmptyFile));
-    }
+    let lines = numbered_lines(text)?;
     let is_hash_line = |line: &str| line.trim_start().starts_with('#');
     let mut metadata = Metadata::default();
     for &(number, line) in lines.iter().filter(|(_, line)| is_hash_line(line)) {
