@@ -5,7 +5,7 @@ use super::super::fit_report::style::{draw_caption, DrawResult, GREY};
 use super::super::fit_report::{format_plain, format_with_uncertainty, sha_prefix};
 use crate::fit::SpectralFitOutcome;
 use crate::material::{FitRecord, SpectralModel};
-use crate::pbrdf::SlopeDistribution;
+use crate::pbrdf::Parameter;
 use crate::plot_style::FONT;
 use crate::text::{number, shown_at_most};
 use plotters::coord::Shift;
@@ -55,7 +55,7 @@ fn shared_lines(model: &SpectralModel, fit: Option<&FitRecord>) -> Vec<Line> {
         )),
         row("σ".into(), model.distribution.sigma(), "sigma"),
     ];
-    if let SlopeDistribution::Cauchy { q, .. } = model.distribution {
+    if let Some(q) = model.distribution.parameter(Parameter::Q) {
         lines.push(row("q".into(), q, "q"));
     }
     if let Some(law) = &model.dispersion {
