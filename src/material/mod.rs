@@ -49,7 +49,7 @@ pub enum MaterialError {
 }
 
 /// The pBRDF parameters of a material (docs/design.md §1.3) at one wavelength. Read through
-/// [`raw::RawModel`], which refuses unknown keys: serde cannot deny them on a struct with a
+/// `raw::RawModel`, which refuses unknown keys: serde cannot deny them on a struct with a
 /// flattened field, and a typo such as `rho = 0.5` must not silently give ρ_d = 0.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "raw::RawModel<f64>")]

@@ -128,7 +128,7 @@ pub enum ThermalSetupError {
          [objects.parts.NAME.thermal] with a stack"
     )]
     NoStack,
-    /// A part's `thermal` table; `part` names it ("objects[0] 'car' part 'hood': thermal").
+    /// A part's `thermal` table; `part` names it ("objects\[0\] 'car' part 'hood': thermal").
     #[error("{part}.{error}")]
     Part {
         part: String,
