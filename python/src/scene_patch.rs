@@ -204,7 +204,7 @@ pub fn patched(
 
 /// A scene file's text, refused as `irpol render` refuses an unreadable scene.
 pub fn scene_text(path: &Path) -> PyResult<String> {
-    irpol::app::render::read_scene_text(path).map_err(raised)
+    irpol::scene::read_scene_text(path).map_err(raised)
 }
 
 /// Checks that every dotted key names an entry of the scene file (a sweep does this before

@@ -9,7 +9,7 @@
 
 use crate::fit::{FitError, OptionError};
 use crate::material::MaterialError;
-use crate::measure::{MeasureError, MeasureErrorKind};
+use crate::measure::MeasureError;
 use crate::pbrdf::ModelError;
 use crate::render::RenderError;
 use crate::report::ReportError;
@@ -63,12 +63,6 @@ pub enum AppError {
     },
     #[error("{}: cannot read", path.display())]
     Read {
-        path: PathBuf,
-        #[source]
-        source: io::Error,
-    },
-    #[error("{}: cannot read the scene", path.display())]
-    ReadScene {
         path: PathBuf,
         #[source]
         source: io::Error,
@@ -185,7 +179,8 @@ impl AppError {
             AppError::Stream(_) => true,
             AppError::Image(image::ImageError::IoError(_)) => true,
             _ => {
-                self.measure_error().is_some_and(measure_path_failed)
+                self.measure_error()
+                    .is_some_and(MeasureError::is_unreadable_path)
                     || causes(self).any(|cause| cause.is::<io::Error>())
             }
         }
@@ -220,17 +215,6 @@ impl AppError {
             _ => None,
         }
     }
-}
-
-/// A measurement path that could not be read at all (as opposed to a file that reads but is
-/// malformed).
-fn measure_path_failed(error: &MeasureError) -> bool {
-    matches!(
-        error.kind,
-        MeasureErrorKind::NotFound
-            | MeasureErrorKind::IsDirectory
-            | MeasureErrorKind::Unreadable { .. }
-    )
 }
 
 /// `error` and each of its sources in turn.

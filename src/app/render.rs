@@ -157,15 +157,6 @@ fn solution_instant(
     })
 }
 
-/// A scene file's text, refused as `irpol render` refuses an unreadable scene (for callers such
-/// as the Python bindings that change the text before [`scene_to_render`]).
-pub fn read_scene_text(path: &Path) -> Result<String, AppError> {
-    std::fs::read_to_string(path).map_err(|source| AppError::ReadScene {
-        path: path.to_owned(),
-        source,
-    })
-}
-
 /// The scene of `path` read from `text` (the file's own, or changed by a caller such as the
 /// Python bindings), as it is rendered: itself, or for a scene with `[thermal]` its thermal
 /// solution at `time_s` seconds from `thermal.start_utc`. Refused as `irpol render` refuses a

@@ -21,6 +21,20 @@ pub struct MeasureError {
     pub kind: MeasureErrorKind,
 }
 
+impl MeasureError {
+    /// The path could not be read at all (missing, a folder, unreadable), as opposed to a file
+    /// that reads but is malformed: an I/O failure to callers that sort errors that way (the
+    /// Python bindings' `OSError`). The reader keeps no `std::io::Error` source, so this is it.
+    pub fn is_unreadable_path(&self) -> bool {
+        matches!(
+            self.kind,
+            MeasureErrorKind::NotFound
+                | MeasureErrorKind::IsDirectory
+                | MeasureErrorKind::Unreadable { .. }
+        )
+    }
+}
+
 /// The reason a measurement input is refused. Values are quoted as they appear in the file
 /// (trimmed), so the message can be matched against the file by eye.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -4,21 +4,7 @@
 use nalgebra::Vector3;
 
 /// A camera that cannot be built: the key at fault and why.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct CameraError(pub String);
-
-impl From<String> for CameraError {
-    fn from(message: String) -> Self {
-        CameraError(message)
-    }
-}
-
-impl From<&str> for CameraError {
-    fn from(message: &str) -> Self {
-        CameraError(message.to_owned())
-    }
-}
+pub type CameraError = super::error::InvalidSetting;
 
 #[derive(Clone, Debug)]
 pub struct Camera {

@@ -12,21 +12,7 @@ use crate::text::number;
 use nalgebra::Vector3;
 
 /// An `[environment]` that cannot be used: the key at fault and why.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct EnvironmentError(pub String);
-
-impl From<String> for EnvironmentError {
-    fn from(message: String) -> Self {
-        EnvironmentError(message)
-    }
-}
-
-impl From<&str> for EnvironmentError {
-    fn from(message: &str) -> Self {
-        EnvironmentError(message.to_owned())
-    }
-}
+pub type EnvironmentError = super::error::InvalidSetting;
 
 /// Samples of the sky radiance over u = sin(elevation) ∈ [0, 1]. The window model is smooth and a
 /// 1/1024 step keeps linear interpolation within ~1e-7 relative.

@@ -10,6 +10,24 @@ use crate::material::SceneMaterialError;
 use crate::thermal::setup::ThermalSetupError;
 use std::path::{Path, PathBuf};
 
+/// A setting of the scene (the camera, the environment) that cannot be used: the key at fault and
+/// why, as one message.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct InvalidSetting(pub String);
+
+impl From<String> for InvalidSetting {
+    fn from(message: String) -> Self {
+        InvalidSetting(message)
+    }
+}
+
+impl From<&str> for InvalidSetting {
+    fn from(message: &str) -> Self {
+        InvalidSetting(message.to_owned())
+    }
+}
+
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file cannot be read.

@@ -126,11 +126,16 @@ impl Scene {
 
 /// Reads and resolves a scene file: meshes, materials, environment. Nothing is written.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+    load_scene_text(path, &read_scene_text(path)?)
+}
+
+/// A scene file's text, for callers that change it before [`load_scene_text`] (the Python
+/// bindings' sweeps); refused as [`load_scene`] refuses an unreadable scene.
+pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
+    std::fs::read_to_string(path).map_err(|source| SceneError::Read {
         file: path.to_owned(),
         source,
-    })?;
-    load_scene_text(path, &text)
+    })
 }
 
 /// [`load_scene`] of a scene's text (e.g. a file's text with some values changed, as the Python
