@@ -13,7 +13,9 @@ pub use error::{one_line, AppError};
 
 use crate::material::{Material, MaterialError};
 use crate::optics::RefractiveIndex;
-use crate::pbrdf::{DistributionError, DistributionKind, ModelError, Pbrdf, Shadowing};
+use crate::pbrdf::{
+    DistributionError, DistributionKind, FacetSide, ModelError, Pbrdf, Shadowing, Subsurface,
+};
 use std::path::PathBuf;
 
 /// A pBRDF chosen on the command line: a material file, or parameters (the flags of `eval` and
@@ -41,6 +43,16 @@ pub struct ModelArgs {
     /// Diffuse (unpolarized) reflectance ρ_d.
     #[arg(long, allow_negative_numbers = true)]
     pub rho: Option<f64>,
+    /// Which side of the facets reflects: external (relative index N, default) or internal
+    /// (1/N, inside grains; docs/design.md §1.10).
+    #[arg(long)]
+    pub facet: Option<String>,
+    /// Subsurface reflectance ρ_s: adds the polarized subsurface term (docs/design.md §1.10).
+    #[arg(long = "rho-s", allow_negative_numbers = true)]
+    pub rho_s: Option<f64>,
+    /// Residual polarization d of the subsurface term (needs --rho-s; default 0).
+    #[arg(long, allow_negative_numbers = true)]
+    pub d: Option<f64>,
     /// Shadowing: none, torrance-sparrow or smith (default smith, as `fit`; with --material,
     /// the material's own).
     #[arg(long)]
@@ -56,6 +68,10 @@ pub struct ModelArgs {
 pub enum ModelArgsError {
     #[error("unknown shadowing '{0}': use none, torrance-sparrow or smith")]
     UnknownShadowing(String),
+    #[error("unknown facet side '{0}': use external or internal")]
+    UnknownFacet(String),
+    #[error("--d is the subsurface term's residual polarization: give --rho-s too")]
+    PolarizationWithoutSubsurface,
     #[error(
         "give either --material or model parameters (--distribution --sigma --q --n --k \
          --rho), not both (got {0} with --material)"
@@ -126,14 +142,37 @@ impl ModelArgs {
             self.n.ok_or(ModelArgsError::Missing("n"))?,
             self.k.ok_or(ModelArgsError::Missing("k"))?,
         );
-        Ok(Pbrdf::new(
+        let model = Pbrdf::new(
             distribution,
             // One default everywhere (fit, eval, emissivity, inline scene materials): Smith, the
             // energy-conserving choice.
             shadowing.unwrap_or(Shadowing::Smith),
             index,
             self.rho.unwrap_or(0.0),
-        )?)
+        )?;
+        self.with_volume_terms(model)
+    }
+
+    /// `--facet`, `--rho-s` and `--d` applied to `model` (docs/design.md §1.10).
+    fn with_volume_terms(&self, model: Pbrdf) -> Result<Pbrdf, ModelArgsError> {
+        if self.facet.is_none() && self.rho_s.is_none() && self.d.is_none() {
+            return Ok(model);
+        }
+        let facet = match &self.facet {
+            Some(name) => {
+                FacetSide::parse(name).ok_or_else(|| ModelArgsError::UnknownFacet(name.clone()))?
+            }
+            None => FacetSide::External,
+        };
+        let subsurface = match (self.rho_s, self.d) {
+            (None, Some(_)) => return Err(ModelArgsError::PolarizationWithoutSubsurface),
+            (None, None) => None,
+            (Some(rho_s), d) => Some(Subsurface {
+                rho_s,
+                d: d.unwrap_or(0.0),
+            }),
+        };
+        Ok(model.with_volume(facet, subsurface)?)
     }
 
     /// The material defines every model parameter: a flag beside it would be silently ignored
@@ -146,6 +185,9 @@ impl ModelArgs {
             ("--n", self.n.is_some()),
             ("--k", self.k.is_some()),
             ("--rho", self.rho.is_some()),
+            ("--facet", self.facet.is_some()),
+            ("--rho-s", self.rho_s.is_some()),
+            ("--d", self.d.is_some()),
         ]
         .into_iter()
         .filter_map(|(flag, set)| set.then_some(flag))
@@ -195,14 +237,23 @@ pub fn model_header(model: &Pbrdf) -> String {
         }
     }
     let index = model.index();
-    format!(
+    let mut header = format!(
         "# irpol {}: {distribution}\n# N = n + ik: n = {}, k = {}; rho_d = {}; shadowing = {}\n",
         env!("CARGO_PKG_VERSION"),
         index.n,
         index.k,
         model.rho_d(),
         model.shadowing().name()
-    )
+    );
+    // Only models with the volume terms say so, so that other tables read as before.
+    if model.facet_side() != FacetSide::External || model.subsurface().is_some() {
+        header.push_str(&format!("# facet = {}", model.facet_side().name()));
+        if let Some(s) = model.subsurface() {
+            header.push_str(&format!("; rho_s = {}, d = {}", s.rho_s, s.d));
+        }
+        header.push('\n');
+    }
+    header
 }
 
 /// Most values one `START:STOP:STEP` sweep may hold.

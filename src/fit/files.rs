@@ -148,6 +148,7 @@ fn validate_options(options: &FitOptions) -> Result<(), FitError> {
         ModelSpace::new(
             kind,
             options.shadowing,
+            options.terms,
             &free,
             options.base_values(),
             &options.bounds,

@@ -12,6 +12,7 @@ use super::stages::ConvergenceHistory;
 use super::uncertainty::{estimate, Uncertainty};
 use super::FitError;
 use crate::material::ModelSpec;
+use crate::pbrdf::ModelTerms;
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::optics::Mueller;
 use rayon::prelude::*;
@@ -21,6 +22,8 @@ use std::collections::BTreeMap;
 #[derive(Clone, Debug)]
 pub struct ModelFit {
     pub distribution: DistributionKind,
+    /// The model's terms (docs/design.md §1.10).
+    pub terms: ModelTerms,
     /// The fitted model (fixed parameters included).
     pub model: ModelSpec,
     /// Free parameters in canonical order, and their fitted values.
@@ -112,6 +115,7 @@ pub(crate) fn model_space(
     ModelSpace::new(
         kind,
         options.shadowing,
+        options.terms,
         &options.free_parameters()?,
         options.base_values(),
         &options.bounds,
@@ -198,6 +202,7 @@ pub(crate) fn fit_model(
     let uncertainty = estimate(&objective, &best, reduced_chi2);
     Ok(ModelFit {
         distribution: kind,
+        terms: space.terms(),
         model: space.model_spec(&values, set.wavelength_um),
         free: space.free().to_vec(),
         values: space.free_values(&values),

@@ -111,7 +111,7 @@ fn trap_at(objective: &Objective, point: &[f64]) -> Option<Trap> {
         match p {
             Parameter::Sigma => at_lower || at_upper,
             Parameter::Q => at_lower,
-            Parameter::N | Parameter::K | Parameter::RhoD => false,
+            Parameter::N | Parameter::K | Parameter::RhoD | Parameter::RhoS | Parameter::D => false,
         }
     });
     let zero_extinction = space.free().contains(&Parameter::K)

@@ -6,7 +6,7 @@ use super::parameters::{DistributionKind, Parameter, ParameterBounds, ParameterV
 use super::robust::RobustLoss;
 use super::stages::Optimizer;
 use super::FitError;
-use crate::pbrdf::Shadowing;
+use crate::pbrdf::{ModelTerms, Shadowing};
 use std::collections::BTreeMap;
 
 /// Options of [`super::fit_measurement`].
@@ -17,6 +17,8 @@ pub struct FitOptions {
     pub distribution: Option<DistributionKind>,
     /// Shadowing of the fitted model (default Smith, which generated the shipped measurements).
     pub shadowing: Shadowing,
+    /// The terms of the fitted model (docs/design.md §1.10); default §1.3's facets + ρ_d.
+    pub terms: ModelTerms,
     /// Adjustable parameters; `None` = every parameter that is not in `fixed`. q is ignored for
     /// the Gaussian.
     pub free: Option<Vec<Parameter>>,
@@ -42,6 +44,7 @@ impl Default for FitOptions {
         FitOptions {
             distribution: None,
             shadowing: Shadowing::Smith,
+            terms: ModelTerms::default(),
             free: None,
             fixed: BTreeMap::new(),
             start: BTreeMap::new(),

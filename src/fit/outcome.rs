@@ -85,7 +85,7 @@ pub(super) fn names(parameters: &[Parameter]) -> Vec<String> {
 fn fixed_values(chosen: &ModelFit) -> BTreeMap<String, f64> {
     Parameter::ALL
         .iter()
-        .filter(|p| chosen.distribution.has(**p) && !chosen.free.contains(p))
+        .filter(|p| chosen.distribution.has(**p) && chosen.terms.has(**p) && !chosen.free.contains(p))
         .map(|&p| (p.name().to_owned(), chosen.value(p)))
         .collect()
 }

@@ -13,6 +13,7 @@
 //! | n         | [0.05, 10]                          | n                  | below 1 near absorption bands     |
 //! | k         | [0, 50]                             | asinh(k / 0.1)     | linear near 0, logarithmic above  |
 //! | ρ_d       | [0, 1]                              | ρ_d                | enters m00 linearly               |
+//! | ρ_s, d    | [0, 1]                              | ρ_s, d             | enter the subsurface term linearly |
 //!
 //! The genetic stage samples the search box; the local stages add a sine map on top of it
 //! (MINUIT's bounded transform) so that Nelder–Mead runs unconstrained and can settle exactly on
@@ -35,6 +36,8 @@ impl Parameter {
             Parameter::N => 1.5,
             Parameter::K => 0.0,
             Parameter::RhoD => 0.0,
+            Parameter::RhoS => 0.5,
+            Parameter::D => 0.0,
         }
     }
 
@@ -47,13 +50,15 @@ impl Parameter {
             Parameter::N => 1.8,
             Parameter::K => 0.1,
             Parameter::RhoD => 0.02,
+            Parameter::RhoS => 0.5,
+            Parameter::D => 0.1,
         }
     }
 }
 
 /// One value per [`Parameter`], in canonical order.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ParameterValues(pub [f64; 5]);
+pub struct ParameterValues(pub [f64; 7]);
 
 impl ParameterValues {
     pub fn get(&self, parameter: Parameter) -> f64 {
@@ -89,6 +94,8 @@ pub struct ParameterBounds {
     pub n: Interval,
     pub k: Interval,
     pub rho_d: Interval,
+    pub rho_s: Interval,
+    pub d: Interval,
 }
 
 /// Lowest q searched with Smith shadowing: Λ of the Cauchy distribution exists only for q > 3/2
@@ -108,6 +115,8 @@ impl Default for ParameterBounds {
             n: interval(Parameter::N),
             k: interval(Parameter::K),
             rho_d: interval(Parameter::RhoD),
+            rho_s: interval(Parameter::RhoS),
+            d: interval(Parameter::D),
         }
     }
 }
@@ -120,6 +129,8 @@ impl ParameterBounds {
             Parameter::N => self.n,
             Parameter::K => self.k,
             Parameter::RhoD => self.rho_d,
+            Parameter::RhoS => self.rho_s,
+            Parameter::D => self.d,
         }
     }
 
@@ -168,7 +179,7 @@ pub fn to_search(parameter: Parameter, value: f64) -> f64 {
     match parameter {
         Parameter::Sigma => value.ln(),
         Parameter::Q => (value - 1.0).ln(),
-        Parameter::N | Parameter::RhoD => value,
+        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D => value,
         Parameter::K => (value / K_SCALE).asinh(),
     }
 }
@@ -178,7 +189,7 @@ pub fn from_search(parameter: Parameter, coordinate: f64) -> f64 {
     match parameter {
         Parameter::Sigma => coordinate.exp(),
         Parameter::Q => 1.0 + coordinate.exp(),
-        Parameter::N | Parameter::RhoD => coordinate,
+        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D => coordinate,
         Parameter::K => K_SCALE * coordinate.sinh(),
     }
 }
@@ -188,7 +199,7 @@ pub fn value_per_coordinate(parameter: Parameter, coordinate: f64) -> f64 {
     match parameter {
         Parameter::Sigma => coordinate.exp(),
         Parameter::Q => coordinate.exp(),
-        Parameter::N | Parameter::RhoD => 1.0,
+        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D => 1.0,
         Parameter::K => K_SCALE * coordinate.cosh(),
     }
 }

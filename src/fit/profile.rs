@@ -63,6 +63,7 @@ impl Profile<'_, '_> {
             let Ok(reduced) = ModelSpace::new(
                 space.kind(),
                 space.shadowing(),
+                space.terms(),
                 &others,
                 values,
                 space.bounds(),

@@ -7,13 +7,14 @@ use super::parameters::{
 use super::FitError;
 use crate::material::ModelSpec;
 use crate::optics::RefractiveIndex;
-use crate::pbrdf::{ModelError, Pbrdf, Shadowing};
+use crate::pbrdf::{Body, ModelError, ModelTerms, Pbrdf, Shadowing, Subsurface};
 
 /// A family of pBRDF models with some parameters free (docs/design.md §1.3).
 #[derive(Clone, Debug)]
 pub struct ModelSpace {
     kind: DistributionKind,
     shadowing: Shadowing,
+    terms: ModelTerms,
     free: Vec<Parameter>,
     /// Values of the parameters that are not free (free entries are overwritten).
     base: ParameterValues,
@@ -29,6 +30,7 @@ impl ModelSpace {
     pub fn new(
         kind: DistributionKind,
         shadowing: Shadowing,
+        terms: ModelTerms,
         free: &[Parameter],
         base: ParameterValues,
         bounds: &ParameterBounds,
@@ -39,7 +41,7 @@ impl ModelSpace {
         let bounds = bounds.effective(shadowing);
         let free: Vec<Parameter> = Parameter::ALL
             .into_iter()
-            .filter(|p| free.contains(p) && kind.has(*p))
+            .filter(|p| free.contains(p) && kind.has(*p) && terms.has(*p))
             .collect();
         if free.is_empty() {
             return Err(FitError::Options(format!(
@@ -56,6 +58,7 @@ impl ModelSpace {
         let space = ModelSpace {
             kind,
             shadowing,
+            terms,
             free,
             base,
             bounds,
@@ -79,6 +82,9 @@ impl ModelSpace {
     }
     pub fn shadowing(&self) -> Shadowing {
         self.shadowing
+    }
+    pub fn terms(&self) -> ModelTerms {
+        self.terms
     }
     /// Free parameters in canonical order: the order of search vectors.
     pub fn free(&self) -> &[Parameter] {
@@ -130,12 +136,32 @@ impl ModelSpace {
     }
 
     pub fn pbrdf(&self, values: &ParameterValues) -> Result<Pbrdf, ModelError> {
-        Pbrdf::new(
+        let model = Pbrdf::new(
             self.kind.with_parameters(|p| values.get(p)),
             self.shadowing,
             RefractiveIndex::new(values.get(Parameter::N), values.get(Parameter::K)),
-            values.get(Parameter::RhoD),
-        )
+            self.body_value(values, Parameter::RhoD),
+        )?;
+        match self.subsurface(values) {
+            None if self.terms == ModelTerms::default() => Ok(model),
+            subsurface => model.with_volume(self.terms.facet_side, subsurface),
+        }
+    }
+
+    /// A body term's parameter: its value where the family has the term, else 0.
+    fn body_value(&self, values: &ParameterValues, parameter: Parameter) -> f64 {
+        if self.terms.has(parameter) {
+            values.get(parameter)
+        } else {
+            0.0
+        }
+    }
+
+    fn subsurface(&self, values: &ParameterValues) -> Option<Subsurface> {
+        (self.terms.body == Body::Subsurface).then(|| Subsurface {
+            rho_s: values.get(Parameter::RhoS),
+            d: values.get(Parameter::D),
+        })
     }
 
     pub fn model_spec(&self, values: &ParameterValues, wavelength_um: f64) -> ModelSpec {
@@ -144,7 +170,10 @@ impl ModelSpace {
             shadowing: self.shadowing,
             n: values.get(Parameter::N),
             k: values.get(Parameter::K),
-            rho_d: values.get(Parameter::RhoD),
+            rho_d: self.body_value(values, Parameter::RhoD),
+            facet: self.terms.facet_side,
+            rho_s: self.subsurface(values).map(|s| s.rho_s),
+            d: self.subsurface(values).map(|s| s.d),
             wavelength_um,
         }
     }

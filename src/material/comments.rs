@@ -103,6 +103,7 @@ const TABLES: &[(&str, &str)] = &[
 /// The keys of `[model]` that are not model parameters (those explain themselves in
 /// [`crate::pbrdf::terms`]); `distribution` lists the laws of [`DistributionKind`].
 const MODEL: &[(&str, &str)] = &[
+    ("facet", "which side of the facets reflects: \"external\" (relative index N, the default) or \"internal\" (1/N, inside grains)"),
     ("shadowing", "shadowing/masking G: \"none\" (G = 1), \"torrance-sparrow\" or \"smith\" (energy conserving)"),
     ("wavelength_um", "wavelength of the measurement the model was fitted to, µm"),
 ];

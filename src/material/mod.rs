@@ -17,7 +17,9 @@ pub use spectral::{
 
 use crate::atomic::write_atomically;
 use crate::optics::RefractiveIndex;
-use crate::pbrdf::{ModelError, Parameter, Pbrdf, Shadowing, SlopeDistribution};
+use crate::pbrdf::{
+    FacetSide, ModelError, Parameter, Pbrdf, Shadowing, SlopeDistribution, Subsurface,
+};
 use crate::text::{number, shown, shown_at_most, significant};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -61,6 +63,15 @@ pub struct ModelSpec {
     pub k: f64,
     #[serde(default)]
     pub rho_d: f64,
+    /// Which side of the facets reflects (docs/design.md §1.10); absent from files for
+    /// `external`, so that models without the volume terms are written as before.
+    #[serde(default, skip_serializing_if = "FacetSide::is_external")]
+    pub facet: FacetSide,
+    /// The subsurface term's ρ_s and d, both present or both absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_s: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d: Option<f64>,
     pub wavelength_um: f64,
 }
 
@@ -72,8 +83,18 @@ impl ModelSpec {
             Parameter::N => Some(self.n),
             Parameter::K => Some(self.k),
             Parameter::RhoD => Some(self.rho_d),
+            Parameter::RhoS => self.rho_s,
+            Parameter::D => self.d,
             slope => self.distribution.parameter(slope),
         }
+    }
+
+    /// The subsurface term, if the model has one.
+    pub fn subsurface(&self) -> Option<Subsurface> {
+        self.rho_s.map(|rho_s| Subsurface {
+            rho_s,
+            d: self.d.unwrap_or(0.0),
+        })
     }
 
     pub fn pbrdf(&self) -> Result<Pbrdf, ModelError> {
@@ -82,7 +103,8 @@ impl ModelSpec {
             self.shadowing,
             RefractiveIndex::new(self.n, self.k),
             self.rho_d,
-        )
+        )?
+        .with_volume(self.facet, self.subsurface())
     }
 }
 

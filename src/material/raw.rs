@@ -7,7 +7,7 @@
 use super::{MaterialModel, ModelSpec, SpectralModel};
 use crate::measure::SAME_WAVELENGTH_UM;
 use crate::optics::{LorentzDispersion, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
-use crate::pbrdf::{DistributionError, DistributionKind, Shadowing};
+use crate::pbrdf::{DistributionError, DistributionKind, FacetSide, Shadowing};
 use crate::text::number;
 use serde::Deserialize;
 
@@ -23,6 +23,10 @@ pub(super) struct RawModel<V> {
     n: V,
     k: V,
     rho_d: Option<V>,
+    #[serde(default)]
+    facet: FacetSide,
+    rho_s: Option<f64>,
+    d: Option<f64>,
     wavelength_um: V,
     dispersion: Option<LorentzDispersion>,
 }
@@ -68,6 +72,13 @@ pub enum ModelTableError {
     NotAscending(f64, f64),
     #[error("dispersion: {0}")]
     Dispersion(#[source] crate::optics::LorentzError),
+    #[error("d needs rho_s: the residual polarization belongs to the subsurface term")]
+    PolarizationWithoutSubsurface,
+    #[error(
+        "facet = \"internal\", rho_s and d are grey-model terms: a spectral table cannot use \
+         them yet (fit each wavelength as a grey material)"
+    )]
+    SpectralVolume,
 }
 
 /// Refuses a wavelength irpol does not model.
@@ -87,12 +98,18 @@ impl TryFrom<RawModel<f64>> for ModelSpec {
         if raw.dispersion.is_some() {
             return Err(ModelTableError::GreyDispersion);
         }
+        if raw.d.is_some() && raw.rho_s.is_none() {
+            return Err(ModelTableError::PolarizationWithoutSubsurface);
+        }
         Ok(ModelSpec {
             distribution,
             shadowing: raw.shadowing,
             n: raw.n,
             k: raw.k,
             rho_d: raw.rho_d.unwrap_or(0.0),
+            facet: raw.facet,
+            rho_s: raw.rho_s,
+            d: raw.rho_s.map(|_| raw.d.unwrap_or(0.0)),
             wavelength_um: check_wavelength(raw.wavelength_um)?,
         })
     }
@@ -111,10 +128,14 @@ impl TryFrom<RawModel<OneOrMany>> for MaterialModel {
             n,
             k,
             rho_d,
+            facet,
+            rho_s,
+            d,
             wavelength_um,
             dispersion,
         } = raw;
         let rho_d = rho_d.unwrap_or(One(0.0));
+        let volume = facet != FacetSide::External || rho_s.is_some() || d.is_some();
         match (wavelength_um, n, k, rho_d) {
             (One(wavelength_um), One(n), One(k), One(rho_d)) => {
                 let grey = RawModel {
@@ -125,11 +146,15 @@ impl TryFrom<RawModel<OneOrMany>> for MaterialModel {
                     n,
                     k,
                     rho_d: Some(rho_d),
+                    facet,
+                    rho_s,
+                    d,
                     wavelength_um,
                     dispersion,
                 };
                 Ok(MaterialModel::Grey(ModelSpec::try_from(grey)?))
             }
+            (Many(_), Many(_), Many(_), _) if volume => Err(ModelTableError::SpectralVolume),
             (Many(wavelength_um), Many(n), Many(k), rho_d) => {
                 let rho_d = match rho_d {
                     One(r) => vec![r; wavelength_um.len()],

@@ -6,7 +6,7 @@
 
 use super::ModelSpec;
 use crate::optics::{Band, LorentzDispersion, TableMissesBand, WavelengthNodes};
-use crate::pbrdf::{BandPbrdf, ModelError, Shadowing, SlopeDistribution};
+use crate::pbrdf::{BandPbrdf, FacetSide, ModelError, Shadowing, SlopeDistribution};
 use crate::text::number;
 use serde::{Deserialize, Serialize};
 
@@ -135,6 +135,9 @@ impl SpectralModel {
             n: interpolate(&self.n),
             k: interpolate(&self.k),
             rho_d: interpolate(&self.rho_d),
+            facet: FacetSide::External,
+            rho_s: None,
+            d: None,
             wavelength_um,
         })
     }

@@ -29,6 +29,13 @@ pub enum ModelError {
         wavelength_um: f64,
         source: Box<ModelError>,
     },
+    #[error(
+        "the renderer cannot use the subsurface term yet (rho_s, d): render with a model \
+         without it (`irpol eval` and `emissivity` evaluate it)"
+    )]
+    SubsurfaceNotRendered,
+    #[error(transparent)]
+    Outside(#[from] super::OutsideDomain),
     #[error("a band material needs one model per wavelength node, all with the same slope distribution and shadowing")]
     BandModels,
 }

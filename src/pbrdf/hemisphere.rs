@@ -192,7 +192,19 @@ impl Pbrdf {
             return;
         }
         self.visit_specular_nodes(scattered, quadrature, &mut visit);
-        if self.rho_d() > 0.0 {
+        if self.subsurface().is_some() {
+            // The subsurface term (docs/design.md §1.10) is smooth over ω_i like the ideal
+            // depolarizer, so it shares its cosine-weighted rule.
+            let cos_r = scattered.cos_theta();
+            for (w_i, weight) in quadrature.cosine_weighted_nodes() {
+                let [s0, s1] = self.subsurface_first_column(w_i.z, cos_r);
+                let depolarized = self.rho_d() * FRAC_1_PI;
+                visit(
+                    w_i,
+                    Stokes::new((depolarized + s0) * weight, s1 * weight, 0.0, 0.0),
+                );
+            }
+        } else if self.rho_d() > 0.0 {
             for (w_i, weight) in quadrature.cosine_weighted_nodes() {
                 visit(
                     w_i,
@@ -210,7 +222,7 @@ impl Pbrdf {
         quadrature: &HemisphereQuadrature,
         mut visit: impl FnMut(&Vector3<f64>, Stokes),
     ) {
-        let permittivity = self.index().permittivity();
+        let permittivity = self.permittivity();
         self.visit_specular_facets(scattered, quadrature, |w_i, facet| {
             visit(w_i, facet.stokes(permittivity))
         });

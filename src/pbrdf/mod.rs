@@ -12,6 +12,7 @@ pub mod limits;
 mod model;
 mod sample;
 mod shadowing;
+mod subsurface;
 pub mod terms;
 mod visible_slopes;
 
@@ -25,4 +26,5 @@ pub use geometry::{fold_signed_zenith, signed_zenith_note};
 pub use hemisphere::{cosine_hemisphere_rule, HemisphereQuadrature};
 pub use model::{Pbrdf, ScatteringGeometry};
 pub use shadowing::Shadowing;
-pub use terms::{OutsideDomain, Parameter, ParameterInfo, Term};
+pub use subsurface::{FacetSide, Subsurface, Transmission};
+pub use terms::{Body, ModelTerms, OutsideDomain, Parameter, ParameterInfo, Term};

@@ -4,6 +4,8 @@
 
 use super::distribution::{CauchySmithTable, PreparedDistribution};
 use super::limits::{within, MAX_K, MAX_N, MIN_N};
+use super::subsurface::{FacetSide, PreparedSubsurface, Subsurface};
+use super::terms::Parameter;
 use super::visible_slopes::VisibleSlopes;
 use super::{ModelError, Shadowing, SlopeDistribution};
 use crate::elementary::inline_exp;
@@ -23,7 +25,11 @@ pub struct Pbrdf {
     shadowing: Shadowing,
     index: RefractiveIndex,
     rho_d: f64,
+    facet_side: FacetSide,
+    /// The polarized subsurface term (docs/design.md §1.10), if the model has one.
+    subsurface: Option<PreparedSubsurface>,
     prepared: PreparedDistribution,
+    /// The permittivity the facets see: N², or 1/N² for internal facets.
     permittivity: Complex64,
     /// Smith–Cauchy Λ, built on the first [`Pbrdf::masking`]; `None` inside for the other
     /// distributions.
@@ -208,6 +214,8 @@ impl Pbrdf {
             shadowing,
             index,
             rho_d,
+            facet_side: FacetSide::External,
+            subsurface: None,
             prepared: distribution.prepare(),
             permittivity: index.permittivity(),
             lambda_table: OnceLock::new(),
@@ -226,6 +234,54 @@ impl Pbrdf {
     }
     pub fn rho_d(&self) -> f64 {
         self.rho_d
+    }
+    pub fn facet_side(&self) -> FacetSide {
+        self.facet_side
+    }
+    /// The subsurface term's parameters, if the model has one.
+    pub fn subsurface(&self) -> Option<Subsurface> {
+        self.subsurface.map(|s| s.terms)
+    }
+
+    /// The model with the volume-scattering terms of docs/design.md §1.10: the facets reflecting
+    /// from `facet_side`, and a polarized subsurface term. ρ_s and d are checked against their
+    /// domains ([`Parameter::check`]).
+    pub fn with_volume(
+        mut self,
+        facet_side: FacetSide,
+        subsurface: Option<Subsurface>,
+    ) -> Result<Pbrdf, ModelError> {
+        if let Some(terms) = subsurface {
+            Parameter::RhoS.check(terms.rho_s)?;
+            Parameter::D.check(terms.d)?;
+        }
+        self.facet_side = facet_side;
+        self.permittivity = facet_side.facet_permittivity(self.index);
+        self.subsurface = subsurface.map(|terms| PreparedSubsurface::new(terms, self.index));
+        Ok(self)
+    }
+
+    /// The reflectance of the terms without a lobe, ρ_d + ρ_s: what the renderer's cosine lobe
+    /// samples.
+    pub fn body_albedo(&self) -> f64 {
+        self.rho_d + self.subsurface.map_or(0.0, |s| s.terms.rho_s)
+    }
+
+    /// The subsurface term's Mueller matrix at cos θ_i, cos θ_r, if the model has one.
+    #[inline]
+    fn subsurface_mueller(&self, cos_i: f64, cos_r: f64) -> Option<Mueller> {
+        let s = self.subsurface.as_ref()?;
+        Some(s.mueller(s.transmission(cos_i), s.transmission(cos_r)))
+    }
+
+    /// (m00, m10) of the subsurface term for incidence from ω_i (cos θ_i = `cos_i`) onto ω_r,
+    /// zero without one: the term's weight in a hemispherical integral over ω_i.
+    #[inline]
+    pub(super) fn subsurface_first_column(&self, cos_i: f64, cos_r: f64) -> [f64; 2] {
+        match &self.subsurface {
+            Some(s) => s.first_column(s.transmission(cos_i), s.transmission(cos_r)),
+            None => [0.0, 0.0],
+        }
     }
     pub(crate) fn prepared_distribution(&self) -> &PreparedDistribution {
         &self.prepared
@@ -360,7 +416,12 @@ impl Pbrdf {
         let (a, b) = facet.scaled_a_and_b();
         let c = facet.cross.re * facet.scale;
         let s = facet.cross.im * facet.scale;
-        geometry.assemble_mueller([a, b, c, s], self.rho_d * FRAC_1_PI)
+        let facets_and_depolarizer = geometry.assemble_mueller([a, b, c, s], self.rho_d * FRAC_1_PI);
+        let facet = &geometry.facet;
+        match self.subsurface_mueller(facet.cos_i, facet.cos_r) {
+            Some(subsurface) => facets_and_depolarizer + subsurface,
+            None => facets_and_depolarizer,
+        }
     }
 
     /// First column F_j0 (sr⁻¹): the Stokes BRDF for unpolarized illumination, the only part that
@@ -373,7 +434,13 @@ impl Pbrdf {
         let facet = self.facet_reflection(&geometry, self.masking_of(&geometry));
         let (cr, sr) = double_angle(facet_axis_in_scattered_frame(&incident.vector, scattered));
         let (a, b) = facet.scaled_a_and_b();
-        Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
+        let facets_and_depolarizer = Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0);
+        let [s0, s1] = self.subsurface_first_column(geometry.cos_i, geometry.cos_r);
+        if self.subsurface.is_some() {
+            facets_and_depolarizer + Stokes::new(s0, s1, 0.0, 0.0)
+        } else {
+            facets_and_depolarizer
+        }
     }
 }
 

@@ -19,7 +19,7 @@ impl Pbrdf {
     /// every sample goes to the lobe; otherwise the lobe gets most samples and the cosine lobe
     /// enough to cover the diffuse term (and, with facet-density sampling, the lobe's far tail).
     pub fn specular_sampling_weight(&self) -> f64 {
-        let diffuse = self.rho_d().clamp(0.0, 1.0);
+        let diffuse = self.body_albedo().clamp(0.0, 1.0);
         if diffuse == 0.0 && self.visible_slopes().is_some() {
             return 1.0;
         }

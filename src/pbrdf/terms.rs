@@ -6,6 +6,7 @@
 //! of repeating it; a new parameter or term is added here (and in the physics that uses it).
 
 use super::limits;
+use super::subsurface::FacetSide;
 use crate::text::number;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -24,6 +25,10 @@ pub enum Parameter {
     K,
     /// Diffuse reflectance ρ_d.
     RhoD,
+    /// Subsurface reflectance ρ_s (docs/design.md §1.10).
+    RhoS,
+    /// Residual polarization d of the subsurface light.
+    D,
 }
 
 /// A term of the model: F = facet term + ideal depolarizer (docs/design.md §1.3).
@@ -33,6 +38,77 @@ pub enum Term {
     Facet,
     /// (ρ_d/π) diag(1, 0, 0, 0): unpolarized diffuse reflection.
     IdealDepolarizer,
+    /// (ρ_s/πZ) T(θ_r) D(d) T(θ_i): light refracted in, scattered inside and refracted out
+    /// (docs/design.md §1.10, `pbrdf::subsurface`).
+    Subsurface,
+}
+
+/// The term that scatters light from under the surface, beside the facet term.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Body {
+    /// [`Term::IdealDepolarizer`] (ρ_d), today's default.
+    #[default]
+    Depolarizer,
+    /// [`Term::Subsurface`] (ρ_s, d).
+    Subsurface,
+}
+
+impl Body {
+    pub fn term(self) -> Term {
+        match self {
+            Body::Depolarizer => Term::IdealDepolarizer,
+            Body::Subsurface => Term::Subsurface,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Body::Depolarizer => "depolarizer",
+            Body::Subsurface => "subsurface",
+        }
+    }
+}
+
+/// Which terms a model is made of (docs/design.md §1.10): the facet term on one side of the
+/// facets, and one body term. Written `external+depolarizer` (the default, §1.3's model),
+/// `external+subsurface`, `internal+subsurface`, `internal+depolarizer`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ModelTerms {
+    pub facet_side: FacetSide,
+    pub body: Body,
+}
+
+impl ModelTerms {
+    /// Every combination, the default first.
+    pub const ALL: [ModelTerms; 4] = [
+        ModelTerms::new(FacetSide::External, Body::Depolarizer),
+        ModelTerms::new(FacetSide::External, Body::Subsurface),
+        ModelTerms::new(FacetSide::Internal, Body::Subsurface),
+        ModelTerms::new(FacetSide::Internal, Body::Depolarizer),
+    ];
+
+    pub const fn new(facet_side: FacetSide, body: Body) -> ModelTerms {
+        ModelTerms { facet_side, body }
+    }
+
+    /// Whether `parameter` belongs to one of these terms (the slope parameters also depend on
+    /// the distribution: [`super::DistributionKind::has`]).
+    pub fn has(&self, parameter: Parameter) -> bool {
+        let term = parameter.info().term;
+        term == Term::Facet || term == self.body.term()
+    }
+
+    /// Parses `external+subsurface` and the like.
+    pub fn parse(text: &str) -> Option<ModelTerms> {
+        ModelTerms::ALL
+            .into_iter()
+            .find(|t| t.to_string() == text.trim())
+    }
+}
+
+impl fmt::Display for ModelTerms {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}+{}", self.facet_side.name(), self.body.name())
+    }
 }
 
 /// What the crate knows about one [`Parameter`].
@@ -57,7 +133,7 @@ pub struct ParameterInfo {
 }
 
 /// Every parameter's entry, in [`Parameter::ALL`] order.
-const REGISTRY: [ParameterInfo; 5] = [
+const REGISTRY: [ParameterInfo; 7] = [
     ParameterInfo {
         key: "sigma",
         aliases: &[],
@@ -109,6 +185,26 @@ const REGISTRY: [ParameterInfo; 5] = [
         default_bounds: (0.0, 1.0),
         comment: "unpolarized diffuse reflectance ρ_d (0–1): adds ρ_d/π to m00 only",
     },
+    ParameterInfo {
+        key: "rho_s",
+        aliases: &[],
+        label: "ρs",
+        unit: "dimensionless",
+        term: Term::Subsurface,
+        domain: (0.0, 1.0, false),
+        default_bounds: (0.0, 1.0),
+        comment: "subsurface reflectance ρ_s (0–1): the fraction of the light refracted in that comes back out, p-polarized by the interface",
+    },
+    ParameterInfo {
+        key: "d",
+        aliases: &[],
+        label: "d",
+        unit: "dimensionless",
+        term: Term::Subsurface,
+        domain: (0.0, 1.0, false),
+        default_bounds: (0.0, 1.0),
+        comment: "residual polarization d (0–1) of the subsurface light: D = diag(1, d, −d, −d)",
+    },
 ];
 
 /// A parameter value outside the values a model accepts.
@@ -128,12 +224,14 @@ fn range(parameter: Parameter) -> String {
 
 impl Parameter {
     /// All parameters in their canonical order (the order of vectors and matrices in a fit).
-    pub const ALL: [Parameter; 5] = [
+    pub const ALL: [Parameter; 7] = [
         Parameter::Sigma,
         Parameter::Q,
         Parameter::N,
         Parameter::K,
         Parameter::RhoD,
+        Parameter::RhoS,
+        Parameter::D,
     ];
 
     /// The parameter's entry in the registry.
@@ -193,7 +291,7 @@ impl fmt::Display for Parameter {
 }
 
 impl Term {
-    pub const ALL: [Term; 2] = [Term::Facet, Term::IdealDepolarizer];
+    pub const ALL: [Term; 3] = [Term::Facet, Term::IdealDepolarizer, Term::Subsurface];
 
     /// The parameters of the term, in canonical order (the facet term's slope parameters are
     /// those of every distribution: [`super::DistributionKind::parameters`] says which one has

@@ -1,0 +1,226 @@
+//! The volume-scattering terms of docs/design.md §1.10: which side of the facets reflects
+//! ([`FacetSide`]), and the polarized subsurface term
+//!     F_ss(ω_i→ω_r) = (ρ_s / (π Z)) · T(θ_r) · D(d) · T(θ_i),
+//! light refracted into the material through a smooth interface, scattered inside with a residual
+//! polarization d, and refracted out.
+//!
+//! - T(θ) is the Fresnel transmission Mueller matrix of the macro surface at cos θ, air → material
+//!   (ε = N²), in the psps frame of its direction: t_s,p = 1 − R_s,p, T± = (t_s ± t_p)/2,
+//!   X = √(t_s t_p); T = [[T+, T−, 0, 0], [T−, T+, 0, 0], [0, 0, X, 0], [0, 0, 0, X]]. For a
+//!   dielectric t_p ≥ t_s, so the light leaves p-polarized — as thermal emission does.
+//! - D(d) = diag(1, d, −d, −d): the polarization that survives volume scattering, with the signs of
+//!   a mirror in psps frames (a perfect mirror is diag(1, 1, −1, −1) there), so d = 1 on an
+//!   index-matched surface behaves like one. D is realizable (Cloude) for −1/3 ≤ d ≤ 1; the model
+//!   accepts d ∈ [0, 1].
+//! - Z = (1 − R̄) + |d|·|Ā|, R̄ = 2∫₀¹ R(μ) μ dμ, Ā = 2∫₀¹ T−(μ) μ dμ, the normalization that
+//!   conserves energy: the term's directional-hemispherical reflectance is
+//!   (ρ_s/Z)[T+(θ_i)(1 − R̄) + d T−(θ_i) Ā] ≤ ρ_s T+(θ_i) = ρ_s (1 − R(θ_i)) — at most a
+//!   fraction ρ_s of what the smooth interface lets in comes out.
+//!
+//! Reciprocity: T is symmetric and D diagonal, so F_ss(ω_r→ω_i) = F_ss(ω_i→ω_r)ᵀ, and the
+//! diagonal Q of Sekera's relation commutes with both; the term is reciprocal like the facet term.
+//! With N = 1 and d = 0 every R is exactly 0, Z exactly 1 and the term is (ρ_s/π) diag(1,0,0,0)
+//! bit for bit: today's ideal depolarizer (§1.3's ρ_d).
+
+use crate::optics::{FresnelFractions, Mueller, RefractiveIndex};
+use num_complex::Complex64;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{FRAC_1_PI, PI};
+
+/// Which side of the surface's facets reflects the facet term (docs/design.md §1.10).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FacetSide {
+    /// Reflection off the outside of the surface: relative index N (docs/design.md §1.3).
+    #[default]
+    External,
+    /// Reflection inside grains at grain/air facets: relative index 1/N, total internal
+    /// reflection included (sintered PTFE, powders, pigments).
+    Internal,
+}
+
+impl FacetSide {
+    pub const ALL: [FacetSide; 2] = [FacetSide::External, FacetSide::Internal];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            FacetSide::External => "external",
+            FacetSide::Internal => "internal",
+        }
+    }
+
+    /// Whether this is the default side (a material file then leaves the key out).
+    pub fn is_external(&self) -> bool {
+        *self == FacetSide::External
+    }
+
+    pub fn parse(text: &str) -> Option<FacetSide> {
+        FacetSide::ALL.into_iter().find(|s| s.name() == text.trim())
+    }
+
+    /// The permittivity the facets' Fresnel coefficients see: N² outside; inside, the relative
+    /// permittivity of air to the grain, 1/N², taken as N²/|N|⁴ = conj(1/N²). Why the
+    /// conjugate: 1/N² has Im < 0 for k > 0, and under total internal reflection the principal
+    /// root w = √(ε − sin²β) then jumps from +i√a (k = 0, the evanescent wave decaying into the
+    /// air) to −i√a for any k > 0, flipping the sign of the retardance m23, m32; with Im ε ≥ 0
+    /// the coefficients are continuous in k, |r| ≤ 1, and k = 0 is unchanged. (conj also turns
+    /// the −0 imaginary part of 1/n² into +0, which keeps k = 0 itself on the physical branch.)
+    pub(super) fn facet_permittivity(&self, index: RefractiveIndex) -> Complex64 {
+        match self {
+            FacetSide::External => index.permittivity(),
+            FacetSide::Internal => index.permittivity().inv().conj(),
+        }
+    }
+}
+
+/// The parameters of the subsurface term: ρ_s ∈ [0, 1], the fraction of the transmitted light
+/// that comes back out, and d ∈ [0, 1], its residual polarization.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Subsurface {
+    pub rho_s: f64,
+    pub d: f64,
+}
+
+/// Fresnel transmission of the macro surface at one zenith angle: (T+, T−, X) of the module docs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transmission {
+    pub plus: f64,
+    pub minus: f64,
+    pub cross: f64,
+}
+
+impl Transmission {
+    /// T(θ) at cos θ = `cos_theta` for permittivity ε = N².
+    #[inline]
+    pub fn at(cos_theta: f64, permittivity: Complex64) -> Transmission {
+        let (rs2, rp2, _) = FresnelFractions::new(cos_theta, permittivity).reflectances_and_cross();
+        let (ts, tp) = (1.0 - rs2, 1.0 - rp2);
+        Transmission {
+            plus: 0.5 * (ts + tp),
+            minus: 0.5 * (ts - tp),
+            cross: (ts * tp).max(0.0).sqrt(),
+        }
+    }
+}
+
+/// A subsurface term ready to evaluate: its parameters, ε = N² and the scale ρ_s/(πZ).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PreparedSubsurface {
+    pub(super) terms: Subsurface,
+    permittivity: Complex64,
+    scale: f64,
+}
+
+impl PreparedSubsurface {
+    pub(super) fn new(terms: Subsurface, index: RefractiveIndex) -> PreparedSubsurface {
+        let permittivity = index.permittivity();
+        let (mean_reflectance, mean_minus) = interface_means(permittivity);
+        let z = (1.0 - mean_reflectance) + terms.d.abs() * mean_minus.abs();
+        PreparedSubsurface {
+            terms,
+            permittivity,
+            scale: terms.rho_s * FRAC_1_PI / z,
+        }
+    }
+
+    /// T(θ) of this material's interface.
+    #[inline]
+    pub(super) fn transmission(&self, cos_theta: f64) -> Transmission {
+        Transmission::at(cos_theta, self.permittivity)
+    }
+
+    /// The term's Mueller matrix from T(θ_i) and T(θ_r) (module docs).
+    #[inline]
+    pub(super) fn mueller(&self, incident: Transmission, scattered: Transmission) -> Mueller {
+        let (i, r, d, k) = (incident, scattered, self.terms.d, self.scale);
+        let mut m = Mueller::zeros();
+        m[(0, 0)] = k * (r.plus * i.plus + d * r.minus * i.minus);
+        m[(0, 1)] = k * (r.plus * i.minus + d * r.minus * i.plus);
+        m[(1, 0)] = k * (r.minus * i.plus + d * r.plus * i.minus);
+        m[(1, 1)] = k * (r.minus * i.minus + d * r.plus * i.plus);
+        m[(2, 2)] = -k * d * r.cross * i.cross;
+        m[(3, 3)] = m[(2, 2)];
+        m
+    }
+
+    /// (m00, m10) of [`PreparedSubsurface::mueller`]: the Stokes BRDF for unpolarized light.
+    #[inline]
+    pub(super) fn first_column(&self, incident: Transmission, scattered: Transmission) -> [f64; 2] {
+        let (i, r, d, k) = (incident, scattered, self.terms.d, self.scale);
+        [
+            k * (r.plus * i.plus + d * r.minus * i.minus),
+            k * (r.minus * i.plus + d * r.plus * i.minus),
+        ]
+    }
+}
+
+/// Gauss–Legendre nodes per panel of [`interface_means`].
+const MEAN_NODES: usize = 48;
+
+/// (R̄, Ā) = (2∫₀¹ R(μ) μ dμ, 2∫₀¹ T−(μ) μ dμ) of the interface with permittivity ε.
+/// R(μ) is analytic except at μ_c = √(1 − Re ε) when Re ε < 1 (the critical angle of a material
+/// optically thinner than air), where it has a square-root kink: the interval is split there and
+/// each panel mapped by μ = a + (b − a) sin²(πv/2), which removes square-root end singularities,
+/// so 48 nodes per panel give the means to ~1e-14.
+fn interface_means(permittivity: Complex64) -> (f64, f64) {
+    let critical = (1.0 - permittivity.re).max(0.0).sqrt();
+    let panels: &[(f64, f64)] = if critical > 0.0 && critical < 1.0 {
+        &[(0.0, critical), (critical, 1.0)]
+    } else {
+        &[(0.0, 1.0)]
+    };
+    let rule = gauss_quad::legendre::GaussLegendre::new(MEAN_NODES.try_into().expect("48 ≥ 1"));
+    let (mut reflectance, mut minus) = (0.0, 0.0);
+    for &(a, b) in panels {
+        for &(x, w) in rule.as_node_weight_pairs().iter() {
+            let v = 0.5 * (x + 1.0);
+            let half_angle = 0.5 * PI * v;
+            let mu = a + (b - a) * half_angle.sin().powi(2);
+            let jacobian = (b - a) * 0.5 * PI * (PI * v).sin() * 0.5 * w;
+            let t = Transmission::at(mu, permittivity);
+            // R = (R_s + R_p)/2 = 1 − T+.
+            reflectance += 2.0 * (1.0 - t.plus) * mu * jacobian;
+            minus += 2.0 * t.minus * mu * jacobian;
+        }
+    }
+    (reflectance, minus)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn index_matched_interface_transmits_everything_exactly() {
+        let eps = RefractiveIndex::new(1.0, 0.0).permittivity();
+        for cos in [1.0, 0.7, 0.3, 0.01] {
+            let t = Transmission::at(cos, eps);
+            assert_eq!((t.plus, t.minus, t.cross), (1.0, 0.0, 1.0));
+        }
+        assert_eq!(interface_means(eps), (0.0, 0.0));
+    }
+
+    /// R̄ of a dielectric against its closed form (Stern 1964 / Walton: the hemispherical
+    /// reflectance of a smooth dielectric, here n = 1.5: R̄ = 0.092 …) computed by brute force.
+    #[test]
+    fn interface_means_match_a_brute_force_sum() {
+        for (n, k) in [(1.5, 0.0), (1.35, 0.0), (2.4, 0.3), (0.7, 0.0), (0.9, 0.05)] {
+            let eps = RefractiveIndex::new(n, k).permittivity();
+            let (r, a) = interface_means(eps);
+            // Midpoint rule on a fine grid (converges slowly but surely, kink or not).
+            let steps = 400_000;
+            let (mut r_ref, mut a_ref) = (0.0, 0.0);
+            for s in 0..steps {
+                let mu = (s as f64 + 0.5) / steps as f64;
+                let t = Transmission::at(mu, eps);
+                r_ref += 2.0 * (1.0 - t.plus) * mu / steps as f64;
+                a_ref += 2.0 * t.minus * mu / steps as f64;
+            }
+            assert!((r - r_ref).abs() < 1e-9, "{n} {k}: {r} vs {r_ref}");
+            assert!((a - a_ref).abs() < 1e-9, "{n} {k}: {a} vs {a_ref}");
+        }
+        // The classic value for n = 1.5: hemispherical reflectance 0.0918 (e.g. Duntley 1942).
+        let (r, _) = interface_means(RefractiveIndex::new(1.5, 0.0).permittivity());
+        assert!((r - 0.0918).abs() < 5e-4, "{r}");
+    }
+}
