@@ -2,6 +2,10 @@
 
 F(w_i -> w_r) = P(theta) G M(beta, eta_i, eta_r) / (4 cos(theta) cos(theta_i) cos(theta_r)) + rho_d/pi diag(1,0,0,0)
 
+The facet Fresnel matrix uses eps = N^2 (`facet="external"`, reflection off the material from air) or
+eps = 1/N^2 (`facet="internal"`, reflection inside the material off grain/air facets, docs/design.md
+§1.10); the subsurface term of §1.10 is in pbrdf_volume_numpy.py.
+
 Written from docs/design.md, not from the Rust code; the SCATMECH side (scatmech_backend.py) is the
 external reference.  Used by the nlopt/emcee cross-checks as a fast model.
 
@@ -67,8 +71,23 @@ def global_frames(theta_i, phi_i, theta_r, phi_r):
 # ---------------------------------------------------------------------------------------------
 
 
-def fresnel(cos_beta, n, k):
-    eps = complex(n, k) ** 2
+FACETS = ("external", "internal")
+
+
+def permittivity(n, k, facet="external"):
+    """Relative permittivity of the facet's far side: N^2 seen from air, 1/N^2 seen from inside."""
+    if facet == "external":
+        return complex(n, k) ** 2
+    if facet == "internal":
+        return 1.0 / complex(n, k) ** 2
+    raise ValueError(f"unknown facet side {facet!r}")
+
+
+def fresnel(cos_beta, n, k, facet="external"):
+    """r_s, r_p of docs/design.md §1.3 with the principal root (Re >= 0).  The `+ 0j` makes the imaginary
+    part of eps - sin^2 a +0 for real eps (k = 0), so total internal reflection takes +i sqrt(...) there,
+    whatever the sign of zero 1/N^2 carries."""
+    eps = permittivity(n, k, facet)
     sin2 = 1.0 - cos_beta**2
     root = np.sqrt(eps - sin2 + 0j)
     r_s = (cos_beta - root) / (cos_beta + root)
@@ -157,6 +176,7 @@ def mueller_brdf(
     k,
     shadowing="none",
     rho_d=0.0,
+    facet="external",
 ):
     """Mueller BRDF (N, 4, 4) in sr^-1, psps frames of the global geometry (docs/design.md §1.3)."""
     if distribution not in DISTRIBUTIONS:
@@ -182,7 +202,7 @@ def mueller_brdf(
     p_loc_in = np.cross(k_in, s_loc)
     p_loc_out = np.cross(k_out, s_loc)
 
-    r_s, r_p = fresnel(cos_b, n, k)
+    r_s, r_p = fresnel(cos_b, n, k, facet)
     # J[a, b] = sum_c (g_out_a . f_out_c) r_c (f_in_c . g_in_b), g = global (s, p), f = facet (s, p)
     out_proj = np.stack(
         [
