@@ -3,8 +3,9 @@
 F(w_i -> w_r) = P(theta) G M(beta, eta_i, eta_r) / (4 cos(theta) cos(theta_i) cos(theta_r)) + rho_d/pi diag(1,0,0,0)
 
 The facet Fresnel matrix uses eps = N^2 (`facet="external"`, reflection off the material from air) or
-eps = 1/N^2 (`facet="internal"`, reflection inside the material off grain/air facets, docs/design.md
-§1.10); the subsurface term of §1.10 is in pbrdf_volume_numpy.py.
+eps = N^2/|N|^4 = conj(1/N^2) (`facet="internal"`, reflection inside the material off grain/air facets,
+docs/design.md §1.10: the conjugate keeps Im eps >= 0, so total internal reflection stays on the physical
+branch for k > 0); the subsurface term of §1.10 is in pbrdf_volume_numpy.py.
 
 Written from docs/design.md, not from the Rust code; the SCATMECH side (scatmech_backend.py) is the
 external reference.  Used by the nlopt/emcee cross-checks as a fast model.
@@ -75,11 +76,11 @@ FACETS = ("external", "internal")
 
 
 def permittivity(n, k, facet="external"):
-    """Relative permittivity of the facet's far side: N^2 seen from air, 1/N^2 seen from inside."""
+    """Relative permittivity of the facet's far side: N^2 seen from air, conj(1/N^2) seen from inside."""
     if facet == "external":
         return complex(n, k) ** 2
     if facet == "internal":
-        return 1.0 / complex(n, k) ** 2
+        return (1.0 / complex(n, k) ** 2).conjugate()
     raise ValueError(f"unknown facet side {facet!r}")
 
 

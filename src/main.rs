@@ -15,6 +15,7 @@ use irpol::app::render::{
 use irpol::app::scene_init::write_starter_scene;
 use irpol::app::sun::{given_times, write_sun_csv};
 use irpol::app::thermal::{run_thermal, run_thermal_and_render};
+use irpol::app::validate::{validate_and_report, validation_summary};
 use irpol::app::{parse_sweep, AppError, ModelArgs};
 use irpol::atomic::staging_folder;
 use irpol::fit::{FitOptions, MaterialFit};
@@ -80,6 +81,18 @@ enum Command {
     },
     /// Fits pBRDF models to measurement CSVs and writes the material library.
     Fit(FitArgs),
+    /// How a material's model predicts measurements it was not fitted to: per-element RMS
+    /// errors (absolute and of m_ij/m00), normalized residuals, and a report page per file.
+    Validate {
+        /// The material TOML.
+        material: PathBuf,
+        /// Measurement CSVs or folders of them.
+        #[arg(required = true)]
+        data: Vec<PathBuf>,
+        /// Folder for the validation report pages.
+        #[arg(long, default_value = "reports")]
+        reports: PathBuf,
+    },
     /// Rebuilds a material's fit report from its library entry and source CSV.
     Report {
         /// The material TOML.
@@ -192,6 +205,14 @@ struct FitArgs {
     /// wavelength (table), or from a Lorentz law of N oscillators (lorentz:N).
     #[arg(long, default_value = "table")]
     dispersion: String,
+    /// Model terms (docs/design.md §1.10): external+depolarizer (default), external+subsurface,
+    /// internal+subsurface, internal+depolarizer; several comma-separated (or `all`) are each
+    /// fitted and compared by AIC (and by --cv).
+    #[arg(long, default_value = "external+depolarizer")]
+    terms: String,
+    /// Score each set of terms by K-fold cross-validation and keep the one that predicts best.
+    #[arg(long, value_name = "K")]
+    cv: Option<usize>,
     /// Library folder for the material TOMLs.
     #[arg(long, default_value = "fits")]
     out: PathBuf,
@@ -280,6 +301,11 @@ fn run(command: Command) -> anyhow::Result<()> {
         }
         Command::Figure { which, out } => figure(&which, &out),
         Command::Fit(args) => fit(args),
+        Command::Validate {
+            material,
+            data,
+            reports,
+        } => validate(&material, &data, &reports),
         Command::Report { material, reports } => report(&material, &reports),
         Command::Render {
             scene,
@@ -345,8 +371,40 @@ fn fit(args: FitArgs) -> anyhow::Result<()> {
         seed: args.seed,
         robust: args.robust,
         dispersion: args.dispersion,
+        terms: args.terms,
+        cv: args.cv,
     };
     fit_and_summarize(&args.inputs, &flags.options()?, &args.out, &args.reports)
+}
+
+/// `irpol validate`: one line per measurement set and its report page.
+fn validate(material: &Path, data: &[PathBuf], reports: &Path) -> anyhow::Result<()> {
+    for result in validate_and_report(material, data, reports)? {
+        say!(
+            "{} on {}: {}",
+            material.display(),
+            result.set.source.display(),
+            validation_summary(&result.validation)
+        );
+        say!("  {}", element_errors(&result.validation));
+        say!("  report {}", result.report.display());
+    }
+    Ok(())
+}
+
+/// `m00 4.1 % · m01 0.0123 · …`: each element's RMS error, m00's relative and the others' of
+/// m_ij/m00.
+fn element_errors(validation: &irpol::fit::Validation) -> String {
+    let parts: Vec<String> = validation
+        .elements
+        .iter()
+        .enumerate()
+        .map(|(i, e)| match i {
+            0 => format!("{} {:.2} %", e.name, 100.0 * e.rms_normalized),
+            _ => format!("{} {:.4}", e.name, e.rms_normalized),
+        })
+        .collect();
+    parts.join(" · ")
 }
 
 /// `irpol sun`: the CSV on stdout.
@@ -420,6 +478,11 @@ fn fit_and_summarize(
             MaterialFit::Spectral(outcome) => spectral_summary_line(outcome, entry),
         };
         say!("{line}");
+        if let MaterialFit::Grey(grey) = outcome {
+            if let Some(choice) = &grey.terms_choice {
+                say!("{}", choice.table());
+            }
+        }
     }
     for report in &written.reports {
         say!("  report {}", report.display());
@@ -494,9 +557,14 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
         .as_ref()
         .map_or(String::new(), |c| format!("; {}", c.summary()));
     format!(
-        "{}: {} {}{}{} χ²_red={:.3}{comparison} → {}",
+        "{}: {}{} {}{}{} χ²_red={:.3}{comparison} → {}",
         outcome.material.name,
         chosen.distribution.name(),
+        if chosen.terms == irpol::pbrdf::ModelTerms::default() {
+            String::new()
+        } else {
+            format!(" {}", chosen.terms)
+        },
         parameters.join(" "),
         listed(" [bounded only: ", &bounded, ", ", "]"),
         listed(" (fixed: ", &fixed, " ", ")"),

@@ -10,7 +10,7 @@ use crate::fit::{
     FitOptions, MaterialFit, Optimizer, RobustLoss,
 };
 use crate::material::{list_library, Material};
-use crate::pbrdf::Shadowing;
+use crate::pbrdf::{ModelTerms, Shadowing};
 use crate::report::fit_report::encode_fit_report;
 use crate::report::index::library_index_html;
 use crate::report::spectral_report::encode_spectral_report;
@@ -36,6 +36,12 @@ pub struct FitFlags {
     pub robust: Option<String>,
     /// `table` or `lorentz:N`.
     pub dispersion: String,
+    /// The model's terms, or several to choose among: `external+depolarizer` (default),
+    /// `external+subsurface`, `internal+subsurface`, `internal+depolarizer`, comma-separated, or
+    /// `all`.
+    pub terms: String,
+    /// K-fold cross-validation (K ≥ 2) of each candidate set of terms.
+    pub cv: Option<usize>,
 }
 
 impl Default for FitFlags {
@@ -50,6 +56,8 @@ impl Default for FitFlags {
             seed: FitOptions::default().seed,
             robust: None,
             dispersion: "table".into(),
+            terms: ModelTerms::default().to_string(),
+            cv: None,
         }
     }
 }
@@ -81,8 +89,38 @@ impl FitFlags {
         if let Some(loss) = &self.robust {
             options.robust = Some(RobustLoss::parse(loss)?);
         }
+        let candidates = parse_terms(&self.terms)?;
+        options.terms = candidates[0];
+        if candidates.len() > 1 {
+            options.term_candidates = candidates;
+        }
+        options.cv_folds = self.cv;
         Ok(options)
     }
+}
+
+/// `--terms`: one or more sets of model terms, comma-separated, or `all`.
+fn parse_terms(text: &str) -> Result<Vec<ModelTerms>, AppError> {
+    if text.trim() == "all" {
+        return Ok(ModelTerms::ALL.to_vec());
+    }
+    let mut list = Vec::new();
+    for name in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let terms = ModelTerms::parse(name).ok_or_else(|| {
+            let known: Vec<String> = ModelTerms::ALL.iter().map(|t| t.to_string()).collect();
+            AppError::invalid(format!(
+                "unknown terms '{name}' in --terms: use {} (comma-separated) or all",
+                known.join(", ")
+            ))
+        })?;
+        if !list.contains(&terms) {
+            list.push(terms);
+        }
+    }
+    if list.is_empty() {
+        return Err(AppError::invalid("--terms is empty: name at least one set of terms"));
+    }
+    Ok(list)
 }
 
 /// What a fit wrote.

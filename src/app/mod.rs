@@ -8,6 +8,7 @@ pub mod render;
 pub mod scene_init;
 pub mod sun;
 pub mod thermal;
+pub mod validate;
 
 pub use error::{one_line, AppError};
 
@@ -53,6 +54,9 @@ pub struct ModelArgs {
     /// Residual polarization d of the subsurface term (needs --rho-s; default 0).
     #[arg(long, allow_negative_numbers = true)]
     pub d: Option<f64>,
+    /// Real index of the subsurface term's interface (needs --rho-s; default --n).
+    #[arg(long = "n-sub", allow_negative_numbers = true)]
+    pub n_sub: Option<f64>,
     /// Shadowing: none, torrance-sparrow or smith (default smith, as `fit`; with --material,
     /// the material's own).
     #[arg(long)]
@@ -70,7 +74,7 @@ pub enum ModelArgsError {
     UnknownShadowing(String),
     #[error("unknown facet side '{0}': use external or internal")]
     UnknownFacet(String),
-    #[error("--d is the subsurface term's residual polarization: give --rho-s too")]
+    #[error("--d and --n-sub belong to the subsurface term: give --rho-s too")]
     PolarizationWithoutSubsurface,
     #[error(
         "give either --material or model parameters (--distribution --sigma --q --n --k \
@@ -155,7 +159,8 @@ impl ModelArgs {
 
     /// `--facet`, `--rho-s` and `--d` applied to `model` (docs/design.md §1.10).
     fn with_volume_terms(&self, model: Pbrdf) -> Result<Pbrdf, ModelArgsError> {
-        if self.facet.is_none() && self.rho_s.is_none() && self.d.is_none() {
+        if self.facet.is_none() && self.rho_s.is_none() && self.d.is_none() && self.n_sub.is_none()
+        {
             return Ok(model);
         }
         let facet = match &self.facet {
@@ -164,12 +169,15 @@ impl ModelArgs {
             }
             None => FacetSide::External,
         };
-        let subsurface = match (self.rho_s, self.d) {
-            (None, Some(_)) => return Err(ModelArgsError::PolarizationWithoutSubsurface),
-            (None, None) => None,
-            (Some(rho_s), d) => Some(Subsurface {
+        let subsurface = match self.rho_s {
+            None if self.d.is_some() || self.n_sub.is_some() => {
+                return Err(ModelArgsError::PolarizationWithoutSubsurface)
+            }
+            None => None,
+            Some(rho_s) => Some(Subsurface {
                 rho_s,
-                d: d.unwrap_or(0.0),
+                d: self.d.unwrap_or(0.0),
+                n_sub: self.n_sub,
             }),
         };
         Ok(model.with_volume(facet, subsurface)?)
@@ -188,6 +196,7 @@ impl ModelArgs {
             ("--facet", self.facet.is_some()),
             ("--rho-s", self.rho_s.is_some()),
             ("--d", self.d.is_some()),
+            ("--n-sub", self.n_sub.is_some()),
         ]
         .into_iter()
         .filter_map(|(flag, set)| set.then_some(flag))
@@ -250,6 +259,9 @@ pub fn model_header(model: &Pbrdf) -> String {
         header.push_str(&format!("# facet = {}", model.facet_side().name()));
         if let Some(s) = model.subsurface() {
             header.push_str(&format!("; rho_s = {}, d = {}", s.rho_s, s.d));
+            if let Some(n_sub) = s.n_sub {
+                header.push_str(&format!(", n_sub = {n_sub}"));
+            }
         }
         header.push('\n');
     }

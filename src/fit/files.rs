@@ -3,7 +3,7 @@
 
 use super::data::MeasurementData;
 use super::options::FitOptions;
-use super::outcome::{fit_measurement, FitOutcome};
+use super::outcome::FitOutcome;
 use super::space::ModelSpace;
 use super::spectral::{fit_spectral, SpectralFitOutcome};
 use super::FitError;
@@ -82,7 +82,8 @@ pub fn fit_inputs(
     for sets in materials {
         progress.message(&sets[0].material);
         let outcome = if sets.len() == 1 {
-            fit_measurement(&sets[0], options).map(|o| MaterialFit::Grey(Box::new(o)))
+            super::cross_validation::fit_grey(&sets[0], options)
+                .map(|o| MaterialFit::Grey(Box::new(o)))
         } else {
             fit_spectral(sets, options, options.dispersion)
                 .map(|o| MaterialFit::Spectral(Box::new(o)))

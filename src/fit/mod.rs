@@ -14,6 +14,7 @@
 //! Entry points: [`fit_measurement`] for one set, [`fit_files`] for `irpol fit`.
 
 mod comparison;
+mod cross_validation;
 mod data;
 mod error;
 mod files;
@@ -34,8 +35,12 @@ mod space;
 mod spectral;
 mod stages;
 mod uncertainty;
+mod validation;
 
 pub use comparison::{aic, bic, Candidate, ModelComparison};
+pub use cross_validation::{
+    fit_choosing_terms, fit_grey, fold_rows, subset, TermsChoice, TermsScore,
+};
 pub use data::{
     ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00,
 };
@@ -60,3 +65,4 @@ pub use space::ModelSpace;
 pub use spectral::{fit_spectral, Dispersion, SpectralFit, SpectralFitOutcome};
 pub use stages::{ConvergenceHistory, Optimizer, Stage, StageHistory};
 pub use uncertainty::Uncertainty;
+pub use validation::{validate_model, ElementError, Validation};

@@ -19,6 +19,11 @@ pub struct FitOptions {
     pub shadowing: Shadowing,
     /// The terms of the fitted model (docs/design.md §1.10); default §1.3's facets + ρ_d.
     pub terms: ModelTerms,
+    /// Several sets of terms to choose among (`--terms a,b`), by AIC or by cross-validation;
+    /// empty: fit `terms` alone.
+    pub term_candidates: Vec<ModelTerms>,
+    /// K of K-fold cross-validation (`--cv K`), reported beside AIC and deciding the terms.
+    pub cv_folds: Option<usize>,
     /// Adjustable parameters; `None` = every parameter that is not in `fixed`. q is ignored for
     /// the Gaussian.
     pub free: Option<Vec<Parameter>>,
@@ -45,6 +50,8 @@ impl Default for FitOptions {
             distribution: None,
             shadowing: Shadowing::Smith,
             terms: ModelTerms::default(),
+            term_candidates: Vec::new(),
+            cv_folds: None,
             free: None,
             fixed: BTreeMap::new(),
             start: BTreeMap::new(),

@@ -23,6 +23,8 @@ pub struct FitOutcome {
     /// The other distribution's fit, when both were fitted.
     pub alternative: Option<ModelFit>,
     pub comparison: Option<ModelComparison>,
+    /// How the model's terms were chosen, when there was a choice (`--terms a,b`, `--cv K`).
+    pub terms_choice: Option<super::cross_validation::TermsChoice>,
 }
 
 /// Fits one measurement: each requested distribution (both in parallel when
@@ -73,6 +75,7 @@ pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<Fit
         chosen,
         alternative,
         comparison,
+        terms_choice: None,
     })
 }
 
@@ -183,6 +186,16 @@ pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap
         },
     );
     settings.insert("bounds".into(), bounds_setting(options));
+    // Only a model with the volume terms says which it has, so that others read as before.
+    if options.terms != crate::pbrdf::ModelTerms::default() {
+        settings.insert("terms".into(), options.terms.to_string());
+    }
+    if let Some(k) = options.cv_folds {
+        settings.insert(
+            "terms_choice".into(),
+            format!("{k}-fold cross-validation (rows dealt by a shuffle seeded with the fit's seed)"),
+        );
+    }
     if !options.fixed.is_empty() {
         settings.insert(
             "fixed".into(),
@@ -223,6 +236,7 @@ fn bounds_setting(options: &FitOptions) -> String {
     let bounds = options.bounds.effective(options.shadowing);
     Parameter::ALL
         .iter()
+        .filter(|p| options.terms.has(**p))
         .map(|&p| {
             let i = bounds.get(p);
             format!("{p} [{}, {}]", i.lower, i.upper)

@@ -14,6 +14,7 @@
 //! | k         | [0, 50]                             | asinh(k / 0.1)     | linear near 0, logarithmic above  |
 //! | ρ_d       | [0, 1]                              | ρ_d                | enters m00 linearly               |
 //! | ρ_s, d    | [0, 1]                              | ρ_s, d             | enter the subsurface term linearly |
+//! | n_sub     | [1, 4]                              | n_sub              | as n                              |
 //!
 //! The genetic stage samples the search box; the local stages add a sine map on top of it
 //! (MINUIT's bounded transform) so that Nelder–Mead runs unconstrained and can settle exactly on
@@ -38,6 +39,7 @@ impl Parameter {
             Parameter::RhoD => 0.0,
             Parameter::RhoS => 0.5,
             Parameter::D => 0.0,
+            Parameter::NSub => 1.5,
         }
     }
 
@@ -52,13 +54,14 @@ impl Parameter {
             Parameter::RhoD => 0.02,
             Parameter::RhoS => 0.5,
             Parameter::D => 0.1,
+            Parameter::NSub => 1.4,
         }
     }
 }
 
 /// One value per [`Parameter`], in canonical order.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ParameterValues(pub [f64; 7]);
+pub struct ParameterValues(pub [f64; 8]);
 
 impl ParameterValues {
     pub fn get(&self, parameter: Parameter) -> f64 {
@@ -96,6 +99,7 @@ pub struct ParameterBounds {
     pub rho_d: Interval,
     pub rho_s: Interval,
     pub d: Interval,
+    pub n_sub: Interval,
 }
 
 /// Lowest q searched with Smith shadowing: Λ of the Cauchy distribution exists only for q > 3/2
@@ -117,6 +121,7 @@ impl Default for ParameterBounds {
             rho_d: interval(Parameter::RhoD),
             rho_s: interval(Parameter::RhoS),
             d: interval(Parameter::D),
+            n_sub: interval(Parameter::NSub),
         }
     }
 }
@@ -131,6 +136,7 @@ impl ParameterBounds {
             Parameter::RhoD => self.rho_d,
             Parameter::RhoS => self.rho_s,
             Parameter::D => self.d,
+            Parameter::NSub => self.n_sub,
         }
     }
 
@@ -179,7 +185,7 @@ pub fn to_search(parameter: Parameter, value: f64) -> f64 {
     match parameter {
         Parameter::Sigma => value.ln(),
         Parameter::Q => (value - 1.0).ln(),
-        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D => value,
+        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D | Parameter::NSub => value,
         Parameter::K => (value / K_SCALE).asinh(),
     }
 }
@@ -189,7 +195,7 @@ pub fn from_search(parameter: Parameter, coordinate: f64) -> f64 {
     match parameter {
         Parameter::Sigma => coordinate.exp(),
         Parameter::Q => 1.0 + coordinate.exp(),
-        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D => coordinate,
+        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D | Parameter::NSub => coordinate,
         Parameter::K => K_SCALE * coordinate.sinh(),
     }
 }
@@ -199,7 +205,7 @@ pub fn value_per_coordinate(parameter: Parameter, coordinate: f64) -> f64 {
     match parameter {
         Parameter::Sigma => coordinate.exp(),
         Parameter::Q => coordinate.exp(),
-        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D => 1.0,
+        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D | Parameter::NSub => 1.0,
         Parameter::K => K_SCALE * coordinate.cosh(),
     }
 }

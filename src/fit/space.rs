@@ -161,6 +161,7 @@ impl ModelSpace {
         (self.terms.body == Body::Subsurface).then(|| Subsurface {
             rho_s: values.get(Parameter::RhoS),
             d: values.get(Parameter::D),
+            n_sub: Some(values.get(Parameter::NSub)),
         })
     }
 
@@ -174,6 +175,7 @@ impl ModelSpace {
             facet: self.terms.facet_side,
             rho_s: self.subsurface(values).map(|s| s.rho_s),
             d: self.subsurface(values).map(|s| s.d),
+            n_sub: self.subsurface(values).and_then(|s| s.n_sub),
             wavelength_um,
         }
     }

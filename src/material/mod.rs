@@ -72,6 +72,9 @@ pub struct ModelSpec {
     pub rho_s: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub d: Option<f64>,
+    /// The subsurface interface's own index (absent: n).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub n_sub: Option<f64>,
     pub wavelength_um: f64,
 }
 
@@ -85,6 +88,7 @@ impl ModelSpec {
             Parameter::RhoD => Some(self.rho_d),
             Parameter::RhoS => self.rho_s,
             Parameter::D => self.d,
+            Parameter::NSub => self.rho_s.map(|_| self.n_sub.unwrap_or(self.n)),
             slope => self.distribution.parameter(slope),
         }
     }
@@ -94,6 +98,7 @@ impl ModelSpec {
         self.rho_s.map(|rho_s| Subsurface {
             rho_s,
             d: self.d.unwrap_or(0.0),
+            n_sub: self.n_sub,
         })
     }
 

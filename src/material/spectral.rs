@@ -138,6 +138,7 @@ impl SpectralModel {
             facet: FacetSide::External,
             rho_s: None,
             d: None,
+            n_sub: None,
             wavelength_um,
         })
     }

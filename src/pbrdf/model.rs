@@ -254,6 +254,9 @@ impl Pbrdf {
         if let Some(terms) = subsurface {
             Parameter::RhoS.check(terms.rho_s)?;
             Parameter::D.check(terms.d)?;
+            if let Some(n_sub) = terms.n_sub {
+                Parameter::NSub.check(n_sub)?;
+            }
         }
         self.facet_side = facet_side;
         self.permittivity = facet_side.facet_permittivity(self.index);

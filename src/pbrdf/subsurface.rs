@@ -12,6 +12,7 @@
 //!   a mirror in psps frames (a perfect mirror is diag(1, 1, −1, −1) there), so d = 1 on an
 //!   index-matched surface behaves like one. D is realizable (Cloude) for −1/3 ≤ d ≤ 1; the model
 //!   accepts d ∈ [0, 1].
+//! - The interface has the material's index N, or n_sub + ik where given ([`Subsurface`]).
 //! - Z = (1 − R̄) + |d|·|Ā|, R̄ = 2∫₀¹ R(μ) μ dμ, Ā = 2∫₀¹ T−(μ) μ dμ, the normalization that
 //!   conserves energy: the term's directional-hemispherical reflectance is
 //!   (ρ_s/Z)[T+(θ_i)(1 − R̄) + d T−(θ_i) Ā] ≤ ρ_s T+(θ_i) = ρ_s (1 − R(θ_i)) — at most a
@@ -74,11 +75,16 @@ impl FacetSide {
 }
 
 /// The parameters of the subsurface term: ρ_s ∈ [0, 1], the fraction of the transmitted light
-/// that comes back out, and d ∈ [0, 1], its residual polarization.
+/// that comes back out, d ∈ [0, 1], its residual polarization, and the real index n_sub of the
+/// interface it crosses (`None`: the material's n). The subsurface light meets the interface
+/// everywhere, not only on the facets that make the lobe; where that interface is rougher or
+/// contaminated its polarization is weaker than a smooth one of index n gives, which a separate
+/// index describes (docs/design.md §1.10).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Subsurface {
     pub rho_s: f64,
     pub d: f64,
+    pub n_sub: Option<f64>,
 }
 
 /// Fresnel transmission of the macro surface at one zenith angle: (T+, T−, X) of the module docs.
@@ -113,7 +119,8 @@ pub(super) struct PreparedSubsurface {
 
 impl PreparedSubsurface {
     pub(super) fn new(terms: Subsurface, index: RefractiveIndex) -> PreparedSubsurface {
-        let permittivity = index.permittivity();
+        let n = terms.n_sub.unwrap_or(index.n);
+        let permittivity = RefractiveIndex::new(n, index.k).permittivity();
         let (mean_reflectance, mean_minus) = interface_means(permittivity);
         let z = (1.0 - mean_reflectance) + terms.d.abs() * mean_minus.abs();
         PreparedSubsurface {

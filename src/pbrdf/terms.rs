@@ -29,6 +29,8 @@ pub enum Parameter {
     RhoS,
     /// Residual polarization d of the subsurface light.
     D,
+    /// Real index of the interface the subsurface light crosses.
+    NSub,
 }
 
 /// A term of the model: F = facet term + ideal depolarizer (docs/design.md §1.3).
@@ -78,12 +80,14 @@ pub struct ModelTerms {
 }
 
 impl ModelTerms {
-    /// Every combination, the default first.
-    pub const ALL: [ModelTerms; 4] = [
+    /// The combinations a fit chooses among (`--terms all`), the default first. Internal
+    /// facets with the ideal depolarizer are left out: for k = 0 they are external facets with
+    /// n → 1/n (the same ε), so they only duplicate the default — which is how a volume
+    /// scatterer fitted with today's model ends at n < 1.
+    pub const ALL: [ModelTerms; 3] = [
         ModelTerms::new(FacetSide::External, Body::Depolarizer),
         ModelTerms::new(FacetSide::External, Body::Subsurface),
         ModelTerms::new(FacetSide::Internal, Body::Subsurface),
-        ModelTerms::new(FacetSide::Internal, Body::Depolarizer),
     ];
 
     pub const fn new(facet_side: FacetSide, body: Body) -> ModelTerms {
@@ -97,10 +101,11 @@ impl ModelTerms {
         term == Term::Facet || term == self.body.term()
     }
 
-    /// Parses `external+subsurface` and the like.
+    /// Parses `external+subsurface` and the like (`internal+depolarizer` too).
     pub fn parse(text: &str) -> Option<ModelTerms> {
         ModelTerms::ALL
             .into_iter()
+            .chain([ModelTerms::new(FacetSide::Internal, Body::Depolarizer)])
             .find(|t| t.to_string() == text.trim())
     }
 }
@@ -133,7 +138,7 @@ pub struct ParameterInfo {
 }
 
 /// Every parameter's entry, in [`Parameter::ALL`] order.
-const REGISTRY: [ParameterInfo; 7] = [
+const REGISTRY: [ParameterInfo; 8] = [
     ParameterInfo {
         key: "sigma",
         aliases: &[],
@@ -205,6 +210,16 @@ const REGISTRY: [ParameterInfo; 7] = [
         default_bounds: (0.0, 1.0),
         comment: "residual polarization d (0–1) of the subsurface light: D = diag(1, d, −d, −d)",
     },
+    ParameterInfo {
+        key: "n_sub",
+        aliases: &[],
+        label: "n_sub",
+        unit: "dimensionless",
+        term: Term::Subsurface,
+        domain: (limits::MIN_N, limits::MAX_N, false),
+        default_bounds: (1.0, 4.0),
+        comment: "real index of the interface the subsurface light crosses (absent: n)",
+    },
 ];
 
 /// A parameter value outside the values a model accepts.
@@ -224,7 +239,7 @@ fn range(parameter: Parameter) -> String {
 
 impl Parameter {
     /// All parameters in their canonical order (the order of vectors and matrices in a fit).
-    pub const ALL: [Parameter; 7] = [
+    pub const ALL: [Parameter; 8] = [
         Parameter::Sigma,
         Parameter::Q,
         Parameter::N,
@@ -232,6 +247,7 @@ impl Parameter {
         Parameter::RhoD,
         Parameter::RhoS,
         Parameter::D,
+        Parameter::NSub,
     ];
 
     /// The parameter's entry in the registry.

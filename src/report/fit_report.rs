@@ -14,10 +14,12 @@ mod diagnostics;
 mod profiles;
 pub(crate) mod style;
 mod table;
+mod validation;
 #[cfg(test)]
 mod test_records;
 
 use table::format_angle;
+pub use validation::encode_validation_report;
 pub(crate) use table::{
     at_bound, format_plain, format_with_uncertainty, is_free, lookup, parameters, preference,
     sha_prefix,

@@ -1,0 +1,76 @@
+//! The page of `irpol validate` (docs/design.md §4): how a material's model predicts a
+//! measurement it was not fitted to, drawn with the fit report's own panels (the in-plane m00,
+//! the linear block, the residual map and its histogram) under a title naming both and a line of
+//! the prediction errors.
+
+use super::data::ReportData;
+use super::{draw_panel, encode_bitmap, report_stem, EncodedReport, PanelKind};
+use crate::material::Material;
+use crate::measure::MeasurementSet;
+use crate::plot_style::{register_fonts, FONT};
+use crate::report::ReportError;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::FontStyle;
+use std::path::Path;
+
+/// Size of the validation page, pixels.
+const PAGE: (u32, u32) = (2400, 1560);
+/// Height of the title block, pixels.
+const TITLE_BLOCK: u32 = 110;
+
+/// Encodes `<out_dir>/<material>_validation_<data stem>.png`; `summary` is the line of errors
+/// printed under the title.
+pub fn encode_validation_report(
+    material: &Material,
+    set: &MeasurementSet,
+    summary: &str,
+    out_dir: &Path,
+) -> Result<EncodedReport, ReportError> {
+    let stem = report_stem(&material.name)?;
+    let data_stem = set
+        .source
+        .file_stem()
+        .map_or_else(|| "data".into(), |s| s.to_string_lossy().into_owned());
+    let png = out_dir.join(format!("{stem}_validation_{data_stem}.png"));
+    let data = ReportData::new(material, set)?;
+    let title = format!(
+        "Validation: {} predicting {} ({} rows × {} Mueller elements, λ = {} µm)",
+        material.name,
+        set.source.display(),
+        set.points.len(),
+        set.elements.len(),
+        set.wavelength_um
+    );
+    let bytes = encode_bitmap(&png, PAGE, |root| {
+        register_fonts();
+        root.fill(&WHITE)?;
+        let (header, body) = root.split_vertically(TITLE_BLOCK);
+        let style = |size: f64, bold: bool| {
+            let font = if bold {
+                (FONT, size, FontStyle::Bold)
+            } else {
+                (FONT, size, FontStyle::Normal)
+            };
+            font.into_font()
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Left, VPos::Top))
+        };
+        header.draw_text(&title, &style(34.0, true).into_text_style(&header), (24, 14))?;
+        header.draw_text(summary, &style(26.0, false).into_text_style(&header), (24, 62))?;
+        let panels = body.split_evenly((2, 2));
+        let kinds = [
+            PanelKind::InPlane,
+            PanelKind::LinearBlock,
+            PanelKind::Residuals,
+            PanelKind::Histogram,
+        ];
+        for (area, kind) in panels.iter().zip(kinds) {
+            draw_panel(kind, area, material, &data, true)?;
+        }
+        root.present()
+    })?;
+    Ok(EncodedReport {
+        files: vec![(png, bytes)],
+    })
+}
