@@ -118,7 +118,9 @@ fn parse_terms(text: &str) -> Result<Vec<ModelTerms>, AppError> {
         }
     }
     if list.is_empty() {
-        return Err(AppError::invalid("--terms is empty: name at least one set of terms"));
+        return Err(AppError::invalid(
+            "--terms is empty: name at least one set of terms",
+        ));
     }
     Ok(list)
 }

@@ -3,7 +3,7 @@
 //! scored by AIC and, with K folds, by K-fold cross-validation — the rows split at random (seeded)
 //! into K folds, the model refitted on K − 1 of them and its normalized residuals taken on the
 //! fold it did not see. The refit of a fold starts from the whole-data fit and runs the local
-//! stage only (Levenberg–Marquardt): the folds are the same surface minus a fifth of its rows,
+//! stage only (Levenberg–Marquardt, under the same energy constraint): the folds are the same surface minus a fifth of its rows,
 //! so the global search would find the same basin at ten times the cost.
 //!
 //! Score = Σ r² over held-out observations / their number (≈ 1 for a model that predicts within
@@ -11,9 +11,8 @@
 //! when folds were asked for, else the lowest AIC; both are reported side by side.
 
 use super::data::MeasurementData;
-use super::model_fit::{model_space, ModelFit};
+use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
-use super::optimize::minimize;
 use super::options::FitOptions;
 use super::outcome::{fit_measurement, FitOutcome};
 use super::stages::Optimizer;
@@ -78,13 +77,16 @@ impl TermsChoice {
 fn lowest(values: impl Iterator<Item = f64>) -> usize {
     values
         .enumerate()
-        .fold((0, f64::INFINITY), |best, (i, v)| {
-            if v < best.1 {
-                (i, v)
-            } else {
-                best
-            }
-        })
+        .fold(
+            (0, f64::INFINITY),
+            |best, (i, v)| {
+                if v < best.1 {
+                    (i, v)
+                } else {
+                    best
+                }
+            },
+        )
         .0
 }
 
@@ -179,7 +181,8 @@ pub fn subset(set: &MeasurementSet, rows: &[usize]) -> MeasurementSet {
     }
 }
 
-/// K-fold cross-validated score of the family of `fit` (module docs).
+/// K-fold cross-validated score of the family of `fit` (module docs). Each fold's refit is
+/// constrained like the whole-data fit (energy, [`super::energy`]).
 fn cross_validate(
     set: &MeasurementSet,
     options: &FitOptions,
@@ -189,39 +192,27 @@ fn cross_validate(
     let options = FitOptions {
         distribution: Some(fit.distribution),
         optimizer: Optimizer::parse("lm").expect("lm is a stage"),
+        start: fit.free.iter().copied().zip(fit.values.clone()).collect(),
         ..options.clone()
     };
-    let space = model_space(fit.distribution, &options)?;
-    let mut start_values = options.base_values();
-    for (&p, &v) in fit.free.iter().zip(&fit.values) {
-        start_values.set(p, v);
-    }
-    let start = space.search(&start_values);
     let (mut total, mut count) = (0.0, 0usize);
     for held_out in fold_rows(set.points.len(), k, options.seed) {
         let training: Vec<usize> = (0..set.points.len())
             .filter(|r| held_out.binary_search(r).is_err())
             .collect();
         let train = subset(set, &training);
-        let train_data = MeasurementData::new(&train)?;
-        let objective = Objective::new(&train_data, &space, options.robust);
-        let (best, _) = minimize(
-            &objective,
-            &options.optimizer,
-            &start,
-            options.seed,
-            &options.settings,
-        )
-        .map_err(|(stage, error)| FitError::Optimizer {
-            file: set.source.clone(),
-            stage: stage.to_string(),
-            message: error.to_string(),
-        })?;
+        let refit = fit_model(
+            &train,
+            &MeasurementData::new(&train)?,
+            fit.distribution,
+            &options,
+        )?;
+        let effective = refit.effective_options(&options);
+        let space = model_space(fit.distribution, &effective)?;
         let test = subset(set, &held_out);
         let test_data = MeasurementData::new(&test)?;
-        let test_objective = Objective::new(&test_data, &space, None);
-        let residuals = test_objective
-            .normalized_residuals(&space.values(&best))
+        let residuals = Objective::new(&test_data, &space, None)
+            .normalized_residuals(&refit.parameter_values(&effective))
             .unwrap_or_default();
         total += residuals.iter().map(|r| r * r).sum::<f64>();
         count += residuals.len();

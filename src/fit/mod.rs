@@ -16,6 +16,7 @@
 mod comparison;
 mod cross_validation;
 mod data;
+mod energy;
 mod error;
 mod files;
 pub mod genetic;
@@ -44,6 +45,7 @@ pub use cross_validation::{
 pub use data::{
     ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00,
 };
+pub use energy::{largest_reflectance, ENERGY_TOLERANCE};
 pub use error::FitError;
 pub use files::{fit_files, fit_inputs, MaterialFit};
 pub use global::GeneticSettings;

@@ -2,6 +2,7 @@
 
 use super::comparison::{aic, bic, Candidate};
 use super::data::MeasurementData;
+use super::energy::{check_energy, EnergyCheck, ENERGY_TOLERANCE};
 use super::objective::Objective;
 use super::optimize::minimize;
 use super::options::FitOptions;
@@ -9,12 +10,13 @@ use super::parameters::{DistributionKind, Parameter, ParameterValues};
 use super::profile::{parameters_to_profile, profile_bounds};
 use super::space::ModelSpace;
 use super::stages::ConvergenceHistory;
+use super::stages::{Optimizer, Stage};
 use super::uncertainty::{estimate, Uncertainty};
 use super::FitError;
 use crate::material::ModelSpec;
-use crate::pbrdf::ModelTerms;
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::optics::Mueller;
+use crate::pbrdf::ModelTerms;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
@@ -48,6 +50,10 @@ pub struct ModelFit {
     pub model_muellers: Vec<Mueller>,
     /// Normalized residuals (model − data)/σ, point-major, aligned with the set's elements.
     pub normalized_residuals: Vec<f64>,
+    /// The body parameter the energy constraint held, and its value ([`fit_model`]).
+    pub held_by_energy: Option<(Parameter, f64)>,
+    /// What the energy constraint did, for the record (`None`: nothing to say).
+    pub energy: Option<String>,
 }
 
 impl ModelFit {
@@ -78,6 +84,27 @@ impl ModelFit {
     }
 
     /// The model value of element `element` (a position in the set's `elements`) at `point`.
+    /// Every parameter's value: the fitted free ones over `options`' base values.
+    pub(crate) fn parameter_values(&self, options: &FitOptions) -> ParameterValues {
+        let mut values = options.base_values();
+        for (&p, &value) in self.free.iter().zip(&self.values) {
+            values.set(p, value);
+        }
+        values
+    }
+
+    /// `options` as the fit ran them: with the parameter the energy constraint held fixed.
+    pub(crate) fn effective_options(&self, options: &FitOptions) -> FitOptions {
+        let mut options = options.clone();
+        if let Some((parameter, limit)) = self.held_by_energy {
+            options.fixed.insert(parameter, limit);
+            if let Some(free) = &mut options.free {
+                free.retain(|p| *p != parameter);
+            }
+        }
+        options
+    }
+
     pub fn model_value(&self, set: &MeasurementSet, point: usize, element: usize) -> f64 {
         let index = set.elements[element];
         self.model_muellers[point][(index / 4, index % 4)]
@@ -131,12 +158,10 @@ impl ModelFit {
         data: &MeasurementData,
         options: &FitOptions,
     ) -> Result<(), FitError> {
+        let options = &self.effective_options(options);
         let space = model_space(self.distribution, options)?;
         let objective = Objective::new(data, &space, options.robust);
-        let mut values = options.base_values();
-        for (&p, &value) in self.free.iter().zip(&self.values) {
-            values.set(p, value);
-        }
+        let values = self.parameter_values(options);
         let best = space.search(&values);
         let settings = &options.settings.levenberg_marquardt;
         let reduced_chi2 = self.reduced_chi2;
@@ -151,8 +176,73 @@ impl ModelFit {
     }
 }
 
-/// Fits the `kind` family to a prepared measurement.
+/// Rounds of [`fit_model`]'s energy constraint (each may move the facets and so the bound).
+const ENERGY_ROUNDS: usize = 3;
+
+/// Fits the `kind` family to a prepared measurement, with the energy constraint of
+/// [`super::energy`]: where the fit's model reflects more than 1, its body reflectance is held at
+/// the largest value that conserves energy and the rest refitted by the local stages.
 pub(crate) fn fit_model(
+    set: &MeasurementSet,
+    data: &MeasurementData,
+    kind: DistributionKind,
+    options: &FitOptions,
+) -> Result<ModelFit, FitError> {
+    let mut fit = fit_model_unconstrained(set, data, kind, options)?;
+    let mut options = options.clone();
+    for _ in 0..ENERGY_ROUNDS {
+        let space = model_space(kind, &options)?;
+        match check_energy(&space, &fit.parameter_values(&options)) {
+            EnergyCheck::Conserved => break,
+            EnergyCheck::FacetsExceed {
+                theta_deg,
+                reflectance,
+            } => {
+                fit.energy = Some(format!(
+                    "not conserved: the facets alone reflect {reflectance:.4} at θ = {theta_deg}° \
+                     (shadowing {}; smith conserves energy)",
+                    options.shadowing.name()
+                ));
+                break;
+            }
+            EnergyCheck::HoldBody { parameter, limit } => {
+                options.start = fit.free.iter().copied().zip(fit.values.clone()).collect();
+                options.start.remove(&parameter);
+                options.fixed.insert(parameter, limit);
+                if let Some(free) = &mut options.free {
+                    free.retain(|p| *p != parameter);
+                }
+                options.optimizer = local_stages(&options.optimizer);
+                fit = fit_model_unconstrained(set, data, kind, &options)?;
+                fit.held_by_energy = Some((parameter, limit));
+                fit.energy = Some(format!(
+                    "{parameter} held at {limit:.6}, where the hemispherical reflectance reaches \
+                     1 + {ENERGY_TOLERANCE}"
+                ));
+            }
+        }
+    }
+    Ok(fit)
+}
+
+/// The local stages of `optimizer` (Levenberg–Marquardt when it has none).
+fn local_stages(optimizer: &Optimizer) -> Optimizer {
+    let local: Vec<&str> = optimizer
+        .stages()
+        .iter()
+        .filter(|s| **s != Stage::Ga)
+        .map(|s| s.name())
+        .collect();
+    let text = if local.is_empty() {
+        "lm".to_owned()
+    } else {
+        local.join("+")
+    };
+    Optimizer::parse(&text).expect("local stage names parse")
+}
+
+/// Fits the `kind` family to a prepared measurement, without the energy constraint.
+fn fit_model_unconstrained(
     set: &MeasurementSet,
     data: &MeasurementData,
     kind: DistributionKind,
@@ -219,6 +309,8 @@ pub(crate) fn fit_model(
         evaluations: objective.evaluations(),
         model_muellers,
         normalized_residuals: residuals,
+        held_by_energy: None,
+        energy: None,
     })
 }
 

@@ -56,6 +56,7 @@ pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<Fit
     };
     let mut chosen = chosen;
     chosen.add_profile_bounds(&data, options)?;
+    let options = &chosen.effective_options(options);
     let material = Material {
         name: set.material.clone(),
         tool_version: format!("irpol {}", env!("CARGO_PKG_VERSION")),
@@ -88,7 +89,9 @@ pub(super) fn names(parameters: &[Parameter]) -> Vec<String> {
 fn fixed_values(chosen: &ModelFit) -> BTreeMap<String, f64> {
     Parameter::ALL
         .iter()
-        .filter(|p| chosen.distribution.has(**p) && chosen.terms.has(**p) && !chosen.free.contains(p))
+        .filter(|p| {
+            chosen.distribution.has(**p) && chosen.terms.has(**p) && !chosen.free.contains(p)
+        })
         .map(|&p| (p.name().to_owned(), chosen.value(p)))
         .collect()
 }
@@ -128,7 +131,13 @@ fn fit_record(
         fixed_parameters: fixed_values(chosen),
         optimizer: options.optimizer.to_string(),
         seed: options.seed,
-        settings: settings(data, options),
+        settings: {
+            let mut settings = settings(data, options);
+            if let Some(energy) = &chosen.energy {
+                settings.insert("energy".into(), energy.clone());
+            }
+            settings
+        },
         iterations: chosen.history.iterations(),
         evaluations: chosen.evaluations,
         cost: chosen.cost,
@@ -193,7 +202,9 @@ pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap
     if let Some(k) = options.cv_folds {
         settings.insert(
             "terms_choice".into(),
-            format!("{k}-fold cross-validation (rows dealt by a shuffle seeded with the fit's seed)"),
+            format!(
+                "{k}-fold cross-validation (rows dealt by a shuffle seeded with the fit's seed)"
+            ),
         );
     }
     if !options.fixed.is_empty() {

@@ -195,7 +195,9 @@ pub fn from_search(parameter: Parameter, coordinate: f64) -> f64 {
     match parameter {
         Parameter::Sigma => coordinate.exp(),
         Parameter::Q => 1.0 + coordinate.exp(),
-        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D | Parameter::NSub => coordinate,
+        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D | Parameter::NSub => {
+            coordinate
+        }
         Parameter::K => K_SCALE * coordinate.sinh(),
     }
 }

@@ -419,7 +419,8 @@ impl Pbrdf {
         let (a, b) = facet.scaled_a_and_b();
         let c = facet.cross.re * facet.scale;
         let s = facet.cross.im * facet.scale;
-        let facets_and_depolarizer = geometry.assemble_mueller([a, b, c, s], self.rho_d * FRAC_1_PI);
+        let facets_and_depolarizer =
+            geometry.assemble_mueller([a, b, c, s], self.rho_d * FRAC_1_PI);
         let facet = &geometry.facet;
         match self.subsurface_mueller(facet.cos_i, facet.cos_r) {
             Some(subsurface) => facets_and_depolarizer + subsurface,

@@ -14,16 +14,16 @@ mod diagnostics;
 mod profiles;
 pub(crate) mod style;
 mod table;
-mod validation;
 #[cfg(test)]
 mod test_records;
+mod validation;
 
 use table::format_angle;
-pub use validation::encode_validation_report;
 pub(crate) use table::{
     at_bound, format_plain, format_with_uncertainty, is_free, lookup, parameters, preference,
     sha_prefix,
 };
+pub use validation::encode_validation_report;
 
 use super::ReportError;
 use crate::atomic::write_atomically;

@@ -56,8 +56,16 @@ pub fn encode_validation_report(
                 .color(&BLACK)
                 .pos(Pos::new(HPos::Left, VPos::Top))
         };
-        header.draw_text(&title, &style(34.0, true).into_text_style(&header), (24, 14))?;
-        header.draw_text(summary, &style(26.0, false).into_text_style(&header), (24, 62))?;
+        header.draw_text(
+            &title,
+            &style(34.0, true).into_text_style(&header),
+            (24, 14),
+        )?;
+        header.draw_text(
+            summary,
+            &style(26.0, false).into_text_style(&header),
+            (24, 62),
+        )?;
         let panels = body.split_evenly((2, 2));
         let kinds = [
             PanelKind::InPlane,
