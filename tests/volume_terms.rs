@@ -1,0 +1,278 @@
+//! The volume-scattering terms of docs/design.md §1.10 — internal facets and the polarized
+//! subsurface term — against closed-form limits (today's ideal depolarizer, reciprocity, energy),
+//! recovery from data made by the independent numpy implementation (scripts/
+//! make_volume_measurements.py, tests/data/volume/), the choice of terms by AIC and
+//! cross-validation, the energy constraint of the fit and `irpol validate`.
+
+use irpol::fit::{fit_grey, largest_reflectance, FitOptions, ENERGY_TOLERANCE};
+use irpol::material::Material;
+use irpol::measure::read_measurement_csv;
+use irpol::optics::{Mueller, RefractiveIndex};
+use irpol::pbrdf::{
+    Body, Direction, FacetSide, HemisphereQuadrature, ModelTerms, Parameter, Pbrdf, Shadowing,
+    SlopeDistribution, Subsurface, Transmission,
+};
+use std::path::Path;
+use std::process::Command;
+
+fn irpol() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_irpol"))
+}
+
+fn model(n: f64, k: f64, rho_d: f64, side: FacetSide, subsurface: Option<Subsurface>) -> Pbrdf {
+    Pbrdf::new(
+        SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 },
+        Shadowing::Smith,
+        RefractiveIndex::new(n, k),
+        rho_d,
+    )
+    .unwrap()
+    .with_volume(side, subsurface)
+    .unwrap()
+}
+
+fn subsurface(rho_s: f64, d: f64) -> Option<Subsurface> {
+    Some(Subsurface {
+        rho_s,
+        d,
+        n_sub: None,
+    })
+}
+
+/// Directions over the hemisphere, away from the horizon.
+fn directions() -> Vec<Direction> {
+    let mut out = Vec::new();
+    for theta in [0.0, 12.0, 33.0, 51.0, 68.0, 80.0] {
+        for phi in [0.0, 47.0, 133.0, 180.0, 251.0] {
+            out.push(Direction::from_degrees(theta, phi));
+        }
+    }
+    out
+}
+
+/// With N = 1 and d = 0 the subsurface term is today's ideal depolarizer (ρ/π) diag(1,0,0,0)
+/// bit for bit: every Fresnel reflectance is exactly 0 and the normalization exactly 1.
+#[test]
+fn index_matched_subsurface_term_is_the_ideal_depolarizer_bit_for_bit() {
+    let depolarizer = model(1.0, 0.0, 0.37, FacetSide::External, None);
+    let subsurface_term = model(1.0, 0.0, 0.0, FacetSide::External, subsurface(0.37, 0.0));
+    for i in directions() {
+        for r in directions() {
+            let (a, b) = (depolarizer.mueller(&i, &r), subsurface_term.mueller(&i, &r));
+            assert!(a.iter().zip(b.iter()).all(|(x, y)| x == y), "{a} {b}");
+        }
+    }
+}
+
+/// Sekera's reciprocity M(ω_r→ω_i) = Q M(ω_i→ω_r)ᵀ Q with the Q that makes §1.3's facet term
+/// reciprocal, diag(1, 1, −1, 1), holds for internal facets and the subsurface term too.
+#[test]
+fn every_term_is_reciprocal_with_the_facet_terms_q() {
+    let q = Mueller::from_diagonal(&nalgebra::Vector4::new(1.0, 1.0, -1.0, 1.0));
+    let models = [
+        model(1.5, 0.1, 0.0, FacetSide::External, None),
+        model(1.35, 0.0, 0.0, FacetSide::Internal, None),
+        model(1.6, 0.2, 0.0, FacetSide::Internal, None),
+        model(1.0, 0.0, 0.0, FacetSide::External, subsurface(0.8, 0.6)),
+        model(1.45, 0.02, 0.05, FacetSide::Internal, subsurface(0.9, 0.3)),
+    ];
+    for (m, pbrdf) in models.iter().enumerate() {
+        for i in directions() {
+            for r in directions() {
+                let forward = pbrdf.mueller(&i, &r);
+                let backward = pbrdf.mueller(&r, &i);
+                let error = (backward - q * forward.transpose() * q).abs().max();
+                assert!(error <= 1e-12 * forward[(0, 0)].max(1e-300), "model {m}: {error}");
+            }
+        }
+    }
+}
+
+/// The subsurface term's directional-hemispherical reflectance is at most ρ_s (1 − R(θ_i)) ≤ ρ_s
+/// over a parameter grid (its normalization Z), and the model's Mueller matrices are all
+/// realizable (Cloude's coherency eigenvalues ≥ 0).
+#[test]
+fn subsurface_term_conserves_energy_and_stays_realizable() {
+    let quadrature = HemisphereQuadrature::default();
+    for n in [1.0, 1.3, 1.6, 2.4] {
+        for d in [0.0, 0.4, 1.0] {
+            let only_subsurface = Pbrdf::new(
+                SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 },
+                Shadowing::Smith,
+                RefractiveIndex::new(1.0, 0.0),
+                0.0,
+            )
+            .unwrap()
+            .with_volume(
+                FacetSide::External,
+                Some(Subsurface {
+                    rho_s: 1.0,
+                    d,
+                    n_sub: Some(n),
+                }),
+            )
+            .unwrap();
+            let eps = RefractiveIndex::new(n, 0.0).permittivity();
+            for theta in [0.0f64, 30.0, 60.0, 80.0, 89.0] {
+                let albedo = only_subsurface
+                    .directional_hemispherical_reflectance(theta.to_radians(), &quadrature);
+                let bound = Transmission::at(theta.to_radians().cos(), eps).plus;
+                assert!(albedo <= bound + 2e-4, "n {n} d {d} θ {theta}: {albedo} > {bound}");
+                assert!(albedo <= 1.0);
+            }
+            for i in directions() {
+                for r in directions() {
+                    let m = only_subsurface.mueller(&i, &r);
+                    let lowest = irpol::optics::coherency_eigenvalues(&m)
+                        .into_iter()
+                        .fold(f64::INFINITY, f64::min);
+                    assert!(lowest >= -1e-12 * m[(0, 0)], "n {n} d {d}: {lowest}");
+                }
+            }
+        }
+    }
+}
+
+fn volume_data(name: &str) -> irpol::measure::MeasurementSet {
+    read_measurement_csv(&Path::new("tests/data/volume").join(name)).unwrap()
+}
+
+fn within(value: f64, truth: f64, relative: f64) -> bool {
+    (value - truth).abs() <= relative * truth.abs()
+}
+
+/// Data made by the numpy implementation with noise: each file's own terms are chosen by both
+/// AIC and 5-fold cross-validation, and its parameters recovered (σ, q within 2 %, n 1 %, ρ_s 2 %,
+/// d within 0.02).
+#[test]
+fn synthetic_volume_scatterers_are_recovered_and_their_terms_chosen() {
+    let cases = [
+        (
+            "external_subsurface.csv",
+            ModelTerms::new(FacetSide::External, Body::Subsurface),
+            [(Parameter::Sigma, 0.15), (Parameter::Q, 2.5), (Parameter::N, 1.45)],
+            0.8,
+            0.2,
+        ),
+        (
+            "internal_subsurface.csv",
+            ModelTerms::new(FacetSide::Internal, Body::Subsurface),
+            [(Parameter::Sigma, 0.25), (Parameter::N, 1.35), (Parameter::N, 1.35)],
+            0.9,
+            0.1,
+        ),
+    ];
+    for (file, terms, shape, rho_s, d) in cases {
+        let set = volume_data(file);
+        let options = FitOptions {
+            term_candidates: ModelTerms::ALL.to_vec(),
+            cv_folds: Some(5),
+            ..FitOptions::default()
+        };
+        let outcome = fit_grey(&set, &options).unwrap();
+        let choice = outcome.terms_choice.as_ref().unwrap();
+        assert_eq!(choice.scores[choice.chosen].terms, terms, "{file}: CV");
+        assert_eq!(choice.scores[choice.best_by_aic()].terms, terms, "{file}: AIC");
+        let model = &outcome.chosen.model;
+        for (p, truth) in shape {
+            let tolerance = if p == Parameter::N { 0.01 } else { 0.02 };
+            let value = model.parameter(p).unwrap();
+            assert!(within(value, truth, tolerance), "{file}: {p} = {value}");
+        }
+        assert!(within(model.rho_s.unwrap(), rho_s, 0.02), "{file}: {model:?}");
+        assert!((model.d.unwrap() - d).abs() <= 0.02, "{file}: {model:?}");
+    }
+}
+
+/// A volume model in a material file reads back as written, and the keys of the subsurface
+/// term are refused without ρ_s and in a spectral table.
+#[test]
+fn material_files_carry_the_volume_terms() {
+    let grey = "name = \"m\"\ntool_version = \"irpol\"\n[model]\ndistribution = \"cauchy\"\n\
+                sigma = 0.2\nq = 2.5\nshadowing = \"smith\"\nn = 1.35\nk = 0.0\n\
+                facet = \"internal\"\nrho_s = 0.9\nd = 0.1\nn_sub = 1.2\nwavelength_um = 1.064\n";
+    let material: Material = toml::from_str(grey).unwrap();
+    let spec = material.grey_model().unwrap();
+    assert_eq!(spec.facet, FacetSide::Internal);
+    assert_eq!((spec.rho_s, spec.d, spec.n_sub), (Some(0.9), Some(0.1), Some(1.2)));
+    let pbrdf = spec.pbrdf().unwrap();
+    assert_eq!(pbrdf.facet_side(), FacetSide::Internal);
+    let orphan = grey.replace("rho_s = 0.9\n", "");
+    let error = toml::from_str::<Material>(&orphan).unwrap_err().to_string();
+    assert!(error.contains("need rho_s"), "{error}");
+    let spectral = grey
+        .replace("n = 1.35", "n = [1.35, 1.36]")
+        .replace("k = 0.0", "k = [0.0, 0.0]")
+        .replace("wavelength_um = 1.064", "wavelength_um = [1.0, 2.0]");
+    let error = toml::from_str::<Material>(&spectral).unwrap_err().to_string();
+    assert!(error.contains("spectral table cannot use"), "{error}");
+}
+
+/// The fit's energy constraint: data whose best unconstrained model (no shadowing) would
+/// reflect more than 1 get a model that does not, with the body reflectance held and said so.
+#[test]
+fn fitted_models_conserve_energy() {
+    let set = volume_data("internal_subsurface.csv");
+    let options = FitOptions {
+        terms: ModelTerms::new(FacetSide::Internal, Body::Subsurface),
+        ..FitOptions::default()
+    };
+    let outcome = fit_grey(&set, &options).unwrap();
+    let (largest, theta) = largest_reflectance(&outcome.chosen.model.pbrdf().unwrap());
+    assert!(largest <= 1.0 + ENERGY_TOLERANCE, "{largest} at {theta}°");
+    // The truth of this file reflects 1.51 at 60°: the constraint held ρ_s below it.
+    let (parameter, limit) = outcome.chosen.held_by_energy.unwrap();
+    assert_eq!(parameter, Parameter::RhoS);
+    assert!(limit < 0.9);
+    let record = outcome.material.fit.as_ref().unwrap();
+    assert!(record.settings["energy"].contains("rho_s held at"));
+}
+
+/// `irpol fit --terms … --cv K` prints the candidates side by side; `irpol validate` scores a
+/// material on a file and writes its page.
+#[test]
+fn fit_with_cross_validation_and_validate_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let (fits, reports) = (dir.path().join("fits"), dir.path().join("reports"));
+    let output = irpol()
+        .args(["fit", "tests/data/volume/external_subsurface.csv", "--terms"])
+        .args(["external+depolarizer,external+subsurface", "--cv", "3"])
+        .arg("--out")
+        .arg(&fits)
+        .arg("--reports")
+        .arg(&reports)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(stdout.contains("* external+subsurface"), "{stdout}");
+    assert!(stdout.contains("CV χ²/obs"), "{stdout}");
+    let entry = fits.join("external_subsurface.toml");
+    let output = irpol()
+        .arg("validate")
+        .arg(&entry)
+        .arg("tests/data/volume/external_subsurface.csv")
+        .arg("--reports")
+        .arg(&reports)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    // Its own data: χ²/obs near 1 with the file's uncertainties.
+    let chi2: f64 = stdout
+        .split("χ²/obs ")
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|s| s.parse().ok())
+        .unwrap();
+    assert!((0.8..1.3).contains(&chi2), "{stdout}");
+    assert!(reports
+        .join("external_subsurface_validation_external_subsurface.png")
+        .is_file());
+    let bad = irpol()
+        .args(["fit", "tests/data/volume/external_subsurface.csv", "--terms", "inside+x"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&bad.stderr);
+    assert!(!bad.status.success() && stderr.contains("unknown terms 'inside+x'"), "{stderr}");
+}
