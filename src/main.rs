@@ -15,10 +15,11 @@ use irpol::app::render::{
 use irpol::app::scene_init::write_starter_scene;
 use irpol::app::sun::{given_times, write_sun_csv};
 use irpol::app::thermal::{run_thermal, run_thermal_and_render};
-use irpol::app::{parse_sweep, AppError, ModelArgs};
+use irpol::app::{parse_sweep, AppError, MeasurementArgs, ModelArgs};
 use irpol::atomic::staging_folder;
 use irpol::fit::{FitOptions, MaterialFit};
 use irpol::material::MaterialModel;
+use irpol::measure::ReadOptions;
 use irpol::output::thermal::ThermalSummary;
 use irpol::pbrdf::Pbrdf;
 use irpol::report::fit_report::rebuild_report;
@@ -167,6 +168,8 @@ struct FitArgs {
     /// Measurement CSVs or folders of them.
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
+    #[command(flatten)]
+    measurements: MeasurementArgs,
     /// Fit only this distribution (cauchy or gaussian); default: both, keep the preferred.
     #[arg(long)]
     distribution: Option<String>,
@@ -346,7 +349,14 @@ fn fit(args: FitArgs) -> anyhow::Result<()> {
         robust: args.robust,
         dispersion: args.dispersion,
     };
-    fit_and_summarize(&args.inputs, &flags.options()?, &args.out, &args.reports)
+    let reading = args.measurements.read_options()?;
+    fit_and_summarize(
+        &args.inputs,
+        &reading,
+        &flags.options()?,
+        &args.out,
+        &args.reports,
+    )
 }
 
 /// `irpol sun`: the CSV on stdout.
@@ -399,6 +409,7 @@ fn scene_init(out: &Path) -> anyhow::Result<()> {
 /// material and where the reports went.
 fn fit_and_summarize(
     inputs: &[PathBuf],
+    reading: &ReadOptions,
     options: &FitOptions,
     fits_dir: &Path,
     reports_dir: &Path,
@@ -406,6 +417,7 @@ fn fit_and_summarize(
     cli::signals::remove_on_interrupt(vec![], vec![fits_dir.to_owned(), reports_dir.to_owned()]);
     let written = fit_and_write(
         inputs,
+        reading,
         options,
         fits_dir,
         reports_dir,
@@ -728,7 +740,13 @@ fn demo() -> anyhow::Result<()> {
         measurements.display(),
         fits.display()
     );
-    fit_and_summarize(&[measurements], &FitOptions::default(), &fits, &reports)?;
+    fit_and_summarize(
+        &[measurements],
+        &ReadOptions::default(),
+        &FitOptions::default(),
+        &fits,
+        &reports,
+    )?;
     say!("the paper's model figures:");
     for figure in [PaperFigure::Fig2, PaperFigure::Fig3] {
         for path in write_paper_figure(figure, &reports)? {

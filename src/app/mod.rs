@@ -6,10 +6,12 @@ pub mod evaluate;
 pub mod fit;
 pub mod render;
 pub mod scene_init;
+pub mod selection;
 pub mod sun;
 pub mod thermal;
 
 pub use error::{one_line, AppError};
+pub use selection::{MeasurementArgs, SelectionArgs};
 
 use crate::material::{Material, MaterialError};
 use crate::optics::RefractiveIndex;

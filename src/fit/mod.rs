@@ -40,7 +40,7 @@ pub use data::{
     ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00,
 };
 pub use error::FitError;
-pub use files::{fit_files, fit_inputs, MaterialFit};
+pub use files::{fit_files, fit_inputs, fit_inputs_with, MaterialFit};
 pub use global::GeneticSettings;
 pub use levenberg_marquardt::LevenbergMarquardtSettings;
 pub use model_fit::ModelFit;
