@@ -16,10 +16,11 @@ use irpol::app::scene_init::write_starter_scene;
 use irpol::app::sun::{given_times, write_sun_csv};
 use irpol::app::thermal::{run_thermal, run_thermal_and_render};
 use irpol::app::validate::{validate_and_report, validation_summary};
-use irpol::app::{parse_sweep, AppError, ModelArgs};
+use irpol::app::{parse_sweep, AppError, MeasurementArgs, ModelArgs};
 use irpol::atomic::staging_folder;
 use irpol::fit::{FitOptions, MaterialFit};
 use irpol::material::MaterialModel;
+use irpol::measure::ReadOptions;
 use irpol::output::thermal::ThermalSummary;
 use irpol::pbrdf::Pbrdf;
 use irpol::report::fit_report::rebuild_report;
@@ -180,6 +181,8 @@ struct FitArgs {
     /// Measurement CSVs or folders of them.
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
+    #[command(flatten)]
+    measurements: MeasurementArgs,
     /// Fit only this distribution (cauchy or gaussian); default: both, keep the preferred.
     #[arg(long)]
     distribution: Option<String>,
@@ -374,7 +377,14 @@ fn fit(args: FitArgs) -> anyhow::Result<()> {
         terms: args.terms,
         cv: args.cv,
     };
-    fit_and_summarize(&args.inputs, &flags.options()?, &args.out, &args.reports)
+    let reading = args.measurements.read_options()?;
+    fit_and_summarize(
+        &args.inputs,
+        &reading,
+        &flags.options()?,
+        &args.out,
+        &args.reports,
+    )
 }
 
 /// `irpol validate`: one line per measurement set and its report page.
@@ -457,6 +467,7 @@ fn scene_init(out: &Path) -> anyhow::Result<()> {
 /// material and where the reports went.
 fn fit_and_summarize(
     inputs: &[PathBuf],
+    reading: &ReadOptions,
     options: &FitOptions,
     fits_dir: &Path,
     reports_dir: &Path,
@@ -464,6 +475,7 @@ fn fit_and_summarize(
     cli::signals::remove_on_interrupt(vec![], vec![fits_dir.to_owned(), reports_dir.to_owned()]);
     let written = fit_and_write(
         inputs,
+        reading,
         options,
         fits_dir,
         reports_dir,
@@ -510,7 +522,7 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
     };
     let (first, last) = model.range_um();
     format!(
-        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={:.3} → {}",
+        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={:.3}{} → {}",
         outcome.material.name,
         chosen.distribution.name(),
         chosen.dispersion,
@@ -519,6 +531,7 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
         range(&model.n),
         range(&model.k),
         chosen.reduced_chi2,
+        realizability_clause(&outcome.measurements),
         entry.display()
     )
 }
@@ -557,7 +570,7 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
         .as_ref()
         .map_or(String::new(), |c| format!("; {}", c.summary()));
     format!(
-        "{}: {}{} {}{}{} χ²_red={:.3}{comparison} → {}",
+        "{}: {}{} {}{}{} χ²_red={:.3}{}{comparison} → {}",
         outcome.material.name,
         chosen.distribution.name(),
         if chosen.terms == irpol::pbrdf::ModelTerms::default() {
@@ -569,9 +582,29 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
         listed(" [bounded only: ", &bounded, ", ", "]"),
         listed(" (fixed: ", &fixed, " ", ")"),
         chosen.reduced_chi2,
+        realizability_clause(std::slice::from_ref(&outcome.measurement)),
         entry.display()
     )
 }
+
+/// `; k of N rows not realizable beyond 2σ` (Cloude's test against each row's uncertainty), or
+/// nothing when no row has all sixteen elements to test.
+fn realizability_clause(sets: &[irpol::measure::MeasurementSet]) -> String {
+    let (mut failed, mut checked) = (0, 0);
+    for set in sets {
+        let outcome = irpol::measure::unrealizable_rows(set, REALIZABILITY_SIGMAS);
+        failed += outcome.unrealizable.len();
+        checked += outcome.checked;
+    }
+    if checked == 0 {
+        return String::new();
+    }
+    format!("; {failed} of {checked} rows not realizable beyond {REALIZABILITY_SIGMAS}σ")
+}
+
+/// A measured row counts as not realizable when its coherency matrix's smallest eigenvalue is
+/// below this many standard deviations of its noise (a bound, so noise alone rarely reaches it).
+const REALIZABILITY_SIGMAS: f64 = 2.0;
 
 /// `items` joined by `separator` between `open` and `close`, or nothing when there are none.
 fn listed(open: &str, items: &[String], separator: &str, close: &str) -> String {
@@ -796,7 +829,13 @@ fn demo() -> anyhow::Result<()> {
         measurements.display(),
         fits.display()
     );
-    fit_and_summarize(&[measurements], &FitOptions::default(), &fits, &reports)?;
+    fit_and_summarize(
+        &[measurements],
+        &ReadOptions::default(),
+        &FitOptions::default(),
+        &fits,
+        &reports,
+    )?;
     say!("the paper's model figures:");
     for figure in [PaperFigure::Fig2, PaperFigure::Fig3] {
         for path in write_paper_figure(figure, &reports)? {

@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use irpol::measure::{
-    parse_with_layout, read_measurement_sets, read_with_layout, Layout, MeasurementSet,
-    MUELLER_ELEMENT_NAMES,
+    parse_with_layout, read_measurement_file, read_measurement_sets, read_with_layout, Layout,
+    MeasurementSet, MUELLER_ELEMENT_NAMES,
 };
 
 const PTFE: &str = "data/ptfe/PTFE_351_1064.csv";
@@ -522,5 +522,412 @@ fn the_worked_example_shows_the_shipped_layout_and_its_notes() {
             page.contains(&format!("\n{note}\n")),
             "docs/measurements.md does not show the note: {note}"
         );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The command line: `irpol fit --layout`, a file's own `# layout:` line, row selection, and the
+// fit record that lets `irpol report` read the source the same way.
+// ---------------------------------------------------------------------------------------------
+
+/// `irpol fit INPUT EXTRA… --out DIR/fits --reports DIR/reports`: (success, stdout, stderr).
+fn fit_cli(dir: &Path, input: &Path, extra: &[&str]) -> (bool, String, String) {
+    let (fits, reports) = (dir.join("fits"), dir.join("reports"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .arg("fit")
+        .arg(input)
+        .args(extra)
+        .args(["--out", fits.to_str().unwrap(), "--reports"])
+        .arg(&reports)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The rows of the shipped file at 1.064 µm and θ_i ∈ {0, 30, 60, 75}°, counted independently
+/// of the selection code: from the file's own signed `thetai` column.
+fn ptfe_rows_at(wavelength: &str, thetas: &[f64]) -> usize {
+    let text = std::fs::read_to_string(PTFE).unwrap();
+    text.lines()
+        .skip(1)
+        .filter(|line| {
+            let fields: Vec<&str> = line.split(',').collect();
+            let theta: f64 = fields[1].parse().unwrap();
+            fields[0] == wavelength && thetas.iter().any(|t| (theta.abs() - t).abs() <= 0.05)
+        })
+        .count()
+}
+
+#[test]
+fn fit_through_the_layout_records_it_and_report_rebuilds_the_same_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let extra = [
+        "--layout",
+        PTFE_LAYOUT,
+        "--wavelength",
+        "1.064",
+        "--theta-i",
+        "0,30,60,75",
+    ];
+    let (ok, stdout, stderr) = fit_cli(dir.path(), Path::new(PTFE), &extra);
+    assert!(ok, "{stderr}");
+    let rows = ptfe_rows_at("1.064", &[0.0, 30.0, 60.0, 75.0]);
+    assert!(rows > 1000, "{rows}");
+    assert!(stdout.starts_with("PTFE_351_1064: "), "{stdout}");
+    // Every row of PTFE's strongly depolarizing matrices passes Cloude's test.
+    assert!(
+        stdout.contains(&format!("; 0 of {rows} rows not realizable beyond 2σ")),
+        "{stdout}"
+    );
+    assert!(
+        stderr.contains(&format!(
+            "note: {PTFE}: kept the rows at 1.064 µm, one of its 2 wavelengths"
+        )) && stderr.contains(&format!(
+            "note: {PTFE} at 1.064 µm: kept {rows} rows of 1824 with θ_i = 0, 30, 60, 75°"
+        )),
+        "{stderr}"
+    );
+    let entry = dir.path().join("fits/PTFE_351_1064.toml");
+    let material = irpol::material::Material::load(&entry).unwrap();
+    let record = material.fit.unwrap();
+    assert_eq!(record.layout.as_deref(), Some(Path::new(PTFE_LAYOUT)));
+    assert_eq!(record.points, rows);
+    let selection = record.selection.unwrap();
+    assert_eq!(selection.wavelength_um, Some(1.064));
+    assert_eq!(selection.theta_i_deg, [0.0, 30.0, 60.0, 75.0]);
+
+    let rebuilt = dir.path().join("rebuilt");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .arg("report")
+        .arg(&entry)
+        .arg("--reports")
+        .arg(&rebuilt)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let figure = |folder: &Path| std::fs::read(folder.join("PTFE_351_1064.png")).unwrap();
+    assert!(
+        figure(&dir.path().join("reports")) == figure(&rebuilt),
+        "the rebuilt report differs from the fit's"
+    );
+
+    // Without the layout the report cannot read the file as it was fitted: the record's layout
+    // is what makes the rebuild possible.
+    let text = std::fs::read_to_string(&entry).unwrap();
+    let without = text.replace(&format!("layout = \"{PTFE_LAYOUT}\"\n"), "");
+    assert_ne!(without, text);
+    std::fs::write(&entry, without).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .arg("report")
+        .arg(&entry)
+        .arg("--reports")
+        .arg(&rebuilt)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+}
+
+/// A copy of the shipped table that names its layout on a `# layout:` line, beside the layout.
+fn ptfe_naming_its_layout(dir: &Path) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir.join("data")).unwrap();
+    std::fs::copy(PTFE_LAYOUT, dir.join("data/instrument.toml")).unwrap();
+    let table = dir.join("data/ptfe.csv");
+    let text = std::fs::read_to_string(PTFE).unwrap();
+    std::fs::write(&table, format!("# layout: instrument.toml\n{text}")).unwrap();
+    table
+}
+
+#[test]
+fn a_file_naming_its_layout_is_read_through_it_and_a_different_layout_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = ptfe_naming_its_layout(dir.path());
+    let own = read_measurement_file(&table, None).unwrap();
+    let layout = Layout::read(Path::new(PTFE_LAYOUT)).unwrap();
+    let shipped = read_with_layout(Path::new(PTFE), &layout).unwrap();
+    assert_eq!(own.len(), 2);
+    for (a, b) in own.iter().zip(&shipped) {
+        assert_eq!(a.points.len(), b.points.len());
+        for (p, q) in a.points.iter().zip(&b.points) {
+            assert_eq!(p.values, q.values);
+            assert_eq!(p.uncertainties, q.uncertainties);
+        }
+    }
+    // The same layout given again (another path, same content) is no disagreement.
+    assert!(read_measurement_file(&table, Some(&layout)).is_ok());
+
+    let extra = ["--wavelength", "1.064", "--theta-i", "0,30,60,75"];
+    let (ok, _, stderr) = fit_cli(dir.path(), &table, &extra);
+    assert!(ok, "{stderr}");
+    let entry = dir.path().join("fits/ptfe.toml");
+    let record = irpol::material::Material::load(&entry)
+        .unwrap()
+        .fit
+        .unwrap();
+    assert_eq!(record.layout, None, "the file names its layout itself");
+    let text = std::fs::read_to_string(&entry).unwrap();
+    assert!(!text.contains("\nlayout ="), "{text}");
+
+    let other = dir.path().join("fixed.toml");
+    let fixed = std::fs::read_to_string(PTFE_LAYOUT)
+        .unwrap()
+        .replace("model = \"estimate\"", "model = \"fixed\"");
+    std::fs::write(&other, fixed).unwrap();
+    let (ok, _, stderr) = fit_cli(
+        &dir.path().join("refused"),
+        &table,
+        &["--layout", other.to_str().unwrap()],
+    );
+    assert!(!ok);
+    assert_eq!(
+        stderr.trim_end(),
+        format!(
+            "irpol: error: {}:1:11: header 'layout': the file names the layout {}, but the \
+             layout {} was given too and reads the table differently: give one of them (drop \
+             --layout, or the '# layout:' line)",
+            table.display(),
+            dir.path().join("data/instrument.toml").display(),
+            other.display()
+        )
+    );
+    assert!(!dir.path().join("refused").exists());
+
+    let missing = dir.path().join("data/missing.csv");
+    let text = std::fs::read_to_string(&table).unwrap();
+    std::fs::write(&missing, text.replace("instrument.toml", "gone.toml")).unwrap();
+    assert_eq!(
+        read_measurement_file(&missing, None)
+            .unwrap_err()
+            .to_string(),
+        format!(
+            "{}:1:11: header 'layout': 'gone.toml' (looked for at {}, beside the file): no such \
+             file or directory: fix the path, relative to the measurement file's folder",
+            missing.display(),
+            dir.path().join("data/gone.toml").display()
+        )
+    );
+}
+
+#[test]
+fn a_selection_the_file_does_not_hold_is_refused_naming_what_it_holds() {
+    let dir = tempfile::tempdir().unwrap();
+    let refused = |extra: &[&str]| {
+        let mut args = vec!["--layout", PTFE_LAYOUT];
+        args.extend_from_slice(extra);
+        let (ok, stdout, stderr) = fit_cli(dir.path(), Path::new(PTFE), &args);
+        assert!(!ok && stdout.is_empty(), "{stdout}");
+        stderr.trim_end().to_string()
+    };
+    assert_eq!(
+        refused(&["--wavelength", "10.6"]),
+        format!(
+            "irpol: error: {PTFE}: holds no rows at the selected wavelength 10.6 µm; it holds \
+             0.351, 1.064 µm: select one of those"
+        )
+    );
+    assert_eq!(
+        refused(&["--wavelength", "1.064", "--theta-i", "0,45.5"]),
+        format!(
+            "irpol: error: {PTFE}: no row has θ_i within 0.05° of the selected 45.5°; its rows \
+             have θ_i = 0, 15, 30, 45, 60, 75°: select among those"
+        )
+    );
+    assert_eq!(
+        refused(&["--theta-i", "95"]),
+        "irpol: error: selected incidence angle 95°: not a zenith angle in [0°, 90°)"
+    );
+    assert!(!dir.path().join("fits").exists());
+}
+
+/// The bad inputs a layout is most often wrong in, refused by `irpol fit --layout` with the
+/// file, the line and what to fix, before anything is written.
+#[test]
+fn fit_refuses_a_layout_that_does_not_fit_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = dir.path().join("table.csv");
+    std::fs::write(
+        &table,
+        "# wavelength_um: 10\nti,tr,pr,M11,M12,M21\n30,20,180,0.5,0.1,0.2\n60,50,180,0.6,0.1,0.2\n",
+    )
+    .unwrap();
+    let layout = dir.path().join("layout.toml");
+    let refused = |layout_text: &str| {
+        std::fs::write(&layout, layout_text).unwrap();
+        let args = ["--layout", layout.to_str().unwrap()];
+        let (ok, _, stderr) = fit_cli(dir.path(), &table, &args);
+        assert!(!ok);
+        stderr.trim_end().to_string()
+    };
+    let (t, l) = (table.display(), layout.display());
+    // A column the file lacks.
+    assert_eq!(
+        refused(&GOOD_LAYOUT.replace("\"tr\"", "\"thetar\"")),
+        format!(
+            "irpol: error: {t}:2:1: column 'thetar', which the layout {l} names for \
+             theta_r_deg, is not in the header row: fix [columns] theta_r_deg (names are \
+             case-sensitive)"
+        )
+    );
+    // A basis irpol does not know.
+    assert_eq!(
+        refused(&format!("{GOOD_LAYOUT}mueller_convention = \"spsp\"\n")),
+        format!(
+            "irpol: error: {l}:9:22: not a valid layout: unknown variant `spsp`, expected `psps` \
+             or `xyxy`"
+        )
+    );
+    // Normalized elements without m00.
+    assert_eq!(
+        refused(
+            &GOOD_LAYOUT
+                .replace("m00 = \"M11\"\n", "")
+                .replace("index_base = 1", "index_base = 1\nnormalized = true")
+        ),
+        format!(
+            "irpol: error: {l}:8:14: layout key [columns] m00: normalized = true multiplies the \
+             elements by m00, but [columns] names no m00 column: add m00 = \"<column of the \
+             unpolarized BRDF>\""
+        )
+    );
+    // Degrees read as radians: θ beyond the hemisphere in the declared unit.
+    assert_eq!(
+        refused(&GOOD_LAYOUT.replace("index_base = 1", "index_base = 1\nangle_unit = \"rad\"")),
+        format!(
+            "irpol: error: {t}:3:1: column 'ti': 30 rad is not a zenith angle within (−π/2, \
+             π/2): the layout says angle_unit = \"rad\"; if the file's angles are in degrees, \
+             set angle_unit = \"deg\""
+        )
+    );
+    // A layout file that is not there.
+    std::fs::remove_file(&layout).unwrap();
+    let args = ["--layout", layout.to_str().unwrap()];
+    let (ok, _, stderr) = fit_cli(dir.path(), &table, &args);
+    assert!(!ok);
+    assert_eq!(
+        stderr.trim_end(),
+        format!("irpol: error: {l}:1:1: no such file or directory")
+    );
+    assert!(!dir.path().join("fits").exists() && !dir.path().join("reports").exists());
+}
+
+/// Radians declared as degrees cannot be refused (a scan near the normal looks the same), so
+/// `irpol fit` says what it suspects.
+#[test]
+fn fit_warns_when_degrees_look_like_radians() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = dir.path().join("table.csv");
+    let mut text = String::from("# wavelength_um: 10\nti,tr,pr,M11\n");
+    for (ti, tr) in [(0.5, 0.5), (0.5, 0.7), (1.0, 0.9), (1.0, 1.2)] {
+        text.push_str(&format!("{ti},{tr},180,0.5\n"));
+    }
+    std::fs::write(&table, text).unwrap();
+    let layout = dir.path().join("layout.toml");
+    std::fs::write(&layout, GOOD_LAYOUT.replace("elements = \"M{i}{j}\"\n", "")).unwrap();
+    let args = ["--layout", layout.to_str().unwrap(), "--free", "sigma,rho"];
+    let (_, _, stderr) = fit_cli(dir.path(), &table, &args);
+    assert!(
+        stderr.contains(&format!(
+            "note: {}: every zenith angle is within 1.2° ≤ π/2: if the angles are in radians, \
+             the layout needs angle_unit = \"rad\"",
+            table.display()
+        )),
+        "{stderr}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Realizability of measured rows (Cloude's test against each row's own noise).
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn rows_are_flagged_unrealizable_only_beyond_their_noise() {
+    let layout = Layout::parse(
+        Path::new("l.toml"),
+        "[columns]\ntheta_i_deg = \"ti\"\ntheta_r_deg = \"tr\"\nm00 = \"M00\"\n\
+         elements = \"M{i}{j}\"\n",
+    )
+    .unwrap();
+    let names: Vec<String> = (0..16).map(|k| format!("M{}{}", k / 4, k % 4)).collect();
+    let mut table = format!("# wavelength_um: 10\nti,tr,{}\n", names.join(","));
+    let diagonal = |d: [f64; 4]| {
+        (0..16)
+            .map(|k| {
+                if k % 5 == 0 {
+                    d[k / 4].to_string()
+                } else {
+                    "0".into()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    // The identity, a realizable depolarizer, and diag(1, 1, 1, −1): eigenvalue −½.
+    for d in [
+        [1.0, 1.0, 1.0, 1.0],
+        [1.0, 0.2, -0.2, -0.2],
+        [1.0, 1.0, 1.0, -1.0],
+    ] {
+        table.push_str(&format!("10,20,{}\n", diagonal(d)));
+    }
+    let set = parse_with_layout(Path::new("t.csv"), table.as_bytes(), &layout)
+        .unwrap()
+        .remove(0);
+    // No uncertainties: any negative eigenvalue beyond rounding counts, a pure one does not.
+    let checked = irpol::measure::unrealizable_rows(&set, 2.0);
+    assert_eq!(
+        (checked.unrealizable.as_slice(), checked.checked),
+        (&[2][..], 3)
+    );
+    let mut noisy = set.clone();
+    for point in &mut noisy.points {
+        point.uncertainties = vec![Some(0.2); 16]; // noise 0.4: −½ is within 2σ
+    }
+    assert!(irpol::measure::unrealizable_rows(&noisy, 2.0)
+        .unrealizable
+        .is_empty());
+    let mut partial = set;
+    partial.elements.truncate(4);
+    let none = irpol::measure::unrealizable_rows(&partial, 2.0);
+    assert_eq!((none.checked, none.unchecked), (0, 3));
+}
+
+/// The shipped PTFE rows read through the layout, with their estimated uncertainties: a
+/// strongly depolarizing sample, every row realizable with a wide margin.
+#[test]
+fn the_shipped_ptfe_rows_are_all_realizable() {
+    let layout = Layout::read(Path::new(PTFE_LAYOUT)).unwrap();
+    for set in read_with_layout(Path::new(PTFE), &layout).unwrap() {
+        let outcome = irpol::measure::unrealizable_rows(&set, 2.0);
+        let at_1 = irpol::measure::unrealizable_rows(&set, 1.0)
+            .unrealizable
+            .len();
+        let at_3 = irpol::measure::unrealizable_rows(&set, 3.0)
+            .unrealizable
+            .len();
+        let smallest = set
+            .points
+            .iter()
+            .map(|p| {
+                let m = irpol::optics::Mueller::from_row_slice(&p.values);
+                irpol::optics::coherency_eigenvalues(&m)[0] / p.values[0]
+            })
+            .fold(f64::INFINITY, f64::min);
+        eprintln!(
+            "PTFE {} µm: {} of {} rows not realizable beyond 2σ (1σ: {at_1}, 3σ: {at_3}); \
+             smallest eigenvalue {smallest:.4} m00",
+            set.wavelength_um,
+            outcome.unrealizable.len(),
+            outcome.checked
+        );
+        assert_eq!((outcome.checked, outcome.unchecked), (1824, 0));
+        assert!(outcome.unrealizable.len() <= at_1 && at_3 <= outcome.unrealizable.len());
+        assert!(at_1 == 0 && smallest > 0.05, "{smallest}");
     }
 }

@@ -41,6 +41,9 @@ pub enum AppError {
     Measure(Box<MeasureError>),
     #[error(transparent)]
     Fit(Box<FitError>),
+    /// Rows selected (`--wavelength`, `--theta-i`) that a file does not hold.
+    #[error(transparent)]
+    Selection(#[from] crate::measure::SelectionError),
     #[error(transparent)]
     FitOption(#[from] OptionError),
     #[error(transparent)]
@@ -213,6 +216,15 @@ impl AppError {
                 _ => None,
             },
             _ => None,
+        }
+    }
+}
+
+impl From<crate::measure::ReadError> for AppError {
+    fn from(error: crate::measure::ReadError) -> AppError {
+        match error {
+            crate::measure::ReadError::Measure(e) => e.into(),
+            crate::measure::ReadError::Selection(e) => e.into(),
         }
     }
 }

@@ -6,10 +6,11 @@
 use super::AppError;
 use crate::atomic::OutputSet;
 use crate::fit::{
-    fit_inputs, parse_parameter_list, parse_parameter_values, Dispersion, DistributionKind,
+    fit_inputs_with, parse_parameter_list, parse_parameter_values, Dispersion, DistributionKind,
     FitOptions, MaterialFit, Optimizer, RobustLoss,
 };
 use crate::material::{list_library, Material};
+use crate::measure::ReadOptions;
 use crate::pbrdf::{ModelTerms, Shadowing};
 use crate::report::fit_report::encode_fit_report;
 use crate::report::index::library_index_html;
@@ -135,16 +136,17 @@ pub struct FitWritten {
     pub index: PathBuf,
 }
 
-/// Fits `inputs` and writes `<fits_dir>/<material>.toml`, `<reports_dir>/<material>.png|svg` and
+/// Fits `inputs` (read as `reading` says) and writes `<fits_dir>/<material>.toml`, `<reports_dir>/<material>.png|svg` and
 /// `<reports_dir>/index.html`, all or nothing.
 pub fn fit_and_write(
     inputs: &[PathBuf],
+    reading: &ReadOptions,
     options: &FitOptions,
     fits_dir: &Path,
     reports_dir: &Path,
     progress: &dyn crate::progress::Progress,
 ) -> Result<FitWritten, AppError> {
-    let outcomes = fit_inputs(inputs, options, progress)?;
+    let outcomes = fit_inputs_with(inputs, reading, options, progress)?;
     let mut entries = Vec::new();
     let mut report_files = Vec::new();
     let mut reports = Vec::new();

@@ -6,11 +6,13 @@ pub mod evaluate;
 pub mod fit;
 pub mod render;
 pub mod scene_init;
+pub mod selection;
 pub mod sun;
 pub mod thermal;
 pub mod validate;
 
 pub use error::{one_line, AppError};
+pub use selection::{MeasurementArgs, SelectionArgs};
 
 use crate::material::{Material, MaterialError};
 use crate::optics::RefractiveIndex;

@@ -9,6 +9,9 @@ pub enum FitError {
     /// A measurement file could not be read or is malformed (`file:line:column: …`).
     #[error(transparent)]
     Read(#[from] MeasureError),
+    /// Rows selected that a file does not hold.
+    #[error(transparent)]
+    Selection(#[from] crate::measure::SelectionError),
     /// A measurement set that cannot be fitted.
     #[error("{}: {message}", file.display())]
     Measurement { file: PathBuf, message: String },
@@ -27,4 +30,13 @@ pub enum FitError {
     },
     #[error(transparent)]
     Material(#[from] MaterialError),
+}
+
+impl From<crate::measure::ReadError> for FitError {
+    fn from(error: crate::measure::ReadError) -> FitError {
+        match error {
+            crate::measure::ReadError::Measure(e) => FitError::Read(e),
+            crate::measure::ReadError::Selection(e) => FitError::Selection(e),
+        }
+    }
 }

@@ -9,7 +9,7 @@ use super::spectral::{fit_spectral, SpectralFitOutcome};
 use super::FitError;
 use crate::material::Material;
 use crate::measure::{
-    collect_measurement_files, merge_repeat_measurements, read_measurement_sets, MeasurementSet,
+    collect_measurement_files, merge_repeat_measurements, MeasurementSet, ReadOptions,
     SAME_WAVELENGTH_UM,
 };
 use crate::progress::Progress;
@@ -68,13 +68,26 @@ pub fn fit_files(
 
 /// [`fit_files`] without writing: every outcome, for a caller that writes the library entries
 /// together with other outputs (`irpol fit` adds reports and an index). A material measured at
-/// several wavelengths is fitted jointly ([`fit_spectral`]).
+/// several wavelengths is fitted jointly ([`fit_spectral`]). Each file is read as it says
+/// (docs/design.md §2.1, or through the layout its `# layout:` line names).
 pub fn fit_inputs(
     inputs: &[PathBuf],
     options: &FitOptions,
     progress: &dyn Progress,
 ) -> Result<Vec<MaterialFit>, FitError> {
-    let materials = read_all(inputs)?;
+    fit_inputs_with(inputs, &ReadOptions::default(), options, progress)
+}
+
+/// [`fit_inputs`] of the files read through `reading`'s layout and with only its selected rows;
+/// each fit record names the layout given and the selection, so that `irpol report` re-reads
+/// the same rows the same way.
+pub fn fit_inputs_with(
+    inputs: &[PathBuf],
+    reading: &ReadOptions,
+    options: &FitOptions,
+    progress: &dyn Progress,
+) -> Result<Vec<MaterialFit>, FitError> {
+    let materials = read_all(inputs, reading)?;
     validate_options(options)?;
 
     progress.begin("fitting", materials.len() as u64);
@@ -89,23 +102,42 @@ pub fn fit_inputs(
                 .map(|o| MaterialFit::Spectral(Box::new(o)))
         };
         progress.advance(1);
-        outcomes.push(outcome.inspect_err(|_| progress.abandon())?);
+        let mut outcome = outcome.inspect_err(|_| progress.abandon())?;
+        record_reading(&mut outcome, reading);
+        outcomes.push(outcome);
     }
     progress.end();
     Ok(outcomes)
 }
 
+/// Writes how the files were read into the fit record: the layout given (a layout the file
+/// names itself is found again from the file) and the selection, when it keeps less than all.
+fn record_reading(outcome: &mut MaterialFit, reading: &ReadOptions) {
+    let material = match outcome {
+        MaterialFit::Grey(o) => &mut o.material,
+        MaterialFit::Spectral(o) => &mut o.material,
+    };
+    if let Some(record) = material.fit.as_mut() {
+        record.layout = reading.layout.as_ref().map(|l| l.source.clone());
+        record.selection = (!reading.selection.is_everything()).then(|| reading.selection.clone());
+    }
+}
+
 /// Reads every input and checks that each set can be fitted, before any fitting starts: the
 /// sets of each material, one per wavelength, ascending.
-fn read_all(inputs: &[PathBuf]) -> Result<Vec<Vec<MeasurementSet>>, FitError> {
+fn read_all(
+    inputs: &[PathBuf],
+    reading: &ReadOptions,
+) -> Result<Vec<Vec<MeasurementSet>>, FitError> {
     if inputs.is_empty() {
         return Err(FitError::Options("no measurement file given".into()));
     }
+    reading.selection.check()?;
     let mut sets = Vec::new();
     for input in inputs {
         let mut read = Vec::new();
         for file in collect_measurement_files(std::slice::from_ref(input))? {
-            read.extend(read_measurement_sets(&file)?);
+            read.extend(reading.read(&file)?);
         }
         if input.is_dir() {
             check_folder_materials(input, &read)?;

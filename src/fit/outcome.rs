@@ -111,6 +111,9 @@ fn fit_record(
         source: set.source.clone(),
         source_sha256: set.sha256.clone(),
         source_data: Some(set.source_data(0)),
+        // How the files were read: set by the caller that read them.
+        layout: None,
+        selection: None,
         merged_sources: set
             .merged
             .iter()

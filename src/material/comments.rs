@@ -52,6 +52,11 @@ const TABLES: &[(&str, &str)] = &[
         "The fingerprint of this file's parsed data (as [fit.source_data]).",
     ),
     (
+        "fit.selection",
+        "The rows of the sources that were fitted (--wavelength, --theta-i); `irpol report`\n\
+         rebuilds from the same rows.",
+    ),
+    (
         "fit.settings",
         "What reproduces the fit besides optimizer and seed: bounds, distribution choice,\n\
                       each stage's stopping rules, robust loss, where the uncertainties came from.",
@@ -128,6 +133,7 @@ fn model_keys() -> Vec<(&'static str, Cow<'static, str>)> {
 const FIT: &[(&str, &str)] = &[
     ("source", "the measurement CSV as given to `irpol fit` (relative to where it ran)"),
     ("source_sha256", "SHA-256 of its bytes: `irpol report` refuses to rebuild from a changed file"),
+    ("layout", "the instrument layout (docs/design.md §2.8) the sources were read through (--layout)"),
     ("points", "measured geometries (rows) used, over all source files"),
     ("elements", "Mueller elements fitted (the columns present)"),
     ("free_parameters", "parameters the fit varied (--free); the others are held at their [model] values"),
@@ -156,6 +162,17 @@ const MERGED_SOURCE: &[(&str, &str)] = &[
     ),
     ("source_sha256", "SHA-256 of its bytes"),
     ("points", "its rows"),
+];
+
+const SELECTION: &[(&str, &str)] = &[
+    (
+        "wavelength_um",
+        "the one wavelength kept of a file of several, µm",
+    ),
+    (
+        "theta_i_deg",
+        "the incidence angles kept, degrees (rows within 0.05° of one)",
+    ),
 ];
 
 const ALTERNATIVE: &[(&str, &str)] = &[
@@ -203,6 +220,7 @@ const KEYED: &[(&str, Keys)] = &[
     ("model", Keys::Model),
     ("fit", Keys::Fixed(FIT)),
     ("fit.merged_sources", Keys::Fixed(MERGED_SOURCE)),
+    ("fit.selection", Keys::Fixed(SELECTION)),
     ("fit.alternative", Keys::Fixed(ALTERNATIVE)),
     ("fit.alternative.model", Keys::Model),
     ("fit.profile_bounds.*", Keys::Fixed(PROFILE_BOUND)),

@@ -123,6 +123,14 @@ pub struct FitRecord {
     /// The fingerprint of the source's parsed data (absent in files written before it existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub source_data: Option<crate::measure::SourceData>,
+    /// The instrument layout the sources were read through (docs/design.md §2.8), as given to
+    /// `irpol fit --layout`; absent when the files were read as they say (docs/design.md §2.1,
+    /// or through a layout their own `# layout:` line names).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layout: Option<PathBuf>,
+    /// The rows of the sources that were fitted (`--wavelength`, `--theta-i`); absent: all.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub selection: Option<crate::measure::RowSelection>,
     /// Further files of the same material and wavelength fitted with `source` as repeat
     /// measurements, in the order their rows follow its rows; absent for a fit of one file.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

@@ -175,6 +175,14 @@ pub enum MeasureErrorKind {
     LayoutNegativeAngle { column: String, value: String },
     #[error("column '{column}' (the layout's m00): {value} is negative, but m00 (the unpolarized BRDF, sr⁻¹) is ≥ 0")]
     LayoutNegativeM00 { column: String, value: String },
+    #[error("header 'layout': the file names the layout {named}, but the layout {given} was given too and reads the table differently: give one of them (drop --layout, or the '# layout:' line)")]
+    LayoutsDisagree { named: String, given: String },
+    #[error("header 'layout': '{value}' (looked for at {path}, beside the file): {reason}: fix the path, relative to the measurement file's folder")]
+    NamedLayoutUnreadable {
+        value: String,
+        path: String,
+        reason: String,
+    },
     #[error("header 'mueller_convention': '{value}' disagrees with the layout's mueller_convention = \"{layout_value}\"")]
     ConventionDisagreesWithLayout {
         value: String,

@@ -27,10 +27,11 @@ pub use validation::encode_validation_report;
 
 use super::ReportError;
 use crate::atomic::write_atomically;
+use crate::fit::FitError;
 use crate::material::{FitRecord, Material};
 use crate::measure::{
-    hex, merge_repeat_measurements, parse_measurement_csv, MeasureError, MeasureErrorKind,
-    MeasurementSet, SourceData,
+    hex, merge_repeat_measurements, parse_measurement_csv, Layout, MeasureError, MeasureErrorKind,
+    MeasurementSet, ReadOptions, SourceData, LAYOUT_KEY,
 };
 use crate::plot_style::{encode_png, register_fonts, FONT};
 use data::ReportData;
@@ -289,19 +290,73 @@ fn source_candidates(material_path: &Path, source: &Path) -> Vec<PathBuf> {
 }
 
 /// Finds each of the fit's source CSVs (the source, then any merged with it) and checks it holds
-/// the data that was fitted; returns each one's parsed data, in that order.
+/// the data that was fitted; returns each one's parsed data, in that order, read as the fit read
+/// it (through the recorded layout, the recorded rows only).
 pub(crate) fn verified_source(
     material_path: &Path,
     fit: &FitRecord,
 ) -> Result<Vec<MeasurementSet>, ReportError> {
+    let reading = ReadOptions {
+        layout: recorded_layout(material_path, fit)?,
+        selection: fit.selection.clone().unwrap_or_default(),
+    };
     std::iter::once((&fit.source, &fit.source_sha256, &fit.source_data))
         .chain(
             fit.merged_sources
                 .iter()
                 .map(|m| (&m.source, &m.source_sha256, &m.source_data)),
         )
-        .map(|(source, sha256, data)| verified_file(material_path, source, sha256, data.as_ref()))
+        .map(|(source, sha256, data)| {
+            verified_file(material_path, source, sha256, data.as_ref(), &reading)
+        })
         .collect()
+}
+
+/// The layout the fit was given, found where its sources are looked for.
+fn recorded_layout(material_path: &Path, fit: &FitRecord) -> Result<Option<Layout>, ReportError> {
+    let Some(layout) = &fit.layout else {
+        return Ok(None);
+    };
+    let candidates = source_candidates(material_path, layout);
+    match candidates.iter().find(|p| p.is_file()) {
+        Some(path) => Ok(Some(Layout::read(path)?)),
+        None => Err(ReportError::LayoutMissing {
+            material: material_path.to_owned(),
+            layout: layout.clone(),
+            tried: candidates
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+        }),
+    }
+}
+
+/// The one set a source holds once read as the fit read it; a file of several wavelengths
+/// without a recorded wavelength is refused by the one-wavelength reader's own message when it
+/// is a docs/design.md §2.1 file.
+fn parse_source(
+    csv: &Path,
+    bytes: &[u8],
+    reading: &ReadOptions,
+) -> Result<MeasurementSet, ReportError> {
+    let mut sets = reading.parse(csv, bytes).map_err(FitError::from)?;
+    if sets.len() == 1 {
+        return Ok(sets.remove(0));
+    }
+    if reading.layout.is_none() && !sets.iter().any(|s| s.metadata.contains_key(LAYOUT_KEY)) {
+        parse_measurement_csv(csv, bytes)?;
+    }
+    let wavelengths: Vec<String> = sets.iter().map(|s| s.wavelength_um.to_string()).collect();
+    Err(FitError::Measurement {
+        file: csv.to_owned(),
+        message: format!(
+            "holds {} wavelengths ({} µm) and the fit record selects none of them",
+            sets.len(),
+            wavelengths.join(", ")
+        ),
+    }
+    .into())
 }
 
 /// One source CSV, checked against its recorded hash and data fingerprint. The bytes may differ
@@ -314,6 +369,7 @@ fn verified_file(
     source: &Path,
     recorded_sha256: &str,
     recorded_data: Option<&SourceData>,
+    reading: &ReadOptions,
 ) -> Result<MeasurementSet, ReportError> {
     let candidates = source_candidates(material_path, source);
     let mut first_changed = None;
@@ -328,9 +384,9 @@ fn verified_file(
         })?;
         let same_bytes = hex(&Sha256::digest(&bytes)).eq_ignore_ascii_case(recorded_sha256.trim());
         let error = match (recorded_data, same_bytes) {
-            (_, true) => return Ok(parse_measurement_csv(csv, &bytes)?),
+            (_, true) => return parse_source(csv, &bytes, reading),
             (Some(recorded), false) => {
-                let set = parse_measurement_csv(csv, &bytes)?;
+                let set = parse_source(csv, &bytes, reading)?;
                 let now = set.source_data(recorded.rows_per_digest);
                 if now.sha256 == recorded.sha256 {
                     return Ok(set);

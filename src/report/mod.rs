@@ -39,6 +39,12 @@ pub enum ReportError {
         csv: std::path::PathBuf,
         tried: String,
     },
+    #[error("{material}: the layout {layout} its fit read the source through is missing (looked for {tried})")]
+    LayoutMissing {
+        material: std::path::PathBuf,
+        layout: std::path::PathBuf,
+        tried: String,
+    },
     #[error("{csv}: source CSV changed since the fit: its bytes are not those of sha256 {recorded} recorded in {material}, which records no fingerprint of the data to compare (written before irpol kept one); refit it with `irpol fit`")]
     SourceChanged {
         csv: std::path::PathBuf,

@@ -26,6 +26,9 @@ pub(super) fn material(
         source: sets[0].source.clone(),
         source_sha256: sets[0].sha256.clone(),
         source_data: None,
+        // How the files were read: set by the caller that read them.
+        layout: None,
+        selection: None,
         merged_sources: merged_sources(sets),
         points: sets.iter().map(|s| s.points.len()).sum(),
         elements: element_names(sets),

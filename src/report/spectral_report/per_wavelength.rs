@@ -133,6 +133,8 @@ fn wavelength_record(
         source: set.source.clone(),
         source_sha256: set.sha256.clone(),
         source_data: None,
+        layout: None,
+        selection: None,
         merged_sources: Vec::new(),
         points: set.points.len(),
         elements: set

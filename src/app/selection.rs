@@ -1,0 +1,64 @@
+//! The flags of every command that reads measurement files (`irpol fit`, and the commands that
+//! predict measurements): the instrument layout to read them through and the rows to keep
+//! (docs/design.md §2.8). One clap struct, flattened into each command, so that all refuse the
+//! same input with the same message.
+
+use std::path::PathBuf;
+
+use super::AppError;
+use crate::measure::{Layout, MeasurementSet, ReadOptions, RowSelection};
+
+/// How to read the measurement files: `--layout`, `--wavelength`, `--theta-i`.
+#[derive(Clone, Debug, Default, clap::Args)]
+pub struct MeasurementArgs {
+    /// Instrument layout (TOML, docs/design.md §2.8) to read the files through, for files in
+    /// an instrument's own columns and conventions; a file may name its own with a
+    /// '# layout: FILE' line instead.
+    #[arg(long, value_name = "L.toml")]
+    pub layout: Option<PathBuf>,
+    #[command(flatten)]
+    pub selection: SelectionArgs,
+}
+
+/// Which rows of each file to keep: `--wavelength`, `--theta-i`.
+#[derive(Clone, Debug, Default, clap::Args)]
+pub struct SelectionArgs {
+    /// Keep only the rows at this wavelength (µm) of a file that holds several.
+    #[arg(long = "wavelength", value_name = "UM")]
+    pub wavelength_um: Option<f64>,
+    /// Keep only the rows at these incidence angles, degrees, comma-separated (a row within
+    /// 0.05° of one is kept), e.g. 0,30,60,75.
+    #[arg(long = "theta-i", value_name = "LIST", value_delimiter = ',')]
+    pub theta_i_deg: Vec<f64>,
+}
+
+impl SelectionArgs {
+    /// The selection, its values checked.
+    pub fn selection(&self) -> Result<RowSelection, AppError> {
+        let selection = RowSelection {
+            wavelength_um: self.wavelength_um,
+            theta_i_deg: self.theta_i_deg.clone(),
+        };
+        selection.check()?;
+        Ok(selection)
+    }
+
+    /// The selected rows of one file's sets (one per wavelength, as a reader returns them).
+    pub fn apply(&self, sets: Vec<MeasurementSet>) -> Result<Vec<MeasurementSet>, AppError> {
+        Ok(self.selection()?.apply(sets)?)
+    }
+}
+
+impl MeasurementArgs {
+    /// The layout read and the selection checked: what [`ReadOptions::read`] reads each file with.
+    pub fn read_options(&self) -> Result<ReadOptions, AppError> {
+        let layout = match &self.layout {
+            Some(path) => Some(Layout::read(path)?),
+            None => None,
+        };
+        Ok(ReadOptions {
+            layout,
+            selection: self.selection.selection()?,
+        })
+    }
+}
