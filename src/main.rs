@@ -10,7 +10,7 @@ use irpol::app::evaluate::{
 };
 use irpol::app::fit::{fit_and_write, FitFlags};
 use irpol::app::render::{
-    default_output_dir, instant_folder, render_scene, render_scene_at, Instants, TimedRender,
+    default_output_dir, render_scene, render_scene_at, Instants, TimedRender,
 };
 use irpol::app::scene_init::write_starter_scene;
 use irpol::app::sun::{given_times, write_sun_csv};
@@ -542,16 +542,8 @@ fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()
 
 fn render_instants(scene: &Path, out: Option<PathBuf>, instants: &Instants) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| default_output_dir(scene));
-    if let Instants::Seconds(times) = instants {
-        let staging = (0..times.len())
-            .map(|i| instant_folder(&out, i, times[i], times.len() > 1))
-            .map(|folder| staging_folder(&folder, std::process::id()))
-            .collect();
-        cli::signals::remove_on_interrupt(staging, vec![out.clone()]);
-    } else {
-        let staging = vec![staging_folder(&out, std::process::id())];
-        cli::signals::remove_on_interrupt(staging, vec![]);
-    }
+    // One instant or a whole series: one output set staged beside the folder.
+    cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
     let renders = render_scene_at(scene, &out, instants, &TerminalProgress::new())?;
     report_instants(scene, &out, &renders);
     Ok(())
