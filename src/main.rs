@@ -382,7 +382,9 @@ fn report(material: &Path, reports: &Path) -> anyhow::Result<()> {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    say!("wrote {}", write_library_index(library, reports)?.display());
+    let index = write_library_index(library, reports)?;
+    warn_once(&index.warnings);
+    say!("wrote {}", index.path.display());
     Ok(())
 }
 
@@ -414,6 +416,7 @@ fn fit_and_summarize(
     for outcome in &written.outcomes {
         note_all(&outcome.notes());
     }
+    warn_once(&written.warnings);
     for (outcome, entry) in written.outcomes.iter().zip(&written.entries) {
         let line = match outcome {
             MaterialFit::Grey(outcome) => fit_summary_line(outcome, entry),
@@ -619,7 +622,9 @@ fn report_thermal(scene: &Path, out: &Path, summary: &ThermalSummary) {
 }
 
 fn print_library(dir: &Path) -> anyhow::Result<()> {
-    let materials = irpol::material::list_library(dir)?;
+    let library = irpol::material::list_library(dir)?;
+    warn_once(&library.warnings());
+    let materials = library.materials;
     if materials.is_empty() {
         say!("no materials in {}", dir.display());
         return Ok(());
