@@ -10,7 +10,7 @@ use irpol::app::evaluate::{
 };
 use irpol::app::fit::{fit_and_write, FitFlags};
 use irpol::app::render::{
-    default_output_dir, instant_folder, render_scene, render_scene_at, Instants, TimedRender,
+    default_output_dir, render_scene, render_scene_at, Instants, TimedRender,
 };
 use irpol::app::scene_init::write_starter_scene;
 use irpol::app::sun::{given_times, write_sun_csv};
@@ -450,7 +450,9 @@ fn report(material: &Path, reports: &Path) -> anyhow::Result<()> {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    say!("wrote {}", write_library_index(library, reports)?.display());
+    let index = write_library_index(library, reports)?;
+    warn_once(&index.warnings);
+    say!("wrote {}", index.path.display());
     Ok(())
 }
 
@@ -484,6 +486,7 @@ fn fit_and_summarize(
     for outcome in &written.outcomes {
         note_all(&outcome.notes());
     }
+    warn_once(&written.warnings);
     for (outcome, entry) in written.outcomes.iter().zip(&written.entries) {
         let line = match outcome {
             MaterialFit::Grey(outcome) => fit_summary_line(outcome, entry),
@@ -643,16 +646,8 @@ fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()
 
 fn render_instants(scene: &Path, out: Option<PathBuf>, instants: &Instants) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| default_output_dir(scene));
-    if let Instants::Seconds(times) = instants {
-        let staging = (0..times.len())
-            .map(|i| instant_folder(&out, i, times[i], times.len() > 1))
-            .map(|folder| staging_folder(&folder, std::process::id()))
-            .collect();
-        cli::signals::remove_on_interrupt(staging, vec![out.clone()]);
-    } else {
-        let staging = vec![staging_folder(&out, std::process::id())];
-        cli::signals::remove_on_interrupt(staging, vec![]);
-    }
+    // One instant or a whole series: one output set staged beside the folder.
+    cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
     let renders = render_scene_at(scene, &out, instants, &TerminalProgress::new())?;
     report_instants(scene, &out, &renders);
     Ok(())
@@ -728,7 +723,9 @@ fn report_thermal(scene: &Path, out: &Path, summary: &ThermalSummary) {
 }
 
 fn print_library(dir: &Path) -> anyhow::Result<()> {
-    let materials = irpol::material::list_library(dir)?;
+    let library = irpol::material::list_library(dir)?;
+    warn_once(&library.warnings());
+    let materials = library.materials;
     if materials.is_empty() {
         say!("no materials in {}", dir.display());
         return Ok(());

@@ -585,3 +585,35 @@ fn library_takes_its_folder_as_an_argument_or_dir() {
     let (ok, stdout, _) = irpol(&["library", empty.path().to_str().unwrap()]);
     assert!(ok && stdout.starts_with("no materials in"), "{stdout}");
 }
+
+/// A file in the library folder that is not a material (notes, an old draft) does not stop a
+/// fit: the index skips it with a warning naming it, and the file is left as it was.
+#[test]
+fn fit_skips_a_file_in_the_library_that_is_not_a_material_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let fits = dir.path().join("fits");
+    std::fs::create_dir_all(&fits).unwrap();
+    std::fs::write(fits.join("notes.toml"), "todo = [\"refit glass\"]\n").unwrap();
+    let good =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("measurements/paper_paint.csv");
+    let (ok, _, stderr) = fit_into(dir.path(), &[&good], &["--optimizer", "lm"]);
+    assert!(ok, "{stderr}");
+    let warning = stderr
+        .lines()
+        .find(|l| l.starts_with("irpol: warning: ") && l.contains("notes.toml"))
+        .unwrap_or_else(|| panic!("no warning naming notes.toml in {stderr}"));
+    assert!(
+        warning.contains("not a valid material TOML") && warning.contains("skipped"),
+        "{warning}"
+    );
+    assert!(fits.join("paper_paint.toml").is_file());
+    let index = std::fs::read_to_string(dir.path().join("reports/index.html")).unwrap();
+    assert!(
+        index.contains("paper_paint") && !index.contains("notes"),
+        "index lists notes"
+    );
+    assert_eq!(
+        std::fs::read_to_string(fits.join("notes.toml")).unwrap(),
+        "todo = [\"refit glass\"]\n"
+    );
+}

@@ -1,6 +1,6 @@
-//! Interrupting `irpol render`: SIGTERM or SIGKILL at any moment leaves the output
-//! folder holding the complete old set or the complete new one, and SIGTERM leaves no temporary
-//! folder (a SIGKILLed run's staging folder is removed by the next run).
+//! Interrupting `irpol render` (one instant or a `--times` series) and `irpol fit`: SIGTERM or
+//! SIGKILL at any moment leaves the outputs holding the complete old set or the complete new one,
+//! and SIGTERM leaves no temporary (a SIGKILLed run's is removed by the next run).
 
 mod common;
 
@@ -106,6 +106,125 @@ fn an_interrupted_render_leaves_the_old_or_the_new_set() {
         .filter(|e| e.file_name().to_string_lossy().contains("irpol-staging"))
         .count();
     assert_eq!(leftovers, 0);
+}
+
+/// A small thermal scene: a steel ball over a steel floor through a summer morning.
+fn thermal_scene_text() -> String {
+    format!(
+        "{}{}{}[render]\nsamples = 8\n\
+         [thermal]\nweather = {{ clear_day = {{ air_min_k = 287.0, air_max_k = 301.0, wind_m_s = 2.0 }} }}\n\
+         start_utc = \"2026-06-21T00:00:00Z\"\nlatitude_deg = 48.14\nlongitude_deg = 11.58\n\
+         output_step_s = 3600\nduration_h = 6\n\
+         [thermal.layers.steel]\nconductivity_w_mk = 45.0\ndensity_kg_m3 = 7850.0\n\
+         heat_capacity_j_kgk = 470.0\n\
+         [[objects]]\nname = \"ball\"\nshape = {{ kind = \"sphere\", radius = 1.0, subdivisions = 3 }}\n\
+         material = \"m\"\nthermal = {{ stack = [[\"steel\", 0.002]], solar_absorptance = 0.6 }}\n\
+         [[objects]]\nname = \"floor\"\nshape = {{ kind = \"plane\", size = [6.0, 6.0], divisions = [4, 4] }}\n\
+         material = \"m\"\ntranslate = [0.0, 0.0, -1.0]\n\
+         thermal = {{ stack = [[\"steel\", 0.01]], solar_absorptance = 0.9 }}\n",
+        camera_toml(96),
+        AUTUMN_ENVIRONMENT,
+        material_toml(0.2, 2.0, 1.5, 0.1, 0.05),
+    )
+}
+
+/// The entries of a series folder and the S0.tif of each frame, sorted by name.
+fn series(out: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut entries: Vec<(String, Vec<u8>)> = std::fs::read_dir(out)
+        .unwrap()
+        .flatten()
+        .map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            (
+                name,
+                std::fs::read(e.path().join("S0.tif")).unwrap_or_default(),
+            )
+        })
+        .collect();
+    entries.sort();
+    entries
+}
+
+/// The folder holds one whole series, `a` or `b`: the same entries, each frame's S0.tif the same,
+/// and every file each frame's summary lists.
+fn one_series(out: &Path, a: &[(String, Vec<u8>)], b: &[(String, Vec<u8>)]) -> bool {
+    let now = series(out);
+    let frames_complete = now
+        .iter()
+        .filter(|(_, s0)| !s0.is_empty())
+        .all(|(frame, _)| {
+            let summary = std::fs::read(out.join(frame).join("summary.json")).unwrap_or_default();
+            let summary: serde_json::Value = serde_json::from_slice(&summary).unwrap_or_default();
+            summary["files"].as_array().is_some_and(|files| {
+                files
+                    .iter()
+                    .all(|f| out.join(frame).join(f.as_str().unwrap()).is_file())
+            })
+        });
+    (now == a || now == b) && frames_complete
+}
+
+/// SIGTERM or SIGKILL at any moment of `irpol render --times` leaves the complete earlier series
+/// or the complete new one, never frames of both; SIGTERM leaves no staging folder.
+#[test]
+fn an_interrupted_series_leaves_the_old_or_the_new_series() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("day.toml");
+    std::fs::write(&scene, thermal_scene_text()).unwrap();
+    let out = dir.path().join("out");
+    let args = |times: &'static str| {
+        [
+            "render".to_owned(),
+            scene.display().to_string(),
+            "--times".to_owned(),
+            times.to_owned(),
+            "--out".to_owned(),
+            out.display().to_string(),
+        ]
+    };
+    let (old_times, new_times) = ("0:21600:10800", "0:21600:7200");
+    let run = |times| {
+        let args = args(times);
+        let (ok, _, err) = irpol(&args.each_ref().map(String::as_str));
+        assert!(ok, "{err}");
+        series(&out)
+    };
+    let new = run(new_times);
+    let old = run(old_times);
+    assert_eq!(
+        (old.len(), new.len()),
+        (5, 6),
+        "frames, preview and manifest"
+    );
+    let staging = || {
+        std::fs::read_dir(dir.path())
+            .unwrap()
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().contains("irpol-staging"))
+            .count()
+    };
+    for (k, signal) in ["TERM", "KILL", "TERM", "KILL", "TERM", "KILL"]
+        .iter()
+        .enumerate()
+    {
+        // Spread over the thermal solve, the frames and the commit.
+        let args = args(new_times);
+        interrupt_after(
+            &args.each_ref().map(String::as_str),
+            150 + 200 * k as u64,
+            signal,
+        );
+        assert!(
+            one_series(&out, &old, &new),
+            "a mixed series after SIG{signal} #{k}"
+        );
+        if *signal == "TERM" {
+            assert_eq!(staging(), 0, "a staging folder left after SIGTERM #{k}");
+        }
+        // Back to the old series (this run also clears a SIGKILL's leftovers).
+        run(old_times);
+        assert_eq!(staging(), 0);
+    }
 }
 
 /// Every library entry in `fits` is from the same fit: all equal to `a` or all equal to `b`.

@@ -2,6 +2,8 @@
 //! refused with an exact `file:line:column: what is wrong` message; good files parsed to known
 //! values; and random or truncated input that must give Ok or Err, never a panic.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use irpol::measure::{
@@ -336,4 +338,29 @@ fn truncated_and_mutated_good_files_never_panic() {
         .0;
     let err = parse_measurement_csv(Path::new("m.csv"), &bytes[..=header_end]).unwrap_err();
     assert_eq!(err.kind, MeasureErrorKind::NoDataRows);
+}
+
+/// A material name too long to name its files is refused at the CSV's `# material:` line, with
+/// the limit, before anything is fitted or written (not by the report file it would have named).
+#[test]
+fn a_material_name_too_long_for_a_file_is_refused_at_its_header_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let shipped = std::fs::read_to_string("measurements/paper_paint.csv").unwrap();
+    let long = "p".repeat(300);
+    let csv = dir.path().join("long.csv");
+    std::fs::write(
+        &csv,
+        shipped.replace("# material: paper_paint", &format!("# material: {long}")),
+    )
+    .unwrap();
+    let (ok, _, stderr) = common::fit_into(dir.path(), &[&csv], &[]);
+    assert!(!ok);
+    let expected = format!(
+        "{}:1:13: header 'material': '{}…' cannot name a file (it is 300 bytes long; at most 200",
+        csv.display(),
+        "p".repeat(40)
+    );
+    assert!(stderr.contains(&expected), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(!dir.path().join("fits").exists() && !dir.path().join("reports").exists());
 }

@@ -151,6 +151,34 @@ fn nan_in_mesh() {
     expect(&text, &["bad.ply"]);
 }
 
+/// A PLY header that declares an element or a property twice is refused by line: the reader
+/// keys them by name, so the second would silently replace the first.
+#[test]
+fn duplicate_ply_declarations_are_refused() {
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+               property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+               property list uchar int vertex_indices\nend_header\n\
+               0 0 0\n1 0 0\n0 0 1\n3 0 1 2 3 0 1 2\n";
+    let text = refuse(&scene_with_mesh("twice.ply", ""), &[("twice.ply", ply)]);
+    expect(
+        &text,
+        &[
+            "twice.ply",
+            "header line 9: element 'face': property 'vertex_indices' is declared twice \
+             (first on line 8)",
+        ],
+    );
+    let ply = ply.replace(
+        "element face 1\n",
+        "element face 1\nproperty uchar flag\nelement face 1\n",
+    );
+    let text = refuse(&scene_with_mesh("twice.ply", ""), &[("twice.ply", &ply)]);
+    expect(
+        &text,
+        &["header line 9: element 'face' is declared twice (first on line 7)"],
+    );
+}
+
 #[test]
 fn bad_values_name_their_key() {
     let scene = scene_with_mesh("panel.obj", "")

@@ -44,7 +44,9 @@ fn library(project: &Path) {
 fn the_index_lists_every_material_with_its_fit_and_provenance() {
     let dir = tempfile::tempdir().unwrap();
     library(dir.path());
-    let index = write_library_index(&dir.path().join("fits"), &dir.path().join("reports")).unwrap();
+    let index = write_library_index(&dir.path().join("fits"), &dir.path().join("reports"))
+        .unwrap()
+        .path;
     assert_eq!(index, dir.path().join("reports/index.html"));
     let html = std::fs::read_to_string(&index).unwrap();
 
@@ -85,7 +87,9 @@ fn the_index_lists_every_material_with_its_fit_and_provenance() {
 fn material_text_is_escaped() {
     let dir = tempfile::tempdir().unwrap();
     library(dir.path());
-    let index = write_library_index(&dir.path().join("fits"), &dir.path().join("reports")).unwrap();
+    let index = write_library_index(&dir.path().join("fits"), &dir.path().join("reports"))
+        .unwrap()
+        .path;
     let html = std::fs::read_to_string(index).unwrap();
     assert!(!html.contains("<b>\"tar\""));
     assert!(html.contains("<h2>&lt;b&gt;&quot;tar&quot; &amp; pitch&lt;/b&gt;</h2>"));
@@ -99,23 +103,33 @@ fn an_empty_library_gives_a_page_that_says_so() {
     let dir = tempfile::tempdir().unwrap();
     let fits = dir.path().join("fits");
     std::fs::create_dir_all(&fits).unwrap();
-    let index = write_library_index(&fits, &dir.path().join("reports")).unwrap();
+    let index = write_library_index(&fits, &dir.path().join("reports"))
+        .unwrap()
+        .path;
     let html = std::fs::read_to_string(index).unwrap();
     assert!(html.contains("0 materials in") && html.contains("No materials yet"));
 }
 
+/// A file of the library folder that is not a material is skipped by the index with a warning
+/// naming it and why, not refused: one stray file must not stop the index of the others.
 #[test]
-fn a_broken_library_entry_is_named_in_the_error() {
+fn a_broken_library_entry_is_skipped_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
     let fits = dir.path().join("fits");
     std::fs::create_dir_all(&fits).unwrap();
     std::fs::write(fits.join("broken.toml"), "name = \"x\"\n").unwrap();
-    let message = write_library_index(&fits, &dir.path().join("reports"))
-        .unwrap_err()
-        .to_string();
+    let written = write_library_index(&fits, &dir.path().join("reports")).unwrap();
+    let [warning] = written.warnings.as_slice() else {
+        panic!("{:?}", written.warnings)
+    };
     assert!(
-        message.contains("broken.toml: not a valid material TOML"),
-        "{message}"
+        warning.contains("broken.toml: not a valid material TOML")
+            && warning.ends_with("; skipped, the library holds only material files"),
+        "{warning}"
     );
-    assert!(!dir.path().join("reports/index.html").exists());
+    let html = std::fs::read_to_string(written.path).unwrap();
+    assert!(
+        html.contains("0 materials in") && !html.contains("broken"),
+        "{html}"
+    );
 }

@@ -307,6 +307,67 @@ fn render_at_times_writes_numbered_folders_and_an_animation() {
     assert_eq!(&gif[..6], b"GIF89a");
 }
 
+/// Frame folders in `out`, sorted.
+fn frame_folders(out: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(out)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.path().is_dir())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// A series replaces the folder's earlier outputs as a whole: a shorter or differently stepped
+/// series leaves no frame of the earlier one, a single instant none of a series (and the reverse),
+/// and the user's own files stay.
+#[test]
+fn a_series_replaces_the_earlier_series_and_keeps_the_users_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path(), &scene_text("duration_h = 6"));
+    let out = dir.path().join("series");
+    let render = |when: &[&str]| {
+        let mut args = vec!["render", scene.to_str().unwrap(), "--out"];
+        args.push(out.to_str().unwrap());
+        args.extend_from_slice(when);
+        let (ok, _, stderr) = irpol(&args);
+        assert!(ok, "{stderr}");
+    };
+    render(&["--times", "0:21600:10800"]);
+    assert_eq!(frame_folders(&out), ["000_0s", "001_10800s", "002_21600s"]);
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    render(&["--times", "0:21600:7200"]);
+    assert_eq!(
+        frame_folders(&out),
+        ["000_0s", "001_7200s", "002_14400s", "003_21600s"]
+    );
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("series.json")).unwrap()).unwrap();
+    assert_eq!(manifest["frames"][1]["folder"], "001_7200s");
+    assert_eq!(manifest["frames"][1]["time_utc"], "2026-06-21T02:00:00Z");
+    render(&["--time", "3600"]);
+    assert!(frame_folders(&out).is_empty());
+    assert!(!out.join("preview.gif").exists() && !out.join("series.json").exists());
+    assert!(out.join("S0.tif").is_file());
+    render(&["--times", "0:3600:3600"]);
+    assert_eq!(frame_folders(&out), ["000_0s", "001_3600s"]);
+    assert!(
+        !out.join("S0.tif").exists(),
+        "the single render's files went"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    let hidden: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "no staging folder left: {hidden:?}");
+}
+
 /// Bad thermal input: one-line errors naming the key, and nothing written.
 #[test]
 fn bad_thermal_input_is_refused_by_name_and_writes_nothing() {

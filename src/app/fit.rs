@@ -9,7 +9,7 @@ use crate::fit::{
     fit_inputs_with, parse_parameter_list, parse_parameter_values, Dispersion, DistributionKind,
     FitOptions, MaterialFit, Optimizer, RobustLoss,
 };
-use crate::material::{list_library, Material};
+use crate::material::{list_library, Library, Material};
 use crate::measure::ReadOptions;
 use crate::pbrdf::{ModelTerms, Shadowing};
 use crate::report::fit_report::encode_fit_report;
@@ -134,6 +134,8 @@ pub struct FitWritten {
     /// Each material's report figure (PNG; an SVG lies beside it).
     pub reports: Vec<PathBuf>,
     pub index: PathBuf,
+    /// Files of the library folder the index skipped (not materials), one warning each.
+    pub warnings: Vec<String>,
 }
 
 /// Fits `inputs` (read as `reading` says) and writes `<fits_dir>/<material>.toml`, `<reports_dir>/<material>.png|svg` and
@@ -162,7 +164,7 @@ pub fn fit_and_write(
         report_files.extend(report.files);
     }
     let index = reports_dir.join("index.html");
-    let html = index_html(&outcomes, fits_dir, reports_dir)?;
+    let (html, warnings) = index_html(&outcomes, fits_dir, reports_dir)?;
 
     let mut set = OutputSet::new();
     let stage = |set: &mut OutputSet, path: &Path, bytes: &[u8]| {
@@ -187,6 +189,7 @@ pub fn fit_and_write(
         entries: entries.into_iter().map(|(path, _)| path).collect(),
         reports,
         index,
+        warnings,
     })
 }
 
@@ -195,31 +198,31 @@ fn entry_path(fits_dir: &Path, material: &Material) -> PathBuf {
 }
 
 /// The index of the library as it will be once the new entries are in: the entries on disk,
-/// with the fitted ones added or replaced.
+/// with the fitted ones added or replaced; and a warning for each other file of the folder that
+/// is not a material (skipped: an unrelated file must not stop the fit).
 fn index_html(
     outcomes: &[MaterialFit],
     fits_dir: &Path,
     reports_dir: &Path,
-) -> Result<String, ReportError> {
-    let mut materials = if fits_dir.is_dir() {
+) -> Result<(String, Vec<String>), ReportError> {
+    let mut library = if fits_dir.is_dir() {
         list_library(fits_dir)?
     } else {
-        Vec::new()
+        Library::default()
     };
     for outcome in outcomes {
         let path = entry_path(fits_dir, outcome.material());
-        materials.retain(|(existing, _)| *existing != path);
-        materials.push((path, outcome.material().clone()));
+        library.materials.retain(|(existing, _)| *existing != path);
+        library.skipped.retain(|(existing, _)| *existing != path);
+        library.materials.push((path, outcome.material().clone()));
     }
+    let warnings = library.warnings();
+    let mut materials = library.materials;
     materials.sort_by(|a, b| a.0.cmp(&b.0));
     let fitted: Vec<&str> = outcomes
         .iter()
         .map(|o| o.material().name.as_str())
         .collect();
-    Ok(library_index_html(
-        fits_dir,
-        reports_dir,
-        &materials,
-        &fitted,
-    ))
+    let html = library_index_html(fits_dir, reports_dir, &materials, &fitted);
+    Ok((html, warnings))
 }

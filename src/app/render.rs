@@ -3,8 +3,8 @@
 
 use super::error::single_line;
 use super::AppError;
-use crate::atomic::write_atomically;
-use crate::output::{write_outputs, RenderSummary};
+use crate::atomic::{StagedDir, StagedFolder};
+use crate::output::{stage_outputs, write_outputs, EarlierOutputs, RenderSummary, SERIES_MANIFEST};
 use crate::progress::Progress;
 use crate::render::render;
 use crate::scene::{load_scene, load_scene_text, Scene};
@@ -109,7 +109,7 @@ pub fn render_scene_at(
 
 /// Renders a thermal scene at each of `times` (recorded in `solution`). One instant renders into
 /// `out_dir` itself; several into numbered folders inside it, plus `preview.gif` animating S0
-/// beside DoLP.
+/// beside DoLP and the manifest `series.json` ([`render_series`]).
 pub fn render_solution_at(
     scene: &Scene,
     solution: &ThermalSolution,
@@ -117,27 +117,98 @@ pub fn render_solution_at(
     out_dir: &Path,
     progress: &dyn Progress,
 ) -> Result<Vec<TimedRender>, AppError> {
-    let series = times.len() > 1;
+    if times.len() > 1 {
+        return render_series(scene, solution, times, out_dir, progress);
+    }
     let mut renders = Vec::with_capacity(times.len());
-    for (i, &time_s) in times.iter().enumerate() {
+    for &time_s in times {
         let start = Instant::now();
         let at = solution_instant(scene, solution, time_s)?;
-        let folder = instant_folder(out_dir, i, time_s, series);
-        let summary = render_loaded(&at, &folder, progress, start)?;
+        let summary = render_loaded(&at, out_dir, progress, start)?;
         renders.push(TimedRender {
             time_s,
-            folder,
+            folder: out_dir.to_owned(),
             summary,
         });
     }
-    if series {
-        let gif = animated_preview(&renders)?;
-        write_atomically(&out_dir.join("preview.gif"), &gif).map_err(|source| AppError::Write {
-            path: out_dir.to_owned(),
-            source,
-        })?;
-    }
     Ok(renders)
+}
+
+/// A series is one output set: every frame folder, the preview and the manifest are staged
+/// together and replace the folder's earlier outputs (a single render's or another series', frame
+/// folders included) in one step, so an interrupted or failed series leaves the old set whole
+/// and a shorter series leaves no frames of a longer one behind.
+fn render_series(
+    scene: &Scene,
+    solution: &ThermalSolution,
+    times: &[f64],
+    out_dir: &Path,
+    progress: &dyn Progress,
+) -> Result<Vec<TimedRender>, AppError> {
+    let write_error = |source| AppError::Write {
+        path: out_dir.to_owned(),
+        source,
+    };
+    let staged = StagedFolder::begin(out_dir).map_err(write_error)?;
+    let mut renders = Vec::with_capacity(times.len());
+    let mut frames = Vec::with_capacity(times.len());
+    for (i, &time_s) in times.iter().enumerate() {
+        let start = Instant::now();
+        let at = solution_instant(scene, solution, time_s)?;
+        let load = start.elapsed().as_secs_f64();
+        let mut rendered = render(&at, progress)?;
+        rendered.timings.load = load;
+        let name = frame_name(i, time_s);
+        let folder = out_dir.join(&name);
+        let dir = staged.subfolder(&name).map_err(write_error)?;
+        let summary = stage_outputs(&at, &rendered, &dir, &folder, start)?;
+        let render = TimedRender {
+            time_s,
+            folder,
+            summary,
+        };
+        frames.push(preview_frame(&render, &dir)?);
+        renders.push(render);
+    }
+    let gif = animated_preview(frames)?;
+    staged.write("preview.gif", &gif).map_err(write_error)?;
+    let manifest = serde_json::to_vec_pretty(&series_manifest(scene, &renders))
+        .map_err(|e| write_error(std::io::Error::other(e)))?;
+    staged
+        .write(SERIES_MANIFEST, &manifest)
+        .map_err(write_error)?;
+    let earlier = EarlierOutputs::of(out_dir);
+    staged
+        .commit(&|name| earlier.contains(name))
+        .map_err(write_error)?;
+    Ok(renders)
+}
+
+/// `series.json`: the scene, each frame's instant and folder, and every entry the series wrote
+/// (what the next render into the folder replaces).
+fn series_manifest(scene: &Scene, renders: &[TimedRender]) -> serde_json::Value {
+    let folder_name = |r: &TimedRender| {
+        r.folder
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned())
+    };
+    let frames: Vec<serde_json::Value> = renders
+        .iter()
+        .map(|r| {
+            serde_json::json!({
+                "time_s": r.time_s,
+                "time_utc": r.summary.thermal_instant.as_ref().map(|i| &i.time_utc),
+                "folder": folder_name(r),
+            })
+        })
+        .collect();
+    let mut files: Vec<String> = renders.iter().map(folder_name).collect();
+    files.extend(["preview.gif".to_owned(), SERIES_MANIFEST.to_owned()]);
+    serde_json::json!({
+        "scene": scene.path.display().to_string(),
+        "frames": frames,
+        "files": files,
+    })
 }
 
 /// The thermal scene with the temperatures of `solution` at `time_s` (an instant of the run).
@@ -179,48 +250,50 @@ pub fn scene_to_render(
     }
 }
 
-/// Where instant `i` at `time_s` is written: `out_dir` itself, or `out_dir/NNN_<t>s/` in a series.
-pub fn instant_folder(out_dir: &Path, i: usize, time_s: f64, series: bool) -> PathBuf {
-    if series {
-        out_dir.join(format!("{i:03}_{}s", time_s.round()))
-    } else {
-        out_dir.to_owned()
-    }
+/// The folder of instant `i` at `time_s` in a series, `NNN_<t>s`.
+fn frame_name(i: usize, time_s: f64) -> String {
+    format!("{i:03}_{}s", time_s.round())
 }
 
-/// One second per frame: the instant above S0.png beside DoLP.png of each rendered instant.
-fn animated_preview(renders: &[TimedRender]) -> Result<Vec<u8>, AppError> {
-    let mut frames = Vec::with_capacity(renders.len());
-    for r in renders {
-        let panel = |name: &str| -> Result<RgbaImage, AppError> {
-            let path = r.folder.join(name);
-            Ok(image::open(&path)
-                .map_err(|source| AppError::ReadImage { path, source })?
-                .to_rgba8())
-        };
-        let (s0, dolp) = (panel("S0.png")?, panel("DoLP.png")?);
-        let label = match &r.summary.thermal_instant {
-            Some(i) => format!("{}   (t = {} s)", i.time_utc, i.time_s),
-            None => format!("t = {} s", r.time_s),
-        };
-        let width = s0.width() + dolp.width();
-        let header = caption_strip(&label, width)?;
-        let top = i64::from(header.height());
-        let mut frame = RgbaImage::from_pixel(
-            width,
-            header.height() + s0.height().max(dolp.height()),
-            image::Rgba([255, 255, 255, 255]),
-        );
-        image::imageops::overlay(&mut frame, &header, 0, 0);
-        image::imageops::overlay(&mut frame, &s0, 0, top);
-        image::imageops::overlay(&mut frame, &dolp, i64::from(s0.width()), top);
-        frames.push(Frame::from_parts(
-            frame,
-            0,
-            0,
-            Delay::from_numer_denom_ms(1000, 1),
-        ));
-    }
+/// One frame of the preview, one second long: the instant above S0.png beside DoLP.png of a
+/// rendered instant, read back from its staged folder `dir`.
+fn preview_frame(r: &TimedRender, dir: &StagedDir) -> Result<Frame, AppError> {
+    let panel = |name: &str| -> Result<RgbaImage, AppError> {
+        let path = r.folder.join(name);
+        let bytes = dir.read(name).map_err(|source| AppError::Read {
+            path: path.clone(),
+            source,
+        })?;
+        Ok(image::load_from_memory(&bytes)
+            .map_err(|source| AppError::ReadImage { path, source })?
+            .to_rgba8())
+    };
+    let (s0, dolp) = (panel("S0.png")?, panel("DoLP.png")?);
+    let label = match &r.summary.thermal_instant {
+        Some(i) => format!("{}   (t = {} s)", i.time_utc, i.time_s),
+        None => format!("t = {} s", r.time_s),
+    };
+    let width = s0.width() + dolp.width();
+    let header = caption_strip(&label, width)?;
+    let top = i64::from(header.height());
+    let mut frame = RgbaImage::from_pixel(
+        width,
+        header.height() + s0.height().max(dolp.height()),
+        image::Rgba([255, 255, 255, 255]),
+    );
+    image::imageops::overlay(&mut frame, &header, 0, 0);
+    image::imageops::overlay(&mut frame, &s0, 0, top);
+    image::imageops::overlay(&mut frame, &dolp, i64::from(s0.width()), top);
+    Ok(Frame::from_parts(
+        frame,
+        0,
+        0,
+        Delay::from_numer_denom_ms(1000, 1),
+    ))
+}
+
+/// The animated GIF of `frames`, looping.
+fn animated_preview(frames: Vec<Frame>) -> Result<Vec<u8>, AppError> {
     let mut bytes = Vec::new();
     {
         let mut encoder = GifEncoder::new_with_speed(&mut bytes, 10);

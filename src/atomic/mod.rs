@@ -18,7 +18,7 @@ mod file_set;
 mod staged_folder;
 
 pub use file_set::OutputSet;
-pub use staged_folder::{staging_folder, StagedFolder};
+pub use staged_folder::{staging_folder, StagedDir, StagedFolder};
 
 use crate::interrupt::process_is_alive;
 use std::io::{self, Write};

@@ -55,8 +55,27 @@ impl StagedFolder {
 
     /// Writes one file of the set.
     pub fn write(&self, name: &str, bytes: &[u8]) -> io::Result<()> {
+        self.root().write(name, bytes)
+    }
+
+    /// The set's top folder, to write files into.
+    pub fn root(&self) -> StagedDir<'_> {
+        StagedDir {
+            dir: self.staging.clone(),
+            _set: std::marker::PhantomData,
+        }
+    }
+
+    /// A new folder `name` inside the set (a frame of a series), to write files into: it is
+    /// swapped into place with the rest of the set.
+    pub fn subfolder(&self, name: &str) -> io::Result<StagedDir<'_>> {
         let _guard = WriteGuard::start()?;
-        fs::write(self.staging.join(name), bytes)
+        let dir = self.staging.join(name);
+        fs::create_dir(&dir)?;
+        Ok(StagedDir {
+            dir,
+            _set: std::marker::PhantomData,
+        })
     }
 
     /// Puts the set in place of the target in one step and removes the old set. `earlier_output`
@@ -104,6 +123,26 @@ impl StagedFolder {
             }
         }
         Ok(())
+    }
+}
+
+/// A folder of a [`StagedFolder`] being written (its top or a subfolder); it lives no longer than
+/// the set, whose drop removes it.
+pub struct StagedDir<'a> {
+    dir: PathBuf,
+    _set: std::marker::PhantomData<&'a StagedFolder>,
+}
+
+impl StagedDir<'_> {
+    /// Writes one file into this folder.
+    pub fn write(&self, name: &str, bytes: &[u8]) -> io::Result<()> {
+        let _guard = WriteGuard::start()?;
+        fs::write(self.dir.join(name), bytes)
+    }
+
+    /// Reads back a file written into this folder (before the set is committed).
+    pub fn read(&self, name: &str) -> io::Result<Vec<u8>> {
+        fs::read(self.dir.join(name))
     }
 }
 

@@ -401,8 +401,37 @@ pub fn find_material(dir: &Path, name: &str) -> Result<PathBuf, MaterialError> {
     }
 }
 
-/// Every material in a library folder, sorted by file name.
-pub fn list_library(dir: &Path) -> Result<Vec<(PathBuf, Material)>, MaterialError> {
+/// A library folder as read: its materials, and the `.toml` files that are not one.
+#[derive(Debug, Default)]
+pub struct Library {
+    /// Every material, sorted by file name.
+    pub materials: Vec<(PathBuf, Material)>,
+    /// Each `.toml` file that does not load as a material (a user's notes, a broken entry), with
+    /// why: skipped, so one stray file does not stop a fit or a listing of the others.
+    pub skipped: Vec<(PathBuf, MaterialError)>,
+}
+
+impl Library {
+    /// One warning per skipped file.
+    pub fn warnings(&self) -> Vec<String> {
+        self.skipped
+            .iter()
+            .map(|(_, error)| {
+                let mut text = error.to_string();
+                let mut source = std::error::Error::source(error);
+                while let Some(cause) = source {
+                    text = format!("{text}: {cause}");
+                    source = cause.source();
+                }
+                format!("{text}; skipped, the library holds only material files")
+            })
+            .collect()
+    }
+}
+
+/// Every material in a library folder, sorted by file name; `.toml` files that do not load are
+/// skipped and reported in [`Library::skipped`]. Only an unreadable folder is an error.
+pub fn list_library(dir: &Path) -> Result<Library, MaterialError> {
     let entries = std::fs::read_dir(dir).map_err(|source| MaterialError::Read {
         path: dir.to_owned(),
         source,
@@ -412,10 +441,14 @@ pub fn list_library(dir: &Path) -> Result<Vec<(PathBuf, Material)>, MaterialErro
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .collect();
     paths.sort();
-    paths
-        .into_iter()
-        .map(|p| Material::load(&p).map(|m| (p, m)))
-        .collect()
+    let mut library = Library::default();
+    for path in paths {
+        match Material::load(&path) {
+            Ok(material) => library.materials.push((path, material)),
+            Err(error) => library.skipped.push((path, error)),
+        }
+    }
+    Ok(library)
 }
 
 #[cfg(test)]
@@ -476,7 +509,7 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("'nope'"));
-        assert_eq!(list_library(dir.path()).unwrap().len(), 1);
+        assert_eq!(list_library(dir.path()).unwrap().materials.len(), 1);
     }
 
     /// A written material explains each field in `#` comments, and the
@@ -532,7 +565,9 @@ mod tests {
     #[test]
     fn shipped_fits_are_written_back_byte_for_byte() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fits");
-        for (path, material) in list_library(&dir).unwrap() {
+        let library = list_library(&dir).unwrap();
+        assert!(library.skipped.is_empty(), "{:?}", library.warnings());
+        for (path, material) in library.materials {
             let text = std::fs::read_to_string(&path).unwrap();
             assert_eq!(material.to_toml(&path).unwrap(), text, "{}", path.display());
         }

@@ -129,9 +129,22 @@ pub(crate) fn wavelength_in_range(um: f64) -> bool {
     (MIN_WAVELENGTH_UM..=MAX_WAVELENGTH_UM).contains(&um)
 }
 
+/// Longest material name, in bytes (UTF-8), that a header may give. The name becomes the files
+/// `<material>.toml`, `.png`, `.svg` and their temporaries `.<material>.toml.<pid>.tmp`, which must
+/// stay within the 255-byte file names of common filesystems.
+pub const MAX_MATERIAL_NAME_BYTES: usize = 200;
+
 /// Why a material name cannot become `fits/<material>.toml` (docs/design.md §2.2), if it cannot: a
-/// name from a file header must not reach outside the output folder.
+/// name from a file header must not reach outside the output folder, nor be longer than a file
+/// name may be.
 fn unusable_file_name(name: &str) -> Option<String> {
+    if name.len() > MAX_MATERIAL_NAME_BYTES {
+        return Some(format!(
+            "it is {} bytes long; at most {MAX_MATERIAL_NAME_BYTES}, as it names the files \
+             <material>.toml, .png and .svg",
+            name.len()
+        ));
+    }
     if let Some(c) = name
         .chars()
         .find(|&c| matches!(c, '/' | '\\') || c.is_control())

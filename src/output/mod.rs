@@ -10,7 +10,7 @@ pub mod ground_truth;
 pub mod thermal;
 pub mod thermal_plot;
 
-use crate::atomic::StagedFolder;
+use crate::atomic::{StagedDir, StagedFolder};
 use crate::optics::TemperatureLookup;
 use crate::render::film::{dolp_aop, polarizer, StokesImage, BACKGROUND};
 use crate::render::TableResolution;
@@ -251,6 +251,28 @@ pub fn write_outputs(
     out_dir: &Path,
     started: Instant,
 ) -> Result<RenderSummary, RenderError> {
+    let write_error = |source| RenderError::Write {
+        path: out_dir.to_owned(),
+        source,
+    };
+    let staged = StagedFolder::begin(out_dir).map_err(write_error)?;
+    let summary = stage_outputs(scene, rendered, &staged.root(), out_dir, started)?;
+    let earlier = EarlierOutputs::of(out_dir);
+    staged
+        .commit(&|name| earlier.contains(name))
+        .map_err(write_error)?;
+    Ok(summary)
+}
+
+/// Writes every output of `rendered` into `staged`, a folder of an output set that becomes
+/// `out_dir` when the set is committed, and returns the summary.
+pub fn stage_outputs(
+    scene: &Scene,
+    rendered: &Rendered,
+    staged: &StagedDir,
+    out_dir: &Path,
+    started: Instant,
+) -> Result<RenderSummary, RenderError> {
     let write_start = Instant::now();
     let image = &rendered.image;
     let channels: Vec<(Channel, Vec<f32>)> = Channel::ALL
@@ -258,15 +280,10 @@ pub fn write_outputs(
         .map(|&c| (c, image.channel(c)))
         .collect();
     let camera = camera_summary(scene);
-    let write_error = |source| RenderError::Write {
-        path: out_dir.to_owned(),
-        source,
-    };
     // Each file goes into the staging folder as soon as it is encoded (the folder is swapped in
     // as a whole at the end), so no more than a file per thread is held in memory.
-    let staged = StagedFolder::begin(out_dir).map_err(write_error)?;
     let images = ImageFiles::new(scene, image, &channels, &camera);
-    let mut files = images.stage(&staged, out_dir)?;
+    let mut files = images.stage(staged, out_dir)?;
     files.push("summary.json".into());
     let mut timings = rendered.timings;
     let mut summary = summarize(scene, rendered, out_dir, &channels, camera, files);
@@ -283,10 +300,6 @@ pub fn write_outputs(
             path: out_dir.join("summary.json"),
             source,
         })?;
-    let earlier = earlier_outputs(out_dir);
-    staged
-        .commit(&|name| earlier.iter().any(|f| f == name))
-        .map_err(write_error)?;
     Ok(summary)
 }
 
@@ -345,7 +358,7 @@ impl<'a> ImageFiles<'a> {
 
     /// Encodes every file in memory, in parallel, each written into `staged` as soon as it is
     /// encoded; the names written, in job order.
-    fn stage(&self, staged: &StagedFolder, out_dir: &Path) -> Result<Vec<String>, RenderError> {
+    fn stage(&self, staged: &StagedDir, out_dir: &Path) -> Result<Vec<String>, RenderError> {
         self.jobs()
             .par_iter()
             .map(|job| {
@@ -504,10 +517,48 @@ fn material_summaries(scene: &Scene, rendered: &Rendered) -> Vec<MaterialSummary
         .collect()
 }
 
-/// The files an earlier render listed in `out_dir/summary.json` (they are replaced as a set;
-/// anything else in the folder is the user's and is kept).
-fn earlier_outputs(out_dir: &Path) -> Vec<String> {
-    let Ok(text) = std::fs::read(out_dir.join("summary.json")) else {
+/// The manifest of a render series (`render --times`): its frames and every entry it wrote.
+pub const SERIES_MANIFEST: &str = "series.json";
+
+/// The entries of an output folder that an earlier render or render series wrote: those listed
+/// in its `summary.json` or [`SERIES_MANIFEST`], and frame folders of a series (`NNN_<t>s/` with
+/// a `summary.json`). They are replaced as a set; anything else in the folder is the user's and
+/// is kept.
+pub struct EarlierOutputs {
+    dir: std::path::PathBuf,
+    listed: Vec<String>,
+}
+
+impl EarlierOutputs {
+    pub fn of(out_dir: &Path) -> EarlierOutputs {
+        let mut listed = listed_files(&out_dir.join("summary.json"));
+        listed.extend(listed_files(&out_dir.join(SERIES_MANIFEST)));
+        EarlierOutputs {
+            dir: out_dir.to_owned(),
+            listed,
+        }
+    }
+
+    pub fn contains(&self, name: &str) -> bool {
+        self.listed.iter().any(|f| f == name)
+            || (is_frame_folder_name(name) && self.dir.join(name).join("summary.json").is_file())
+    }
+}
+
+/// Whether `name` is how a series names a frame's folder, `NNN_<t>s` (a series written before
+/// series had a manifest is still recognised).
+fn is_frame_folder_name(name: &str) -> bool {
+    let Some((index, time)) = name.split_once('_') else {
+        return false;
+    };
+    let digits = |t: &str| !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit());
+    let time = time.strip_suffix('s').unwrap_or("");
+    index.len() >= 3 && digits(index) && digits(time.strip_prefix('-').unwrap_or(time))
+}
+
+/// The `files` a summary or manifest at `path` lists (none if it is missing or unreadable).
+fn listed_files(path: &Path) -> Vec<String> {
+    let Ok(text) = std::fs::read(path) else {
         return Vec::new();
     };
     let summary: serde_json::Value = serde_json::from_slice(&text).unwrap_or_default();

@@ -14,20 +14,34 @@ use crate::pbrdf::Parameter;
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
 
-/// Writes `<reports_dir>/index.html` for the library in `library_dir`; returns its path.
-pub fn write_library_index(library_dir: &Path, reports_dir: &Path) -> Result<PathBuf, ReportError> {
-    let materials = list_library(library_dir)?;
+/// The index written, and a warning for each file of the library folder it skipped.
+pub struct WrittenIndex {
+    pub path: PathBuf,
+    pub warnings: Vec<String>,
+}
+
+/// Writes `<reports_dir>/index.html` for the library in `library_dir` (skipping files that are
+/// not materials, with a warning each).
+pub fn write_library_index(
+    library_dir: &Path,
+    reports_dir: &Path,
+) -> Result<WrittenIndex, ReportError> {
+    let library = list_library(library_dir)?;
+    let materials = library.materials.as_slice();
     let index = reports_dir.join("index.html");
     std::fs::create_dir_all(reports_dir).map_err(|source| ReportError::Write {
         path: reports_dir.to_owned(),
         source,
     })?;
-    let html = library_index_html(library_dir, reports_dir, &materials, &[]);
+    let html = library_index_html(library_dir, reports_dir, materials, &[]);
     write_atomically(&index, html.as_bytes()).map_err(|source| ReportError::Write {
         path: index.clone(),
         source,
     })?;
-    Ok(index)
+    Ok(WrittenIndex {
+        path: index,
+        warnings: library.warnings(),
+    })
 }
 
 /// Text made safe for HTML element content and attribute values.

@@ -149,6 +149,7 @@ fn read_checked(bytes: &[u8]) -> Result<Payload<DefaultElement>, MeshError> {
             shown_at_most(&e.to_string(), PARSER_MESSAGE_CHARS)
         ))
     };
+    check_unique_declarations(bytes)?;
     let parser = Parser::<DefaultElement>::new();
     let mut reader = Reader::new(bytes);
     let header = parser
@@ -159,6 +160,52 @@ fn read_checked(bytes: &[u8]) -> Result<Payload<DefaultElement>, MeshError> {
     parser
         .read_payload(&mut reader, &header)
         .map_err(|e| unreadable(&e))
+}
+
+/// Refuses an element declared twice, or a property declared twice in one element. The parser
+/// keys both by name, so a second declaration would silently replace the first while the payload
+/// still holds values for both: the items would be read misaligned.
+fn check_unique_declarations(bytes: &[u8]) -> Result<(), MeshError> {
+    let mut elements: Vec<(&[u8], usize)> = Vec::new();
+    let mut properties: Vec<(&[u8], usize)> = Vec::new();
+    for (index, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let words: Vec<&[u8]> = line
+            .split(u8::is_ascii_whitespace)
+            .filter(|w| !w.is_empty())
+            .collect();
+        let (first, name) = match words.as_slice() {
+            [b"end_header", ..] => break,
+            [b"element", name, ..] => (None, *name),
+            [b"property", b"list", _, _, name, ..] | [b"property", _, name, ..] => {
+                (elements.last().map(|e| e.0), *name)
+            }
+            _ => continue,
+        };
+        let line = index + 1;
+        let (seen, what) = match first {
+            None => {
+                properties.clear();
+                (&mut elements, "element".to_owned())
+            }
+            Some(element) => (
+                &mut properties,
+                format!(
+                    "element '{}': property",
+                    shown(&String::from_utf8_lossy(element))
+                ),
+            ),
+        };
+        if let Some((_, earlier)) = seen.iter().find(|(n, _)| *n == name) {
+            return Err(format!(
+                "header line {line}: {what} '{}' is declared twice (first on line {earlier}); \
+                 remove one declaration",
+                shown(&String::from_utf8_lossy(name))
+            )
+            .into());
+        }
+        seen.push((name, line));
+    }
+    Ok(())
 }
 
 /// Refuses versions other than 1.0 (the only PLY standard) and element counts that the payload's
