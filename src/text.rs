@@ -41,6 +41,16 @@ pub fn number(x: f64) -> String {
     }
 }
 
+/// A large or computed number as a message shows it: [`number`] of it rounded to three
+/// significant digits ("7.2e12 steps", not "7.200000000001e12").
+pub fn about(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return number(x);
+    }
+    let rounded: f64 = format!("{x:.2e}").parse().unwrap_or(x);
+    number(rounded)
+}
+
 /// `value` to `digits` significant digits in plain notation (0.0000061 stays readable as such).
 pub fn significant(value: f64, digits: i32) -> String {
     if value == 0.0 || !value.is_finite() {
@@ -83,5 +93,8 @@ mod tests {
         assert_eq!(number(-0.1), "-0.1");
         assert_eq!(number(f64::NAN), "NaN");
         assert_eq!(number(2.0), "2");
+        assert_eq!(about(7.200000000001e12), "7.2e12");
+        assert_eq!(about(123456.7), "123000");
+        assert_eq!(about(-0.000123456), "-0.000123");
     }
 }

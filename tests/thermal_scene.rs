@@ -377,8 +377,16 @@ fn bad_thermal_input_is_refused_by_name_and_writes_nothing() {
             "",
             "layer 'stel' is not defined in [thermal.layers] (defined: asphalt, paint, steel)",
         ),
-        ("[[\"paint\", -0.0001]]", "", "thickness must be positive"),
-        ("[[\"asphalt\", 0.1]]", "", "conductivity must be positive"),
+        (
+            "[[\"paint\", -0.0001]]",
+            "",
+            "layer 1 ('paint'): thickness = -0.0001 m is outside 1e-6…100 m",
+        ),
+        (
+            "[[\"asphalt\", 0.1]]",
+            "",
+            "layer 1 ('asphalt'): conductivity = -0.75 W/m/K is outside 0.001…10000 W/m/K",
+        ),
         (
             "[[\"paint\"]]",
             "",

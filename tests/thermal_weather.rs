@@ -135,7 +135,7 @@ fn bad_files_are_refused_with_file_line_and_column() {
         ),
         (
             format!("{header}0,290,1\n600,291,-0.5\n"),
-            "FILE:3:9: column 'wind_speed_m_s': -0.5 is negative; a wind speed is ≥ 0 m/s",
+            "FILE:3:9: column 'wind_speed_m_s': -0.5 m/s is outside 0…150 m/s",
         ),
         (
             format!("{header}0,NaN,1\n600,291,1\n"),
@@ -155,7 +155,7 @@ fn bad_files_are_refused_with_file_line_and_column() {
         ),
         (
             "time_s,air_temperature_k,direct_normal_w_m2\n0,290,-1\n600,291,0\n".to_string(),
-            "FILE:2:7: column 'direct_normal_w_m2': -1 is negative; an irradiance is ≥ 0 W/m²",
+            "FILE:2:7: column 'direct_normal_w_m2': -1 W/m² is outside 0…100000 W/m² (an irradiance)",
         ),
         (
             "time_s,air_temperature_k,sun_elevation_deg,sun_azimuth_deg\n0,290,91,0\n".to_string(),
@@ -244,7 +244,7 @@ fn a_missing_file_and_a_bad_site_are_one_line() {
                 wind_m_s: f64::NAN,
                 ..day
             },
-            "wind_m_s = NaN must be finite",
+            "wind_m_s = NaN is outside 0…150 m/s",
         ),
     ] {
         let error = Weather::clear_day(&bad, &munich("2026-06-21T00:00:00Z"), 3600.0);

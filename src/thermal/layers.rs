@@ -20,38 +20,124 @@
 //! that is where the forcing changes fastest (the penetration depth √(αΔt) of a one-minute change
 //! is ~2 mm in paint); deep cells can be coarse because the diurnal signal there is smooth.
 
+use crate::optics::MAX_TEMPERATURE_K;
+use crate::text::number;
 use std::fmt;
 
-/// Errors of the thermal model: every message names the item and value at fault.
+/// Errors of the thermal model: every message names the item and value at fault, once (the
+/// caller adds which part and when, not the same words again).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ThermalError {
     /// A layer stack has no layers.
-    #[error("thermal layer stack is empty: give at least one layer")]
+    #[error("the layer stack is empty: give at least one layer")]
     EmptyStack,
-    /// A layer's material or thickness is not a positive finite number.
-    #[error("thermal layer {index} ('{name}'): {quantity} must be positive and finite, got {value} {unit}")]
+    /// A layer's material or thickness is outside [`LAYER_LIMITS`].
+    #[error(
+        "layer {index} ('{name}'): {quantity} = {} {unit} is outside {}…{} {unit} ({why})",
+        number(*value), number(LAYER_LIMITS[*limit].min), number(LAYER_LIMITS[*limit].max),
+        quantity = LAYER_LIMITS[*limit].quantity, unit = LAYER_LIMITS[*limit].unit,
+        why = LAYER_LIMITS[*limit].spans
+    )]
     InvalidLayer {
         /// 1-based position of the layer from the front.
         index: usize,
         /// Name of the layer's material.
         name: String,
-        /// Which quantity is wrong.
-        quantity: &'static str,
         /// The value given.
         value: f64,
-        /// Its unit.
-        unit: &'static str,
+        /// Which of [`LAYER_LIMITS`] it breaks.
+        limit: usize,
     },
+    /// The stack's grid would have more nodes than [`MAX_GRID_NODES`].
+    #[error(
+        "the layer stack needs more than {MAX_GRID_NODES} grid nodes under this resolution: use \
+         fewer or thicker layers"
+    )]
+    TooManyNodes,
     /// A grid resolution parameter is out of range.
-    #[error("thermal grid: {0}")]
+    #[error("grid resolution: {0}")]
     InvalidResolution(String),
     /// A forcing, boundary or control value is out of range.
-    #[error("thermal solver: {0}")]
+    #[error("{0}")]
     InvalidInput(String),
-    /// The implicit step produced no physical surface temperature.
-    #[error("thermal solver: {0}")]
-    NoSolution(String),
+    /// No positive surface temperature balances the step: more heat leaves than the layers hold.
+    #[error(
+        "no positive surface temperature balances the heat flows (more heat is drawn out than \
+         the layers hold): check internal_heat_w_m2 and the back boundary"
+    )]
+    NoSurfaceTemperature,
+    /// The scalar surface balance did not converge.
+    #[error("the surface balance did not converge in {iterations} Newton iterations (last {} K)", number(*last_k))]
+    NewtonDiverged { iterations: usize, last_k: f64 },
+    /// The adaptive sub-steps did not meet their tolerance within the cap of sub-steps.
+    #[error(
+        "the time step of {} s did not converge in {substeps} sub-steps (surface at {} K): the \
+         layers or the forcing are too extreme for the solver (see the thermal limits in \
+         docs/thermal.md)",
+        number(*step_s), number(*surface_k)
+    )]
+    NotConverged {
+        step_s: f64,
+        substeps: usize,
+        surface_k: f64,
+    },
+    /// A node temperature left (0, MAX_TEMPERATURE_K]: the forcing is beyond what the model holds.
+    #[error(
+        "a temperature reached {} K, outside (0, {MAX_TEMPERATURE_K}] K: the forcing (irradiance, \
+         internal heat, convection) is beyond what the model represents",
+        number(*temperature_k)
+    )]
+    Runaway { temperature_k: f64 },
 }
+
+/// The accepted range of one layer quantity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LayerLimit {
+    pub quantity: &'static str,
+    pub unit: &'static str,
+    pub min: f64,
+    pub max: f64,
+    /// What the range spans, for the message.
+    pub spans: &'static str,
+}
+
+/// The accepted range of thickness, conductivity, density and heat capacity, in that order.
+/// Beyond them the model is not a model of anything (a 5e-324 m layer, a 1e12 W/m/K conductor),
+/// the grid stops being small and the implicit steps lose every digit to round-off.
+pub const LAYER_LIMITS: [LayerLimit; 4] = [
+    LayerLimit {
+        quantity: "thickness",
+        unit: "m",
+        min: 1e-6,
+        max: 100.0,
+        spans: "a micrometre film to 100 m of ground",
+    },
+    LayerLimit {
+        quantity: "conductivity",
+        unit: "W/m/K",
+        min: 1e-3,
+        max: 1e4,
+        spans: "below aerogel to above diamond",
+    },
+    LayerLimit {
+        quantity: "density",
+        unit: "kg/m^3",
+        min: 0.1,
+        max: 1e5,
+        spans: "thin gas to above osmium",
+    },
+    LayerLimit {
+        quantity: "heat capacity",
+        unit: "J/kg/K",
+        min: 10.0,
+        max: 1e5,
+        spans: "below lead to above hydrogen",
+    },
+];
+
+/// Most nodes of one stack's grid: the default resolution gives a thin panel ~30 nodes and 100 m
+/// of ground ~130; each node costs a few doubles per distinct solve.
+pub const MAX_GRID_NODES: usize = 10_000;
 
 /// Thermal properties of one layer material.
 #[derive(Debug, Clone, PartialEq)]
@@ -119,27 +205,26 @@ pub struct LayerStack {
 }
 
 impl LayerStack {
-    /// Validates every layer: k, ρ, c and d must be positive and finite.
+    /// Validates every layer: d, k, ρ and c finite and within [`LAYER_LIMITS`].
     pub fn new(layers: Vec<Layer>) -> Result<Self, ThermalError> {
         if layers.is_empty() {
             return Err(ThermalError::EmptyStack);
         }
         for (i, layer) in layers.iter().enumerate() {
             let m = &layer.material;
-            let checks = [
-                ("thickness", layer.thickness_m, "m"),
-                ("conductivity", m.conductivity_w_mk, "W/m/K"),
-                ("density", m.density_kg_m3, "kg/m^3"),
-                ("heat capacity", m.heat_capacity_j_kgk, "J/kg/K"),
+            let values = [
+                layer.thickness_m,
+                m.conductivity_w_mk,
+                m.density_kg_m3,
+                m.heat_capacity_j_kgk,
             ];
-            for (quantity, value, unit) in checks {
-                if !(value.is_finite() && value > 0.0) {
+            for (limit, (value, range)) in values.into_iter().zip(LAYER_LIMITS).enumerate() {
+                if !(range.min..=range.max).contains(&value) {
                     return Err(ThermalError::InvalidLayer {
                         index: i + 1,
                         name: m.name.clone(),
-                        quantity,
                         value,
-                        unit,
+                        limit,
                     });
                 }
             }
@@ -179,7 +264,8 @@ impl LayerStack {
         let mut cells: Vec<(f64, usize)> = Vec::new(); // (width, layer index)
         let mut next = resolution.first_cell_m;
         for (li, layer) in self.layers.iter().enumerate() {
-            let widths = layer_cells(layer.thickness_m, next, resolution);
+            let budget = MAX_GRID_NODES - 1 - cells.len();
+            let widths = layer_cells(layer.thickness_m, next, resolution, budget)?;
             next = widths.last().copied().unwrap_or(next) * resolution.growth;
             cells.extend(widths.into_iter().map(|w| (w, li)));
         }
@@ -187,13 +273,22 @@ impl LayerStack {
     }
 }
 
-/// Cells of one layer: geometric from `start` (capped at d/min_cells), scaled to fill d exactly.
-fn layer_cells(d: f64, start: f64, res: &Resolution) -> Vec<f64> {
+/// Cells of one layer: geometric from `start` (capped at d/min_cells), scaled to fill d exactly;
+/// refused beyond `budget` cells, which a fine [`Resolution`] over many layers can reach.
+fn layer_cells(
+    d: f64,
+    start: f64,
+    res: &Resolution,
+    budget: usize,
+) -> Result<Vec<f64>, ThermalError> {
     let cap = d / res.min_cells as f64;
     let mut w = start.min(cap);
     let mut widths = Vec::new();
     let mut sum = 0.0;
     while sum < d * (1.0 - 1e-12) {
+        if widths.len() >= budget {
+            return Err(ThermalError::TooManyNodes);
+        }
         widths.push(w);
         sum += w;
         w = (w * res.growth).min(cap);
@@ -201,7 +296,7 @@ fn layer_cells(d: f64, start: f64, res: &Resolution) -> Vec<f64> {
     // Scaling down (sum ≥ d) keeps every cell within the rule.
     let scale = d / sum;
     widths.iter_mut().for_each(|w| *w *= scale);
-    widths
+    Ok(widths)
 }
 
 /// Grid spacing controls (see the module docs for the rule).
@@ -243,13 +338,13 @@ impl Resolution {
         if !(self.first_cell_m.is_finite() && self.first_cell_m > 0.0) {
             return Err(ThermalError::InvalidResolution(format!(
                 "first_cell_m must be positive and finite, got {}",
-                self.first_cell_m
+                number(self.first_cell_m)
             )));
         }
         if !(self.growth.is_finite() && self.growth > 1.0 && self.growth <= 2.0) {
             return Err(ThermalError::InvalidResolution(format!(
                 "growth must be in (1, 2], got {}",
-                self.growth
+                number(self.growth)
             )));
         }
         if !(1..=1000).contains(&self.min_cells) {
@@ -359,7 +454,7 @@ mod tests {
             "{text}"
         );
         assert!(
-            text.contains("conductivity") && text.contains("-0.04"),
+            text.contains("conductivity = -0.04 W/m/K is outside 0.001…10000 W/m/K"),
             "{text}"
         );
         let err = LayerStack::new(vec![Layer::new(steel(), f64::NAN)]).unwrap_err();

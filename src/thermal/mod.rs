@@ -17,7 +17,10 @@ pub mod setup;
 pub mod solver;
 pub mod weather;
 
-pub use layers::{Grid, Layer, LayerMaterial, LayerStack, Resolution, ThermalError};
+pub use layers::{
+    Grid, Layer, LayerLimit, LayerMaterial, LayerStack, Resolution, ThermalError, LAYER_LIMITS,
+    MAX_GRID_NODES,
+};
 pub use solver::{
     Back, Forcing, FrontForcing, Solver, SolverControl, StepReport, ThermalState, STEFAN_BOLTZMANN,
 };

@@ -10,7 +10,7 @@ use super::config::{
 use super::{Back, Layer, LayerMaterial, LayerStack, Site, ThermalError, Weather, WeatherError};
 use crate::emitter::{parse_time_utc, SunError};
 use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
-use crate::text::number;
+use crate::text::{about, number};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -86,16 +86,16 @@ impl Schedule {
 pub enum ThermalSetupError {
     #[error("thermal.start_utc: {0}")]
     StartUtc(SunError),
-    #[error("thermal.latitude_deg = {0} must be within [-90°, 90°]")]
+    #[error("thermal.latitude_deg = {} must be within [-90°, 90°]", number(*.0))]
     Latitude(f64),
-    #[error("thermal.longitude_deg = {0} must be within [-180°, 360°]")]
+    #[error("thermal.longitude_deg = {} must be within [-180°, 360°]", number(*.0))]
     Longitude(f64),
-    #[error("thermal.duration_h = {0} must be positive")]
+    #[error("thermal.duration_h = {} must be positive", number(*.0))]
     Duration(f64),
     /// The weather file cannot be read, or the weather has no value at an instant.
     #[error("{0}")]
     Weather(WeatherError),
-    #[error("thermal.weather.clear_day: {0}")]
+    #[error("thermal.weather.clear_day: {}", .0.detail())]
     ClearDay(WeatherError),
     #[error(
         "thermal: the weather covers {}…{} s but the run needs 0…{} s (duration_h = {})",
@@ -111,13 +111,22 @@ pub enum ThermalSetupError {
         number(*last_s)
     )]
     SpinupSpan { spinup_days: u32, last_s: f64 },
-    #[error("thermal.{key} = {step} must be positive")]
+    #[error("thermal.{key} = {} must be positive", number(*step))]
     Step { key: &'static str, step: f64 },
     #[error(
-        "thermal: {} s in steps of {} s is more than {MAX_STEPS} steps; use longer steps",
-        number(*duration_s), number(*step_s)
+        "thermal.{key} = {} s makes {} steps over the run of {} s (at most {}): use a longer step \
+         or a shorter run",
+        number(*step_s), about(*steps), number(*duration_s), number(*limit as f64)
     )]
-    TooManySteps { duration_s: f64, step_s: f64 },
+    TooManySteps {
+        key: &'static str,
+        step_s: f64,
+        duration_s: f64,
+        steps: f64,
+        limit: usize,
+    },
+    #[error("thermal.spinup_days = {0} is more than {MAX_SPINUP_DAYS} days: a periodic start needs a few")]
+    Spinup(u32),
     #[error(
         "thermal.ground_temperature_k = {} must be within (0, {MAX_TEMPERATURE_K}] K",
         number(*ground_k)
@@ -148,21 +157,26 @@ pub enum PartThermalError {
     UnknownLayer { name: String, defined: Vec<String> },
     #[error("stack: {0}")]
     Stack(ThermalError),
-    #[error("{key} = {value} must be within [0, 1]")]
+    #[error("{key} = {} must be within [0, 1]", number(*value))]
     Fraction { key: &'static str, value: f64 },
-    #[error("convection_w_m2k = {0} must be ≥ 0")]
-    Convection(f64),
+    #[error(
+        "{key} = {} W/m²/K is outside 0…{MAX_CONVECTION_W_M2K} W/m²/K (still air ~5, forced \
+         water ~1e4)",
+        number(*value)
+    )]
+    Convection { key: &'static str, value: f64 },
     #[error(
         "back.temperature_k = {} must be within (0, {MAX_TEMPERATURE_K}] K",
         number(*temperature_k)
     )]
     BackTemperature { temperature_k: f64 },
-    #[error("back.convection_w_m2k = {0} must be ≥ 0")]
-    BackConvection(f64),
     #[error("internal_heat_w_m2 is an empty schedule: give [[time_h, w_m2], …]")]
     EmptySchedule,
-    #[error("internal_heat_w_m2 has a non-finite point [{time_h}, {w_m2}]")]
-    NonFinitePoint { time_h: f64, w_m2: f64 },
+    #[error(
+        "internal_heat_w_m2 has a point [{} h, {} W/m²] outside ±{} h, ±{} W/m²",
+        number(*time_h), number(*w_m2), number(MAX_SCHEDULE_H), number(MAX_INTERNAL_HEAT_W_M2)
+    )]
+    OutOfRangePoint { time_h: f64, w_m2: f64 },
     #[error(
         "internal_heat_w_m2: times must not decrease ({} h after {} h)",
         number(*later_h), number(*earlier_h)
@@ -178,6 +192,9 @@ pub fn resolve_run(
     default_ground_k: f64,
 ) -> Result<ThermalSetup, ThermalSetupError> {
     let site = resolve_site(config)?;
+    if config.spinup_days > MAX_SPINUP_DAYS {
+        return Err(ThermalSetupError::Spinup(config.spinup_days));
+    }
     let requested_s = match config.duration_h {
         Some(h) if h.is_finite() && h > 0.0 => Some(h * 3600.0),
         Some(h) => return Err(ThermalSetupError::Duration(h)),
@@ -254,28 +271,57 @@ fn resolve_weather(
     }
 }
 
-/// The three time steps are positive and the run has a sane number of them.
+/// The three time steps are positive and the run has no more of each than its limit, checked
+/// before anything is allocated (a 1e-300 s output step once asked for 1e304 recorded instants).
 fn check_steps(config: &ThermalConfig, duration_s: f64) -> Result<(), ThermalSetupError> {
+    // Weather and shadow samples run through the spun-up first day too.
+    let sampled_s = if config.spinup_days > 0 {
+        duration_s.max(DAY_S)
+    } else {
+        duration_s
+    };
     let steps = [
-        ("output_step_s", config.output_step_s),
-        ("time_step_s", config.time_step_s),
-        ("shadow_step_s", config.shadow_step_s),
+        (
+            "output_step_s",
+            config.output_step_s,
+            duration_s,
+            MAX_RECORDED_INSTANTS,
+        ),
+        ("time_step_s", config.time_step_s, sampled_s, MAX_STEPS),
+        ("shadow_step_s", config.shadow_step_s, sampled_s, MAX_STEPS),
     ];
-    for (key, step) in steps {
-        if !(step.is_finite() && step > 0.0) {
-            return Err(ThermalSetupError::Step { key, step });
+    for (key, step_s, span_s, limit) in steps {
+        if !(step_s.is_finite() && step_s > 0.0) {
+            return Err(ThermalSetupError::Step { key, step: step_s });
         }
-    }
-    let step_s = config.time_step_s.min(config.shadow_step_s);
-    if duration_s / step_s > MAX_STEPS {
-        return Err(ThermalSetupError::TooManySteps { duration_s, step_s });
+        let count = (span_s / step_s).floor() + 1.0;
+        if count > limit as f64 {
+            return Err(ThermalSetupError::TooManySteps {
+                key,
+                step_s,
+                duration_s: span_s,
+                steps: count,
+                limit,
+            });
+        }
     }
     Ok(())
 }
 
 const DAY_S: f64 = 86_400.0;
-/// Longest run in forcing or shadow steps: a 10-year run at 60 s is 5e6, far beyond any use.
-const MAX_STEPS: f64 = 1e7;
+/// Most weather and shadow samples of a run: a year at the default 60 s is 525 600; each sample
+/// holds a weather row (~80 bytes) and, per thermal vertex, a byte of sun visibility.
+pub const MAX_STEPS: usize = 2_000_000;
+/// Most recorded instants (rows of temperatures.csv per part, one PLY each): 10 days every minute.
+pub const MAX_RECORDED_INSTANTS: usize = 15_000;
+/// Most spin-up days: the periodic state is reached in one to a few.
+pub const MAX_SPINUP_DAYS: u32 = 100;
+/// Largest convective coefficient (W m⁻² K⁻¹), front or back: forced water flow is ~1e4.
+pub const MAX_CONVECTION_W_M2K: f64 = 1e5;
+/// Largest |internal heat flux| (W m⁻²): a thousand times an engine under a hood.
+pub const MAX_INTERNAL_HEAT_W_M2: f64 = 1e6;
+/// Largest |time| of a schedule point (h): beyond any run ([`MAX_STEPS`] minutes is ~4 years).
+pub const MAX_SCHEDULE_H: f64 = 1e6;
 
 /// One part's keys, checked, with its thermal `emissivity` (given, or its material's).
 pub fn resolve_part(
@@ -294,9 +340,7 @@ pub fn resolve_part(
     fraction("solar_absorptance", part.solar_absorptance)?;
     fraction("emissivity", emissivity)?;
     if let Some(h) = part.convection_w_m2k {
-        if !(h.is_finite() && h >= 0.0) {
-            return Err(PartThermalError::Convection(h));
-        }
+        convection("convection_w_m2k", h)?;
     }
     Ok(SurfaceThermal {
         stack,
@@ -344,15 +388,19 @@ fn resolve_back(back: &BackConfig) -> Result<Back, PartThermalError> {
         BackConfig::Fixed(f) => Err(PartThermalError::BackTemperature {
             temperature_k: f.temperature_k,
         }),
-        BackConfig::Convective(c)
-            if c.convection_w_m2k.is_finite() && c.convection_w_m2k >= 0.0 =>
-        {
-            Ok(Back::Convective {
-                h_w_m2k: c.convection_w_m2k,
-                air_k: None,
-            })
-        }
-        BackConfig::Convective(c) => Err(PartThermalError::BackConvection(c.convection_w_m2k)),
+        BackConfig::Convective(c) => Ok(Back::Convective {
+            h_w_m2k: convection("back.convection_w_m2k", c.convection_w_m2k)?,
+            air_k: None,
+        }),
+    }
+}
+
+/// A convective coefficient within 0…[`MAX_CONVECTION_W_M2K`].
+fn convection(key: &'static str, value: f64) -> Result<f64, PartThermalError> {
+    if (0.0..=MAX_CONVECTION_W_M2K).contains(&value) {
+        Ok(value)
+    } else {
+        Err(PartThermalError::Convection { key, value })
     }
 }
 
@@ -368,9 +416,9 @@ fn resolve_schedule(heat: &InternalHeatConfig) -> Result<Schedule, PartThermalEr
     }
     if let Some((t, q)) = points
         .iter()
-        .find(|(t, q)| !(t.is_finite() && q.is_finite()))
+        .find(|(t, q)| !(t.abs() <= MAX_SCHEDULE_H * 3600.0 && q.abs() <= MAX_INTERNAL_HEAT_W_M2))
     {
-        return Err(PartThermalError::NonFinitePoint {
+        return Err(PartThermalError::OutOfRangePoint {
             time_h: t / 3600.0,
             w_m2: *q,
         });

@@ -36,6 +36,8 @@
 //! something a general banded solver offers; no crate does it better.
 
 use super::layers::{Grid, ThermalError};
+use crate::optics::MAX_TEMPERATURE_K;
+use crate::text::number;
 
 /// Stefan–Boltzmann constant σ (W m⁻² K⁻⁴), CODATA 2018.
 pub const STEFAN_BOLTZMANN: f64 = 5.670_374_419e-8;
@@ -77,7 +79,8 @@ impl FrontForcing {
     fn validate(&self) -> Result<(), ThermalError> {
         let bad = |what: &str, v: f64, rule: &str| {
             Err(ThermalError::InvalidInput(format!(
-                "front forcing {what} must be {rule}, got {v}"
+                "front forcing {what} must be {rule}, got {}",
+                number(v)
             )))
         };
         if !(self.absorbed_w_m2.is_finite() && self.absorbed_w_m2 >= 0.0) {
@@ -158,17 +161,20 @@ impl Back {
             Back::Adiabatic => Ok(()),
             Back::Fixed(t) if temp_ok(t) => Ok(()),
             Back::Fixed(t) => Err(ThermalError::InvalidInput(format!(
-                "back temperature must be positive and finite, got {t} K"
+                "back temperature must be positive and finite, got {} K",
+                number(t)
             ))),
             Back::Convective { h_w_m2k, air_k } => {
                 if !(h_w_m2k.is_finite() && h_w_m2k >= 0.0) {
                     return Err(ThermalError::InvalidInput(format!(
-                        "back h_w_m2k must be finite and >= 0, got {h_w_m2k}"
+                        "back h_w_m2k must be finite and >= 0, got {}",
+                        number(h_w_m2k)
                     )));
                 }
                 match air_k {
                     Some(t) if !temp_ok(t) => Err(ThermalError::InvalidInput(format!(
-                        "back air temperature must be positive and finite, got {t} K"
+                        "back air temperature must be positive and finite, got {} K",
+                        number(t)
                     ))),
                     _ => Ok(()),
                 }
@@ -203,7 +209,7 @@ impl Forcing {
         if !self.internal_w_m2.is_finite() {
             return Err(ThermalError::InvalidInput(format!(
                 "internal_w_m2 must be finite, got {}",
-                self.internal_w_m2
+                number(self.internal_w_m2)
             )));
         }
         Ok(())
@@ -265,7 +271,8 @@ impl SolverControl {
         for (name, v) in fields {
             if !(v.is_finite() && v > 0.0) {
                 return Err(ThermalError::InvalidInput(format!(
-                    "control {name} must be positive and finite, got {v}"
+                    "control {name} must be positive and finite, got {}",
+                    number(v)
                 )));
             }
         }
@@ -285,7 +292,8 @@ impl ThermalState {
     pub fn uniform(grid: &Grid, temperature_k: f64) -> Result<Self, ThermalError> {
         if !(temperature_k.is_finite() && temperature_k > 0.0) {
             return Err(ThermalError::InvalidInput(format!(
-                "initial temperature must be positive and finite, got {temperature_k} K"
+                "initial temperature must be positive and finite, got {} K",
+                number(temperature_k)
             )));
         }
         Ok(Self {
@@ -417,7 +425,8 @@ impl Solver {
     ) -> Result<StepReport, ThermalError> {
         if !(dt_s.is_finite() && dt_s > 0.0) {
             return Err(ThermalError::InvalidInput(format!(
-                "time step must be positive and finite, got {dt_s} s"
+                "time step must be positive and finite, got {} s",
+                number(dt_s)
             )));
         }
         if state.temperatures_k.len() != self.grid.len() {
@@ -433,7 +442,15 @@ impl Solver {
         let mut report = StepReport::default();
         let mut t = 0.0;
         let mut h = state.next_substep_s.min(self.control.max_substep_s);
+        let cap = MAX_SUBSTEPS_PER_STEP + (dt_s / self.control.max_substep_s).ceil() as usize;
         while t < dt_s {
+            if report.substeps + report.rejected >= cap {
+                return Err(ThermalError::NotConverged {
+                    step_s: dt_s,
+                    substeps: report.substeps + report.rejected,
+                    surface_k: state.surface_k(),
+                });
+            }
             let remaining = dt_s - t;
             let take = if h >= 0.99 * remaining { remaining } else { h };
             let (err, change) = self.try_substep(state, t, take, dt_s, start, end, &mut report)?;
@@ -529,14 +546,12 @@ impl Solver {
             report.add(e1, 2.0);
             report.add(e2, 2.0);
             report.add(e_full, -1.0);
-            if !state
+            if let Some(&t) = state
                 .temperatures_k
                 .iter()
-                .all(|t| t.is_finite() && *t > 0.0)
+                .find(|t| !(**t > 0.0 && **t <= MAX_TEMPERATURE_K))
             {
-                return Err(ThermalError::NoSolution(
-                    "a node temperature left (0, inf) K after extrapolation".into(),
-                ));
+                return Err(ThermalError::Runaway { temperature_k: t });
             }
         }
         Ok((err, change))
@@ -639,12 +654,10 @@ fn substitute_from_front(r: &Rows, t_s: f64, out: &mut [f64]) {
 /// Newton on B T + K T⁴ = D (B > 0, K ≥ 0): convex and increasing for T > 0, so one positive root.
 fn solve_surface(b: f64, k4: f64, d: f64, start: f64, tol: f64) -> Result<f64, ThermalError> {
     if !(d > 0.0 && b > 0.0) {
-        return Err(ThermalError::NoSolution(format!(
-            "surface balance has no positive temperature (B = {b}, D = {d})"
-        )));
+        return Err(ThermalError::NoSurfaceTemperature);
     }
     let mut t = start.max(1.0);
-    for _ in 0..100 {
+    for _ in 0..NEWTON_ITERATIONS {
         let t3 = t * t * t;
         let step = (b * t + k4 * t3 * t - d) / (b + 4.0 * k4 * t3);
         // From the left, Newton may overshoot below zero only if it started there; keep T > 0.
@@ -653,10 +666,21 @@ fn solve_surface(b: f64, k4: f64, d: f64, start: f64, tol: f64) -> Result<f64, T
             return Ok(t);
         }
     }
-    Err(ThermalError::NoSolution(format!(
-        "surface Newton did not converge to {tol} K in 100 iterations (last T = {t} K)"
-    )))
+    Err(ThermalError::NewtonDiverged {
+        iterations: NEWTON_ITERATIONS,
+        last_k: t,
+    })
 }
+
+/// Newton iterations of the surface balance before it is given up: it converges quadratically
+/// from any positive start (a few iterations); halving from far above takes at most ~60.
+const NEWTON_ITERATIONS: usize = 100;
+
+/// Sub-steps (accepted and rejected) one [`Solver::step`] may take beyond the dt/max_substep it
+/// needs at least, before it ends in [`ThermalError::NotConverged`]. The shipped car's day takes
+/// at most 36 per 60 s step; a stack the round-off defeats (a conductivity of 1e12 W/m/K) took
+/// ~19 000 per step and would run for hours.
+pub const MAX_SUBSTEPS_PER_STEP: usize = 10_000;
 
 #[cfg(test)]
 mod tests {
@@ -703,6 +727,53 @@ mod tests {
             );
         }
         assert!(solve_surface(b, k, -1.0, 300.0, 1e-9).is_err());
+    }
+
+    /// A step whose sub-steps never meet their tolerance (here, one no step meets, with a
+    /// shortest sub-step too short to advance the clock) ends in a typed error after the cap
+    /// instead of looping for ever.
+    #[test]
+    fn a_step_that_does_not_converge_ends_in_an_error_naming_it() {
+        use crate::thermal::{Layer, LayerMaterial, LayerStack, Resolution};
+        let stack = LayerStack::new(vec![Layer::new(
+            LayerMaterial::new("steel", 45.0, 7850.0, 470.0),
+            1e-3,
+        )])
+        .unwrap();
+        let grid = stack.discretise(&Resolution::default()).unwrap();
+        let control = SolverControl {
+            tolerance_k: 1e-300,
+            max_surface_change_k: 1e-300,
+            min_substep_s: 1e-300,
+            ..SolverControl::default()
+        };
+        let mut solver = Solver::new(grid.clone(), control).unwrap();
+        let mut state = ThermalState::uniform(&grid, 280.0).unwrap();
+        let forcing = Forcing {
+            front: FrontForcing {
+                absorbed_w_m2: 500.0,
+                longwave_in_w_m2: 300.0,
+                emissivity: 0.9,
+                h_w_m2k: 10.0,
+                air_k: 290.0,
+            },
+            back: Back::Adiabatic,
+            internal_w_m2: 0.0,
+        };
+        let error = solver
+            .step(&mut state, 60.0, &forcing, &forcing)
+            .unwrap_err();
+        assert!(
+            matches!(error, ThermalError::NotConverged { substeps, .. } if substeps == MAX_SUBSTEPS_PER_STEP + 1),
+            "{error:?}"
+        );
+        let text = error.to_string();
+        assert!(
+            text.starts_with(
+                "the time step of 60 s did not converge in 10001 sub-steps (surface at 280"
+            ),
+            "{text}"
+        );
     }
 
     #[test]

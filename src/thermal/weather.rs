@@ -48,6 +48,17 @@ pub const CLEAR_DAY_STEP_S: f64 = 300.0;
 /// Longest clear day (s): 400 days of rows every 5 minutes (115 200 rows).
 pub const MAX_CLEAR_DAY_DURATION_S: f64 = 400.0 * 86_400.0;
 
+/// Fastest wind (m/s): above the strongest gust measured (113 m/s); the convective coefficient
+/// grows with it.
+pub const MAX_WIND_M_S: f64 = 150.0;
+
+/// Largest irradiance of any kind (W m⁻²): 70 solar constants, a black body at 1150 K. Beyond
+/// it the surface balance runs to temperatures the model does not represent.
+pub const MAX_IRRADIANCE_W_M2: f64 = 1e5;
+
+/// Most rows of a weather file: two years of minutes (~100 MB held).
+pub const MAX_WEATHER_ROWS: usize = 1_000_000;
+
 /// Clear-sky downwelling long-wave irradiance (W m⁻²) for air at `air_k`, Swinbank (1963).
 pub fn swinbank_longwave_w_m2(air_k: f64) -> f64 {
     SWINBANK_W_M2_K6 * air_k.powi(6)
@@ -151,6 +162,17 @@ pub enum WeatherError {
         last_s: f64,
         start_utc: String,
     },
+}
+
+impl WeatherError {
+    /// The message without the "clear day: " a caller that names the clear day already says.
+    pub fn detail(&self) -> String {
+        match self {
+            WeatherError::InvalidClearDay(message) => message.clone(),
+            WeatherError::Sun(error) => error.to_string(),
+            other => other.to_string(),
+        }
+    }
 }
 
 /// Weather rows in time (at least two, strictly ascending), read back by [`Weather::at`].

@@ -17,6 +17,7 @@ use super::exposure::{sky_view_factors, sun_visibility, VertexFrame};
 use crate::progress::Progress;
 use crate::scene::mesh::{bounding_diagonal, ShadedMesh};
 use crate::scene::Scene;
+use crate::text::{about, number};
 use crate::thermal::convection::mcadams_coefficient;
 use crate::thermal::setup::{SurfaceThermal, ThermalSetup};
 use crate::thermal::{
@@ -65,14 +66,68 @@ pub enum ThermalRunError {
     /// The weather has no value at a time the run needs.
     #[error("{0}")]
     Weather(crate::thermal::WeatherError),
-    #[error("thermal time {time_s} s is outside the run 0…{duration_s} s")]
+    #[error(
+        "thermal time {} s is outside the run 0…{} s",
+        number(*time_s), number(*duration_s)
+    )]
     OutsideRun { time_s: f64, duration_s: f64 },
-    #[error("part '{part}': {source}")]
+    /// A table of the run would outgrow its limit ([`MAX_SHADOW_SAMPLES`],
+    /// [`MAX_RECORDED_VALUES`]); refused before it is allocated.
+    #[error(
+        "{vertices} {} × {instants} {what} = {} values, more than {}: use a coarser mesh or a \
+         longer {key}",
+        if *what == "shadow instants" { "thermal vertices" } else { "vertices" },
+        about((*vertices as f64) * (*instants as f64)), number(*limit as f64)
+    )]
+    TooLarge {
+        vertices: usize,
+        instants: usize,
+        what: &'static str,
+        key: &'static str,
+        limit: usize,
+    },
+    /// The solve of one part's vertex failed; `part` names it ("objects[0] 'car' part 'hood'"),
+    /// `at` says when. The solver's error is part of the message, said once.
+    #[error("{part}{at}: {error}")]
     Solver {
         part: String,
-        #[source]
-        source: ThermalError,
+        at: String,
+        error: ThermalError,
     },
+}
+
+/// Most (thermal vertex, shadow instant) pairs: one byte of sun visibility each, one shadow ray
+/// traced each. The shipped car's day is 9694 × 145 = 1.4e6.
+pub const MAX_SHADOW_SAMPLES: usize = 500_000_000;
+
+/// Most (vertex, recorded instant) surface temperatures held (8 bytes each, 0.8 GB at most).
+pub const MAX_RECORDED_VALUES: usize = 100_000_000;
+
+/// Where in the run a vertex's solve failed.
+struct VertexFailure {
+    /// Start of the failed step (s from `start_utc`), `None` before the first step.
+    time_s: Option<f64>,
+    spinup: bool,
+    error: ThermalError,
+}
+
+impl VertexFailure {
+    fn before_run(error: ThermalError) -> VertexFailure {
+        VertexFailure {
+            time_s: None,
+            spinup: false,
+            error,
+        }
+    }
+
+    /// " at t = 3600 s" (" of the spin-up day"), or nothing.
+    fn at(&self) -> String {
+        match (self.time_s, self.spinup) {
+            (None, _) => String::new(),
+            (Some(t), false) => format!(", step from t = {} s", number(t)),
+            (Some(t), true) => format!(", spin-up step from t = {} s", number(t)),
+        }
+    }
 }
 
 const DAY_S: f64 = 86_400.0;
@@ -81,11 +136,7 @@ const DAY_S: f64 = 86_400.0;
 /// (through the first day too when it is spun up), and which of them are recorded.
 fn sample_times(setup: &ThermalSetup, extra: &[f64]) -> (Vec<f64>, Vec<bool>) {
     let end = setup.duration_s;
-    let sampled_end = if setup.spinup_days > 0 {
-        end.max(DAY_S)
-    } else {
-        end
-    };
+    let sampled_end = sampled_end(setup);
     let mut times: Vec<(f64, bool)> = Vec::new();
     let mut push_grid = |step: f64, last: f64, record: bool| {
         let n = (last / step).floor() as usize;
@@ -222,6 +273,7 @@ pub fn solve_scene(
             duration_s: setup.duration_s,
         });
     }
+    check_sizes(scene, setup)?;
     let (times, recorded) = sample_times(setup, extra_times_s);
     let samples = times
         .iter()
@@ -250,9 +302,16 @@ pub fn solve_scene(
             };
             let result = run
                 .vertex(model, &exposure, scene.mesh.temperatures[v])
-                .map_err(|source| ThermalRunError::Solver {
-                    part: scene.surfaces[surface].part.clone(),
-                    source,
+                .map_err(|failure| {
+                    let object = scene.surfaces[surface].object;
+                    ThermalRunError::Solver {
+                        part: format!(
+                            "objects[{object}] '{}' part '{}'",
+                            scene.object_names[object], scene.surfaces[surface].part
+                        ),
+                        at: failure.at(),
+                        error: failure.error,
+                    }
                 });
             progress.advance(1);
             result
@@ -260,6 +319,47 @@ pub fn solve_scene(
         .collect::<Result<Vec<_>, _>>()?;
     progress.end();
     Ok(run.solution(&scene.mesh, &vertices, &class, &histories))
+}
+
+/// The run's tables within their limits, before any is allocated: sun visibility per thermal
+/// vertex and shadow instant, surface temperatures per vertex and recorded instant (the instants
+/// themselves are limited by the `[thermal]` keys, [`crate::thermal::setup`]).
+fn check_sizes(scene: &Scene, setup: &ThermalSetup) -> Result<(), ThermalRunError> {
+    let surfaces = vertex_surfaces(scene);
+    let thermal = surfaces
+        .iter()
+        .filter(|&&s| setup.surfaces[s as usize].is_some())
+        .count();
+    let shadows = shadow_instants_count(setup);
+    let recorded = (setup.duration_s / setup.output_step_s).floor() as usize + 2;
+    let tables = [
+        (
+            thermal,
+            shadows,
+            "shadow instants",
+            "shadow_step_s",
+            MAX_SHADOW_SAMPLES,
+        ),
+        (
+            surfaces.len(),
+            recorded,
+            "recorded instants",
+            "output_step_s",
+            MAX_RECORDED_VALUES,
+        ),
+    ];
+    for (vertices, instants, what, key, limit) in tables {
+        if vertices.saturating_mul(instants) > limit {
+            return Err(ThermalRunError::TooLarge {
+                vertices,
+                instants,
+                what,
+                key,
+                limit,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The surface (object part) of every shading vertex (a shading vertex belongs to one part).
@@ -278,15 +378,24 @@ pub fn vertex_surfaces(scene: &Scene) -> Vec<u32> {
     surface
 }
 
-/// Shadow instants 0, step, 2·step, … through the end of the run (and of the spin-up day).
-fn shadow_instants(setup: &ThermalSetup) -> Vec<f64> {
-    let end = if setup.spinup_days > 0 {
+/// The end of the sampled time: the run's, or the spun-up first day's if longer.
+fn sampled_end(setup: &ThermalSetup) -> f64 {
+    if setup.spinup_days > 0 {
         setup.duration_s.max(DAY_S)
     } else {
         setup.duration_s
-    };
-    let n = (end / setup.shadow_step_s).ceil() as usize;
-    (0..=n)
+    }
+}
+
+/// How many [`shadow_instants`] there are.
+fn shadow_instants_count(setup: &ThermalSetup) -> usize {
+    (sampled_end(setup) / setup.shadow_step_s).ceil() as usize + 1
+}
+
+/// Shadow instants 0, step, 2·step, … through the end of the run (and of the spin-up day).
+fn shadow_instants(setup: &ThermalSetup) -> Vec<f64> {
+    let end = sampled_end(setup);
+    (0..shadow_instants_count(setup))
         .map(|i| (i as f64 * setup.shadow_step_s).min(end))
         .collect()
 }
@@ -394,10 +503,15 @@ impl Run<'_> {
         model: &SurfaceThermal,
         exposure: &Exposure,
         initial_k: f64,
-    ) -> Result<History, ThermalError> {
-        let grid = model.stack.discretise(&Resolution::default())?;
-        let mut state = ThermalState::uniform(&grid, initial_k)?;
-        let mut solver = Solver::new(grid, SolverControl::default())?;
+    ) -> Result<History, VertexFailure> {
+        let grid = model
+            .stack
+            .discretise(&Resolution::default())
+            .map_err(VertexFailure::before_run)?;
+        let mut state =
+            ThermalState::uniform(&grid, initial_k).map_err(VertexFailure::before_run)?;
+        let mut solver =
+            Solver::new(grid, SolverControl::default()).map_err(VertexFailure::before_run)?;
         let mut history = History {
             surface_k: Vec::new(),
             substeps: 0,
@@ -431,14 +545,22 @@ impl Run<'_> {
         exposure: &Exposure,
         range: std::ops::Range<usize>,
         mut history: Option<&mut History>,
-    ) -> Result<(), ThermalError> {
+    ) -> Result<(), VertexFailure> {
         let mut stored = 0.0;
         let mut net_in = 0.0;
         let mut gross = 0.0;
         let mut start = self.forcing(model, exposure, range.start);
         for j in range.start + 1..range.end {
             let end = self.forcing(model, exposure, j);
-            let report = solver.step(state, self.times[j] - self.times[j - 1], &start, &end)?;
+            let (t0, t1) = (self.times[j - 1], self.times[j]);
+            let report =
+                solver
+                    .step(state, t1 - t0, &start, &end)
+                    .map_err(|error| VertexFailure {
+                        time_s: Some(t0),
+                        spinup: history.is_none(),
+                        error,
+                    })?;
             stored += report.stored_j_m2;
             net_in += report.net_in_j_m2();
             gross +=

@@ -18,10 +18,11 @@
 
 use super::{
     simplified_solis, swinbank_longwave_w_m2, ClearDay, Site, SolisAtmosphere, Weather,
-    WeatherError, WeatherSample, CLEAR_DAY_STEP_S, MAX_CLEAR_DAY_DURATION_S,
+    WeatherError, WeatherSample, CLEAR_DAY_STEP_S, MAX_CLEAR_DAY_DURATION_S, MAX_WIND_M_S,
 };
 use crate::emitter::{format_time_utc, sun_position, SunError};
 use crate::optics::MAX_TEMPERATURE_K;
+use crate::text::number;
 use chrono::{DateTime, TimeDelta, Utc};
 use solar_positioning::{delta_t, Horizon, Location, SolarEvents};
 
@@ -67,25 +68,29 @@ fn check(day: &ClearDay, duration_s: f64) -> Result<(), WeatherError> {
     for (name, t) in [("air_min_k", day.air_min_k), ("air_max_k", day.air_max_k)] {
         if !(t > 0.0 && t <= MAX_TEMPERATURE_K) {
             return invalid(format!(
-                "{name} = {t} K is outside (0, {MAX_TEMPERATURE_K}] K"
+                "{name} = {} K is outside (0, {MAX_TEMPERATURE_K}] K",
+                number(t)
             ));
         }
     }
     if day.air_min_k > day.air_max_k {
         return invalid(format!(
             "air_min_k = {} K is above air_max_k = {} K",
-            day.air_min_k, day.air_max_k
+            number(day.air_min_k),
+            number(day.air_max_k)
         ));
     }
-    if !(day.wind_m_s.is_finite() && day.wind_m_s >= 0.0) {
+    if !(0.0..=MAX_WIND_M_S).contains(&day.wind_m_s) {
         return invalid(format!(
-            "wind_m_s = {} must be finite and ≥ 0 m/s",
-            day.wind_m_s
+            "wind_m_s = {} is outside 0…{MAX_WIND_M_S} m/s",
+            number(day.wind_m_s)
         ));
     }
     if !(0.0..=MAX_CLEAR_DAY_DURATION_S).contains(&duration_s) {
         return invalid(format!(
-            "duration {duration_s} s is outside [0, {MAX_CLEAR_DAY_DURATION_S}] s (400 days)"
+            "duration {} s is outside [0, {}] s (400 days)",
+            number(duration_s),
+            number(MAX_CLEAR_DAY_DURATION_S)
         ));
     }
     Ok(())

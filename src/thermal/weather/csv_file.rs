@@ -6,10 +6,14 @@
 //! required; `wind_speed_m_s`, `direct_normal_w_m2`, `diffuse_horizontal_w_m2` (0 when absent),
 //! `longwave_down_w_m2` (Swinbank when absent) and `sun_elevation_deg` + `sun_azimuth_deg` (both
 //! or neither; the SPA when absent) optional. Every value is a finite number; times strictly
-//! ascending (any sign, |time_s| ≤ 1e15: seconds from `start_utc`), air temperatures within (0, 10⁴] K, wind and
-//! irradiances ≥ 0, elevations within [−90°, 90°]; at least two rows.
+//! ascending (any sign, |time_s| ≤ 1e15: seconds from `start_utc`), air temperatures within
+//! (0, 10⁴] K, wind within 0…150 m/s, irradiances within 0…1e5 W/m², elevations within
+//! [−90°, 90°]; at least two rows and at most [`MAX_WEATHER_ROWS`].
 
-use super::{nlerp_defined, swinbank_longwave_w_m2, Site, Weather, WeatherError, WeatherSample};
+use super::{
+    nlerp_defined, swinbank_longwave_w_m2, Site, Weather, WeatherError, WeatherSample,
+    MAX_IRRADIANCE_W_M2, MAX_WEATHER_ROWS, MAX_WIND_M_S,
+};
 use crate::emitter::{format_time_utc, sun_direction, sun_position};
 use crate::optics::MAX_TEMPERATURE_K;
 use crate::text::{number, shown};
@@ -60,9 +64,16 @@ impl Column {
             Column::Air if !(value > 0.0 && value <= MAX_TEMPERATURE_K) => {
                 format!("{text} K is outside (0, {MAX_TEMPERATURE_K}] K")
             }
-            Column::Wind if value < 0.0 => format!("{text} is negative; a wind speed is ≥ 0 m/s"),
-            Column::Direct | Column::Diffuse | Column::Longwave if value < 0.0 => {
-                format!("{text} is negative; an irradiance is ≥ 0 W/m²")
+            Column::Wind if !(0.0..=MAX_WIND_M_S).contains(&value) => {
+                format!("{text} m/s is outside 0…{MAX_WIND_M_S} m/s")
+            }
+            Column::Direct | Column::Diffuse | Column::Longwave
+                if !(0.0..=MAX_IRRADIANCE_W_M2).contains(&value) =>
+            {
+                format!(
+                    "{text} W/m² is outside 0…{} W/m² (an irradiance)",
+                    number(MAX_IRRADIANCE_W_M2)
+                )
             }
             Column::SunElevation if value.abs() > 90.0 => {
                 format!("{text}° is outside [-90°, 90°]")
@@ -133,6 +144,11 @@ fn parse_rows(bytes: &[u8], site: &Site) -> Result<Weather, Refusal> {
     for record in records {
         let record = record.map_err(|e| csv_refusal(bytes, e))?;
         let (line, raw) = locate(bytes, record.position());
+        if rows.len() == MAX_WEATHER_ROWS {
+            let message =
+                format!("more than {MAX_WEATHER_ROWS} data rows: split the weather or thin it out");
+            return Err((line, 1, message));
+        }
         let (time_s, sample) = parse_row(&record, line, raw, &layout, site)?;
         let row = Row {
             time_s,
