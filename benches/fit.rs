@@ -13,7 +13,7 @@ use irpol::fit::{
     ModelSpace, Objective, Parameter, ParameterBounds, ParameterValues,
 };
 use irpol::measure::{read_measurement_csv, read_measurement_sets, MeasurementSet};
-use irpol::pbrdf::{Shadowing, SlopeDistribution};
+use irpol::pbrdf::{ModelTerms, Shadowing, SlopeDistribution};
 use std::path::Path;
 use std::time::Duration;
 
@@ -48,11 +48,12 @@ fn shipped(name: &str) -> MeasurementSet {
 fn objective(c: &mut Criterion) {
     let set = synthetic();
     let data = MeasurementData::new(&set).unwrap();
-    let values = ParameterValues([0.15, 2.5, 1.6, 0.05, 0.01]);
+    let values = ParameterValues([0.15, 2.5, 1.6, 0.05, 0.01, 0.5, 0.0, 1.5]);
     for kind in [DistributionKind::Cauchy, DistributionKind::Gaussian] {
         let space = ModelSpace::new(
             kind,
             Shadowing::Smith,
+            ModelTerms::default(),
             &Parameter::ALL,
             values,
             &ParameterBounds::default(),

@@ -18,6 +18,10 @@ pub fn truth() -> ModelSpec {
         n: 1.5,
         k: 0.1,
         rho_d: 0.02,
+        facet: Default::default(),
+        rho_s: None,
+        d: None,
+        n_sub: None,
         wavelength_um: 9.925,
     }
 }

@@ -678,6 +678,10 @@ mod tests {
             n: 1.5,
             k: 0.1,
             rho_d: 0.01,
+            facet: Default::default(),
+            rho_s: None,
+            d: None,
+            n_sub: None,
             wavelength_um: 10.0,
         }
     }

@@ -640,6 +640,10 @@ mod tests {
             n: 1.2,
             k: 0.2,
             rho_d: 0.0,
+            facet: Default::default(),
+            rho_s: None,
+            d: None,
+            n_sub: None,
             wavelength_um: 9.925,
         };
         Material {
