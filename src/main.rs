@@ -90,6 +90,8 @@ enum Command {
         /// Measurement CSVs or folders of them.
         #[arg(required = true)]
         data: Vec<PathBuf>,
+        #[command(flatten)]
+        measurements: MeasurementArgs,
         /// Folder for the validation report pages.
         #[arg(long, default_value = "reports")]
         reports: PathBuf,
@@ -307,8 +309,9 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Validate {
             material,
             data,
+            measurements,
             reports,
-        } => validate(&material, &data, &reports),
+        } => validate(&material, &data, &measurements, &reports),
         Command::Report { material, reports } => report(&material, &reports),
         Command::Render {
             scene,
@@ -388,8 +391,14 @@ fn fit(args: FitArgs) -> anyhow::Result<()> {
 }
 
 /// `irpol validate`: one line per measurement set and its report page.
-fn validate(material: &Path, data: &[PathBuf], reports: &Path) -> anyhow::Result<()> {
-    for result in validate_and_report(material, data, reports)? {
+fn validate(
+    material: &Path,
+    data: &[PathBuf],
+    measurements: &MeasurementArgs,
+    reports: &Path,
+) -> anyhow::Result<()> {
+    let reading = measurements.read_options()?;
+    for result in validate_and_report(material, data, &reading, reports)? {
         say!(
             "{} on {}: {}",
             material.display(),

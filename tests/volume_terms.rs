@@ -82,7 +82,10 @@ fn every_term_is_reciprocal_with_the_facet_terms_q() {
                 let forward = pbrdf.mueller(&i, &r);
                 let backward = pbrdf.mueller(&r, &i);
                 let error = (backward - q * forward.transpose() * q).abs().max();
-                assert!(error <= 1e-12 * forward[(0, 0)].max(1e-300), "model {m}: {error}");
+                assert!(
+                    error <= 1e-12 * forward[(0, 0)].max(1e-300),
+                    "model {m}: {error}"
+                );
             }
         }
     }
@@ -117,7 +120,10 @@ fn subsurface_term_conserves_energy_and_stays_realizable() {
                 let albedo = only_subsurface
                     .directional_hemispherical_reflectance(theta.to_radians(), &quadrature);
                 let bound = Transmission::at(theta.to_radians().cos(), eps).plus;
-                assert!(albedo <= bound + 2e-4, "n {n} d {d} θ {theta}: {albedo} > {bound}");
+                assert!(
+                    albedo <= bound + 2e-4,
+                    "n {n} d {d} θ {theta}: {albedo} > {bound}"
+                );
                 assert!(albedo <= 1.0);
             }
             for i in directions() {
@@ -150,15 +156,23 @@ fn synthetic_volume_scatterers_are_recovered_and_their_terms_chosen() {
         (
             "external_subsurface.csv",
             ModelTerms::new(FacetSide::External, Body::Subsurface),
-            [(Parameter::Sigma, 0.15), (Parameter::Q, 2.5), (Parameter::N, 1.45)],
+            [
+                (Parameter::Sigma, 0.15),
+                (Parameter::Q, 2.5),
+                (Parameter::N, 1.45),
+            ],
             0.8,
             0.2,
         ),
         (
             "internal_subsurface.csv",
             ModelTerms::new(FacetSide::Internal, Body::Subsurface),
-            [(Parameter::Sigma, 0.25), (Parameter::N, 1.35), (Parameter::N, 1.35)],
-            0.9,
+            [
+                (Parameter::Sigma, 0.8),
+                (Parameter::N, 1.35),
+                (Parameter::N, 1.35),
+            ],
+            0.6,
             0.1,
         ),
     ];
@@ -172,14 +186,21 @@ fn synthetic_volume_scatterers_are_recovered_and_their_terms_chosen() {
         let outcome = fit_grey(&set, &options).unwrap();
         let choice = outcome.terms_choice.as_ref().unwrap();
         assert_eq!(choice.scores[choice.chosen].terms, terms, "{file}: CV");
-        assert_eq!(choice.scores[choice.best_by_aic()].terms, terms, "{file}: AIC");
+        assert_eq!(
+            choice.scores[choice.best_by_aic()].terms,
+            terms,
+            "{file}: AIC"
+        );
         let model = &outcome.chosen.model;
         for (p, truth) in shape {
             let tolerance = if p == Parameter::N { 0.01 } else { 0.02 };
             let value = model.parameter(p).unwrap();
             assert!(within(value, truth, tolerance), "{file}: {p} = {value}");
         }
-        assert!(within(model.rho_s.unwrap(), rho_s, 0.02), "{file}: {model:?}");
+        assert!(
+            within(model.rho_s.unwrap(), rho_s, 0.02),
+            "{file}: {model:?}"
+        );
         assert!((model.d.unwrap() - d).abs() <= 0.02, "{file}: {model:?}");
     }
 }
@@ -194,7 +215,10 @@ fn material_files_carry_the_volume_terms() {
     let material: Material = toml::from_str(grey).unwrap();
     let spec = material.grey_model().unwrap();
     assert_eq!(spec.facet, FacetSide::Internal);
-    assert_eq!((spec.rho_s, spec.d, spec.n_sub), (Some(0.9), Some(0.1), Some(1.2)));
+    assert_eq!(
+        (spec.rho_s, spec.d, spec.n_sub),
+        (Some(0.9), Some(0.1), Some(1.2))
+    );
     let pbrdf = spec.pbrdf().unwrap();
     assert_eq!(pbrdf.facet_side(), FacetSide::Internal);
     let orphan = grey.replace("rho_s = 0.9\n", "");
@@ -204,28 +228,99 @@ fn material_files_carry_the_volume_terms() {
         .replace("n = 1.35", "n = [1.35, 1.36]")
         .replace("k = 0.0", "k = [0.0, 0.0]")
         .replace("wavelength_um = 1.064", "wavelength_um = [1.0, 2.0]");
-    let error = toml::from_str::<Material>(&spectral).unwrap_err().to_string();
+    let error = toml::from_str::<Material>(&spectral)
+        .unwrap_err()
+        .to_string();
     assert!(error.contains("spectral table cannot use"), "{error}");
 }
 
-/// The fit's energy constraint: data whose best unconstrained model (no shadowing) would
-/// reflect more than 1 get a model that does not, with the body reflectance held and said so.
+/// NIST's PTFE through its layout (1.064 µm): today's model fits it only by creating energy
+/// (ρ_d ≈ 0.94 with n ≈ 0.79 reflects more than 1 at grazing incidence), so the fit's energy
+/// constraint holds ρ_d and says so; internal facets with the subsurface term need no hold, and
+/// predict the incidences the fit did not see (15°, 45°) with less m00 error. Numbers in
+/// docs/measurements.md.
 #[test]
-fn fitted_models_conserve_energy() {
-    let set = volume_data("internal_subsurface.csv");
-    let options = FitOptions {
-        terms: ModelTerms::new(FacetSide::Internal, Body::Subsurface),
-        ..FitOptions::default()
+fn ptfe_fits_conserve_energy_and_the_volume_model_predicts_m00_better() {
+    let dir = tempfile::tempdir().unwrap();
+    let fit = |terms: &str, name: &str| {
+        let (fits, reports) = (dir.path().join(name), dir.path().join("reports"));
+        let output = irpol()
+            .args([
+                "fit",
+                "data/ptfe/PTFE_351_1064.csv",
+                "--layout",
+                "data/ptfe/layout.toml",
+            ])
+            .args([
+                "--wavelength",
+                "1.064",
+                "--theta-i",
+                "0,30,60,75",
+                "--terms",
+                terms,
+            ])
+            .arg("--out")
+            .arg(&fits)
+            .arg("--reports")
+            .arg(&reports)
+            .output()
+            .unwrap();
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let entry = std::fs::read_dir(&fits)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.extension().is_some_and(|e| e == "toml"))
+            .unwrap();
+        let material = Material::load(&entry).unwrap();
+        let pbrdf = material.grey_model().unwrap().pbrdf().unwrap();
+        let (largest, theta) = largest_reflectance(&pbrdf);
+        assert!(
+            largest <= 1.0 + ENERGY_TOLERANCE,
+            "{terms}: {largest} at {theta}°"
+        );
+        let validation = irpol()
+            .arg("validate")
+            .arg(&entry)
+            .args([
+                "data/ptfe/PTFE_351_1064.csv",
+                "--layout",
+                "data/ptfe/layout.toml",
+            ])
+            .args(["--wavelength", "1.064", "--theta-i", "15,45", "--reports"])
+            .arg(dir.path().join("validation"))
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&validation.stdout).into_owned();
+        assert!(
+            validation.status.success(),
+            "{}",
+            String::from_utf8_lossy(&validation.stderr)
+        );
+        let m00: f64 = stdout
+            .split("m00 relative RMS ")
+            .nth(1)
+            .and_then(|s| s.split_whitespace().next())
+            .and_then(|s| s.parse().ok())
+            .unwrap();
+        (material, m00)
     };
-    let outcome = fit_grey(&set, &options).unwrap();
-    let (largest, theta) = largest_reflectance(&outcome.chosen.model.pbrdf().unwrap());
-    assert!(largest <= 1.0 + ENERGY_TOLERANCE, "{largest} at {theta}°");
-    // The truth of this file reflects 1.51 at 60°: the constraint held ρ_s below it.
-    let (parameter, limit) = outcome.chosen.held_by_energy.unwrap();
-    assert_eq!(parameter, Parameter::RhoS);
-    assert!(limit < 0.9);
-    let record = outcome.material.fit.as_ref().unwrap();
-    assert!(record.settings["energy"].contains("rho_s held at"));
+    let (today, today_m00) = fit("external+depolarizer", "today");
+    let record = today.fit.as_ref().unwrap();
+    assert!(
+        record.settings["energy"].contains("rho_d held at"),
+        "{record:?}"
+    );
+    let (volume, volume_m00) = fit("internal+subsurface", "volume");
+    let spec = volume.grey_model().unwrap();
+    assert!((1.15..1.45).contains(&spec.n), "{spec:?}");
+    assert!(
+        volume_m00 < 0.5 * today_m00,
+        "{volume_m00} % vs {today_m00} %"
+    );
 }
 
 /// `irpol fit --terms … --cv K` prints the candidates side by side; `irpol validate` scores a
@@ -235,7 +330,11 @@ fn fit_with_cross_validation_and_validate_from_the_command_line() {
     let dir = tempfile::tempdir().unwrap();
     let (fits, reports) = (dir.path().join("fits"), dir.path().join("reports"));
     let output = irpol()
-        .args(["fit", "tests/data/volume/external_subsurface.csv", "--terms"])
+        .args([
+            "fit",
+            "tests/data/volume/external_subsurface.csv",
+            "--terms",
+        ])
         .args(["external+depolarizer,external+subsurface", "--cv", "3"])
         .arg("--out")
         .arg(&fits)
@@ -244,7 +343,11 @@ fn fit_with_cross_validation_and_validate_from_the_command_line() {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     assert!(stdout.contains("* external+subsurface"), "{stdout}");
     assert!(stdout.contains("CV χ²/obs"), "{stdout}");
     let entry = fits.join("external_subsurface.toml");
@@ -257,7 +360,11 @@ fn fit_with_cross_validation_and_validate_from_the_command_line() {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     // Its own data: χ²/obs near 1 with the file's uncertainties.
     let chi2: f64 = stdout
         .split("χ²/obs ")
@@ -270,9 +377,17 @@ fn fit_with_cross_validation_and_validate_from_the_command_line() {
         .join("external_subsurface_validation_external_subsurface.png")
         .is_file());
     let bad = irpol()
-        .args(["fit", "tests/data/volume/external_subsurface.csv", "--terms", "inside+x"])
+        .args([
+            "fit",
+            "tests/data/volume/external_subsurface.csv",
+            "--terms",
+            "inside+x",
+        ])
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&bad.stderr);
-    assert!(!bad.status.success() && stderr.contains("unknown terms 'inside+x'"), "{stderr}");
+    assert!(
+        !bad.status.success() && stderr.contains("unknown terms 'inside+x'"),
+        "{stderr}"
+    );
 }

@@ -6,7 +6,7 @@ use super::{material_pbrdf, AppError};
 use crate::atomic::OutputSet;
 use crate::fit::{validate_model, Validation};
 use crate::material::Material;
-use crate::measure::{collect_measurement_files, read_measurement_sets, MeasurementSet};
+use crate::measure::{collect_measurement_files, MeasurementSet, ReadOptions};
 use crate::report::fit_report::encode_validation_report;
 use std::path::{Path, PathBuf};
 
@@ -18,17 +18,19 @@ pub struct SetValidation {
     pub report: PathBuf,
 }
 
-/// Scores the model of `material` on every set of `inputs` (files or folders) and writes a
-/// report page per set into `reports_dir`, all or nothing.
+/// Scores the model of `material` on every set of `inputs` (files or folders, read as
+/// `reading` says: a layout, a row selection) and writes a report page per set into
+/// `reports_dir`, all or nothing.
 pub fn validate_and_report(
     material: &Path,
     inputs: &[PathBuf],
+    reading: &ReadOptions,
     reports_dir: &Path,
 ) -> Result<Vec<SetValidation>, AppError> {
     let material = Material::load(material)?;
     let mut sets = Vec::new();
     for file in collect_measurement_files(inputs)? {
-        sets.extend(read_measurement_sets(&file)?);
+        sets.extend(reading.read(&file)?);
     }
     validate_sets(&material, sets, reports_dir)
 }

@@ -177,7 +177,7 @@ impl ModelFit {
 }
 
 /// Rounds of [`fit_model`]'s energy constraint (each may move the facets and so the bound).
-const ENERGY_ROUNDS: usize = 3;
+const ENERGY_ROUNDS: usize = 4;
 
 /// Fits the `kind` family to a prepared measurement, with the energy constraint of
 /// [`super::energy`]: where the fit's model reflects more than 1, its body reflectance is held at

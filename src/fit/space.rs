@@ -9,6 +9,9 @@ use crate::material::ModelSpec;
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{Body, ModelError, ModelTerms, Pbrdf, Shadowing, Subsurface};
 
+/// Lowest n searched with the volume terms (see [`ModelSpace::new`]).
+pub const VOLUME_MIN_N: f64 = 1.0;
+
 /// A family of pBRDF models with some parameters free (docs/design.md §1.3).
 #[derive(Clone, Debug)]
 pub struct ModelSpace {
@@ -38,7 +41,14 @@ impl ModelSpace {
         bounds
             .validate()
             .map_err(|e| FitError::Options(e.to_string()))?;
-        let bounds = bounds.effective(shadowing);
+        let mut bounds = bounds.effective(shadowing);
+        if terms != ModelTerms::default() {
+            // With the volume terms n must mean the material's index: an n below 1 would make
+            // internal facets external ones of index 1/n (the same ε) and, with its own n_sub,
+            // the subsurface term could not tell them apart (docs/design.md §1.10).
+            bounds.n.lower = bounds.n.lower.max(VOLUME_MIN_N);
+            bounds.n.upper = bounds.n.upper.max(bounds.n.lower * 1.5);
+        }
         let free: Vec<Parameter> = Parameter::ALL
             .into_iter()
             .filter(|p| free.contains(p) && kind.has(*p) && terms.has(*p))
