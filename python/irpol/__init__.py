@@ -148,10 +148,25 @@ class Measurements:
         return cls(**d)
 
 
-def read_measurements(path: PathLike) -> List[Measurements]:
-    """Reads a measurement CSV: one :class:`Measurements` per wavelength, ascending. Raises
-    OSError (unreadable) or ValueError (``file:line:column: what is wrong``)."""
-    return [Measurements._from_dict(d) for d in _irpol.read_measurement_sets(os.fspath(path))]
+def read_measurements(
+    path: PathLike,
+    *,
+    layout: Optional[PathLike] = None,
+    wavelength: Optional[float] = None,
+    theta_i: Optional[Sequence[float]] = None,
+) -> List[Measurements]:
+    """Reads a measurement CSV: one :class:`Measurements` per wavelength, ascending. `layout` is
+    an instrument layout TOML to read an instrument's own table through (a file may name its own
+    with a ``# layout: FILE`` line); `wavelength` (µm) and `theta_i` (degrees) keep only those
+    rows, as ``irpol fit --layout --wavelength --theta-i``. Raises OSError (unreadable) or
+    ValueError (``file:line:column: what is wrong``)."""
+    sets = _irpol.read_measurement_sets(
+        os.fspath(path),
+        layout=None if layout is None else os.fspath(layout),
+        wavelength_um=wavelength,
+        theta_i_deg=None if theta_i is None else [float(t) for t in theta_i],
+    )
+    return [Measurements._from_dict(d) for d in sets]
 
 
 from ._fit import FitResult, fit  # noqa: E402  (needs Measurements)

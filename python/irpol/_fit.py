@@ -82,12 +82,16 @@ def fit(
     seed: Optional[int] = None,
     robust: Optional[str] = None,
     dispersion: str = "table",
+    layout: Optional[Union[str, "os.PathLike[str]"]] = None,
+    wavelength: Optional[float] = None,
+    theta_i: Optional[Sequence[float]] = None,
 ) -> List[FitResult]:
     """Fits every material among `inputs` (measurement CSVs or folders of them) as
     ``irpol fit`` does, with its options (same names, values and defaults: `free` as
     ``"sigma,q,n,k,rho"`` or a list, `fix` as ``"k=0.1,rho=0"`` or a dict, `optimizer` as
-    ``"ga+lm"``, `robust` as ``"huber:2"``, `dispersion` as ``"table"`` or ``"lorentz:N"``).
-    Nothing is written. One :class:`FitResult` per material, in the order ``irpol fit`` prints
+    ``"ga+lm"``, `robust` as ``"huber:2"``, `dispersion` as ``"table"`` or ``"lorentz:N"``;
+    `layout` an instrument layout TOML, `wavelength` (µm) and `theta_i` (degrees) the rows kept,
+    as ``--layout``, ``--wavelength``, ``--theta-i``). Nothing is written. One :class:`FitResult` per material, in the order ``irpol fit`` prints
     them. Raises OSError (unreadable input) or ValueError (bad data or options)."""
     if isinstance(inputs, (str, os.PathLike)):
         inputs = [inputs]
@@ -105,5 +109,8 @@ def fit(
         seed=seed,
         robust=robust,
         dispersion=dispersion,
+        layout=None if layout is None else os.fspath(layout),
+        wavelength_um=wavelength,
+        theta_i_deg=None if theta_i is None else [float(t) for t in theta_i],
     )
     return [_result(d) for d in results]

@@ -3,9 +3,9 @@
 
 use crate::errors::raised;
 use crate::material::PyMaterial;
-use crate::measurements::set_dict;
+use crate::measurements::{measurement_args, set_dict};
 use irpol::app::fit::FitFlags;
-use irpol::fit::{fit_inputs, MaterialFit};
+use irpol::fit::{fit_inputs_with, MaterialFit};
 use irpol::measure::MeasurementSet;
 use irpol::optics::Mueller;
 use numpy::{PyArray1, PyArray2};
@@ -14,12 +14,13 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// Fits every material among `inputs` (CSV files or folders) with the options `irpol fit` takes
-/// as flags (same names, same defaults, same messages); one dict per material, in the order
-/// `irpol fit` reports them.
+/// as flags (same names, same defaults, same messages; `layout`, `wavelength_um`, `theta_i_deg`
+/// are `--layout`, `--wavelength`, `--theta-i`); one dict per material, in the order `irpol fit`
+/// reports them.
 #[pyfunction]
 #[pyo3(signature = (inputs, *, distribution = None, shadowing = "smith".to_owned(), free = None,
     fix = None, optimizer = "ga+lm".to_owned(), seed = None, robust = None,
-    dispersion = "table".to_owned()))]
+    dispersion = "table".to_owned(), layout = None, wavelength_um = None, theta_i_deg = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_materials(
     py: Python<'_>,
@@ -32,6 +33,9 @@ pub fn fit_materials(
     seed: Option<u64>,
     robust: Option<String>,
     dispersion: String,
+    layout: Option<PathBuf>,
+    wavelength_um: Option<f64>,
+    theta_i_deg: Option<Vec<f64>>,
 ) -> PyResult<Vec<Bound<'_, PyDict>>> {
     let flags = FitFlags {
         distribution,
@@ -44,8 +48,11 @@ pub fn fit_materials(
         dispersion,
     };
     let options = flags.options().map_err(raised)?;
+    let reading = measurement_args(layout, wavelength_um, theta_i_deg)
+        .read_options()
+        .map_err(raised)?;
     let outcomes = py
-        .detach(|| fit_inputs(&inputs, &options, &irpol::progress::Silent))
+        .detach(|| fit_inputs_with(&inputs, &reading, &options, &irpol::progress::Silent))
         .map_err(raised)?;
     outcomes.iter().map(|o| outcome_dict(py, o)).collect()
 }

@@ -1,6 +1,7 @@
 //! Measurement CSVs (docs/design.md §2.1) read and validated by the library's reader, as numpy arrays.
 
 use crate::errors::raised;
+use irpol::app::{MeasurementArgs, SelectionArgs};
 use irpol::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -9,13 +10,37 @@ use std::path::PathBuf;
 
 /// Every set of one measurement file, one per wavelength (ascending), each as a dict of arrays
 /// (angles in degrees, Mueller elements and their 1-σ uncertainties in sr⁻¹, NaN where the file
-/// gives no uncertainty) and metadata.
+/// gives no uncertainty) and metadata. `layout` (an instrument layout TOML), `wavelength_um` and
+/// `theta_i_deg` are `irpol fit`'s `--layout`, `--wavelength` and `--theta-i`.
 #[pyfunction]
-pub fn read_measurement_sets(py: Python<'_>, path: PathBuf) -> PyResult<Vec<Bound<'_, PyDict>>> {
-    let sets = py
-        .detach(|| irpol::measure::read_measurement_sets(&path))
+#[pyo3(signature = (path, *, layout = None, wavelength_um = None, theta_i_deg = None))]
+pub fn read_measurement_sets(
+    py: Python<'_>,
+    path: PathBuf,
+    layout: Option<PathBuf>,
+    wavelength_um: Option<f64>,
+    theta_i_deg: Option<Vec<f64>>,
+) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    let reading = measurement_args(layout, wavelength_um, theta_i_deg)
+        .read_options()
         .map_err(raised)?;
+    let sets = py.detach(|| reading.read(&path)).map_err(raised)?;
     sets.iter().map(|set| set_dict(py, set)).collect()
+}
+
+/// The command line's reading flags from the Python arguments of the same meaning.
+pub fn measurement_args(
+    layout: Option<PathBuf>,
+    wavelength_um: Option<f64>,
+    theta_i_deg: Option<Vec<f64>>,
+) -> MeasurementArgs {
+    MeasurementArgs {
+        layout,
+        selection: SelectionArgs {
+            wavelength_um,
+            theta_i_deg: theta_i_deg.unwrap_or_default(),
+        },
+    }
 }
 
 pub fn set_dict<'py>(py: Python<'py>, set: &MeasurementSet) -> PyResult<Bound<'py, PyDict>> {

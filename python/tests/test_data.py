@@ -66,6 +66,64 @@ def test_bad_measurement_files_raise_the_cli_message(tmp_path):
     assert str(raised.value) == message
 
 
+PTFE = ROOT / "data" / "ptfe" / "PTFE_351_1064.csv"
+PTFE_LAYOUT = ROOT / "data" / "ptfe" / "layout.toml"
+
+
+def test_read_measurements_through_a_layout():
+    sets = irpol.read_measurements(PTFE, layout=PTFE_LAYOUT)
+    assert [s.wavelength_um for s in sets] == [0.351, 1.064]
+    assert all(s.values.shape == (1824, 16) for s in sets)
+    rows = [r for r in csv.DictReader(open(PTFE)) if r["lambda"] == "1.064"]
+    m00 = np.array([float(r["f_r11"]) for r in rows])
+    assert np.array_equal(sets[1].values[:, 0], m00)
+    # The normal-plane element m33 (f_r44) is the same in xyxy and psps: m00 times the ratio.
+    m33 = np.array([float(r["f_r44/f_r11"]) for r in rows]) * m00
+    assert np.allclose(sets[1].values[:, 15], m33, rtol=1e-15, atol=0)
+    assert np.all(sets[1].uncertainties > 0)
+    assert sets[1].metadata["layout"] == str(PTFE_LAYOUT)
+    [kept] = irpol.read_measurements(PTFE, layout=PTFE_LAYOUT, wavelength=1.064, theta_i=[0, 75])
+    thetas = np.array([abs(float(r["thetai"])) for r in rows])
+    near = (np.abs(thetas - 0) <= 0.05) | (np.abs(thetas - 75) <= 0.05)
+    assert kept.values.shape[0] == near.sum() > 0
+    assert np.array_equal(kept.values[:, 0], m00[near])
+    # Without the layout the instrument's columns are not irpol's.
+    with pytest.raises(ValueError, match="unknown column 'lambda'"):
+        irpol.read_measurements(PTFE)
+
+
+def test_layout_and_selection_refusals_raise_the_cli_message(tmp_path):
+    out = ["--out", tmp_path / "f", "--reports", tmp_path / "r"]
+    message = cli_error("fit", PTFE, "--layout", PTFE_LAYOUT, "--wavelength", "10.6", *out)
+    with pytest.raises(ValueError) as raised:
+        irpol.read_measurements(PTFE, layout=PTFE_LAYOUT, wavelength=10.6)
+    assert str(raised.value) == message
+    with pytest.raises(ValueError) as raised:
+        irpol.fit(PTFE, layout=PTFE_LAYOUT, wavelength=10.6)
+    assert str(raised.value) == message
+    bad = tmp_path / "layout.toml"
+    bad.write_text(PTFE_LAYOUT.read_text().replace('"xyxy"', '"spsp"'))
+    message = cli_error("fit", PTFE, "--layout", bad, *out)
+    with pytest.raises(ValueError) as raised:
+        irpol.read_measurements(PTFE, layout=bad)
+    assert str(raised.value) == message
+    message = cli_error("fit", PTFE, "--layout", tmp_path / "none.toml", *out)
+    with pytest.raises(OSError) as raised:
+        irpol.fit(PTFE, layout=tmp_path / "none.toml")
+    assert str(raised.value) == message
+
+
+def test_fit_through_a_layout_equals_irpol_fit(tmp_path):
+    flags = ["--layout", PTFE_LAYOUT, "--wavelength", "1.064", "--theta-i", "0,30,60,75"]
+    cli_output("fit", PTFE, *flags, "--out", tmp_path / "fits", "--reports", tmp_path / "r")
+    [result] = irpol.fit(PTFE, layout=PTFE_LAYOUT, wavelength=1.064, theta_i=[0, 30, 60, 75])
+    assert result.toml == (tmp_path / "fits" / "PTFE_351_1064.toml").read_text()
+    assert f'layout = "{PTFE_LAYOUT}"' in result.toml
+    [measured] = result.measurements
+    assert measured.wavelength_um == 1.064
+    assert sorted(set(np.round(measured.theta_i_deg))) == [0, 30, 60, 75]
+
+
 def test_fit_equals_irpol_fit(tmp_path):
     source = MEASUREMENTS / "rough_paint.csv"
     options = ["--optimizer", "ga+lm", "--seed", "7", "--fix", "rho=0.03"]
