@@ -459,7 +459,7 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
     };
     let (first, last) = model.range_um();
     format!(
-        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={:.3} → {}",
+        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={:.3}{} → {}",
         outcome.material.name,
         chosen.distribution.name(),
         chosen.dispersion,
@@ -468,6 +468,7 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
         range(&model.n),
         range(&model.k),
         chosen.reduced_chi2,
+        realizability_clause(&outcome.measurements),
         entry.display()
     )
 }
@@ -506,16 +507,36 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
         .as_ref()
         .map_or(String::new(), |c| format!("; {}", c.summary()));
     format!(
-        "{}: {} {}{}{} χ²_red={:.3}{comparison} → {}",
+        "{}: {} {}{}{} χ²_red={:.3}{}{comparison} → {}",
         outcome.material.name,
         chosen.distribution.name(),
         parameters.join(" "),
         listed(" [bounded only: ", &bounded, ", ", "]"),
         listed(" (fixed: ", &fixed, " ", ")"),
         chosen.reduced_chi2,
+        realizability_clause(std::slice::from_ref(&outcome.measurement)),
         entry.display()
     )
 }
+
+/// `; k of N rows not realizable beyond 2σ` (Cloude's test against each row's uncertainty), or
+/// nothing when no row has all sixteen elements to test.
+fn realizability_clause(sets: &[irpol::measure::MeasurementSet]) -> String {
+    let (mut failed, mut checked) = (0, 0);
+    for set in sets {
+        let outcome = irpol::measure::unrealizable_rows(set, REALIZABILITY_SIGMAS);
+        failed += outcome.unrealizable.len();
+        checked += outcome.checked;
+    }
+    if checked == 0 {
+        return String::new();
+    }
+    format!("; {failed} of {checked} rows not realizable beyond {REALIZABILITY_SIGMAS}σ")
+}
+
+/// A measured row counts as not realizable when its coherency matrix's smallest eigenvalue is
+/// below this many standard deviations of its noise (a bound, so noise alone rarely reaches it).
+const REALIZABILITY_SIGMAS: f64 = 2.0;
 
 /// `items` joined by `separator` between `open` and `close`, or nothing when there are none.
 fn listed(open: &str, items: &[String], separator: &str, close: &str) -> String {

@@ -578,6 +578,11 @@ fn fit_through_the_layout_records_it_and_report_rebuilds_the_same_figure() {
     let rows = ptfe_rows_at("1.064", &[0.0, 30.0, 60.0, 75.0]);
     assert!(rows > 1000, "{rows}");
     assert!(stdout.starts_with("PTFE_351_1064: "), "{stdout}");
+    // Every row of PTFE's strongly depolarizing matrices passes Cloude's test.
+    assert!(
+        stdout.contains(&format!("; 0 of {rows} rows not realizable beyond 2σ")),
+        "{stdout}"
+    );
     assert!(
         stderr.contains(&format!(
             "note: {PTFE}: kept the rows at 1.064 µm, one of its 2 wavelengths"
@@ -835,4 +840,94 @@ fn fit_warns_when_degrees_look_like_radians() {
         )),
         "{stderr}"
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Realizability of measured rows (Cloude's test against each row's own noise).
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn rows_are_flagged_unrealizable_only_beyond_their_noise() {
+    let layout = Layout::parse(
+        Path::new("l.toml"),
+        "[columns]\ntheta_i_deg = \"ti\"\ntheta_r_deg = \"tr\"\nm00 = \"M00\"\n\
+         elements = \"M{i}{j}\"\n",
+    )
+    .unwrap();
+    let names: Vec<String> = (0..16).map(|k| format!("M{}{}", k / 4, k % 4)).collect();
+    let mut table = format!("# wavelength_um: 10\nti,tr,{}\n", names.join(","));
+    let diagonal = |d: [f64; 4]| {
+        (0..16)
+            .map(|k| {
+                if k % 5 == 0 {
+                    d[k / 4].to_string()
+                } else {
+                    "0".into()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    // The identity, a realizable depolarizer, and diag(1, 1, 1, −1): eigenvalue −½.
+    for d in [
+        [1.0, 1.0, 1.0, 1.0],
+        [1.0, 0.2, -0.2, -0.2],
+        [1.0, 1.0, 1.0, -1.0],
+    ] {
+        table.push_str(&format!("10,20,{}\n", diagonal(d)));
+    }
+    let set = parse_with_layout(Path::new("t.csv"), table.as_bytes(), &layout)
+        .unwrap()
+        .remove(0);
+    // No uncertainties: any negative eigenvalue beyond rounding counts, a pure one does not.
+    let checked = irpol::measure::unrealizable_rows(&set, 2.0);
+    assert_eq!(
+        (checked.unrealizable.as_slice(), checked.checked),
+        (&[2][..], 3)
+    );
+    let mut noisy = set.clone();
+    for point in &mut noisy.points {
+        point.uncertainties = vec![Some(0.2); 16]; // noise 0.4: −½ is within 2σ
+    }
+    assert!(irpol::measure::unrealizable_rows(&noisy, 2.0)
+        .unrealizable
+        .is_empty());
+    let mut partial = set;
+    partial.elements.truncate(4);
+    let none = irpol::measure::unrealizable_rows(&partial, 2.0);
+    assert_eq!((none.checked, none.unchecked), (0, 3));
+}
+
+/// The shipped PTFE rows read through the layout, with their estimated uncertainties: a
+/// strongly depolarizing sample, every row realizable with a wide margin.
+#[test]
+fn the_shipped_ptfe_rows_are_all_realizable() {
+    let layout = Layout::read(Path::new(PTFE_LAYOUT)).unwrap();
+    for set in read_with_layout(Path::new(PTFE), &layout).unwrap() {
+        let outcome = irpol::measure::unrealizable_rows(&set, 2.0);
+        let at_1 = irpol::measure::unrealizable_rows(&set, 1.0)
+            .unrealizable
+            .len();
+        let at_3 = irpol::measure::unrealizable_rows(&set, 3.0)
+            .unrealizable
+            .len();
+        let smallest = set
+            .points
+            .iter()
+            .map(|p| {
+                let m = irpol::optics::Mueller::from_row_slice(&p.values);
+                irpol::optics::coherency_eigenvalues(&m)[0] / p.values[0]
+            })
+            .fold(f64::INFINITY, f64::min);
+        eprintln!(
+            "PTFE {} µm: {} of {} rows not realizable beyond 2σ (1σ: {at_1}, 3σ: {at_3}); \
+             smallest eigenvalue {smallest:.4} m00",
+            set.wavelength_um,
+            outcome.unrealizable.len(),
+            outcome.checked
+        );
+        assert_eq!((outcome.checked, outcome.unchecked), (1824, 0));
+        assert!(outcome.unrealizable.len() <= at_1 && at_3 <= outcome.unrealizable.len());
+        assert!(at_1 == 0 && smallest > 0.05, "{smallest}");
+    }
 }

@@ -28,6 +28,7 @@ mod layout;
 mod merge;
 mod metadata;
 mod reading;
+mod realizability;
 mod selection;
 
 use std::collections::BTreeMap;
@@ -48,6 +49,7 @@ pub use merge::{merge_repeat_measurements, MergeError, SAME_WAVELENGTH_UM};
 pub use reading::{
     parse_measurement_file, read_measurement_file, ReadError, ReadOptions, LAYOUT_KEY,
 };
+pub use realizability::{unrealizable_rows, Realizability};
 pub use selection::{RowSelection, SelectionError, THETA_I_TOLERANCE_DEG};
 
 /// Column names of the 16 Mueller elements; element (r, c) has index r*4 + c (row-major).

@@ -8,6 +8,7 @@ pub mod frame;
 mod fresnel;
 mod planck;
 mod polarization;
+mod realizability;
 
 pub use band_nodes::{SpectralMix, TableMissesBand, WavelengthNodes};
 pub use brightness::TemperatureLookup;
@@ -21,3 +22,4 @@ pub use planck::{
 pub use polarization::{
     fresnel_mueller, jones_to_mueller, rotate_stokes, stokes_rotator, Mueller, Stokes,
 };
+pub use realizability::{coherency_eigenvalues, coherency_matrix, Coherency};
