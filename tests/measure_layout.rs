@@ -591,7 +591,10 @@ fn fit_through_the_layout_records_it_and_report_rebuilds_the_same_figure() {
         format!("{PTFE} at 1.064 µm: kept {rows} rows of 1824 with θ_i = 0, 30, 60, 75°"),
     ] {
         assert!(stderr.contains(&format!("note: {note}\n")), "{stderr}");
-        assert!(page.contains(&format!("\n{note}\n")), "the page lacks: {note}");
+        assert!(
+            page.contains(&format!("\n{note}\n")),
+            "the page lacks: {note}"
+        );
     }
     let entry = dir.path().join("fits/PTFE_351_1064.toml");
     let material = irpol::material::Material::load(&entry).unwrap();
