@@ -583,14 +583,19 @@ fn fit_through_the_layout_records_it_and_report_rebuilds_the_same_figure() {
         stdout.contains(&format!("; 0 of {rows} rows not realizable beyond 2σ")),
         "{stdout}"
     );
-    assert!(
-        stderr.contains(&format!(
-            "note: {PTFE}: kept the rows at 1.064 µm, one of its 2 wavelengths"
-        )) && stderr.contains(&format!(
-            "note: {PTFE} at 1.064 µm: kept {rows} rows of 1824 with θ_i = 0, 30, 60, 75°"
-        )),
-        "{stderr}"
-    );
+    // docs/measurements.md's worked example shows the command and these notes.
+    let page = std::fs::read_to_string("docs/measurements.md").unwrap();
+    assert!(page.contains(&format!("\nirpol fit {PTFE} {}", extra.join(" "))));
+    for note in [
+        format!("{PTFE}: kept the rows at 1.064 µm, one of its 2 wavelengths"),
+        format!("{PTFE} at 1.064 µm: kept {rows} rows of 1824 with θ_i = 0, 30, 60, 75°"),
+    ] {
+        assert!(stderr.contains(&format!("note: {note}\n")), "{stderr}");
+        assert!(
+            page.contains(&format!("\n{note}\n")),
+            "the page lacks: {note}"
+        );
+    }
     let entry = dir.path().join("fits/PTFE_351_1064.toml");
     let material = irpol::material::Material::load(&entry).unwrap();
     let record = material.fit.unwrap();

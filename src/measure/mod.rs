@@ -17,6 +17,11 @@
 //! any of m01…m33, and absolute 1-σ uncertainties u_m00…u_m33 for any subset of the elements
 //! present. Mueller elements are BRDF values in sr⁻¹ in SCATMECH's psps convention (docs/design.md §1.3),
 //! not normalized by m00.
+//!
+//! Tables in an instrument's own columns and conventions are read through a [`Layout`]
+//! (docs/design.md §2.8), given by the caller or named by the file's `# layout: FILE` line
+//! ([`read_measurement_file`]); [`RowSelection`] keeps one wavelength and chosen incidence angles,
+//! and [`unrealizable_rows`] flags rows that no passive surface can produce (Cloude).
 
 mod columns;
 mod csv_reader;
