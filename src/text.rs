@@ -1,5 +1,7 @@
 //! User text quoted in error messages. Every reader (measurement CSV, OBJ, PLY, eval geometry CSV,
-//! material TOML) quotes the offending text through [`shown`] or [`shown_at_most`], so that a stray
+//! material and scene TOML, weather CSV, times file, `--times` and other flags) quotes the
+//! offending text through [`shown`], [`shown_at_most`] or [`parser_message`], and a scene's names
+//! pass [`name_problem`] before any message quotes them whole, so that a stray
 //! control character (a carriage return, an escape sequence, a NUL) is visible in the message
 //! instead of acting on the user's terminal, and a multi-megabyte line cannot become a
 //! multi-megabyte message: one message stays one short line.
@@ -60,6 +62,32 @@ pub fn significant(value: f64, digits: i32) -> String {
     format!("{value:.decimals$}")
 }
 
+/// Longest name (of an object, part, material or layer) a scene may give, in characters: messages
+/// quote names whole, so a name stays short enough for a one-line message.
+pub const MAX_NAME_CHARS: usize = 100;
+
+/// Why `name` cannot be a name that messages quote whole, if it cannot: it holds a control
+/// character or is longer than [`MAX_NAME_CHARS`]. The reason quotes it through [`shown`].
+pub fn name_problem(name: &str) -> Option<String> {
+    if name.chars().any(is_hidden) {
+        return Some(format!("'{}' contains a control character", shown(name)));
+    }
+    let count = name.chars().count();
+    (count > MAX_NAME_CHARS).then(|| {
+        format!(
+            "'{}' is {count} characters long; at most {MAX_NAME_CHARS}",
+            shown(name)
+        )
+    })
+}
+
+/// A parser's message as one short line: runs of whitespace (its line breaks) as one space,
+/// control characters escaped, at most `max_chars` characters.
+pub fn parser_message(message: &str, max_chars: usize) -> String {
+    let joined = message.split_whitespace().collect::<Vec<_>>().join(" ");
+    shown_at_most(&joined, max_chars)
+}
+
 /// Characters that a terminal acts on or that reorder the text around them: C0/C1 controls and
 /// the Unicode bidirectional marks, embeddings, overrides and isolates.
 fn is_hidden(c: char) -> bool {
@@ -96,5 +124,25 @@ mod tests {
         assert_eq!(about(7.200000000001e12), "7.2e12");
         assert_eq!(about(123456.7), "123000");
         assert_eq!(about(-0.000123456), "-0.000123");
+    }
+
+    #[test]
+    fn names_are_short_and_printable_and_parser_messages_one_short_line() {
+        assert_eq!(name_problem("hood"), None);
+        assert_eq!(name_problem(&"é".repeat(MAX_NAME_CHARS)), None);
+        let long = name_problem(&"n".repeat(101)).unwrap();
+        assert!(
+            long.ends_with("is 101 characters long; at most 100"),
+            "{long}"
+        );
+        assert_eq!(
+            name_problem("a\u{1e}b").unwrap(),
+            "'a\\u{1e}b' contains a control character"
+        );
+        assert_eq!(
+            parser_message("unknown\n  field `x\u{1b}`", 100),
+            "unknown field `x\\u{1b}`"
+        );
+        assert_eq!(parser_message(&"x ".repeat(500), 10), "x x x x x …");
     }
 }

@@ -617,3 +617,65 @@ fn fit_skips_a_file_in_the_library_that_is_not_a_material_with_a_warning() {
         "todo = [\"refit glass\"]\n"
     );
 }
+
+/// Every error that quotes input quotes it cut short and with control characters escaped: a
+/// scene name, a scene value the TOML reader quotes, a `--times` spec.
+#[test]
+fn quoted_input_is_cut_short_and_escaped() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |object_name: &str| {
+        format!(
+            "{}{}{}[[objects]]\nname = \"{object_name}\"\n\
+             shape = {{ kind = \"sphere\", radius = 1.0, subdivisions = 1 }}\n\
+             material = \"m\"\ntemperature_k = 300.0\n",
+            common::camera_toml(8),
+            common::AUTUMN_ENVIRONMENT,
+            common::material_toml(0.2, 2.0, 1.5, 0.1, 0.05),
+        )
+    };
+    let render = |text: &str, extra: &[&str]| {
+        let path = dir.path().join("scene.toml");
+        std::fs::write(&path, text).unwrap();
+        let out = dir.path().join("out");
+        let mut args = vec![
+            "render",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let (ok, _, stderr) = irpol(&args);
+        assert!(!ok && !out.exists(), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.chars().count() < 400, "{stderr}");
+        assert!(
+            !stderr.trim_end().chars().any(char::is_control),
+            "{stderr:?}"
+        );
+        stderr
+    };
+    let long = "b".repeat(300);
+    let stderr = render(&scene(&long), &[]);
+    assert!(
+        stderr.contains(&format!(
+            "objects[0].name: the name '{}…' is 300 characters long; at most 100",
+            "b".repeat(40)
+        )),
+        "{stderr}"
+    );
+    let stderr = render(&scene("car\\u001eleft"), &[]);
+    assert!(
+        stderr.contains("objects[0].name: the name 'car\\u{1e}left' contains a control character"),
+        "{stderr}"
+    );
+    // The TOML reader's own message quotes the bad value: cut and escaped too.
+    let bad_kind = scene("ball").replace("\"sphere\"", &format!("\"sph\\u001e{long}\""));
+    let stderr = render(&bad_kind, &[]);
+    assert!(stderr.contains("not a valid scene: line"), "{stderr}");
+    let spec = format!("0:{}:1\u{1e}", "9".repeat(100_000));
+    let stderr = render(&scene("ball"), &["--times", &spec]);
+    assert!(
+        stderr.contains(&format!("--times: '{}…' is not finite", "9".repeat(40))),
+        "{stderr}"
+    );
+}

@@ -1,19 +1,26 @@
-//! Bounded fuzzing of every reader of user files: the measurement CSV reader, the OBJ
-//! and PLY mesh readers, the material TOML loader, the eval geometry reader and the thermal
-//! weather CSV reader get random bytes
-//! and mutations of real inputs (the shipped measurements and materials, excerpts of the car
-//! mesh, small PLY files, weather CSVs). Whatever they are fed, they must return — a value or an error whose
-//! message is one line without control characters — and never panic.
+//! Bounded fuzzing of every reader of user files and flags: the measurement CSV reader, the OBJ
+//! and PLY mesh readers, the material TOML loader (grey and spectral), the eval geometry reader,
+//! the thermal weather CSV reader, the scene loader (a thermal scene's keys), the `--times`
+//! sweep and the `sun --times-file` reader get random bytes and mutations of real inputs (the
+//! shipped measurements and materials, excerpts of the car mesh, small PLY files, weather CSVs, a
+//! thermal scene, sweeps and instants), some with runs of thousands of one character. Whatever
+//! they are fed, they must return — a value or an error whose message is one line of at most a
+//! few hundred characters without control characters — and never panic. (The sweep specs of
+//! `python -m irpol.dataset` are read in Python; what they reach in Rust is the scene loader.)
 //!
-//! Each property runs a fixed number of cases with proptest's default deterministic-per-run RNG;
-//! together they take well under 20 s in a release build. Raise `FUZZ_CASES` (environment) to
-//! fuzz longer, e.g. `FUZZ_CASES=100000 cargo test --release --test fuzz_readers`.
+//! Each property runs a fixed number of cases with proptest's default deterministic-per-run RNG
+//! (the scene loader, the slowest reader, a tenth as many); together they take well under 30 s
+//! in a release build. Raise `FUZZ_CASES` (environment) to fuzz longer, e.g.
+//! `FUZZ_CASES=100000 cargo test --release --test fuzz_readers`.
 
 use irpol::app::evaluate::{parse_geometry_csv, write_mueller_csv};
+use irpol::app::sun::parse_times;
+use irpol::app::{one_line, parse_sweep, MAX_SWEEP_VALUES};
 use irpol::material::Material;
 use irpol::measure::parse_measurement_csv;
 use irpol::optics::RefractiveIndex;
 use irpol::pbrdf::{Pbrdf, Shadowing, SlopeDistribution};
+use irpol::scene::load_scene_text;
 use irpol::scene::obj::parse_obj;
 use irpol::scene::ply::parse_ply;
 use irpol::thermal::{Site, Weather};
@@ -28,6 +35,16 @@ fn config() -> ProptestConfig {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(DEFAULT_CASES);
+    config_of(cases)
+}
+
+/// [`config`] with a tenth of the cases, for readers that build a whole scene per case.
+fn scene_config() -> ProptestConfig {
+    let cases = config().cases;
+    config_of((cases / 10).max(1))
+}
+
+fn config_of(cases: u32) -> ProptestConfig {
     ProptestConfig {
         cases,
         // Failures are reported with the shrunk input; nothing is written into the source tree.
@@ -159,6 +176,8 @@ enum Mutation {
     Repeat(f64, f64, usize),
     /// Keep only a relative prefix.
     Truncate(f64),
+    /// Insert one byte repeated 1000 to 4000 times (a line or value far too long to quote).
+    Long(f64, u8, usize),
 }
 
 fn mutation() -> impl Strategy<Value = Mutation> {
@@ -170,7 +189,9 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         4 => (at.clone(), 0..TOKENS.len()).prop_map(|(p, t)| Mutation::Token(p, t)),
         2 => (at.clone(), 0.0..0.2f64).prop_map(|(p, w)| Mutation::Remove(p, w)),
         1 => (at.clone(), 0.0..0.05f64, 1..8usize).prop_map(|(p, w, n)| Mutation::Repeat(p, w, n)),
-        1 => at.prop_map(Mutation::Truncate),
+        1 => at.clone().prop_map(Mutation::Truncate),
+        1 => (at, prop_oneof![Just(b'9'), Just(b'a'), Just(0x1e), any::<u8>()], 1000..4000usize)
+            .prop_map(|(p, b, n)| Mutation::Long(p, b, n)),
     ]
 }
 
@@ -204,6 +225,10 @@ fn apply(mut bytes: Vec<u8>, mutations: &[Mutation]) -> Vec<u8> {
                 bytes.splice(end..end, piece);
             }
             Mutation::Truncate(p) => bytes.truncate(index(len, *p)),
+            Mutation::Long(p, byte, n) => {
+                let i = index(len, *p);
+                bytes.splice(i..i, std::iter::repeat_n(*byte, *n));
+            }
         }
     }
     bytes
@@ -230,13 +255,14 @@ fn noise() -> impl Strategy<Value = Vec<u8>> {
     ]
 }
 
-/// An error message as the CLI prints it must be one line without raw control characters.
+/// An error message as the CLI prints it must be one line without raw control characters, its
+/// length bounded whatever the input (quoted text is cut: a 4000-character value stays short).
 fn check_message(message: &str) -> Result<(), TestCaseError> {
     prop_assert!(
         !message.chars().any(char::is_control),
         "control character in {message:?}"
     );
-    prop_assert!(message.chars().count() < 1000, "long message {message:?}");
+    prop_assert!(message.chars().count() < 800, "long message {message:?}");
     Ok(())
 }
 
@@ -286,14 +312,98 @@ fn weather_seeds() -> Vec<Vec<u8>> {
 }
 
 fn material_seeds() -> Vec<Vec<u8>> {
-    ["paper_paint", "anodized_panel"]
+    ["paper_paint", "anodized_panel", "silicate_glass"]
         .iter()
         .map(|name| shipped(&format!("fits/{name}.toml")))
         .collect()
 }
 
+/// A thermal scene with every kind of thermal key: weather, site, steps, layers, stacks, a
+/// part's own stack, back conditions, absorptance; and one with a weather file (not there).
+fn scene_seeds() -> Vec<Vec<u8>> {
+    let scene = "[camera]\nposition = [6.0, -6.0, 3.0]\nlook_at = [0.0, 0.0, 0.5]\nfov_deg = 40.0\n\
+        resolution = [64, 48]\n\
+        [environment]\nair_temperature_k = 290.0\n\
+        sky = { model = \"window\", zenith_emissivity = 0.75 }\n\
+        ground = { temperature_k = 290.0, emissivity = 0.95 }\n\
+        [render]\nsamples = 2\n\
+        [materials.paint]\ndistribution = \"cauchy\"\nsigma = 0.2\nq = 2.0\nn = 1.5\nk = 0.2\n\
+        rho_d = 0.02\nshadowing = \"smith\"\n\
+        [thermal]\n\
+        weather = { clear_day = { air_min_k = 287.0, air_max_k = 301.0, wind_m_s = 2.0 } }\n\
+        start_utc = \"2026-06-21T00:00:00Z\"\nlatitude_deg = 48.14\nlongitude_deg = 11.58\n\
+        duration_h = 12\noutput_step_s = 3600\ntime_step_s = 600\nshadow_step_s = 1800\n\
+        spinup_days = 1\nground_temperature_k = 288.0\n\
+        [thermal.layers.paint]\nconductivity_w_mk = 0.2\ndensity_kg_m3 = 1200.0\n\
+        heat_capacity_j_kgk = 1500.0\n\
+        [thermal.layers.steel]\nconductivity_w_mk = 45.0\ndensity_kg_m3 = 7850.0\n\
+        heat_capacity_j_kgk = 470.0\n\
+        [[objects]]\nname = \"ball\"\nshape = { kind = \"sphere\", radius = 0.5, subdivisions = 1 }\n\
+        translate = [0.0, 0.0, 0.8]\nmaterial = \"paint\"\n\
+        [objects.thermal]\nstack = [[\"paint\", 0.0001], [\"steel\", 0.001]]\n\
+        back = { convection_w_m2k = 3.0 }\nsolar_absorptance = 0.6\n\
+        [[objects]]\nname = \"ground\"\nshape = { kind = \"plane\", size = [8.0, 8.0], divisions = [2, 2] }\n\
+        material = \"paint\"\n\
+        [objects.thermal]\nstack = [[\"steel\", 0.2]]\nback = { temperature_k = 290.0 }\n\
+        solar_absorptance = 0.9\n";
+    let with_file = scene.replace(
+        "weather = { clear_day = { air_min_k = 287.0, air_max_k = 301.0, wind_m_s = 2.0 } }",
+        "weather = \"munich.csv\"",
+    );
+    vec![scene.as_bytes().to_vec(), with_file.into_bytes()]
+}
+
+fn sweep_seeds() -> Vec<Vec<u8>> {
+    [
+        "0:86400:10800",
+        "0:21600:7200",
+        "3600",
+        "-1e3:1e3:0.5",
+        " 0 : 10 : 1 ",
+    ]
+    .map(|s| s.as_bytes().to_vec())
+    .to_vec()
+}
+
+fn times_file_seeds() -> Vec<Vec<u8>> {
+    vec![
+        b"# Munich, 21 June\n2026-06-21T06:00:00Z\n\n2026-06-21T11:00:00.5+02:00\n".to_vec(),
+        b"2026-12-21T12:00:00Z\r\n  2027-01-01T00:00:00-05:30  \r\n".to_vec(),
+    ]
+}
+
+proptest! {
+    #![proptest_config(scene_config())]
+
+    #[test]
+    fn thermal_scene_loader_never_panics(bytes in prop_oneof![mutated(scene_seeds()), noise()]) {
+        if let Err(e) = load_scene_text(Path::new("fuzz/scene.toml"), &text(&bytes)) {
+            check_message(&e.to_string())?;
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(config())]
+
+    #[test]
+    fn times_sweep_never_panics(bytes in prop_oneof![mutated(sweep_seeds()), noise()]) {
+        match parse_sweep(&text(&bytes), "times") {
+            Ok(times) => {
+                prop_assert!(!times.is_empty() && times.len() <= MAX_SWEEP_VALUES);
+                prop_assert!(times.iter().all(|t| t.is_finite()));
+            }
+            Err(e) => check_message(&one_line(&e))?,
+        }
+    }
+
+    #[test]
+    fn times_file_reader_never_panics(bytes in prop_oneof![mutated(times_file_seeds()), noise()]) {
+        if let Err(e) = parse_times(Path::new("times.txt"), &text(&bytes)) {
+            check_message(&one_line(&e))?;
+        }
+    }
+
 
     #[test]
     fn measurement_reader_never_panics(bytes in prop_oneof![mutated(measurement_seeds()), noise()]) {
@@ -362,5 +472,20 @@ proptest! {
             }
             Err(e) => check_message(&e.to_string())?,
         }
+    }
+}
+
+/// The seeds are valid input, so the mutations start from text that reaches every check.
+#[test]
+fn the_seeds_are_read() {
+    load_scene_text(Path::new("fuzz/scene.toml"), &text(&scene_seeds()[0])).unwrap();
+    for seed in sweep_seeds() {
+        parse_sweep(&text(&seed), "times").unwrap();
+    }
+    for seed in times_file_seeds() {
+        assert_eq!(
+            parse_times(Path::new("t.txt"), &text(&seed)).unwrap().len(),
+            2
+        );
     }
 }

@@ -79,6 +79,34 @@ fn a_times_file_gives_one_line_per_instant_in_order() {
     assert!(elevation[1] > elevation[0] && elevation[1] > elevation[2]);
 }
 
+/// A bad line of a times file is quoted cut short and with its control characters escaped: a
+/// 100 000-character line gives a short message, a record separator (0x1e) shows as `\u{1e}`.
+#[test]
+fn a_bad_times_line_is_quoted_short_and_escaped() {
+    let long = format!("2026-06-21T06:00:00Z\n{}\n", "9".repeat(100_000));
+    let (ok, _, stderr) = munich_times(&long, &[]);
+    assert!(!ok);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.chars().count() < 400, "{} characters", stderr.len());
+    assert!(
+        stderr.contains(&format!(
+            "times.txt:2: time '{}…' is not an RFC 3339 instant",
+            "9".repeat(40)
+        )),
+        "{stderr}"
+    );
+    let (ok, _, stderr) = munich_times("2026-06-21T06:00:00Z\u{1e}\n", &[]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("time '2026-06-21T06:00:00Z\\u{1e}'"),
+        "{stderr:?}"
+    );
+    assert!(
+        !stderr.trim_end().chars().any(char::is_control),
+        "{stderr:?}"
+    );
+}
+
 #[test]
 fn bad_input_is_one_clear_line() {
     let base = ["sun", "--latitude", "48.14", "--longitude", "11.58"];

@@ -71,7 +71,8 @@ impl FitFlags {
             dispersion: Dispersion::parse(&self.dispersion)?,
             shadowing: Shadowing::parse(shadowing).ok_or_else(|| {
                 AppError::invalid(format!(
-                    "unknown shadowing '{shadowing}': use none, torrance-sparrow or smith"
+                    "unknown shadowing '{}': use none, torrance-sparrow or smith",
+                    crate::text::shown(shadowing)
                 ))
             })?,
             optimizer: Optimizer::parse(&self.optimizer)?,

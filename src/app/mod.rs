@@ -19,6 +19,7 @@ use crate::optics::RefractiveIndex;
 use crate::pbrdf::{
     DistributionError, DistributionKind, FacetSide, ModelError, Pbrdf, Shadowing, Subsurface,
 };
+use crate::text::shown;
 use std::path::PathBuf;
 
 /// A pBRDF chosen on the command line: a material file, or parameters (the flags of `eval` and
@@ -72,9 +73,12 @@ pub struct ModelArgs {
 /// Why the model of [`ModelArgs`] or of a material cannot be built.
 #[derive(Debug, thiserror::Error)]
 pub enum ModelArgsError {
-    #[error("unknown shadowing '{0}': use none, torrance-sparrow or smith")]
+    #[error(
+        "unknown shadowing '{}': use none, torrance-sparrow or smith",
+        crate::text::shown(.0)
+    )]
     UnknownShadowing(String),
-    #[error("unknown facet side '{0}': use external or internal")]
+    #[error("unknown facet side '{}': use external or internal", crate::text::shown(.0))]
     UnknownFacet(String),
     #[error("--d and --n-sub belong to the subsurface term: give --rho-s too")]
     PolarizationWithoutSubsurface,
@@ -281,11 +285,14 @@ pub fn parse_sweep(text: &str, name: &str) -> Result<Vec<f64>, AppError> {
         let value: f64 = s
             .trim()
             .parse()
-            .map_err(|_| AppError::invalid(format!("--{name}: '{s}' is not a number")))?;
+            .map_err(|_| AppError::invalid(format!("--{name}: '{}' is not a number", shown(s))))?;
         if value.is_finite() {
             Ok(value)
         } else {
-            Err(AppError::invalid(format!("--{name}: '{s}' is not finite")))
+            Err(AppError::invalid(format!(
+                "--{name}: '{}' is not finite",
+                shown(s)
+            )))
         }
     };
     match parts.as_slice() {
@@ -294,7 +301,8 @@ pub fn parse_sweep(text: &str, name: &str) -> Result<Vec<f64>, AppError> {
             let (start, stop, step) = (number(start)?, number(stop)?, number(step)?);
             if step <= 0.0 || stop < start {
                 return Err(AppError::invalid(format!(
-                    "--{name}: need STEP > 0 and STOP ≥ START in START:STOP:STEP, got '{text}'"
+                    "--{name}: need STEP > 0 and STOP ≥ START in START:STOP:STEP, got '{}'",
+                    shown(text)
                 )));
             }
             // Counted in floating point first: a tiny step (1e-300) makes the quotient overflow
@@ -302,7 +310,8 @@ pub fn parse_sweep(text: &str, name: &str) -> Result<Vec<f64>, AppError> {
             let steps = ((stop - start) / step + 1e-9).floor();
             if !steps.is_finite() || steps >= MAX_SWEEP_VALUES as f64 {
                 return Err(AppError::invalid(format!(
-                    "--{name}: '{text}' asks for {} values; at most {MAX_SWEEP_VALUES}",
+                    "--{name}: '{}' asks for {} values; at most {MAX_SWEEP_VALUES}",
+                    shown(text),
                     if steps.is_finite() {
                         crate::text::number(steps + 1.0)
                     } else {
@@ -314,7 +323,8 @@ pub fn parse_sweep(text: &str, name: &str) -> Result<Vec<f64>, AppError> {
             Ok((0..count).map(|i| start + i as f64 * step).collect())
         }
         _ => Err(AppError::invalid(format!(
-            "--{name}: expected a number or START:STOP:STEP, got '{text}'"
+            "--{name}: expected a number or START:STOP:STEP, got '{}'",
+            shown(text)
         ))),
     }
 }

@@ -21,6 +21,11 @@ pub fn read_times_file(path: &Path) -> Result<Vec<DateTime<Utc>>, AppError> {
         path: path.to_owned(),
         source,
     })?;
+    parse_times(path, &text)
+}
+
+/// [`read_times_file`] of a file's text; `path` names it in messages.
+pub fn parse_times(path: &Path, text: &str) -> Result<Vec<DateTime<Utc>>, AppError> {
     let mut times = Vec::new();
     for (index, line) in text.lines().enumerate() {
         let line = line.trim();

@@ -137,7 +137,7 @@ pub fn parse_time_utc(text: &str) -> Result<DateTime<Utc>, SunError> {
     DateTime::parse_from_rfc3339(text.trim())
         .map(|time| time.with_timezone(&Utc))
         .map_err(|error| SunError::InvalidTime {
-            text: text.to_string(),
+            text: crate::text::shown(text),
             reason: error.to_string(),
         })
 }

@@ -26,18 +26,20 @@ pub enum OptionError {
     GivenTwice(Parameter),
     #[error("no name=value pair given")]
     NoPairs,
-    #[error("robust loss scale '{0}' is not a number")]
+    #[error("robust loss scale '{}' is not a number", shown(.0))]
     RobustScaleNotNumber(String),
     #[error("robust loss scale {0} must be finite and > 0")]
     RobustScale(f64),
-    #[error("unknown robust loss '{0}' (huber or cauchy)")]
+    #[error("unknown robust loss '{}' (huber or cauchy)", shown(.0))]
     UnknownRobustLoss(String),
     #[error("the optimizer needs at least one stage")]
     NoStage,
     #[error("the genetic stage (ga) can only come first")]
     GeneticNotFirst,
     #[error(
-        "unknown optimizer stage '{stage}' in '{text}' (use ga, nm, lm joined by +, e.g. ga+nm)"
+        "unknown optimizer stage '{}' in '{}' (use ga, nm, lm joined by +, e.g. ga+nm)",
+        shown(.stage),
+        shown(.text)
     )]
     UnknownStage { stage: String, text: String },
     #[error(

@@ -120,7 +120,11 @@ pub enum DistributionKind {
 /// Why a distribution name or a distribution's parameters are refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum DistributionError {
-    #[error("unknown distribution '{0}': use {names}", names = DistributionKind::names())]
+    #[error(
+        "unknown distribution '{}': use {names}",
+        crate::text::shown(.0),
+        names = DistributionKind::names()
+    )]
     Unknown(String),
     #[error("the {0} distribution needs q")]
     NeedsQ(DistributionKind),

@@ -130,7 +130,7 @@ impl SceneError {
             file: file.to_owned(),
             line,
             column,
-            message: error.message().to_owned(),
+            message: crate::text::parser_message(error.message(), PARSER_MESSAGE_CHARS),
         }
     }
 }
@@ -150,7 +150,14 @@ fn labelled(item: &Option<String>, error: &SceneMaterialError) -> String {
     }
 }
 
-/// Messages are kept to one line (some parsers format theirs over several).
+/// Characters of the TOML reader's own message kept in ours (it may quote a whole value).
+const PARSER_MESSAGE_CHARS: usize = 200;
+
+/// Characters of a message kept at most: a safety net over the quoting of each value.
+const MESSAGE_CHARS: usize = 800;
+
+/// Messages are kept to one short line of printable characters (some parsers format theirs over
+/// several, and a message may carry text of the scene's files).
 fn one_line(message: &str) -> String {
-    message.split_whitespace().collect::<Vec<_>>().join(" ")
+    crate::text::parser_message(message, MESSAGE_CHARS)
 }

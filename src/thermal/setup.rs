@@ -151,8 +151,9 @@ pub enum PartThermalError {
     #[error("stack is empty: give [[layer name, thickness_m], …] front to back")]
     EmptyStack,
     #[error(
-        "stack: layer '{name}' is not defined in [thermal.layers] (defined: {})",
-        if defined.is_empty() { "none".to_owned() } else { defined.join(", ") }
+        "stack: layer '{}' is not defined in [thermal.layers] (defined: {})",
+        crate::text::shown(name),
+        if defined.is_empty() { "none".to_owned() } else { crate::text::shown_at_most(&defined.join(", "), 200) }
     )]
     UnknownLayer { name: String, defined: Vec<String> },
     #[error("stack: {0}")]
