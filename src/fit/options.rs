@@ -80,7 +80,7 @@ impl FitOptions {
         match &self.free {
             None => Ok(Parameter::ALL
                 .into_iter()
-                .filter(|p| !self.fixed.contains_key(p))
+                .filter(|p| self.terms.has(*p) && !self.fixed.contains_key(p))
                 .collect()),
             Some(free) => {
                 if let Some(p) = free.iter().find(|p| self.fixed.contains_key(p)) {

@@ -18,7 +18,8 @@ pub use spectral::{
 use crate::atomic::write_atomically;
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{
-    FacetSide, ModelError, Parameter, Pbrdf, Shadowing, SlopeDistribution, Subsurface,
+    Body, FacetSide, ModelError, ModelTerms, Parameter, Pbrdf, Shadowing, SlopeDistribution,
+    Subsurface,
 };
 use crate::text::{number, shown, shown_at_most, significant};
 use serde::{Deserialize, Serialize};
@@ -91,6 +92,16 @@ impl ModelSpec {
             Parameter::NSub => self.rho_s.map(|_| self.n_sub.unwrap_or(self.n)),
             slope => self.distribution.parameter(slope),
         }
+    }
+
+    /// The model's terms (docs/design.md §1.10).
+    pub fn terms(&self) -> ModelTerms {
+        let body = if self.rho_s.is_some() {
+            Body::Subsurface
+        } else {
+            Body::Depolarizer
+        };
+        ModelTerms::new(self.facet, body)
     }
 
     /// The subsurface term, if the model has one.

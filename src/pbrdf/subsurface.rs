@@ -223,8 +223,9 @@ mod tests {
                 r_ref += 2.0 * (1.0 - t.plus) * mu / steps as f64;
                 a_ref += 2.0 * t.minus * mu / steps as f64;
             }
-            assert!((r - r_ref).abs() < 1e-9, "{n} {k}: {r} vs {r_ref}");
-            assert!((a - a_ref).abs() < 1e-9, "{n} {k}: {a} vs {a_ref}");
+            // The midpoint rule's own error at the kink of n < 1 is ~5e-9.
+            assert!((r - r_ref).abs() < 2e-8, "{n} {k}: {r} vs {r_ref}");
+            assert!((a - a_ref).abs() < 2e-8, "{n} {k}: {a} vs {a_ref}");
         }
         // The classic value for n = 1.5: hemispherical reflectance 0.0918 (e.g. Duntley 1942).
         let (r, _) = interface_means(RefractiveIndex::new(1.5, 0.0).permittivity());

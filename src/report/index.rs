@@ -272,9 +272,17 @@ fn model_cells(material: &Material) -> (String, Vec<String>) {
     match &material.model {
         MaterialModel::Grey(model) => (
             format_plain(model.wavelength_um),
-            parameters(model)
+            // The summary's columns are §1.3's σ, q, n, k, ρ_d; a volume model's own parameters
+            // are in its section below.
+            ["sigma", "q", "n", "k", "rho_d"]
                 .into_iter()
-                .map(|(_, name, value)| cell(name, value))
+                .map(|name| {
+                    let value = parameters(model)
+                        .into_iter()
+                        .find(|(_, n, _)| *n == name)
+                        .and_then(|(_, _, v)| v);
+                    cell(name, value)
+                })
                 .collect(),
         ),
         MaterialModel::Spectral(model) => {

@@ -78,11 +78,14 @@ pub fn format_angle(degrees: f64) -> String {
     text.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
-/// The model parameters: (symbol, name in `FitRecord` maps, value).
+/// The parameters of the model's terms: (symbol, name in `FitRecord` maps, value).
 pub fn parameters(model: &ModelSpec) -> Vec<(&'static str, &'static str, Option<f64>)> {
+    let terms = model.terms();
     Parameter::ALL
+        .into_iter()
+        .filter(|p| terms.has(*p))
         .map(|p| (p.label(), p.name(), model.parameter(p)))
-        .to_vec()
+        .collect()
 }
 
 /// A fit map entry under the parameter's name, accepting `rho` for `rho_d` (docs/design.md §4 spelling).
