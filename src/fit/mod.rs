@@ -35,6 +35,7 @@ mod robust;
 mod space;
 mod spectral;
 mod stages;
+mod terms_choice;
 mod uncertainty;
 mod validation;
 

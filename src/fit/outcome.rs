@@ -24,7 +24,7 @@ pub struct FitOutcome {
     pub alternative: Option<ModelFit>,
     pub comparison: Option<ModelComparison>,
     /// How the model's terms were chosen, when there was a choice (`--terms a,b`, `--cv K`).
-    pub terms_choice: Option<super::cross_validation::TermsChoice>,
+    pub terms_choice: Option<super::terms_choice::TermsChoice>,
 }
 
 /// Fits one measurement: each requested distribution (both in parallel when
@@ -134,13 +134,7 @@ fn fit_record(
         fixed_parameters: fixed_values(chosen),
         optimizer: options.optimizer.to_string(),
         seed: options.seed,
-        settings: {
-            let mut settings = settings(data, options);
-            if let Some(energy) = &chosen.energy {
-                settings.insert("energy".into(), energy.clone());
-            }
-            settings
-        },
+        settings: settings_with_energy(data, options, chosen),
         iterations: chosen.history.iterations(),
         evaluations: chosen.evaluations,
         cost: chosen.cost,
@@ -181,6 +175,19 @@ fn fit_record(
 }
 
 /// The settings that, with the optimizer name and seed, reproduce the fit.
+/// [`settings`], and what the energy constraint did to `chosen` when it did anything.
+fn settings_with_energy(
+    data: &MeasurementData,
+    options: &FitOptions,
+    chosen: &ModelFit,
+) -> BTreeMap<String, String> {
+    let mut settings = settings(data, options);
+    if let Some(energy) = &chosen.energy {
+        settings.insert("energy".into(), energy.clone());
+    }
+    settings
+}
+
 pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap<String, String> {
     let mut settings = BTreeMap::new();
     settings.insert("uncertainties".into(), uncertainty_setting(data));
