@@ -212,6 +212,14 @@ impl Weather {
         clear_day::build(day, site, duration_s)
     }
 
+    /// The coldest air temperature of any row (K).
+    pub fn coldest_air_k(&self) -> f64 {
+        self.samples
+            .iter()
+            .map(|s| s.air_k)
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Last time (s) the weather covers; first is 0 for clear_day, the first row for CSV.
     pub fn span_s(&self) -> (f64, f64) {
         (self.times_s[0], self.times_s[self.times_s.len() - 1])
