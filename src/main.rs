@@ -447,7 +447,7 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
     };
     let (first, last) = model.range_um();
     format!(
-        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={:.3} → {}",
+        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={} → {}",
         outcome.material.name,
         chosen.distribution.name(),
         chosen.dispersion,
@@ -455,7 +455,7 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
         shared.join(" "),
         range(&model.n),
         range(&model.k),
-        chosen.reduced_chi2,
+        chi2(chosen.reduced_chi2),
         entry.display()
     )
 }
@@ -494,15 +494,25 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
         .as_ref()
         .map_or(String::new(), |c| format!("; {}", c.summary()));
     format!(
-        "{}: {} {}{}{} χ²_red={:.3}{comparison} → {}",
+        "{}: {} {}{}{} χ²_red={}{comparison} → {}",
         outcome.material.name,
         chosen.distribution.name(),
         parameters.join(" "),
         listed(" [bounded only: ", &bounded, ", ", "]"),
         listed(" (fixed: ", &fixed, " ", ")"),
-        chosen.reduced_chi2,
+        chi2(chosen.reduced_chi2),
         entry.display()
     )
+}
+
+/// A reduced χ² for the summary line: three decimals, in exponent form from 1e6 on (an absurd
+/// fit's 3e50 is not printed as 51 digits).
+fn chi2(x: f64) -> String {
+    if x.abs() < 1e6 {
+        format!("{x:.3}")
+    } else {
+        format!("{x:.3e}")
+    }
 }
 
 /// `items` joined by `separator` between `open` and `close`, or nothing when there are none.
