@@ -280,3 +280,49 @@ fn tables_of_vertices_by_instants_beyond_their_limits_are_refused() {
         &["40401 vertices × 7202 recorded instants = 2.91e8 values, more than 1e8"],
     );
 }
+
+#[test]
+fn echoed_numbers_are_written_concisely() {
+    // Rust writes 1e300 as 301 digits; each of these messages once did.
+    let cases = [
+        (
+            "fov_deg = 40.0",
+            "fov_deg = 1e300",
+            "camera fov_deg = 1e300 must be",
+        ),
+        (
+            "zenith_emissivity = 0.75",
+            "zenith_emissivity = 1e300",
+            "zenith_emissivity = 1e300 must be",
+        ),
+        (
+            "emissivity = 0.95 }",
+            "emissivity = -1e300 }",
+            "ground.emissivity = -1e300 must be",
+        ),
+        (
+            "latitude_deg = 48.14",
+            "latitude_deg = 1e300",
+            "thermal.latitude_deg = 1e300 must be",
+        ),
+        (
+            "duration_h = 2",
+            "duration_h = -1e300",
+            "thermal.duration_h = -1e300 must be positive",
+        ),
+        (
+            "[[objects]]",
+            "[sensor]\nnetd_mk = -1e300\n\n[[objects]]",
+            "sensor.netd_mk = -1e300 must be",
+        ),
+        (
+            "[[objects]]",
+            "[render]\naop_mask_dolp = 1e300\n\n[[objects]]",
+            "render.aop_mask_dolp = 1e300 must be",
+        ),
+    ];
+    for (from, to, needle) in cases {
+        let text = scene(|s| s.replacen(from, to, 1));
+        refused(&text, &[], &[needle]);
+    }
+}
