@@ -132,6 +132,14 @@ fn typed_temperatures(config: &SceneConfig) -> Vec<(String, f64)> {
             .into_iter()
             .filter_map(|(k, t)| Some((k.to_owned(), t?))),
     );
+    typed.extend(object_temperatures(config));
+    typed
+}
+
+/// The temperatures typed on objects and parts: their starting (or fixed) temperature and a
+/// stack's fixed back face.
+fn object_temperatures(config: &SceneConfig) -> Vec<(String, f64)> {
+    let mut typed = Vec::new();
     for (i, object) in config.objects.iter().enumerate() {
         let name = object
             .name
