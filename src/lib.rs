@@ -27,6 +27,7 @@ pub mod progress;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod tables;
 pub mod text;
 pub mod thermal;
 pub mod thermal_scene;

@@ -534,7 +534,7 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
     };
     let (first, last) = model.range_um();
     format!(
-        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={:.3}{} → {}",
+        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={}{} → {}",
         outcome.material.name,
         chosen.distribution.name(),
         chosen.dispersion,
@@ -542,7 +542,7 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
         shared.join(" "),
         range(&model.n),
         range(&model.k),
-        chosen.reduced_chi2,
+        chi2(chosen.reduced_chi2),
         realizability_clause(&outcome.measurements),
         entry.display()
     )
@@ -582,7 +582,7 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
         .as_ref()
         .map_or(String::new(), |c| format!("; {}", c.summary()));
     format!(
-        "{}: {}{} {}{}{} χ²_red={:.3}{}{comparison} → {}",
+        "{}: {}{} {}{}{} χ²_red={}{}{comparison} → {}",
         outcome.material.name,
         chosen.distribution.name(),
         if chosen.terms == irpol::pbrdf::ModelTerms::default() {
@@ -593,7 +593,7 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
         parameters.join(" "),
         listed(" [bounded only: ", &bounded, ", ", "]"),
         listed(" (fixed: ", &fixed, " ", ")"),
-        chosen.reduced_chi2,
+        chi2(chosen.reduced_chi2),
         realizability_clause(std::slice::from_ref(&outcome.measurement)),
         entry.display()
     )
@@ -617,6 +617,16 @@ fn realizability_clause(sets: &[irpol::measure::MeasurementSet]) -> String {
 /// A measured row counts as not realizable when its coherency matrix's smallest eigenvalue is
 /// below this many standard deviations of its noise (a bound, so noise alone rarely reaches it).
 const REALIZABILITY_SIGMAS: f64 = 2.0;
+
+/// A reduced χ² for the summary line: three decimals, in exponent form from 1e6 on (an absurd
+/// fit's 3e50 is not printed as 51 digits).
+fn chi2(x: f64) -> String {
+    if x.abs() < 1e6 {
+        format!("{x:.3}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
 
 /// `items` joined by `separator` between `open` and `close`, or nothing when there are none.
 fn listed(open: &str, items: &[String], separator: &str, close: &str) -> String {

@@ -284,13 +284,27 @@ fn a_fit_with_an_absurd_fixed_value_is_refused_before_fitting() {
 
 // ---- 2. Hangs, and a fit's outputs written as a whole ----------------------------------------
 
+/// Values a fit can square fit and report without hanging; beyond ±1e12 sr⁻¹ (or an uncertainty
+/// outside 1e-15…1e12) they are refused where read: they once fitted to χ² = inf and wrote `inf`
+/// and `nan` into the material file.
 #[test]
 fn extreme_measured_values_fit_and_report_without_hanging() {
     let (m00, u_m00) = (paint_column("m00"), paint_column("u_m00"));
-    for (name, column, value) in [
-        ("huge", m00, "1e308"),
-        ("subnormal", m00, "1e-320"),
-        ("uncertain", u_m00, "1e308"),
+    for (name, column, value, refusal) in [
+        (
+            "huge",
+            m00,
+            "1e308",
+            Some("column 'm00': 1e308 sr⁻¹ is beyond ±1e12 sr⁻¹"),
+        ),
+        ("large", m00, "1e12", None),
+        ("subnormal", m00, "1e-320", None),
+        (
+            "uncertain",
+            u_m00,
+            "1e308",
+            Some("column 'u_m00': uncertainty 1e308 sr⁻¹ is outside 1e-15…1e12 sr⁻¹"),
+        ),
     ] {
         let dir = tempfile::tempdir().unwrap();
         let csv = edited_paint(|row, fields| {
@@ -302,7 +316,19 @@ fn extreme_measured_values_fit_and_report_without_hanging() {
         let command = format!("fit m.csv {QUICK_FIT}");
         let run = irpol(dir.path(), &command.split(' ').collect::<Vec<_>>());
         assert!(!run.timed_out, "{name}: the fit or its report hung");
+        if let Some(needle) = refusal {
+            assert_refused(&run, needle);
+            assert!(!dir.path().join("fits").exists(), "{name}");
+            continue;
+        }
         assert_eq!(run.code, Some(0), "{name}: {}", run.stderr);
+        let entry = std::fs::read_to_string(dir.path().join("fits/paper_paint.toml")).unwrap();
+        let non_finite = entry
+            .lines()
+            .filter(|line| !line.trim_start().starts_with('#'))
+            .flat_map(|line| line.split(|c: char| !(c.is_alphanumeric() || c == '_')))
+            .any(|token| token == "nan" || token == "inf");
+        assert!(!non_finite, "{name}: a non-finite number in the entry");
         // The file's `# material:` header names the outputs.
         for out in [
             "fits/paper_paint.toml",

@@ -3,6 +3,9 @@
 //! names the key and says each thing once, with numbers written concisely. Every run is under a
 //! 4 GB address-space limit and a time limit, so a regression fails the test instead of the machine.
 
+mod common;
+
+use common::thermal_plate_scene as scene;
 use std::io::Read;
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -16,53 +19,6 @@ fn binary() -> std::path::PathBuf {
     std::env::var_os("IRPOL_BIN")
         .map(Into::into)
         .unwrap_or_else(|| env!("CARGO_BIN_EXE_irpol").into())
-}
-
-/// A plate on a clear day for two hours: `edit` changes the text before it is written.
-fn scene(edit: impl Fn(String) -> String) -> String {
-    edit(
-        r#"[camera]
-position = [6.0, -6.0, 3.0]
-look_at = [0.0, 0.0, 0.5]
-fov_deg = 40.0
-resolution = [16, 12]
-
-[environment]
-air_temperature_k = 290.0
-sky = { model = "window", zenith_emissivity = 0.75 }
-ground = { temperature_k = 290.0, emissivity = 0.95 }
-
-[materials.paint]
-distribution = "cauchy"
-sigma = 0.2
-q = 2.0
-n = 1.5
-k = 0.2
-shadowing = "smith"
-
-[thermal]
-weather = { clear_day = { air_min_k = 287.0, air_max_k = 301.0, wind_m_s = 2.0 } }
-start_utc = "2026-06-21T00:00:00Z"
-latitude_deg = 48.14
-longitude_deg = 11.58
-output_step_s = 3600
-duration_h = 2
-
-[thermal.layers.steel]
-conductivity_w_mk = 45.0
-density_kg_m3 = 7850.0
-heat_capacity_j_kgk = 470.0
-
-[[objects]]
-name = "plate"
-shape = { kind = "plane", size = [0.5, 0.5], divisions = [1, 1] }
-material = "paint"
-[objects.thermal]
-stack = [["steel", 0.001]]
-solar_absorptance = 0.6
-"#
-        .to_owned(),
-    )
 }
 
 /// `irpol thermal scene.toml --out out` in `dir` under the limits: (exit code, stderr, seconds).
@@ -323,4 +279,50 @@ fn tables_of_vertices_by_instants_beyond_their_limits_are_refused() {
         &[],
         &["40401 vertices × 7202 recorded instants = 2.91e8 values, more than 1e8"],
     );
+}
+
+#[test]
+fn echoed_numbers_are_written_concisely() {
+    // Rust writes 1e300 as 301 digits; each of these messages once did.
+    let cases = [
+        (
+            "fov_deg = 40.0",
+            "fov_deg = 1e300",
+            "camera fov_deg = 1e300 must be",
+        ),
+        (
+            "zenith_emissivity = 0.75",
+            "zenith_emissivity = 1e300",
+            "zenith_emissivity = 1e300 must be",
+        ),
+        (
+            "emissivity = 0.95 }",
+            "emissivity = -1e300 }",
+            "ground.emissivity = -1e300 must be",
+        ),
+        (
+            "latitude_deg = 48.14",
+            "latitude_deg = 1e300",
+            "thermal.latitude_deg = 1e300 must be",
+        ),
+        (
+            "duration_h = 2",
+            "duration_h = -1e300",
+            "thermal.duration_h = -1e300 must be positive",
+        ),
+        (
+            "[[objects]]",
+            "[sensor]\nnetd_mk = -1e300\n\n[[objects]]",
+            "sensor.netd_mk = -1e300 must be",
+        ),
+        (
+            "[[objects]]",
+            "[render]\naop_mask_dolp = 1e300\n\n[[objects]]",
+            "render.aop_mask_dolp = 1e300 must be",
+        ),
+    ];
+    for (from, to, needle) in cases {
+        let text = scene(|s| s.replacen(from, to, 1));
+        refused(&text, &[], &[needle]);
+    }
 }

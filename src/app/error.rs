@@ -141,7 +141,7 @@ pub enum AppError {
         .0.display()
     )]
     InstantNeedsThermal(PathBuf),
-    #[error("t = {0} s is not an instant of the thermal run")]
+    #[error("t = {} s is not an instant of the thermal run", crate::text::number(*.0))]
     NotAnInstant(f64),
     /// The scene at an instant of its thermal run could not be built.
     #[error("{}: {message}", path.display())]

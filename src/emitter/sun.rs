@@ -47,16 +47,30 @@ pub const SUN_TEMPERATURE_K: f64 = 5772.0;
 pub enum SunError {
     #[error("time '{text}' is not an RFC 3339 instant such as 2026-06-21T10:00:00Z: {reason}")]
     InvalidTime { text: String, reason: String },
-    #[error("sun elevation {0}° is invalid: it must be finite and within [-90°, 90°]")]
+    #[error(
+        "sun elevation {}° is invalid: it must be finite and within [-90°, 90°]",
+        crate::text::number(*.0)
+    )]
     InvalidElevation(f64),
-    #[error("sun azimuth {0}° is invalid: it must be finite (degrees clockwise from north)")]
+    #[error(
+        "sun azimuth {}° is invalid: it must be finite (degrees clockwise from north)",
+        crate::text::number(*.0)
+    )]
     InvalidAzimuth(f64),
-    #[error("sun transmittance {0} is invalid: it must be finite and within [0, 1]")]
+    #[error(
+        "sun transmittance {} is invalid: it must be finite and within [0, 1]",
+        crate::text::number(*.0)
+    )]
     InvalidTransmittance(f64),
-    #[error("sun irradiance {0} W·m⁻² is invalid: it must be finite and ≥ 0")]
+    #[error(
+        "sun irradiance {} W·m⁻² is invalid: it must be finite and ≥ 0",
+        crate::text::number(*.0)
+    )]
     InvalidIrradiance(f64),
     #[error(
-        "no sun position at latitude {latitude_deg}°, longitude {longitude_deg}°, {time}: {reason}"
+        "no sun position at latitude {}°, longitude {}°, {time}: {reason}",
+        crate::text::number(*latitude_deg),
+        crate::text::number(*longitude_deg)
     )]
     Position {
         latitude_deg: f64,

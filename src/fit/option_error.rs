@@ -28,7 +28,7 @@ pub enum OptionError {
     NoPairs,
     #[error("robust loss scale '{}' is not a number", shown(.0))]
     RobustScaleNotNumber(String),
-    #[error("robust loss scale {0} must be finite and > 0")]
+    #[error("robust loss scale {} must be finite and > 0", crate::text::number(*.0))]
     RobustScale(f64),
     #[error("unknown robust loss '{}' (huber or cauchy)", shown(.0))]
     UnknownRobustLoss(String),

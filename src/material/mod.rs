@@ -44,6 +44,18 @@ pub enum MaterialError {
     Spectral { name: String },
     #[error("material '{name}': wavelength {error}")]
     OutsideTable { name: String, error: OutsideTable },
+    /// A value of the entry is NaN or infinite: no file is written (TOML would hold `nan`/`inf`,
+    /// which no reader of a material should have to meet).
+    #[error(
+        "{path}: not written: {key} = {} is not a finite number (the fit did not converge to \
+         finite values; look for extreme values or uncertainties in the measurements)",
+        number(*value)
+    )]
+    NotFinite {
+        path: PathBuf,
+        key: String,
+        value: f64,
+    },
     #[error("{path}: cannot write")]
     Write {
         path: PathBuf,
@@ -361,6 +373,14 @@ impl Material {
             path: path.to_owned(),
             source: std::io::Error::other(e.to_string()),
         };
+        let value = toml::Value::try_from(self).map_err(|e| error(&e))?;
+        if let Some((key, value)) = first_non_finite(&value, String::new()) {
+            return Err(MaterialError::NotFinite {
+                path: path.to_owned(),
+                key,
+                value,
+            });
+        }
         let text = toml::to_string_pretty(self).map_err(|e| error(&e))?;
         comments::commented(&text).map_err(|e| error(&e))
     }
@@ -373,6 +393,26 @@ impl Material {
             path: path.to_owned(),
             source,
         })
+    }
+}
+
+/// The first NaN or infinite number in `value` with its key path (`fit.correlation[3][5]`).
+fn first_non_finite(value: &toml::Value, key: String) -> Option<(String, f64)> {
+    match value {
+        toml::Value::Float(x) if !x.is_finite() => Some((key, *x)),
+        toml::Value::Table(table) => table.iter().find_map(|(k, v)| {
+            let key = if key.is_empty() {
+                k.clone()
+            } else {
+                format!("{key}.{k}")
+            };
+            first_non_finite(v, key)
+        }),
+        toml::Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .find_map(|(i, v)| first_non_finite(v, format!("{key}[{i}]"))),
+        _ => None,
     }
 }
 
@@ -506,6 +546,34 @@ mod tests {
             bound(None, None).describe("q"),
             "q not bounded in the search interval"
         );
+    }
+
+    /// Nothing non-finite reaches a written entry: TOML would take `nan` and `inf` as floats.
+    #[test]
+    fn a_non_finite_value_is_refused_by_key_and_nothing_is_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("paper_paint.toml");
+        for (value, shown) in [(f64::NAN, "NaN"), (f64::INFINITY, "inf")] {
+            let mut material = sample();
+            if let MaterialModel::Grey(spec) = &mut material.model {
+                spec.k = value;
+            }
+            let error = material.save(&path).unwrap_err();
+            let text = error.to_string();
+            assert!(matches!(error, MaterialError::NotFinite { .. }), "{text}");
+            assert!(
+                text.contains(&format!(
+                    "not written: model.k = {shown} is not a finite number"
+                )),
+                "{text}"
+            );
+            assert!(!path.exists());
+        }
+        let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("fits/paper_paint.toml");
+        let mut material = Material::load(&shipped).unwrap();
+        material.fit.as_mut().unwrap().correlation[0][1] = f64::NAN;
+        let text = material.to_toml(&path).unwrap_err().to_string();
+        assert!(text.contains("fit.correlation[0][1] = NaN"), "{text}");
     }
 
     #[test]

@@ -71,6 +71,14 @@ pub enum ModelTableError {
         number(*.1)
     )]
     NotAscending(f64, f64),
+    #[error(
+        "wavelength_um lists one wavelength twice: {} µm and {} µm are within {} µm, the \
+         tolerance of one wavelength; keep one",
+        number(*.0),
+        number(*.1),
+        number(SAME_WAVELENGTH_UM)
+    )]
+    DuplicateWavelength(f64, f64),
     #[error("dispersion: {0}")]
     Dispersion(#[source] crate::optics::LorentzError),
     #[error("d and n_sub need rho_s: they belong to the subsurface term")]
@@ -209,7 +217,11 @@ fn check_table(model: &SpectralModel) -> Result<(), ModelTableError> {
         .windows(2)
         .find(|p| p[1] - p[0] <= SAME_WAVELENGTH_UM)
     {
-        return Err(ModelTableError::NotAscending(pair[0], pair[1]));
+        return Err(if (pair[1] - pair[0]).abs() <= SAME_WAVELENGTH_UM {
+            ModelTableError::DuplicateWavelength(pair[0], pair[1])
+        } else {
+            ModelTableError::NotAscending(pair[0], pair[1])
+        });
     }
     if let Some(law) = &model.dispersion {
         law.validate().map_err(ModelTableError::Dispersion)?;

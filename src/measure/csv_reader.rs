@@ -13,7 +13,7 @@ use super::columns::{parse_header_row, wrong_delimiter, Layout, Quantity};
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
 use super::fields::{split_fields, Field};
 use super::metadata::{split_metadata_line, wavelength_in_range, HeaderWavelength, Metadata};
-use super::{MeasurementPoint, MeasurementSet};
+use super::{MeasurementPoint, MeasurementSet, MAX_MUELLER_SR, MIN_UNCERTAINTY_SR};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
 use crate::text::shown;
 
@@ -454,6 +454,12 @@ fn store_value(
             if index == 0 && value < 0.0 {
                 return Err(MeasureErrorKind::NegativeM00 { value: shown(text) });
             }
+            if value.abs() > MAX_MUELLER_SR {
+                return Err(MeasureErrorKind::ElementTooLarge {
+                    column: name.to_owned(),
+                    value: shown(text),
+                });
+            }
             if let Some(slot) = layout.slot(index) {
                 point.values[slot] = value;
             }
@@ -461,6 +467,12 @@ fn store_value(
         Quantity::Uncertainty(index) => {
             if value <= 0.0 {
                 return Err(MeasureErrorKind::NonPositiveUncertainty {
+                    column: name.to_owned(),
+                    value: shown(text),
+                });
+            }
+            if !(MIN_UNCERTAINTY_SR..=MAX_MUELLER_SR).contains(&value) {
+                return Err(MeasureErrorKind::UncertaintyOutOfRange {
                     column: name.to_owned(),
                     value: shown(text),
                 });

@@ -114,6 +114,19 @@ pub enum MeasureErrorKind {
     NegativeM00 { value: String },
     #[error("column '{column}': {value} is not a positive uncertainty")]
     NonPositiveUncertainty { column: String, value: String },
+    #[error(
+        "column '{column}': {value} sr⁻¹ is beyond ±{} sr⁻¹, far above any measurable BRDF (the \
+         mirror peak of the smoothest model is ~1e7 sr⁻¹): a fit of it has no finite χ²",
+        crate::text::number(super::MAX_MUELLER_SR)
+    )]
+    ElementTooLarge { column: String, value: String },
+    #[error(
+        "column '{column}': uncertainty {value} sr⁻¹ is outside {}…{} sr⁻¹: weighted by it, a \
+         residual has no finite square",
+        crate::text::number(super::MIN_UNCERTAINTY_SR),
+        crate::text::number(super::MAX_MUELLER_SR)
+    )]
+    UncertaintyOutOfRange { column: String, value: String },
     #[error("column 'wavelength_um': {value} is not a positive wavelength")]
     NonPositiveWavelength { value: String },
     #[error("{place}: {value} µm is outside 0.1–1000 µm, the wavelengths irpol models")]

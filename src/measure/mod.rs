@@ -57,6 +57,16 @@ pub use reading::{
 pub use realizability::{unrealizable_rows, Realizability};
 pub use selection::{RowSelection, SelectionError, THETA_I_TOLERANCE_DEG};
 
+/// Largest |Mueller element| and uncertainty a measurement file may hold (sr⁻¹): far above the
+/// mirror peak of the smoothest model (σ = 1e-4, ~1e7 sr⁻¹), small enough that every weighted
+/// residual, squared and summed over the largest file, stays finite (m00 = 1e308 once made a
+/// fit whose χ² and covariance were inf and nan, written into the material file).
+pub const MAX_MUELLER_SR: f64 = 1e12;
+
+/// Smallest uncertainty (sr⁻¹): a subnormal one (5e-324) made every residual it weighs infinite.
+/// Measured BRDF noise floors are ~1e-8 sr⁻¹.
+pub const MIN_UNCERTAINTY_SR: f64 = 1e-15;
+
 /// Column names of the 16 Mueller elements; element (r, c) has index r*4 + c (row-major).
 pub const MUELLER_ELEMENT_NAMES: [&str; 16] = [
     "m00", "m01", "m02", "m03", "m10", "m11", "m12", "m13", "m20", "m21", "m22", "m23", "m30",

@@ -16,12 +16,15 @@ use serde::{Deserialize, Serialize};
 /// Why a Lorentz law is not physical.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LorentzError {
-    #[error("eps_inf = {0} must be ≥ 1")]
+    #[error("eps_inf = {} must be ≥ 1", crate::text::number(*.0))]
     EpsInf(f64),
     #[error("a Lorentz dispersion needs at least one oscillator")]
     NoOscillator,
     /// `oscillator` counts from 1.
-    #[error("oscillator {oscillator}: {name} = {value} must be positive")]
+    #[error(
+        "oscillator {oscillator}: {name} = {} must be positive",
+        crate::text::number(*value)
+    )]
     Oscillator {
         oscillator: usize,
         name: &'static str,

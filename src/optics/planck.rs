@@ -42,7 +42,10 @@ pub enum OpticsError {
     InvalidBand { lo_um: f64, hi_um: f64 },
     #[error("spectral response table is invalid: {0}")]
     InvalidResponse(String),
-    #[error("radiance {0} W·m⁻²·sr⁻¹ has no temperature: it must be finite and ≥ 0")]
+    #[error(
+        "radiance {} W·m⁻²·sr⁻¹ has no temperature: it must be finite and ≥ 0",
+        crate::text::number(*.0)
+    )]
     InvalidRadiance(f64),
 }
 

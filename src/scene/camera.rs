@@ -44,7 +44,11 @@ impl Camera {
         let right = right.normalize();
         let up = right.cross(&forward);
         if !(fov_y_deg.is_finite() && fov_y_deg > 0.0 && fov_y_deg < 179.0) {
-            return Err(format!("camera fov_deg = {fov_y_deg} must be within (0°, 179°)").into());
+            return Err(format!(
+                "camera fov_deg = {} must be within (0°, 179°)",
+                crate::text::number(fov_y_deg)
+            )
+            .into());
         }
         // ~200 bytes per pixel in flight (Stokes, fragments, channels, encoded files): 8K UHD
         // stays within a few GiB.

@@ -65,6 +65,7 @@
 
 pub use crate::emitter::SunConfig;
 pub use crate::material::InlineMaterialConfig;
+use crate::tables::{optional_table, table, table_list, table_map};
 pub use crate::thermal::config::{
     BackConfig, BackKeyword, ConvectiveBack, FixedBack, GeneratedWeather, InternalHeatConfig,
     LayerMaterialConfig, PartThermalConfig, ThermalConfig, WeatherConfig,
@@ -109,20 +110,25 @@ pub struct SceneConfig {
     /// Folder of the material library (names resolve to `<dir>/<name>.toml`), relative to the
     /// scene file; default `fits`.
     pub material_library: Option<String>,
+    #[serde(deserialize_with = "table")]
     pub camera: CameraConfig,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub sensor: SensorConfig,
+    #[serde(deserialize_with = "table")]
     pub environment: EnvironmentConfig,
+    #[serde(default, deserialize_with = "optional_table")]
     pub atmosphere: Option<AtmosphereConfig>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub render: RenderConfig,
+    #[serde(default, deserialize_with = "optional_table")]
     pub sun: Option<SunConfig>,
     /// Temperatures from the thermal model (docs/design.md §1.8, §2.4) instead of typed in.
+    #[serde(default, deserialize_with = "optional_table")]
     pub thermal: Option<ThermalConfig>,
     /// Inline material definitions by name.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table_map")]
     pub materials: BTreeMap<String, InlineMaterialConfig>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table_list")]
     pub objects: Vec<ObjectConfig>,
 }
 
@@ -185,7 +191,9 @@ impl Default for SensorConfig {
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentConfig {
     pub air_temperature_k: f64,
+    #[serde(deserialize_with = "table")]
     pub sky: SkyConfig,
+    #[serde(deserialize_with = "table")]
     pub ground: GroundConfig,
 }
 
@@ -248,7 +256,7 @@ pub struct RenderConfig {
     #[serde(default)]
     pub open_world: bool,
     /// `[render.preview]`: colour ranges and maps of the PNG previews.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub preview: PreviewConfig,
 }
 
@@ -341,6 +349,7 @@ pub struct ObjectConfig {
     pub name: Option<String>,
     /// OBJ or PLY file, relative to the scene file. Exactly one of `mesh` and `shape`.
     pub mesh: Option<String>,
+    #[serde(default, deserialize_with = "optional_table")]
     pub shape: Option<ShapeConfig>,
     /// Default material and temperature of every part not listed in `parts`.
     pub material: Option<String>,
@@ -354,9 +363,10 @@ pub struct ObjectConfig {
     /// Normals of faces meeting at less than this angle are averaged (meshes without `vn`).
     #[serde(default = "default_crease")]
     pub crease_angle_deg: f64,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table_map")]
     pub parts: BTreeMap<String, PartConfig>,
     /// Thermal stack of every part that has none of its own (§2.4 `[objects.thermal]`).
+    #[serde(default, deserialize_with = "optional_table")]
     pub thermal: Option<PartThermalConfig>,
 }
 
@@ -374,6 +384,7 @@ pub struct PartConfig {
     pub material: Option<String>,
     pub temperature_k: Option<f64>,
     /// With `[thermal]`: this part's temperatures come from the model (§2.4).
+    #[serde(default, deserialize_with = "optional_table")]
     pub thermal: Option<PartThermalConfig>,
 }
 

@@ -148,7 +148,8 @@ fn sky_model<'a>(
             let e = *zenith_emissivity;
             if !(e.is_finite() && e > 0.0 && e <= 1.0) {
                 return Err(format!(
-                    "environment.sky.zenith_emissivity = {e} must be within (0, 1]"
+                    "environment.sky.zenith_emissivity = {} must be within (0, 1]",
+                    number(e)
                 )
                 .into());
             }
@@ -245,7 +246,11 @@ fn ground_radiance(
         .into());
     }
     if !(e.is_finite() && (0.0..=1.0).contains(&e)) {
-        return Err(format!("environment.ground.emissivity = {e} must be within [0, 1]").into());
+        return Err(format!(
+            "environment.ground.emissivity = {} must be within [0, 1]",
+            number(e)
+        )
+        .into());
     }
     // E_sky/π = 2∫₀¹ L(u) u du by the trapezoid rule on the sample grid.
     let h = 1.0 / (sky.len() - 1) as f64;

@@ -31,7 +31,7 @@ use crate::emitter::Sun;
 use crate::material::MaterialResolver;
 use crate::optics::Band;
 use camera::Camera;
-use config::{ObjectConfig, SceneConfig, Shading};
+use config::{ObjectConfig, SceneConfig, Shading, WeatherConfig};
 use environment::Environment;
 use mesh::ShadedMesh;
 use object::{build_object, ObjectSink};
@@ -184,7 +184,15 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
     let materials = materials
         .finish()
         .map_err(|error| SceneError::material(path, None, error))?;
-    warnings.extend(likely_mistakes(&config, &materials, band));
+    // The air of a weather file (a clear day's is its own keys, warned about as such).
+    let weather_air = match (&config.thermal, &thermal_run) {
+        (Some(t), Some((run, _, _))) => match &t.weather {
+            WeatherConfig::File(file) => Some((file.as_str(), run.weather.coldest_air_k())),
+            WeatherConfig::Generated(_) => None,
+        },
+        _ => None,
+    };
+    warnings.extend(likely_mistakes(&config, &materials, band, weather_air));
     let (thermal, thermal_rebuild) = match thermal_run {
         Some((mut run, instants, _)) => {
             run.surfaces =

@@ -113,7 +113,7 @@ fn check_placement(object: &ObjectConfig, invalid: Invalid) -> Result<(), SceneE
     if !(object.scale.is_finite() && object.scale > 0.0) {
         return Err(invalid(format!(
             "scale = {} must be finite and > 0",
-            object.scale
+            number(object.scale)
         )));
     }
     if !object
@@ -127,7 +127,8 @@ fn check_placement(object: &ObjectConfig, invalid: Invalid) -> Result<(), SceneE
     let crease = object.crease_angle_deg;
     if !(crease.is_finite() && (0.0..=180.0).contains(&crease)) {
         return Err(invalid(format!(
-            "crease_angle_deg = {crease} must be within [0°, 180°]"
+            "crease_angle_deg = {} must be within [0°, 180°]",
+            number(crease)
         )));
     }
     Ok(())
@@ -267,7 +268,8 @@ fn procedural_shape(shape: &ShapeConfig, invalid: Invalid) -> Result<RawMesh, Sc
         } => {
             if !(radius.is_finite() && radius > 0.0) {
                 return Err(invalid(format!(
-                    "shape.radius = {radius} must be finite and > 0"
+                    "shape.radius = {} must be finite and > 0",
+                    number(radius)
                 )));
             }
             if subdivisions > 7 {

@@ -47,7 +47,8 @@ pub(super) fn resolve_viewing(path: &Path, config: &SceneConfig) -> Result<Viewi
     let mask = config.render.aop_mask_dolp;
     if !(mask.is_finite() && (0.0..=1.0).contains(&mask)) {
         return Err(fail(format!(
-            "render.aop_mask_dolp = {mask} must be within [0, 1]"
+            "render.aop_mask_dolp = {} must be within [0, 1]",
+            number(mask)
         )));
     }
     Ok(Viewing {
@@ -75,7 +76,10 @@ fn resolve_sensor(path: &Path, config: &SceneConfig) -> Result<Sensor, SceneErro
         .netd_reference_k
         .unwrap_or(config.environment.air_temperature_k);
     if !(s.netd_mk.is_finite() && s.netd_mk >= 0.0) {
-        return Err(fail(format!("sensor.netd_mk = {} must be ≥ 0", s.netd_mk)));
+        return Err(fail(format!(
+            "sensor.netd_mk = {} must be ≥ 0",
+            number(s.netd_mk)
+        )));
     }
     // An explicit reference is checked here; the default (the air) by the environment.
     if s.netd_reference_k.is_some()
@@ -107,7 +111,7 @@ fn resolve_atmosphere(
             path,
             format!(
                 "atmosphere.extinction_per_km = {} must be finite and ≥ 0",
-                a.extinction_per_km
+                number(a.extinction_per_km)
             ),
         ));
     }

@@ -1,6 +1,7 @@
 //! The thermal keys of a scene file (docs/design.md §1.8, §2.4): `[thermal]`, its layer
 //! materials, and the stack of an object or part. Checked by [`super::setup`].
 
+use crate::tables::{table, table_map};
 use serde::{Deserialize, Deserializer};
 use std::collections::BTreeMap;
 
@@ -32,7 +33,7 @@ pub struct ThermalConfig {
     #[serde(default = "default_shadow_step")]
     pub shadow_step_s: f64,
     /// Layer materials by name.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table_map")]
     pub layers: BTreeMap<String, LayerMaterialConfig>,
 }
 
@@ -56,12 +57,14 @@ fn default_shadow_step() -> f64 {
 )]
 pub enum WeatherConfig {
     File(String),
+    #[serde(deserialize_with = "table")]
     Generated(GeneratedWeather),
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GeneratedWeather {
+    #[serde(deserialize_with = "table")]
     pub clear_day: crate::thermal::ClearDay,
 }
 
@@ -133,7 +136,9 @@ pub enum BackConfig {
     #[serde(skip)]
     Adiabatic,
     Keyword(BackKeyword),
+    #[serde(deserialize_with = "table")]
     Fixed(FixedBack),
+    #[serde(deserialize_with = "table")]
     Convective(ConvectiveBack),
 }
 

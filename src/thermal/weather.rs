@@ -34,6 +34,7 @@ pub mod solis;
 pub use solis::{simplified_solis, ClearSkyIrradiance, SolisAtmosphere};
 
 use crate::emitter::{format_time_utc, SunError};
+use crate::text::number;
 use chrono::{DateTime, TimeDelta, Utc};
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
@@ -141,8 +142,10 @@ pub enum WeatherError {
         message: String,
     },
     #[error(
-        "weather site latitude {latitude_deg}°, longitude {longitude_deg}° is invalid: latitude \
-         must be within [-90°, 90°] and longitude within [-180°, 180°]"
+        "weather site latitude {}°, longitude {}° is invalid: latitude must be within \
+         [-90°, 90°] and longitude within [-180°, 180°]",
+        number(*latitude_deg),
+        number(*longitude_deg)
     )]
     InvalidSite {
         latitude_deg: f64,
@@ -153,8 +156,10 @@ pub enum WeatherError {
     #[error("clear day: {0}")]
     Sun(#[from] SunError),
     #[error(
-        "no weather at time {time_s} s: the weather covers {first_s} s to {last_s} s after \
-         start_utc {start_utc}"
+        "no weather at time {} s: the weather covers {} s to {} s after start_utc {start_utc}",
+        number(*time_s),
+        number(*first_s),
+        number(*last_s)
     )]
     OutOfRange {
         time_s: f64,
@@ -210,6 +215,14 @@ impl Weather {
     ) -> Result<Weather, WeatherError> {
         site.validate()?;
         clear_day::build(day, site, duration_s)
+    }
+
+    /// The coldest air temperature of any row (K).
+    pub fn coldest_air_k(&self) -> f64 {
+        self.samples
+            .iter()
+            .map(|s| s.air_k)
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Last time (s) the weather covers; first is 0 for clear_day, the first row for CSV.

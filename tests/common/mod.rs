@@ -222,3 +222,51 @@ pub fn fit_into(dir: &Path, inputs: &[&Path], extra: &[&str]) -> (bool, String, 
     args.extend(["--reports", reports.to_str().unwrap()]);
     irpol(&args)
 }
+
+/// A scene of one steel plate with `[thermal]` on a clear day for two hours (the thermal limit
+/// and input tests): `edit` changes the text before it is written.
+pub fn thermal_plate_scene(edit: impl Fn(String) -> String) -> String {
+    edit(
+        r#"[camera]
+position = [6.0, -6.0, 3.0]
+look_at = [0.0, 0.0, 0.5]
+fov_deg = 40.0
+resolution = [16, 12]
+
+[environment]
+air_temperature_k = 290.0
+sky = { model = "window", zenith_emissivity = 0.75 }
+ground = { temperature_k = 290.0, emissivity = 0.95 }
+
+[materials.paint]
+distribution = "cauchy"
+sigma = 0.2
+q = 2.0
+n = 1.5
+k = 0.2
+shadowing = "smith"
+
+[thermal]
+weather = { clear_day = { air_min_k = 287.0, air_max_k = 301.0, wind_m_s = 2.0 } }
+start_utc = "2026-06-21T00:00:00Z"
+latitude_deg = 48.14
+longitude_deg = 11.58
+output_step_s = 3600
+duration_h = 2
+
+[thermal.layers.steel]
+conductivity_w_mk = 45.0
+density_kg_m3 = 7850.0
+heat_capacity_j_kgk = 470.0
+
+[[objects]]
+name = "plate"
+shape = { kind = "plane", size = [0.5, 0.5], divisions = [1, 1] }
+material = "paint"
+[objects.thermal]
+stack = [["steel", 0.001]]
+solar_absorptance = 0.6
+"#
+        .to_owned(),
+    )
+}
