@@ -19,16 +19,16 @@ mod test_records;
 
 use table::format_angle;
 pub(crate) use table::{
-    at_bound, format_plain, format_with_uncertainty, is_free, lookup, parameters, preference,
-    sha_prefix,
+    fitted_cells, format_plain, format_with_uncertainty, is_free, parameters, preference,
+    sha_prefix, FOOTNOTE_BOUND, FOOTNOTE_PROFILE,
 };
 
 use super::ReportError;
 use crate::atomic::write_atomically;
 use crate::material::{FitRecord, Material};
 use crate::measure::{
-    hex, merge_repeat_measurements, parse_measurement_csv, MeasureError, MeasureErrorKind,
-    MeasurementSet, SourceData,
+    hex, merge_repeat_measurements, parse_measurement_csv, parse_measurement_sets, MeasureError,
+    MeasureErrorKind, MeasurementSet, SourceData,
 };
 use crate::plot_style::{encode_png, register_fonts, FONT};
 use data::ReportData;
@@ -292,27 +292,56 @@ pub(crate) fn verified_source(
     material_path: &Path,
     fit: &FitRecord,
 ) -> Result<Vec<MeasurementSet>, ReportError> {
+    let one_wavelength =
+        |csv: &Path, bytes: &[u8]| parse_measurement_csv(csv, bytes).map(|s| vec![s]);
+    Ok(verified_files(material_path, fit, one_wavelength)?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
+/// [`verified_source`] of a spectral material: its files may hold several wavelengths each (a
+/// `wavelength_um` column), which only the spectral reader reads; returns every set of every file.
+pub(crate) fn verified_spectral_source(
+    material_path: &Path,
+    fit: &FitRecord,
+) -> Result<Vec<MeasurementSet>, ReportError> {
+    Ok(verified_files(material_path, fit, parse_measurement_sets)?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
+/// Each of the fit's source files checked by [`verified_file`], read with `parse`.
+fn verified_files(
+    material_path: &Path,
+    fit: &FitRecord,
+    parse: impl Fn(&Path, &[u8]) -> Result<Vec<MeasurementSet>, MeasureError>,
+) -> Result<Vec<Vec<MeasurementSet>>, ReportError> {
     std::iter::once((&fit.source, &fit.source_sha256, &fit.source_data))
         .chain(
             fit.merged_sources
                 .iter()
                 .map(|m| (&m.source, &m.source_sha256, &m.source_data)),
         )
-        .map(|(source, sha256, data)| verified_file(material_path, source, sha256, data.as_ref()))
+        .map(|(source, sha256, data)| {
+            verified_file(material_path, source, sha256, data.as_ref(), &parse)
+        })
         .collect()
 }
 
 /// One source CSV, checked against its recorded hash and data fingerprint. The bytes may differ
 /// (a comment, blank lines, number spelling) when the record has the data's fingerprint and the
-/// parsed data match it; a record without one (written before fingerprints) needs the very
-/// bytes. Of several candidates the first that matches wins (a same-named file elsewhere is not
-/// the source); if none does, the first existing one is reported changed.
+/// parsed data match it; a record without one (written before fingerprints, or by a spectral
+/// fit) needs the very bytes. Of several candidates the first that matches wins (a same-named
+/// file elsewhere is not the source); if none does, the first existing one is reported changed.
 fn verified_file(
     material_path: &Path,
     source: &Path,
     recorded_sha256: &str,
     recorded_data: Option<&SourceData>,
-) -> Result<MeasurementSet, ReportError> {
+    parse: &impl Fn(&Path, &[u8]) -> Result<Vec<MeasurementSet>, MeasureError>,
+) -> Result<Vec<MeasurementSet>, ReportError> {
     let candidates = source_candidates(material_path, source);
     let mut first_changed = None;
     for csv in candidates.iter().filter(|p| p.is_file()) {
@@ -326,12 +355,13 @@ fn verified_file(
         })?;
         let same_bytes = hex(&Sha256::digest(&bytes)).eq_ignore_ascii_case(recorded_sha256.trim());
         let error = match (recorded_data, same_bytes) {
-            (_, true) => return Ok(parse_measurement_csv(csv, &bytes)?),
+            (_, true) => return Ok(parse(csv, &bytes)?),
             (Some(recorded), false) => {
-                let set = parse_measurement_csv(csv, &bytes)?;
-                let now = set.source_data(recorded.rows_per_digest);
+                // A fingerprint is recorded for a file of one wavelength only.
+                let sets = parse(csv, &bytes)?;
+                let now = sets[0].source_data(recorded.rows_per_digest);
                 if now.sha256 == recorded.sha256 {
-                    return Ok(set);
+                    return Ok(sets);
                 }
                 ReportError::SourceDataChanged {
                     csv: csv.clone(),
