@@ -4,13 +4,14 @@
 use super::error::single_line;
 use super::AppError;
 use crate::atomic::write_atomically;
+use crate::output::figure::SeriesPreview;
 use crate::output::{write_outputs, RenderSummary};
 use crate::progress::Progress;
-use crate::render::render;
+use crate::render::{render, Rendered};
 use crate::scene::{load_scene, load_scene_text, Scene};
 use crate::thermal_scene::{scene_at, solve_scene, ThermalSolution};
 use image::codecs::gif::{GifEncoder, Repeat};
-use image::{Delay, Frame, RgbaImage};
+use image::{Delay, DynamicImage, Frame, RgbaImage};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -35,19 +36,20 @@ pub fn render_scene(
     if scene.thermal.is_some() {
         return Err(AppError::ThermalNeedsInstant(scene_path.to_owned()));
     }
-    render_loaded(&scene, out_dir, progress, start)
+    Ok(render_loaded(&scene, out_dir, progress, start)?.0)
 }
 
+/// Renders `scene` and writes its outputs into `out_dir`; returns their summary and the render.
 fn render_loaded(
     scene: &Scene,
     out_dir: &Path,
     progress: &dyn Progress,
     start: Instant,
-) -> Result<RenderSummary, AppError> {
+) -> Result<(RenderSummary, Rendered), AppError> {
     let load = start.elapsed().as_secs_f64();
     let mut rendered = render(scene, progress)?;
     rendered.timings.load = load;
-    Ok(write_outputs(scene, &rendered, out_dir, start)?)
+    Ok((write_outputs(scene, &rendered, out_dir, start)?, rendered))
 }
 
 /// When to render a thermal scene.
@@ -119,11 +121,15 @@ pub fn render_solution_at(
 ) -> Result<Vec<TimedRender>, AppError> {
     let series = times.len() > 1;
     let mut renders = Vec::with_capacity(times.len());
+    let mut previews = SeriesPreview::new();
     for (i, &time_s) in times.iter().enumerate() {
         let start = Instant::now();
         let at = solution_instant(scene, solution, time_s)?;
         let folder = instant_folder(out_dir, i, time_s, series);
-        let summary = render_loaded(&at, &folder, progress, start)?;
+        let (summary, rendered) = render_loaded(&at, &folder, progress, start)?;
+        if series {
+            previews.push(&at, &rendered.image);
+        }
         renders.push(TimedRender {
             time_s,
             folder,
@@ -131,7 +137,7 @@ pub fn render_solution_at(
         });
     }
     if series {
-        let gif = animated_preview(&renders)?;
+        let gif = animated_preview(&renders, previews)?;
         write_atomically(&out_dir.join("preview.gif"), &gif).map_err(|source| AppError::Write {
             path: out_dir.to_owned(),
             source,
@@ -188,17 +194,18 @@ pub fn instant_folder(out_dir: &Path, i: usize, time_s: f64, series: bool) -> Pa
     }
 }
 
-/// One second per frame: the instant above S0.png beside DoLP.png of each rendered instant.
-fn animated_preview(renders: &[TimedRender]) -> Result<Vec<u8>, AppError> {
+/// One second per frame: the instant above the S0 and DoLP previews of each rendered instant,
+/// coloured over one range for the whole series ([`SeriesPreview`]).
+fn animated_preview(renders: &[TimedRender], previews: SeriesPreview) -> Result<Vec<u8>, AppError> {
+    let panels = previews
+        .frames()
+        .map_err(|e| AppError::Caption(e.to_string()))?;
     let mut frames = Vec::with_capacity(renders.len());
-    for r in renders {
-        let panel = |name: &str| -> Result<RgbaImage, AppError> {
-            let path = r.folder.join(name);
-            Ok(image::open(&path)
-                .map_err(|source| AppError::ReadImage { path, source })?
-                .to_rgba8())
-        };
-        let (s0, dolp) = (panel("S0.png")?, panel("DoLP.png")?);
+    for (r, [s0, dolp]) in renders.iter().zip(panels) {
+        let (s0, dolp) = (
+            DynamicImage::ImageRgb8(s0).to_rgba8(),
+            DynamicImage::ImageRgb8(dolp).to_rgba8(),
+        );
         let label = match &r.summary.thermal_instant {
             Some(i) => format!("{}   (t = {} s)", i.time_utc, i.time_s),
             None => format!("t = {} s", r.time_s),
