@@ -12,7 +12,6 @@ use super::colormap::{cyclic, ColorMap, Lut, DIVERGING, GRAY, MASKED, SEQUENTIAL
 use crate::optics::TemperatureLookup;
 use crate::plot_style::{register_fonts, FONT};
 use crate::render::film::{dolp_aop, StokesImage, BACKGROUND};
-use crate::scene::config::Shading;
 use crate::scene::config::{PreviewConfig, PreviewRange, S0Colormap};
 use crate::scene::{Scene, Transport};
 use image::ImageEncoder;
@@ -483,10 +482,7 @@ fn caption(scene: &Scene, image: &StokesImage) -> String {
         stem += &format!(" at {}", instant.time_utc);
     }
     let (lo_um, hi_um) = scene.sensor.band.limits_um();
-    let shading = match scene.shading {
-        Shading::Pixel => "per-pixel",
-        Shading::Gouraud => "Gouraud",
-    };
+    let shading = scene.shading.describe();
     let mut caption = format!(
         "{stem}: {}×{}, {shading} shading, {lo_um}–{hi_um} µm, air {:.2} K",
         image.width, image.height, scene.air_temperature_k
