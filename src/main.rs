@@ -649,11 +649,11 @@ fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()
             format!(", apparent temperature {:.1}–{:.1} K", t.min, t.max)
         });
     say!(
-        "rendered {} ({}×{}, {:?} shading{temperature}) in {:.2} s → {}",
+        "rendered {} ({}×{}, {} shading{temperature}) in {:.2} s → {}",
         scene.display(),
         summary.width,
         summary.height,
-        summary.shading,
+        summary.shading.describe(),
         summary.timings_s.total,
         out.display()
     );

@@ -200,3 +200,52 @@ fn the_hand_written_material_is_a_library_entry() {
         }
     }
 }
+
+/// The part list of the shipped car in docs/scenes.md names every group of scenes/car.obj.
+#[test]
+fn the_cars_part_list_names_every_part_of_its_mesh() {
+    let obj = std::fs::read_to_string(root().join("scenes/car.obj")).unwrap();
+    let groups: Vec<&str> = obj
+        .lines()
+        .filter_map(|line| line.strip_prefix("g "))
+        .map(str::trim)
+        .collect();
+    assert!(groups.len() > 10, "{groups:?}");
+    let page = page("scenes.md");
+    let start = page
+        .find("The shipped `scenes/car.obj` has the parts")
+        .expect("the car's part list");
+    let list = &page[start..start + page[start..].find(".\n").unwrap()];
+    for group in groups {
+        assert!(
+            list.contains(&format!("`{group}`")),
+            "{group} missing: {list}"
+        );
+    }
+}
+
+/// The pages give the default shadowing of an inline scene material as the loader has it.
+#[test]
+fn the_pages_state_the_inline_shadowing_default_the_loader_uses() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.toml");
+    // The starter scene with the shadowing lines of its inline materials left out.
+    let text: String = include_str!("../src/app/starter_scene.toml")
+        .lines()
+        .filter(|line| !line.starts_with("shadowing"))
+        .map(|line| format!("{line}\n"))
+        .collect();
+    assert!(text.contains("[materials.paint]") && !text.contains("\nshadowing"));
+    std::fs::write(&scene, text).unwrap();
+    let loaded = load_scene(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let paint = &loaded.materials[loaded.surfaces[0].material];
+    assert_eq!(paint.name, "paint");
+    assert_eq!(paint.optics.sampling_pbrdf().shadowing().name(), "smith");
+    for name in ["scenes.md", "materials.md"] {
+        let page = page(name);
+        for claim in ["(the inline default)", "`shadowing` to `\"none\"`"] {
+            assert!(!page.contains(claim), "{name} says {claim}");
+        }
+    }
+    assert!(page("materials.md").contains("`shadowing` to `\"smith\"`"));
+}

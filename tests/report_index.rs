@@ -133,3 +133,53 @@ fn a_broken_library_entry_is_skipped_with_a_warning() {
         "{html}"
     );
 }
+
+/// The summary-table row of `material` in an index page.
+fn summary_row<'a>(html: &'a str, material: &str) -> &'a str {
+    let start = html
+        .find(&format!("<tr><td><a href=\"#m-{material}\">"))
+        .unwrap_or_else(|| panic!("no summary row of {material}"));
+    let end = start + html[start..].find("</tr>").unwrap();
+    &html[start..end]
+}
+
+/// The shipped library (fits/ over measurements/): a spectral material's source is a file of
+/// several wavelengths, verified by the spectral reader; a parameter the data bound from one side
+/// shows that bound, as the fit's line and the report do, not a ± around a value on its bound.
+#[test]
+fn the_shipped_library_index_verifies_spectral_sources_and_shows_one_sided_bounds() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let index = write_library_index(&root.join("fits"), dir.path())
+        .unwrap()
+        .path;
+    let html = std::fs::read_to_string(index).unwrap();
+
+    let glass = summary_row(&html, "silicate_glass");
+    assert!(
+        glass.contains("<td class=\"ok\">source unchanged</td>"),
+        "{glass}"
+    );
+    assert!(!html.contains("reader of one wavelength"));
+    for material in [
+        "paper_paint",
+        "rough_paint",
+        "smooth_glass",
+        "anodized_panel",
+    ] {
+        let row = summary_row(&html, material);
+        assert!(row.contains("source unchanged"), "{row}");
+    }
+
+    let paint = summary_row(&html, "paper_paint");
+    assert!(
+        paint.contains("<td class=\"num\">0 † &lt; 3.721e-6 ‡</td>"),
+        "{paint}"
+    );
+    assert!(
+        !paint.contains("(at bound)") && !paint.contains("± 0.0000032"),
+        "{paint}"
+    );
+    assert!(html.contains("† at a bound of its search interval"));
+    assert!(html.contains("‡ one-sided 95 % profile-likelihood bounds, where a ± would mislead"));
+}

@@ -26,6 +26,8 @@ fn the_starter_scene_renders_and_is_never_overwritten() {
     let (ok, stdout, stderr) = irpol(&["render", scene_arg, "--out", out.to_str().unwrap()]);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("rendered"), "{stdout}");
+    // The shading in words, not the setting's internal name ("Pixel shading").
+    assert!(stdout.contains(", per-pixel shading"), "{stdout}");
     assert!(out.join("S0.tif").is_file());
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();

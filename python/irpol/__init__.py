@@ -116,7 +116,7 @@ def brightness_temperature(radiance: Any, band_um: Tuple[float, float] = LWIR_BA
     return values.reshape(r.shape)[()]
 
 
-@dataclass
+@dataclass(repr=False)
 class Measurements:
     """One wavelength of a measurement file (docs/design.md §2.1), validated by irpol's reader.
 
@@ -139,6 +139,15 @@ class Measurements:
     line: np.ndarray
     merged: List[str]
     notes: List[str]
+
+    def __repr__(self) -> str:
+        # A summary: the arrays hold thousands of rows, which a repr must not print.
+        merged = f", merged={len(self.merged)} files" if self.merged else ""
+        return (
+            f"Measurements(material={self.material!r}, wavelength_um={self.wavelength_um!r}, "
+            f"rows={len(self.theta_i_deg)}, elements={self.elements!r}, "
+            f"source={self.source!r}{merged})"
+        )
 
     @classmethod
     def _from_dict(cls, d: Dict[str, Any]) -> "Measurements":

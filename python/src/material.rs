@@ -212,28 +212,90 @@ impl PyMaterial {
         Ok((rebuild, PyTuple::new(py, [self.to_toml()?])?))
     }
 
+    /// Every model parameter: `Material(name='paper_paint', distribution='cauchy', sigma=0.1,
+    /// q=1.8, n=1.2, k=0.2, rho_d=0.0, shadowing='smith', wavelength_um=9.925)`; a spectral
+    /// material gives the range of n, k and ρ_d over its table.
     fn __repr__(&self) -> String {
         let m = &self.inner.model;
-        let q = self.q().map_or(String::new(), |q| format!(", q={q}"));
-        let spectral = match m.spectral() {
-            Some(s) => {
+        let q = self
+            .q()
+            .map_or(String::new(), |q| format!(", q={}", py_float(q)));
+        let optics = match m {
+            MaterialModel::Grey(g) => format!(
+                "n={}, k={}, rho_d={}, shadowing={}, wavelength_um={}",
+                py_float(g.n),
+                py_float(g.k),
+                py_float(g.rho_d),
+                py_str(m.shadowing().name()),
+                py_float(g.wavelength_um)
+            ),
+            MaterialModel::Spectral(s) => {
                 let (a, b) = s.range_um();
                 format!(
-                    ", spectral {}–{} µm ({} wavelengths)",
-                    a,
-                    b,
+                    "n={}, k={}, rho_d={}, shadowing={}, wavelength_um={}–{} ({} wavelengths)",
+                    span(&s.n),
+                    span(&s.k),
+                    span(&s.rho_d),
+                    py_str(m.shadowing().name()),
+                    py_float(a),
+                    py_float(b),
                     s.wavelength_um.len()
                 )
             }
-            None => String::new(),
         };
         format!(
-            "Material(name={:?}, distribution={:?}, sigma={}{q}, shadowing={:?}{spectral})",
-            self.inner.name,
-            m.distribution().name(),
-            m.distribution().sigma(),
-            m.shadowing().name()
+            "Material(name={}, distribution={}, sigma={}{q}, {optics})",
+            py_str(&self.inner.name),
+            py_str(m.distribution().name()),
+            py_float(m.distribution().sigma()),
         )
+    }
+}
+
+/// A string as Python's repr writes it (in single quotes, control characters escaped).
+fn py_str(text: &str) -> String {
+    let mut out = String::from("'");
+    for c in text.chars() {
+        match c {
+            '\\' => out.push_str("\\\\"),
+            '\'' => out.push_str("\\'"),
+            c if c.is_control() => out.extend(c.escape_default()),
+            c => out.push(c),
+        }
+    }
+    out.push('\'');
+    out
+}
+
+/// A float as Python's repr writes it: shortest round-trip digits, an exponent below 1e-4 and
+/// from 1e16 (Rust's `{}` never uses one, so 3.2e-6 would read "0.0000032").
+fn py_float(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e16).contains(&x.abs()) || !x.is_finite() {
+        let text = format!("{x}");
+        if x.is_finite() && !text.contains('.') {
+            text + ".0"
+        } else {
+            text
+        }
+    } else {
+        let text = format!("{x:e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        let exponent: i32 = exponent.parse().unwrap_or(0);
+        let sign = if exponent < 0 { '-' } else { '+' };
+        format!("{mantissa}e{sign}{:02}", exponent.abs())
+    }
+}
+
+/// "min–max" of a spectral table's values to four significant digits ("0.5178–2.873"), or the
+/// one value they all share.
+fn span(values: &[f64]) -> String {
+    let four = |x: f64| py_float(format!("{x:.3e}").parse().unwrap_or(x));
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if lo == hi {
+        four(lo)
+    } else {
+        format!("{}–{}", four(lo), four(hi))
     }
 }
 

@@ -55,6 +55,24 @@ fn render_images(
     })
 }
 
+/// `error` raised as [`raised`] does, except that the refusals naming the command line's
+/// `--time` flags name the keyword `time_s` of `irpol.render` instead.
+fn in_python_terms(error: AppError) -> PyErr {
+    match error {
+        AppError::ThermalNeedsInstant(path) => bad_argument(format!(
+            "{}: has a [thermal] section: say when to render it with time_s=SECONDS \
+             (seconds from thermal.start_utc)",
+            path.display()
+        )),
+        AppError::InstantNeedsThermal(path) => bad_argument(format!(
+            "{}: time_s needs temperatures from the thermal model, but the scene has no \
+             [thermal] section",
+            path.display()
+        )),
+        other => raised(other),
+    }
+}
+
 /// Dotted scene keys and the values to give them.
 type Patch<'py> = Vec<(String, Bound<'py, PyAny>)>;
 
@@ -92,7 +110,7 @@ pub fn render_scene<'py>(
     let text = apply(&scene, text, overrides, Missing::Create)?;
     let images = py
         .detach(|| render_images(&scene, &text, time_s, out.as_deref()))
-        .map_err(raised)?;
+        .map_err(in_python_terms)?;
     let d = PyDict::new(py);
     for (name, data) in images.channels {
         let array = PyArray1::from_vec(py, data).reshape([images.height, images.width])?;

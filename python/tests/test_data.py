@@ -49,6 +49,16 @@ def test_read_measurements_holds_the_file():
     assert len(spectral) > 1 and wavelengths == sorted(wavelengths)
 
 
+def test_repr_of_measurements_is_a_summary():
+    path = MEASUREMENTS / "rough_paint.csv"
+    [sets] = irpol.read_measurements(path)
+    text = repr(sets)
+    assert "\n" not in text and len(text) < 400, text
+    assert text.startswith(f"Measurements(material='rough_paint', wavelength_um={sets.wavelength_um!r}, "
+                           f"rows={sets.values.shape[0]}, elements={sets.elements!r}, "), text
+    assert f"source={str(path)!r}" in text
+
+
 def test_bad_measurement_files_raise_the_cli_message(tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("theta_i_deg,theta_r_deg,m00\n10,20,abc\n")
@@ -222,3 +232,18 @@ def test_bad_scenes_raise_the_cli_message(small_scene, tmp_path):
         irpol.render(small_scene, patch={"sun.elevation_dg": 20.0})
     with pytest.raises(ValueError, match="'7' is not an index of the array 'objects' \\(2 entries\\)"):
         irpol.render(small_scene, patch={"objects.7.temperature_k": 300.0})
+
+
+def test_a_thermal_scene_without_an_instant_names_the_keyword_not_the_flag(small_scene):
+    # The command line asks for --time; irpol.render for its keyword time_s.
+    thermal_scene = ROOT / "scenes" / "car_day.toml"
+    with pytest.raises(ValueError) as raised:
+        irpol.render(thermal_scene)
+    message = str(raised.value)
+    assert message.startswith(f"{thermal_scene}: has a [thermal] section"), message
+    assert "time_s=" in message and "--time" not in message, message
+    with pytest.raises(ValueError) as raised:
+        irpol.render(small_scene, time_s=3600.0)
+    message = str(raised.value)
+    assert "time_s needs temperatures from the thermal model" in message, message
+    assert "--time" not in message, message

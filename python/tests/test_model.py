@@ -140,3 +140,18 @@ def test_material_round_trips_and_pickles(tmp_path):
     paint.save(tmp_path / "p.toml")
     assert (tmp_path / "p.toml").read_text() == paint.to_toml()
     assert paint.fit_json is not None and irpol.Material(sigma=0.1, q=2, n=1.5, k=0.1).fit_json is None
+
+
+def test_repr_of_a_material_names_every_model_parameter():
+    paint = irpol.Material.load(PAINT)
+    text = repr(paint)
+    for name in ("sigma", "q", "n", "k", "rho_d"):
+        assert f"{name}={getattr(paint, name)!r}" in text, (name, text)
+    assert text.startswith("Material(name='paper_paint', distribution='cauchy', ")
+    assert "shadowing='smith'" in text and "wavelength_um=9.925" in text
+    # Small values as Python writes them, not as 0.0000032.
+    built = irpol.Material(sigma=0.1, q=2, n=1.5, k=0.1, rho_d=3.2e-6)
+    assert "rho_d=3.2e-06" in repr(built) and "q=2.0" in repr(built)
+    glass = repr(irpol.Material.load(ROOT / "fits" / "silicate_glass.toml"))
+    assert "n=0.5178–2.873, k=0.03596–2.121, rho_d=0.0–1.948e-06" in glass, glass
+    assert "wavelength_um=8.0–14.0 (9 wavelengths)" in glass, glass

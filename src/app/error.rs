@@ -91,7 +91,7 @@ pub enum AppError {
     },
     #[error("cannot write the CSV: {0}")]
     Csv(String),
-    #[error("cannot draw the preview caption: {0}")]
+    #[error("cannot draw the animated preview: {0}")]
     Caption(String),
 
     // --- input the application refuses ---

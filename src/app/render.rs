@@ -3,14 +3,15 @@
 
 use super::error::single_line;
 use super::AppError;
-use crate::atomic::{StagedDir, StagedFolder};
+use crate::atomic::StagedFolder;
+use crate::output::figure::SeriesPreview;
 use crate::output::{stage_outputs, write_outputs, EarlierOutputs, RenderSummary, SERIES_MANIFEST};
 use crate::progress::Progress;
 use crate::render::render;
 use crate::scene::{load_scene, load_scene_text, Scene};
 use crate::thermal_scene::{scene_at, solve_scene, ThermalSolution};
 use image::codecs::gif::{GifEncoder, Repeat};
-use image::{Delay, Frame, RgbaImage};
+use image::{Delay, DynamicImage, Frame, RgbImage, RgbaImage};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -151,7 +152,7 @@ fn render_series(
     };
     let staged = StagedFolder::begin(out_dir).map_err(write_error)?;
     let mut renders = Vec::with_capacity(times.len());
-    let mut frames = Vec::with_capacity(times.len());
+    let mut previews = SeriesPreview::new();
     for (i, &time_s) in times.iter().enumerate() {
         let start = Instant::now();
         let at = solution_instant(scene, solution, time_s)?;
@@ -162,15 +163,14 @@ fn render_series(
         let folder = out_dir.join(&name);
         let dir = staged.subfolder(&name).map_err(write_error)?;
         let summary = stage_outputs(&at, &rendered, &dir, &folder, start)?;
-        let render = TimedRender {
+        previews.push(&at, &rendered.image);
+        renders.push(TimedRender {
             time_s,
             folder,
             summary,
-        };
-        frames.push(preview_frame(&render, &dir)?);
-        renders.push(render);
+        });
     }
-    let gif = animated_preview(frames)?;
+    let gif = animated_preview(&renders, previews)?;
     staged.write("preview.gif", &gif).map_err(write_error)?;
     let manifest = serde_json::to_vec_pretty(&series_manifest(scene, &renders))
         .map_err(|e| write_error(std::io::Error::other(e)))?;
@@ -255,20 +255,12 @@ fn frame_name(i: usize, time_s: f64) -> String {
     format!("{i:03}_{}s", time_s.round())
 }
 
-/// One frame of the preview, one second long: the instant above S0.png beside DoLP.png of a
-/// rendered instant, read back from its staged folder `dir`.
-fn preview_frame(r: &TimedRender, dir: &StagedDir) -> Result<Frame, AppError> {
-    let panel = |name: &str| -> Result<RgbaImage, AppError> {
-        let path = r.folder.join(name);
-        let bytes = dir.read(name).map_err(|source| AppError::Read {
-            path: path.clone(),
-            source,
-        })?;
-        Ok(image::load_from_memory(&bytes)
-            .map_err(|source| AppError::ReadImage { path, source })?
-            .to_rgba8())
-    };
-    let (s0, dolp) = (panel("S0.png")?, panel("DoLP.png")?);
+/// One frame of the preview, one second long: the instant of `r` above its S0 and DoLP panels.
+fn preview_frame(r: &TimedRender, s0: RgbImage, dolp: RgbImage) -> Result<Frame, AppError> {
+    let (s0, dolp) = (
+        DynamicImage::ImageRgb8(s0).to_rgba8(),
+        DynamicImage::ImageRgb8(dolp).to_rgba8(),
+    );
     let label = match &r.summary.thermal_instant {
         Some(i) => format!("{}   (t = {} s)", i.time_utc, i.time_s),
         None => format!("t = {} s", r.time_s),
@@ -292,8 +284,17 @@ fn preview_frame(r: &TimedRender, dir: &StagedDir) -> Result<Frame, AppError> {
     ))
 }
 
-/// The animated GIF of `frames`, looping.
-fn animated_preview(frames: Vec<Frame>) -> Result<Vec<u8>, AppError> {
+/// The looping animated GIF of the series' `renders`, their S0 and DoLP panels coloured over one
+/// range for the whole series ([`SeriesPreview`]), so frames compare by colour.
+fn animated_preview(renders: &[TimedRender], previews: SeriesPreview) -> Result<Vec<u8>, AppError> {
+    let panels = previews
+        .frames()
+        .map_err(|e| AppError::Caption(e.to_string()))?;
+    let frames = renders
+        .iter()
+        .zip(panels)
+        .map(|(r, [s0, dolp])| preview_frame(r, s0, dolp))
+        .collect::<Result<Vec<_>, _>>()?;
     let mut bytes = Vec::new();
     {
         let mut encoder = GifEncoder::new_with_speed(&mut bytes, 10);

@@ -139,11 +139,6 @@ impl StagedDir<'_> {
         let _guard = WriteGuard::start()?;
         fs::write(self.dir.join(name), bytes)
     }
-
-    /// Reads back a file written into this folder (before the set is committed).
-    pub fn read(&self, name: &str) -> io::Result<Vec<u8>> {
-        fs::read(self.dir.join(name))
-    }
 }
 
 impl Drop for StagedFolder {

@@ -1,16 +1,17 @@
 //! PNG previews with colour bars (S0 as apparent temperature, S1/S2 diverging about zero, DoLP
 //! sequential, AoP cyclic and masked where DoLP is below the scene's threshold) and a composite
 //! figure in the layout of the paper's Fig. 5. Colour ranges follow `[render.preview]`: by default
-//! the 0.1th–99.9th percentiles over the object pixels (symmetric for S1/S2/S3), so a few glints do
-//! not wash out the image; values outside are drawn in the map's under/over colours, capped on the
-//! colour bar and counted in the title, never silently clipped.
+//! the 0.1th–99.9th percentiles over the object pixels (symmetric for S1/S2/S3), reaching past them
+//! to take in values just beyond (noise), so a few glints do not wash out the image and noise does
+//! not speckle it; object pixels outside are drawn in the map's under/over colours, capped on the
+//! colour bar and counted in the title, never silently clipped. Sky and environment ground take
+//! the map's end colours. A time series is coloured over one range ([`SeriesPreview`]).
 //! Text is drawn with plotters using the embedded DejaVu Sans font.
 
 use super::colormap::{cyclic, ColorMap, Lut, DIVERGING, GRAY, MASKED, SEQUENTIAL, THERMAL};
 use crate::optics::TemperatureLookup;
 use crate::plot_style::{register_fonts, FONT};
 use crate::render::film::{dolp_aop, StokesImage, BACKGROUND};
-use crate::scene::config::Shading;
 use crate::scene::config::{PreviewConfig, PreviewRange, S0Colormap};
 use crate::scene::{Scene, Transport};
 use image::ImageEncoder;
@@ -25,6 +26,12 @@ use std::io;
 /// a handful of glint or noise pixels does not wash the image out; what falls outside is drawn in
 /// the map's under/over colours and counted in the title.
 const DEFAULT_PERCENTILES: [f64; 2] = [0.1, 99.9];
+
+/// How far past the default percentiles (a fraction of their distance) the range reaches to
+/// take in the values just beyond them. Pure Gaussian noise (a flat scene under NETD) has its
+/// 0.1/99.9 % points at ±3.09σ and its extremes near ±4.9σ over a megapixel, ±5.3σ over ten:
+/// 0.4 × 6.18σ reaches ±5.56σ, so noise alone is not drawn clipped.
+const DEFAULT_MARGIN: f64 = 0.4;
 
 /// How a panel's colour bar is drawn: its colours bottom to top and labelled ticks.
 enum Bar {
@@ -173,23 +180,34 @@ impl Previews {
 
 impl LinearPanel {
     /// The panel: its range (fixed, else by `settings.range` over the `ranged` pixels), each
-    /// pixel's colour, out-of-range pixels in the map's under/over colours, the clip stated in
-    /// the title.
+    /// pixel's colour, ranged pixels out of range in the map's under/over colours, the clip
+    /// stated in the title.
     fn panel(self, ranged: &[bool], settings: &PreviewConfig) -> Panel {
+        let range = self.range(self.ranging_values(ranged).collect(), settings);
+        self.coloured(ranged, range)
+    }
+
+    /// The values of the `ranged` pixels that set an automatic range (|value| when symmetric).
+    fn ranging_values<'a>(&'a self, ranged: &'a [bool]) -> impl Iterator<Item = f64> + 'a {
+        self.values
+            .iter()
+            .zip(ranged)
+            .filter(|&(v, &r)| r && v.is_finite())
+            .map(|(&v, _)| if self.symmetric { v.abs() } else { v })
+    }
+
+    /// The display range: fixed, or automatic over `chosen` ([`Self::ranging_values`], of one
+    /// image or of a whole time series).
+    fn range(&self, chosen: Vec<f64>, settings: &PreviewConfig) -> (f64, f64) {
         let auto = || {
-            let chosen: Vec<f64> = self
-                .values
-                .iter()
-                .zip(ranged)
-                .filter(|&(v, &r)| r && v.is_finite())
-                .map(|(&v, _)| if self.symmetric { v.abs() } else { v })
-                .collect();
-            let [p_lo, p_hi] = match settings.range {
-                PreviewRange::Minmax => [0.0, 100.0],
-                PreviewRange::Percentile => settings.percentiles.unwrap_or(DEFAULT_PERCENTILES),
+            let (percentiles, margin) = match (settings.range, settings.percentiles) {
+                (PreviewRange::Minmax, _) => ([0.0, 100.0], 0.0),
+                (PreviewRange::Percentile, Some(given)) => (given, 0.0),
+                (PreviewRange::Percentile, None) => (DEFAULT_PERCENTILES, DEFAULT_MARGIN),
             };
+            let [p_lo, p_hi] = percentiles;
             let p_lo = if self.symmetric { 0.0 } else { p_lo };
-            robust_range(chosen, p_lo / 100.0, p_hi / 100.0)
+            robust_range(chosen, p_lo / 100.0, p_hi / 100.0, margin)
         };
         let (lo, hi) = match self.fixed {
             // DoLP's default: from 0 to the automatic high end.
@@ -202,31 +220,48 @@ impl LinearPanel {
             }
             None => auto(),
         };
-        let (lo, hi) = widen(lo, hi);
+        widen(lo, hi)
+    }
+
+    /// The panel coloured over `(lo, hi)`. A ranged pixel outside it takes the map's under/over
+    /// colour and is counted in the title; the others (sky and the environment's ground beside
+    /// objects, which do not set the range) take the map's end colour: a sky colder than every
+    /// object is the map's cold end, not an alarm.
+    fn coloured(self, ranged: &[bool], (lo, hi): (f64, f64)) -> Panel {
         let lut = Lut::new(self.map);
         let colors: Vec<[u8; 3]> = self
             .values
             .par_iter()
-            .map(|&v| match v {
-                v if v < lo => self.map.under,
-                v if v > hi => self.map.over,
+            .zip(ranged)
+            .map(|(&v, &r)| match v {
+                v if v < lo && r => self.map.under,
+                v if v > hi && r => self.map.over,
+                v if v < lo => lut.at(0.0),
+                v if v > hi => lut.at(1.0),
                 v => lut.at((v - lo) / (hi - lo)),
             })
             .collect();
+        let ranged_count = ranged.iter().filter(|&&r| r).count().max(1) as f64;
         let count = |f: &dyn Fn(f64) -> bool| {
-            self.values.iter().filter(|&&v| f(v)).count() as f64 / self.values.len().max(1) as f64
+            self.values
+                .iter()
+                .zip(ranged)
+                .filter(|&(&v, &r)| r && f(v))
+                .count() as f64
+                / ranged_count
         };
         let clipped = Clipped {
             below: count(&|v| v < lo),
             above: count(&|v| v > hi),
         };
         let mut title = self.title;
-        if clipped.below + clipped.above > 0.0 {
-            title += &format!(
-                " — clipped {:.1} % below, {:.1} % above",
-                100.0 * clipped.below,
-                100.0 * clipped.above
-            );
+        let sides: Vec<String> = [(clipped.below, "below"), (clipped.above, "above")]
+            .iter()
+            .filter(|(fraction, _)| *fraction > 0.0)
+            .map(|(fraction, side)| format!("{} {side}", percent(*fraction)))
+            .collect();
+        if !sides.is_empty() {
+            title += &format!(" — clipped {}", sides.join(", "));
         }
         Panel {
             file: self.file,
@@ -240,6 +275,92 @@ impl LinearPanel {
                 clipped,
             },
         }
+    }
+}
+
+/// A clipped fraction (> 0) as a percentage: one decimal, but never "0.0 %" for a few pixels.
+fn percent(fraction: f64) -> String {
+    match 100.0 * fraction {
+        p if p < 0.05 => "< 0.1 %".into(),
+        p => format!("{p:.1} %"),
+    }
+}
+
+/// The S0 and DoLP previews of a time series (`render --times`, its `preview.gif`), coloured
+/// over one range for the whole series, so midnight looks colder than noon. Each frame keeps
+/// only the two panels' values until [`SeriesPreview::frames`] colours them.
+#[derive(Default)]
+pub struct SeriesPreview {
+    width: usize,
+    height: usize,
+    settings: PreviewConfig,
+    frames: Vec<SeriesFrame>,
+}
+
+struct SeriesFrame {
+    ranged: Vec<bool>,
+    s0: LinearPanel,
+    dolp: LinearPanel,
+}
+
+impl SeriesPreview {
+    pub fn new() -> SeriesPreview {
+        SeriesPreview::default()
+    }
+
+    /// Adds the next frame: `image` rendered from `scene` (one instant of the series).
+    pub fn push(&mut self, scene: &Scene, image: &StokesImage) {
+        let mut panels = linear_panels(scene, image).into_iter();
+        let (Some(s0), Some(dolp)) = (panels.next(), panels.nth(2)) else {
+            unreachable!("linear_panels gives S0, S1, S2, DoLP first")
+        };
+        self.settings = scene.preview.clone();
+        (self.width, self.height) = (image.width, image.height);
+        self.frames.push(SeriesFrame {
+            ranged: ranged_pixels(image),
+            s0,
+            dolp,
+        });
+    }
+
+    /// The S0 and DoLP ranges over every frame's ranged pixels (fixed ranges where the scene
+    /// gives them).
+    pub fn ranges(&self) -> [(f64, f64); 2] {
+        let Some(first) = self.frames.first() else {
+            return [(0.0, 1.0); 2];
+        };
+        let pooled = |panel: fn(&SeriesFrame) -> &LinearPanel| -> Vec<f64> {
+            self.frames
+                .iter()
+                .flat_map(|f| panel(f).ranging_values(&f.ranged))
+                .collect()
+        };
+        [
+            first.s0.range(pooled(|f| &f.s0), &self.settings),
+            first.dolp.range(pooled(|f| &f.dolp), &self.settings),
+        ]
+    }
+
+    /// Each frame's S0 and DoLP panels (title, image, colour bar) over the series' [`ranges`].
+    ///
+    /// [`ranges`]: SeriesPreview::ranges
+    pub fn frames(self) -> io::Result<Vec<[image::RgbImage; 2]>> {
+        let [s0_range, dolp_range] = self.ranges();
+        let (width, height) = (self.width, self.height);
+        let image_of = |panel: Panel| -> io::Result<image::RgbImage> {
+            let canvas = draw_panel(&panel, width, height, width, height)?;
+            image::RgbImage::from_raw(canvas.width as u32, canvas.height as u32, canvas.rgb)
+                .ok_or_else(|| io::Error::other("a preview panel has the wrong buffer size"))
+        };
+        self.frames
+            .into_iter()
+            .map(|f| {
+                Ok([
+                    image_of(f.s0.coloured(&f.ranged, s0_range))?,
+                    image_of(f.dolp.coloured(&f.ranged, dolp_range))?,
+                ])
+            })
+            .collect()
     }
 }
 
@@ -361,10 +482,7 @@ fn caption(scene: &Scene, image: &StokesImage) -> String {
         stem += &format!(" at {}", instant.time_utc);
     }
     let (lo_um, hi_um) = scene.sensor.band.limits_um();
-    let shading = match scene.shading {
-        Shading::Pixel => "per-pixel",
-        Shading::Gouraud => "Gouraud",
-    };
+    let shading = scene.shading.describe();
     let mut caption = format!(
         "{stem}: {}×{}, {shading} shading, {lo_um}–{hi_um} µm, air {:.2} K",
         image.width, image.height, scene.air_temperature_k
@@ -615,8 +733,10 @@ fn format_signed(v: f64) -> String {
     }
 }
 
-/// (p_lo, p_hi) quantiles of the values (0, 1 when empty).
-fn robust_range(mut values: Vec<f64>, p_lo: f64, p_hi: f64) -> (f64, f64) {
+/// (p_lo, p_hi) quantiles of the values (0, 1 when empty), each moved out by `margin` times
+/// their distance but not past the values' own extremes: noise that straddles a cut-off stays in
+/// range (it would paint speckle in the under/over colours), outliers far beyond it do not.
+fn robust_range(mut values: Vec<f64>, p_lo: f64, p_hi: f64, margin: f64) -> (f64, f64) {
     if values.is_empty() {
         return (0.0, 1.0);
     }
@@ -624,7 +744,17 @@ fn robust_range(mut values: Vec<f64>, p_lo: f64, p_hi: f64) -> (f64, f64) {
         let k = ((values.len() - 1) as f64 * p).round() as usize;
         *values.select_nth_unstable_by(k, f64::total_cmp).1
     };
-    (quantile(p_lo), quantile(p_hi))
+    let (lo, hi) = (quantile(p_lo), quantile(p_hi));
+    if margin == 0.0 {
+        return (lo, hi);
+    }
+    let (min, max) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let reach = margin * (hi - lo);
+    ((lo - reach).max(min), (hi + reach).min(max))
 }
 
 /// A non-empty display range.
@@ -693,10 +823,154 @@ mod tests {
         assert_eq!(clipped(&minmax), (0.0, 999.0, 0.0, 0.0));
         assert_eq!(minmax.title, "x");
 
-        // The default percentiles clip one pixel in a thousand at each end.
+        // The default percentiles (1 and 998) reach out to the ramp's ends: nothing clipped.
         let auto = ramp_panel(None, PreviewRange::Percentile);
-        let (lo, hi, below, above) = clipped(&auto);
-        assert_eq!((lo, hi), (1.0, 998.0));
-        assert_eq!((below, above), (0.001, 0.001));
+        assert_eq!(clipped(&auto), (0.0, 999.0, 0.0, 0.0));
+        assert_eq!(auto.title, "x");
+    }
+
+    /// `n` standard normal values (Box–Muller over a seeded generator).
+    fn gaussian(n: usize, seed: u64) -> Vec<f64> {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| {
+                let (u, v): (f64, f64) = (rng.random(), rng.random());
+                (-2.0 * (1.0 - u).ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+            })
+            .collect()
+    }
+
+    fn panel_of(values: Vec<f64>, ranged: &[bool], settings: &PreviewConfig) -> Panel {
+        LinearPanel {
+            file: "S0.png",
+            title: "S0".into(),
+            values,
+            fixed: None,
+            symmetric: false,
+            map: &THERMAL,
+            format: |v| format!("{v}"),
+        }
+        .panel(ranged, settings)
+    }
+
+    #[test]
+    fn detector_noise_alone_is_not_drawn_clipped_but_a_glint_is() {
+        // A flat 300 K scene with 20 mK of noise over a megapixel: its extremes lie beyond the
+        // 0.1/99.9 % points, which used to paint ~2000 speckles in the under/over colours.
+        let values: Vec<f64> = gaussian(1 << 20, 7)
+            .into_iter()
+            .map(|z| 300.0 + 0.02 * z)
+            .collect();
+        let ranged = vec![true; values.len()];
+        let settings = PreviewConfig::default();
+        let panel = panel_of(values.clone(), &ranged, &settings);
+        let (lo, hi, below, above) = clipped(&panel);
+        assert_eq!((below, above), (0.0, 0.0), "{lo} … {hi}");
+        assert!(!panel.title.contains("clipped"), "{}", panel.title);
+
+        // A glint of 20 pixels at 340 K is far beyond the noise: it is clipped and counted.
+        let mut glinting = values;
+        glinting[..20].fill(340.0);
+        let panel = panel_of(glinting, &ranged, &settings);
+        let (_, hi, below, above) = clipped(&panel);
+        assert!(hi < 300.2 && below == 0.0 && above > 0.0, "{hi} {above}");
+        assert_eq!(panel.colors[0], THERMAL.over);
+        assert!(
+            panel.title.ends_with(" — clipped < 0.1 % above"),
+            "{}",
+            panel.title
+        );
+
+        // Percentiles the scene gives are taken as they are.
+        let given = PreviewConfig {
+            percentiles: Some([5.0, 95.0]),
+            ..PreviewConfig::default()
+        };
+        let ramp: Vec<f64> = (0..1000).map(f64::from).collect();
+        let panel = panel_of(ramp, &[true; 1000], &given);
+        assert_eq!(clipped(&panel), (50.0, 949.0, 0.05, 0.05));
+    }
+
+    #[test]
+    fn sky_outside_the_range_takes_the_maps_end_colour_and_is_not_counted_as_clipped() {
+        // Objects at 290…300 K in the first 100 pixels, a 230 K sky and a 320 K patch of the
+        // environment's ground in the others: neither sets the range nor is drawn as a clip.
+        let mut values: Vec<f64> = (0..100).map(|i| 290.0 + 0.1 * f64::from(i)).collect();
+        values.extend([230.0; 50]);
+        values.extend([320.0; 50]);
+        let ranged: Vec<bool> = (0..200).map(|i| i < 100).collect();
+        let panel = panel_of(values, &ranged, &PreviewConfig::default());
+        let (lo, hi, below, above) = clipped(&panel);
+        assert_eq!((lo, hi, below, above), (290.0, 299.9, 0.0, 0.0));
+        assert_eq!(panel.colors[120], THERMAL.at(0.0));
+        assert_eq!(panel.colors[170], THERMAL.at(1.0));
+        assert!(!panel.title.contains("clipped"), "{}", panel.title);
+    }
+
+    fn series_frame(values: Vec<f64>) -> SeriesFrame {
+        let panel = |values: Vec<f64>, fixed| LinearPanel {
+            file: "S0.png",
+            title: "S0".into(),
+            values,
+            fixed,
+            symmetric: false,
+            map: &THERMAL,
+            format: |v| format!("{v:.1}"),
+        };
+        let dolp: Vec<f64> = values.iter().map(|t| (t - 280.0) / 10.0).collect();
+        SeriesFrame {
+            ranged: vec![true; values.len()],
+            s0: panel(values, None),
+            dolp: panel(dolp, Some([0.0, f64::NAN])),
+        }
+    }
+
+    #[test]
+    fn a_time_series_is_coloured_over_one_range() {
+        // Midnight at 284…290 K, noon at 295…325 K (16 × 16 pixels each).
+        let ramp = |lo: f64, hi: f64| -> Vec<f64> {
+            (0..256)
+                .map(|i| lo + (hi - lo) * f64::from(i) / 255.0)
+                .collect()
+        };
+        let series = SeriesPreview {
+            width: 16,
+            height: 16,
+            settings: PreviewConfig::default(),
+            frames: vec![
+                series_frame(ramp(284.0, 290.0)),
+                series_frame(ramp(295.0, 325.0)),
+            ],
+        };
+        let [s0, dolp] = series.ranges();
+        assert_eq!(s0, (284.0, 325.0));
+        assert_eq!(dolp, (0.0, 4.5));
+        // Each frame alone would span its own range; together the midnight frame is the cold end.
+        let frames = series.frames().unwrap();
+        let layout = PanelLayout::new(
+            &Bar::Linear {
+                map: &THERMAL,
+                lo: 0.0,
+                hi: 1.0,
+                format: |v| format!("{v}"),
+                clipped: Clipped::default(),
+            },
+            16,
+            16,
+        );
+        let pixel = |image: &image::RgbImage, i: u32| {
+            image
+                .get_pixel(
+                    layout.margin as u32 + i % 16,
+                    layout.title_h as u32 + i / 16,
+                )
+                .0
+        };
+        assert_eq!(pixel(&frames[0][0], 0), THERMAL.at(0.0));
+        assert_eq!(pixel(&frames[1][0], 255), THERMAL.at(1.0));
+        let midnight_top = pixel(&frames[0][0], 255);
+        assert_eq!(midnight_top, Lut::new(&THERMAL).at(6.0 / 41.0));
+        assert_eq!(frames[0][0].dimensions(), frames[1][0].dimensions());
     }
 }

@@ -20,8 +20,8 @@ mod validation;
 
 use table::format_angle;
 pub(crate) use table::{
-    at_bound, format_plain, format_with_uncertainty, is_free, lookup, parameters, preference,
-    sha_prefix,
+    fitted_cells, format_plain, format_with_uncertainty, is_free, parameters, preference,
+    sha_prefix, FOOTNOTE_BOUND, FOOTNOTE_PROFILE,
 };
 pub use validation::encode_validation_report;
 
@@ -296,10 +296,45 @@ pub(crate) fn verified_source(
     material_path: &Path,
     fit: &FitRecord,
 ) -> Result<Vec<MeasurementSet>, ReportError> {
-    let reading = ReadOptions {
+    let reading = recorded_reading(material_path, fit)?;
+    let one_set = |csv: &Path, bytes: &[u8]| parse_source(csv, bytes, &reading).map(|s| vec![s]);
+    Ok(verified_files(material_path, fit, one_set)?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
+/// [`verified_source`] of a spectral material: its files may hold several wavelengths each (a
+/// `wavelength_um` column), all of which it keeps; returns every set of every file, read as the
+/// fit read them.
+pub(crate) fn verified_spectral_source(
+    material_path: &Path,
+    fit: &FitRecord,
+) -> Result<Vec<MeasurementSet>, ReportError> {
+    let reading = recorded_reading(material_path, fit)?;
+    let every_set = |csv: &Path, bytes: &[u8]| -> Result<Vec<MeasurementSet>, ReportError> {
+        Ok(reading.parse(csv, bytes).map_err(FitError::from)?)
+    };
+    Ok(verified_files(material_path, fit, every_set)?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
+/// How the fit read its files: the recorded layout and row selection.
+fn recorded_reading(material_path: &Path, fit: &FitRecord) -> Result<ReadOptions, ReportError> {
+    Ok(ReadOptions {
         layout: recorded_layout(material_path, fit)?,
         selection: fit.selection.clone().unwrap_or_default(),
-    };
+    })
+}
+
+/// Each of the fit's source files checked by [`verified_file`], read with `parse`.
+fn verified_files(
+    material_path: &Path,
+    fit: &FitRecord,
+    parse: impl Fn(&Path, &[u8]) -> Result<Vec<MeasurementSet>, ReportError>,
+) -> Result<Vec<Vec<MeasurementSet>>, ReportError> {
     std::iter::once((&fit.source, &fit.source_sha256, &fit.source_data))
         .chain(
             fit.merged_sources
@@ -307,7 +342,7 @@ pub(crate) fn verified_source(
                 .map(|m| (&m.source, &m.source_sha256, &m.source_data)),
         )
         .map(|(source, sha256, data)| {
-            verified_file(material_path, source, sha256, data.as_ref(), &reading)
+            verified_file(material_path, source, sha256, data.as_ref(), &parse)
         })
         .collect()
 }
@@ -361,16 +396,16 @@ fn parse_source(
 
 /// One source CSV, checked against its recorded hash and data fingerprint. The bytes may differ
 /// (a comment, blank lines, number spelling) when the record has the data's fingerprint and the
-/// parsed data match it; a record without one (written before fingerprints) needs the very
-/// bytes. Of several candidates the first that matches wins (a same-named file elsewhere is not
-/// the source); if none does, the first existing one is reported changed.
+/// parsed data match it; a record without one (written before fingerprints, or by a spectral
+/// fit) needs the very bytes. Of several candidates the first that matches wins (a same-named
+/// file elsewhere is not the source); if none does, the first existing one is reported changed.
 fn verified_file(
     material_path: &Path,
     source: &Path,
     recorded_sha256: &str,
     recorded_data: Option<&SourceData>,
-    reading: &ReadOptions,
-) -> Result<MeasurementSet, ReportError> {
+    parse: &impl Fn(&Path, &[u8]) -> Result<Vec<MeasurementSet>, ReportError>,
+) -> Result<Vec<MeasurementSet>, ReportError> {
     let candidates = source_candidates(material_path, source);
     let mut first_changed = None;
     for csv in candidates.iter().filter(|p| p.is_file()) {
@@ -384,12 +419,22 @@ fn verified_file(
         })?;
         let same_bytes = hex(&Sha256::digest(&bytes)).eq_ignore_ascii_case(recorded_sha256.trim());
         let error = match (recorded_data, same_bytes) {
-            (_, true) => return parse_source(csv, &bytes, reading),
+            (_, true) => return parse(csv, &bytes),
             (Some(recorded), false) => {
-                let set = parse_source(csv, &bytes, reading)?;
+                let sets = parse(csv, &bytes)?;
+                // A fingerprint is recorded for a file of one wavelength only: of several sets
+                // (a hand-edited record) only the very bytes would do.
+                let [set] = sets.as_slice() else {
+                    first_changed.get_or_insert(ReportError::SourceChanged {
+                        csv: csv.clone(),
+                        recorded: recorded_sha256.to_owned(),
+                        material: material_path.to_owned(),
+                    });
+                    continue;
+                };
                 let now = set.source_data(recorded.rows_per_digest);
                 if now.sha256 == recorded.sha256 {
-                    return Ok(set);
+                    return Ok(sets);
                 }
                 ReportError::SourceDataChanged {
                     csv: csv.clone(),

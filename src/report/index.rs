@@ -4,8 +4,8 @@
 //! links only, so the page works from a file browser and when the folder is copied elsewhere.
 
 use super::fit_report::{
-    at_bound, format_plain, format_with_uncertainty, is_free, lookup, parameters, preference,
-    sha_prefix, verified_source,
+    fitted_cells, format_plain, is_free, parameters, preference, sha_prefix, verified_source,
+    verified_spectral_source, FOOTNOTE_BOUND, FOOTNOTE_PROFILE,
 };
 use super::ReportError;
 use crate::atomic::write_atomically;
@@ -130,32 +130,50 @@ fn relative_to(from: &Path, target: &Path) -> PathBuf {
     relative
 }
 
-/// "value ± σ" of one parameter in the index, or "value (fixed)".
+/// "value ± σ" of one parameter in the index, "value (fixed)", or the report's cells of a
+/// parameter on a bound ("0 † < 3.722e-6 ‡"; [`footnotes`] explains the marks).
 fn parameter_text(material: &Material, name: &str, value: f64) -> String {
     match material.fit.as_ref() {
         Some(fit) if is_free(fit, name) => {
-            let sigma = lookup(|k| fit.uncertainty.get(k), name).copied();
-            let bound = if at_bound(fit, name) {
-                " (at bound)"
-            } else {
-                ""
-            };
-            match format_with_uncertainty(value, sigma) {
-                (value, Some(sigma)) => format!("{value} ± {sigma}{bound}"),
-                (value, None) => format!("{value} ± ?{bound}"),
-            }
+            let (value, sigma, _) = fitted_cells(fit, name, value);
+            format!("{value} {sigma}")
         }
         Some(_) => format!("{} (fixed)", format_plain(value)),
         None => format_plain(value),
     }
 }
 
-/// Whether the fit's source CSV is still the file that was fitted.
+/// The notes on the marks the parameter cells of `materials` carry, one paragraph (or nothing).
+fn footnotes(materials: &[(PathBuf, Material)]) -> String {
+    let fits = || materials.iter().filter_map(|(_, m)| m.fit.as_ref());
+    let mut notes = Vec::new();
+    if fits().any(|fit| !fit.at_bound.is_empty()) {
+        notes.push(FOOTNOTE_BOUND.to_owned());
+    }
+    if fits().any(|fit| !fit.profile_bounds.is_empty()) {
+        notes.push(format!("{FOOTNOTE_PROFILE}, where a ± would mislead"));
+    }
+    if notes.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "<p class=\"muted\">{}.</p>\n",
+            escape_html(&notes.join("; "))
+        )
+    }
+}
+
+/// Whether the fit's source files are still the files that were fitted, each read by the reader
+/// of the material's kind (a spectral file may hold several wavelengths).
 fn provenance(material_path: &Path, material: &Material) -> (String, &'static str) {
     let Some(fit) = material.fit.as_ref() else {
         return ("not fitted by irpol".into(), "warn");
     };
-    match verified_source(material_path, fit) {
+    let verified = match material.model {
+        MaterialModel::Grey(_) => verified_source(material_path, fit),
+        MaterialModel::Spectral(_) => verified_spectral_source(material_path, fit),
+    };
+    match verified {
         Ok(_) => ("source unchanged".into(), "ok"),
         Err(ReportError::SourceChanged { .. } | ReportError::SourceDataChanged { .. }) => {
             ("source CSV changed since the fit".into(), "warn")
@@ -210,6 +228,7 @@ pub fn library_index_html(
         return html;
     }
     summary_table(&mut html, materials);
+    html.push_str(&footnotes(materials));
     for (path, material) in materials {
         let has_report = new_reports.contains(&material.name.as_str())
             || reports_dir.join(format!("{}.png", material.name)).is_file();

@@ -237,6 +237,16 @@ pub enum Shading {
     Pixel,
 }
 
+impl Shading {
+    /// The shading in words, as captions and the command line's summary print it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Shading::Pixel => "per-pixel",
+            Shading::Gouraud => "Gouraud",
+        }
+    }
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RenderConfig {

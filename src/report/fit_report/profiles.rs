@@ -5,8 +5,8 @@
 use super::data::{ModelSweep, PointView, ReportData};
 use super::style::{
     incidence_color, log_tick, report_mesh_style, sane_linear_range, sane_log_range, DrawResult,
-    Marker, YAxis, AXIS_DESC_SIZE, CAPTION_SIZE, MAX_LOG_DECADES, SMALL_CAPTION_SIZE,
-    SMALL_TICK_SIZE, TICK_SIZE,
+    Marker, YAxis, AXIS_DESC_SIZE, CAPTION_SIZE, GREY, LEGEND_SIZE, MAX_LOG_DECADES,
+    SMALL_CAPTION_SIZE, SMALL_TICK_SIZE, TICK_SIZE,
 };
 use crate::measure::MUELLER_ELEMENT_NAMES;
 use crate::optics::Mueller;
@@ -14,6 +14,7 @@ use crate::plot_style::FONT;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// What a profile panel shows on its y axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -510,13 +511,105 @@ fn draw_series<DB: DrawingBackend, Y: Ranged<ValueType = f64> + ValueFormatter<f
         }
         chart.draw_series(visible.map(|p| s.marker.at((p.x, p.value), marker_size, s.color)))?;
     }
+    if let (false, Some(at)) = (profile.compact, flat_floor(&profile.series, axis)) {
+        let style = (FONT, LEGEND_SIZE)
+            .into_font()
+            .color(&GREY)
+            .pos(Pos::new(HPos::Left, VPos::Bottom));
+        chart.draw_series(std::iter::once(
+            EmptyElement::at(at) + Text::new(FLOOR_LABEL, (6, -4), style),
+        ))?;
+    }
     Ok(())
+}
+
+/// The label on a dashed curve running flat along the bottom of a log axis.
+pub const FLOOR_LABEL: &str = "dashed: the competing fit's diffuse floor ρd/π";
+/// A stretch of a dashed curve within 1 % of its first value counts as flat when it covers this
+/// share of the points, in the lowest [`FLOOR_BOTTOM_SHARE`] of the log axis' decades.
+const FLOOR_MIN_SHARE: f64 = 0.15;
+const FLOOR_BOTTOM_SHARE: f64 = 0.25;
+
+/// Where the competing fit's curves run flat near the bottom of a log axis: where its facet lobe
+/// has died away and its diffuse term ρd/π is all that is left, a level line that reads as a
+/// threshold unless it is labelled. The left end (x, y) of the longest such stretch.
+pub fn flat_floor(series: &[ProfileSeries], axis: YAxis) -> Option<(f64, f64)> {
+    let YAxis::Log { low, high } = axis else {
+        return None;
+    };
+    let bottom = low * (high / low).powf(FLOOR_BOTTOM_SHARE);
+    let mut best: Option<(usize, (f64, f64))> = None;
+    for line in series.iter().filter_map(|s| s.alternative.as_ref()) {
+        let mut start = 0;
+        for i in 1..=line.len() {
+            let level = line[start].1;
+            if i < line.len() && (line[i].1 / level - 1.0).abs() < 0.01 {
+                continue;
+            }
+            let length = i - start;
+            let long = length as f64 >= FLOOR_MIN_SHARE * line.len() as f64 && length > 2;
+            if long && (low..=bottom).contains(&level) && best.is_none_or(|(b, _)| length > b) {
+                best = Some((length, line[start]));
+            }
+            start = i;
+        }
+    }
+    best.map(|(_, at)| at)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::report::fit_report::data::Reading;
+
+    /// A dashed curve over x = −90…90°: a lobe falling to a level `floor` on the left third.
+    fn floor_series(floor: f64) -> ProfileSeries {
+        let line = (0..=180)
+            .map(|i| {
+                let x = f64::from(i) - 90.0;
+                (
+                    x,
+                    floor
+                        + if x < -30.0 {
+                            0.0
+                        } else {
+                            0.1 * ((x + 30.0) / 20.0).exp()
+                        },
+                )
+            })
+            .collect();
+        ProfileSeries {
+            color: BLACK,
+            marker: Marker::FilledCircle,
+            points: Vec::new(),
+            chosen: Vec::new(),
+            alternative: Some(line),
+        }
+    }
+
+    #[test]
+    fn a_competing_curve_flat_along_the_bottom_of_a_log_axis_is_labelled() {
+        let axis = YAxis::Log {
+            low: 1e-4,
+            high: 100.0,
+        };
+        // Flat at 2e-4 over −90…−30°: labelled at its left end.
+        assert_eq!(flat_floor(&[floor_series(2e-4)], axis), Some((-90.0, 2e-4)));
+        // A level high on the axis is not a floor; one below the axis is not drawn at all; a
+        // linear axis has none; no competing fit, no label.
+        assert_eq!(flat_floor(&[floor_series(0.5)], axis), None);
+        assert_eq!(flat_floor(&[floor_series(1e-6)], axis), None);
+        let linear = YAxis::Linear {
+            low: 0.0,
+            high: 1.0,
+        };
+        assert_eq!(flat_floor(&[floor_series(2e-4)], linear), None);
+        let chosen_only = ProfileSeries {
+            alternative: None,
+            ..floor_series(2e-4)
+        };
+        assert_eq!(flat_floor(&[chosen_only], axis), None);
+    }
 
     fn point(readings: &[(usize, f64, f64)]) -> PointView {
         let mut all = [None; 16];

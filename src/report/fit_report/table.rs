@@ -221,8 +221,9 @@ fn parameter_rows(model: &ModelSpec, fit: Option<&FitRecord>) -> Vec<Row> {
 
 /// The value and ± cells of free parameter `name` and their tone: the value marked † on a bound
 /// of its search interval; an undetermined parameter's ± means nothing, so it is flagged, or
-/// replaced by its profile bound when the fit has one.
-fn fitted_cells(fit: &FitRecord, name: &str, value: f64) -> (String, String, Tone) {
+/// replaced by its profile bound when the fit has one. The report's table and the library index
+/// both show these, so a parameter reads the same in both.
+pub fn fitted_cells(fit: &FitRecord, name: &str, value: f64) -> (String, String, Tone) {
     let sigma = lookup(|k| fit.uncertainty.get(k), name).copied();
     let (text, sigma_text) = format_with_uncertainty(value, sigma);
     let undetermined = fit.undetermined.iter().any(|u| u == name);
@@ -285,6 +286,11 @@ fn quality_rows(material: &Material, fit: &FitRecord) -> Vec<Row> {
     rows
 }
 
+/// The note on a value marked †.
+pub const FOOTNOTE_BOUND: &str = "† at a bound of its search interval";
+/// The note on a ± cell marked ‡.
+pub const FOOTNOTE_PROFILE: &str = "‡ one-sided 95 % profile-likelihood bounds";
+
 /// What the fit could not pin down: undetermined parameters, parameters on a bound (the † of
 /// their value) and one-sided profile bounds (the ‡ of their ± cell).
 fn caveat_rows(fit: &FitRecord) -> Vec<Row> {
@@ -301,7 +307,7 @@ fn caveat_rows(fit: &FitRecord) -> Vec<Row> {
     if !fit.at_bound.is_empty() {
         let names: Vec<&str> = fit.at_bound.iter().map(|n| symbol(n)).collect();
         rows.push(Row::Text(
-            format!("† at a bound of its search interval: {}", names.join(", ")),
+            format!("{FOOTNOTE_BOUND}: {}", names.join(", ")),
             Tone::Muted,
         ));
     }
@@ -309,8 +315,7 @@ fn caveat_rows(fit: &FitRecord) -> Vec<Row> {
         let names: Vec<&str> = fit.profile_bounds.keys().map(|n| symbol(n)).collect();
         rows.push(Row::Text(
             format!(
-                "‡ one-sided 95 % profile-likelihood bounds (the data bound {} from one side \
-                 at most; a ± would mislead)",
+                "{FOOTNOTE_PROFILE} (the data bound {} from one side at most; a ± would mislead)",
                 names.join(", ")
             ),
             Tone::Warning,

@@ -23,12 +23,8 @@ pub enum Line {
     Muted(String),
 }
 
-/// Column stops (pixels from the left) of the parameter rows and of the per-wavelength table.
-const PARAMETER_STOPS: [i32; 2] = [18, 200];
-const WAVELENGTH_STOPS: [i32; 6] = [18, 150, 390, 630, 880, 1040];
-/// Font size and line height the summary starts from; shrunk when its lines do not fit.
+/// Font size the summary starts from; shrunk when its lines do not fit ([`summary_layout`]).
 const FONT_SIZE: i32 = 20;
-const LINE_HEIGHT: i32 = 30;
 const TOP: i32 = 52;
 /// Characters of a free-text line kept (a long source path).
 const MAX_TEXT: usize = 100;
@@ -176,18 +172,17 @@ pub fn summary_lines(outcome: &SpectralFitOutcome, model: &SpectralModel) -> Vec
     lines
 }
 
-/// Draws the summary into `area`, its font shrunk when the lines would not fit.
+/// Draws the summary into `area`: [`summary_layout`]'s lines at its font and column stops.
 pub fn draw_summary<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     outcome: &SpectralFitOutcome,
     model: &SpectralModel,
 ) -> DrawResult<DB> {
-    let (width, height) = area.dim_in_pixel();
+    let (width, _) = area.dim_in_pixel();
     draw_caption(area, &format!("(e) {} — joint fit", outcome.material.name))?;
-    let lines = summary_lines(outcome, model);
-    let room = (height as i32 - TOP - 10).max(1);
-    let line_height = LINE_HEIGHT.min(room / lines.len().max(1) as i32).max(12);
-    let size = (FONT_SIZE * line_height / LINE_HEIGHT).max(10) & !1;
+    let note = format!("{}/<λ>um.png", outcome.material.name);
+    let layout = summary_layout(area, summary_lines(outcome, model), &note)?;
+    let size = layout.size;
     let anchor = Pos::new(HPos::Left, VPos::Top);
     let normal = (FONT, size).into_font().color(&BLACK).pos(anchor);
     let muted = (FONT, size).into_font().color(&GREY).pos(anchor);
@@ -196,22 +191,22 @@ pub fn draw_summary<DB: DrawingBackend>(
         .color(&BLACK)
         .pos(anchor);
     let right = width as i32 - 18;
-    for (i, line) in lines.iter().enumerate() {
-        let y = TOP + i as i32 * line_height;
+    for (i, line) in layout.lines.iter().enumerate() {
+        let y = TOP + i as i32 * layout.line_height;
         match line {
             Line::Heading(text) => {
                 area.draw_text(text, &bold, (18, y))?;
-                let rule = y + line_height - 3;
+                let rule = y + layout.line_height - 3;
                 area.draw(&PathElement::new(
                     vec![(18, rule), (right, rule)],
                     RGBColor(190, 190, 190).stroke_width(1),
                 ))?;
             }
             Line::Cells(cells, wide) => {
-                let stops: &[i32] = if *wide {
-                    &WAVELENGTH_STOPS
+                let stops = if *wide {
+                    &layout.wide_stops
                 } else {
-                    &PARAMETER_STOPS
+                    &layout.stops
                 };
                 for (cell, &x) in cells.iter().zip(stops) {
                     area.draw_text(cell, &normal, (x, y))?;
@@ -222,4 +217,207 @@ pub fn draw_summary<DB: DrawingBackend>(
         }
     }
     Ok(())
+}
+
+/// The summary as drawn: font size, line height, the column stops of the parameter rows and of
+/// the per-wavelength table, and the lines (the per-wavelength rows cut short when even the
+/// smallest font cannot hold them all).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SummaryLayout {
+    pub size: i32,
+    pub line_height: i32,
+    pub stops: Vec<i32>,
+    pub wide_stops: Vec<i32>,
+    pub lines: Vec<Line>,
+}
+
+/// Smallest font the summary shrinks to; gap between its columns.
+const MIN_FONT_SIZE: i32 = 10;
+const COLUMN_GAP: i32 = 16;
+
+/// Lays `lines` out in `area`: each column as wide as its widest cell (fixed stops let a long
+/// value run into the next column), the font shrunk until every row fits the width and every
+/// line the height; at the smallest font, per-wavelength rows that still do not fit give way to
+/// one line saying how many more there are and where their fits are (`note`).
+pub fn summary_layout<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    mut lines: Vec<Line>,
+    note: &str,
+) -> Result<SummaryLayout, DrawingAreaErrorKind<DB::ErrorType>> {
+    let (width, height) = area.dim_in_pixel();
+    let (width, room) = (width as i32 - 18, (height as i32 - TOP - 10).max(1));
+    let mut size = FONT_SIZE;
+    loop {
+        let style = (FONT, size).into_font().color(&BLACK);
+        let stops = |wide: bool| -> Result<(Vec<i32>, i32), DrawingAreaErrorKind<DB::ErrorType>> {
+            let mut widths: Vec<i32> = Vec::new();
+            for cells in lines.iter().filter_map(|l| match l {
+                Line::Cells(cells, w) if *w == wide => Some(cells),
+                _ => None,
+            }) {
+                for (i, cell) in cells.iter().enumerate() {
+                    let w = area.estimate_text_size(cell, &style)?.0 as i32;
+                    match widths.get_mut(i) {
+                        Some(widest) => *widest = (*widest).max(w),
+                        None => widths.push(w),
+                    }
+                }
+            }
+            let mut x = 18;
+            let stops = widths
+                .iter()
+                .map(|w| {
+                    let stop = x;
+                    x += w + COLUMN_GAP;
+                    stop
+                })
+                .collect();
+            Ok((stops, x - COLUMN_GAP))
+        };
+        let ((stops, narrow_end), (wide_stops, wide_end)) = (stops(false)?, stops(true)?);
+        let line_height = size * 3 / 2;
+        let fits_width = narrow_end.max(wide_end) <= width;
+        let fits_height = lines.len() as i32 * line_height <= room;
+        if (fits_width && fits_height) || size <= MIN_FONT_SIZE {
+            if !fits_height {
+                cut_wavelength_rows(&mut lines, (room / line_height) as usize, note);
+            }
+            return Ok(SummaryLayout {
+                size,
+                line_height,
+                stops,
+                wide_stops,
+                lines,
+            });
+        }
+        size -= 1;
+    }
+}
+
+/// Keeps `lines` within `capacity` by dropping per-wavelength rows from the end of the table
+/// (the rows after its header), and says how many were dropped and where they are (`note`).
+fn cut_wavelength_rows(lines: &mut Vec<Line>, capacity: usize, note: &str) {
+    let rows: Vec<usize> = lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| matches!(l, Line::Cells(_, true)))
+        .map(|(i, _)| i)
+        .skip(1)
+        .collect();
+    let excess = (lines.len() + 1).saturating_sub(capacity).min(rows.len());
+    if excess == 0 {
+        return;
+    }
+    let dropped = &rows[rows.len() - excess..];
+    let at = dropped[0];
+    lines.drain(at..at + excess);
+    lines.insert(
+        at,
+        Line::Muted(format!(
+            "… {excess} more wavelengths: each one's fit in {note}"
+        )),
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wavelength_row(j: usize) -> Line {
+        let cells = [
+            format!("{}", 8.0 + 0.05 * j as f64),
+            "2.8725 ± 0.0020".into(),
+            "1.3862 ± 0.0014".into(),
+            "0.0000019478 ± 0.0000017123".into(),
+            "1.003".into(),
+            "433".into(),
+        ];
+        Line::Cells(cells.to_vec(), true)
+    }
+
+    fn lines(wavelengths: usize) -> Vec<Line> {
+        let mut lines = vec![
+            Line::Heading("Shared by every wavelength".into()),
+            Line::Cells(vec!["σ".into(), "0.0600032 ± 0.0000071".into()], false),
+            Line::Heading("Per wavelength".into()),
+            Line::Cells(
+                ["λ (µm)", "n ± 1σ", "k ± 1σ", "ρd ± 1σ", "χ²/obs", "points"]
+                    .map(String::from)
+                    .to_vec(),
+                true,
+            ),
+        ];
+        lines.extend((0..wavelengths).map(wavelength_row));
+        lines.push(Line::Muted("source x.csv".into()));
+        lines
+    }
+
+    /// The layout of `lines` in the report's (e) panel, 1200 × 800 pixels.
+    fn layout(lines: Vec<Line>) -> SummaryLayout {
+        crate::plot_style::register_fonts();
+        let mut buffer = vec![0u8; 1200 * 800 * 3];
+        let area = BitMapBackend::with_buffer(&mut buffer, (1200, 800)).into_drawing_area();
+        let layout = summary_layout(&area, lines, "glass/<λ>um.png").unwrap();
+        // Every cell ends before the next column starts and within the panel.
+        let style = (FONT, layout.size).into_font().color(&BLACK);
+        for line in &layout.lines {
+            if let Line::Cells(cells, wide) = line {
+                let stops = if *wide {
+                    &layout.wide_stops
+                } else {
+                    &layout.stops
+                };
+                for (i, cell) in cells.iter().enumerate() {
+                    let end = stops[i] + area.estimate_text_size(cell, &style).unwrap().0 as i32;
+                    let next = stops.get(i + 1).copied().unwrap_or(1200 - 18);
+                    assert!(end <= next, "{cell} runs into the next column");
+                }
+            }
+        }
+        layout
+    }
+
+    #[test]
+    fn the_summary_stays_inside_its_panel() {
+        // Nine wavelengths fit at full size, every row kept.
+        let few = layout(lines(9));
+        assert_eq!((few.size, few.lines.len()), (FONT_SIZE, lines(9).len()));
+        // Forty shrink the font and still fit.
+        let many = layout(lines(40));
+        assert!(
+            many.size < FONT_SIZE && many.lines == lines(40),
+            "{}",
+            many.size
+        );
+        assert!(TOP + many.lines.len() as i32 * many.line_height <= 800 - 10);
+        // Two hundred cannot: the table ends with how many more there are and where.
+        let too_many = layout(lines(200));
+        assert_eq!(too_many.size, MIN_FONT_SIZE);
+        assert!(TOP + too_many.lines.len() as i32 * too_many.line_height <= 800 - 10);
+        let cut = too_many
+            .lines
+            .iter()
+            .find_map(|l| match l {
+                Line::Muted(text) if text.starts_with('…') => Some(text.clone()),
+                _ => None,
+            })
+            .expect("a line saying what was cut");
+        let kept = too_many
+            .lines
+            .iter()
+            .filter(|l| matches!(l, Line::Cells(_, true)))
+            .count()
+            - 1;
+        assert_eq!(
+            cut,
+            format!(
+                "… {} more wavelengths: each one's fit in glass/<λ>um.png",
+                200 - kept
+            )
+        );
+        assert_eq!(
+            too_many.lines.last(),
+            Some(&Line::Muted("source x.csv".into()))
+        );
+    }
 }
