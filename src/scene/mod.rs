@@ -18,6 +18,7 @@ pub mod config;
 pub mod environment;
 mod error;
 pub mod mesh;
+mod names;
 pub mod obj;
 mod object;
 pub mod ply;
@@ -147,7 +148,7 @@ pub fn load_scene_text(path: &Path, text: &str) -> Result<Scene, SceneError> {
 }
 
 fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
-    check_names(path, &config)?;
+    names::check_names(path, &config)?;
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
@@ -222,44 +223,6 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         thermal_instant: None,
         warnings,
     })
-}
-
-/// Refuses a name (of a material, layer, object or part, given or referred to) that holds a
-/// control character or is longer than [`crate::text::MAX_NAME_CHARS`]: messages and summaries
-/// quote names whole, and each must stay one short printable line.
-fn check_names(path: &Path, config: &SceneConfig) -> Result<(), SceneError> {
-    let mut names: Vec<(String, &str)> = Vec::new();
-    names.extend(
-        config
-            .materials
-            .keys()
-            .map(|k| ("materials".to_owned(), k.as_str())),
-    );
-    if let Some(thermal) = &config.thermal {
-        let layers = thermal.layers.keys();
-        names.extend(layers.map(|k| ("thermal.layers".to_owned(), k.as_str())));
-    }
-    for (i, object) in config.objects.iter().enumerate() {
-        let key = |what: &str| format!("objects[{i}].{what}");
-        names.extend(object.name.as_deref().map(|n| (key("name"), n)));
-        names.extend(object.material.as_deref().map(|n| (key("material"), n)));
-        for (part, config) in &object.parts {
-            names.push((key("parts"), part.as_str()));
-            names.extend(
-                config
-                    .material
-                    .as_deref()
-                    .map(|n| (key("parts.material"), n)),
-            );
-        }
-    }
-    match names
-        .into_iter()
-        .find_map(|(key, name)| crate::text::name_problem(name).map(|p| (key, p)))
-    {
-        Some((key, problem)) => Err(SceneError::new(path, format!("{key}: the name {problem}"))),
-        None => Ok(()),
-    }
 }
 
 /// Every object, named (given, else its mesh file's stem, else `objectN`), in one mesh.
