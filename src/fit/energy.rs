@@ -22,18 +22,27 @@ fn checked_angles() -> impl ParallelIterator<Item = f64> {
         .chain(rayon::iter::once(89.0))
 }
 
-/// The largest hemispherical reflectance of `model` over the checked angles, and where.
-pub fn largest_reflectance(model: &Pbrdf) -> (f64, f64) {
+/// The hemispherical reflectance of `model` at each checked angle: (degrees, reflectance).
+fn reflectances(model: &Pbrdf) -> Vec<(f64, f64)> {
     let quadrature = HemisphereQuadrature::default();
     checked_angles()
         .map(|deg| {
             let r = model.directional_hemispherical_reflectance(deg.to_radians(), &quadrature);
-            (r, deg)
+            (deg, r)
         })
-        .reduce(
-            || (f64::NEG_INFINITY, 0.0),
-            |a, b| if b.0 > a.0 { b } else { a },
-        )
+        .collect()
+}
+
+/// The largest hemispherical reflectance of `model` over the checked angles, and where.
+pub fn largest_reflectance(model: &Pbrdf) -> (f64, f64) {
+    largest(&reflectances(model))
+}
+
+fn largest(per_angle: &[(f64, f64)]) -> (f64, f64) {
+    per_angle.iter().fold(
+        (f64::NEG_INFINITY, 0.0),
+        |a, &(deg, r)| if r > a.0 { (r, deg) } else { a },
+    )
 }
 
 /// What the constraint asks of a fitted model.
@@ -52,8 +61,9 @@ pub fn check_energy(space: &ModelSpace, values: &ParameterValues) -> EnergyCheck
     let Ok(model) = space.pbrdf(values) else {
         return EnergyCheck::Conserved;
     };
-    let (largest, _) = largest_reflectance(&model);
-    if largest <= 1.0 + ENERGY_TOLERANCE {
+    // Each angle's total reflectance is computed once: for the check, then for the bound.
+    let totals = reflectances(&model);
+    if largest(&totals).0 <= 1.0 + ENERGY_TOLERANCE {
         return EnergyCheck::Conserved;
     }
     let parameter = if space.terms().has(Parameter::RhoS) {
@@ -67,12 +77,10 @@ pub fn check_energy(space: &ModelSpace, values: &ParameterValues) -> EnergyCheck
     let Ok(facets) = space.pbrdf(&without_body) else {
         return EnergyCheck::Conserved;
     };
-    let quadrature = HemisphereQuadrature::default();
-    let limit = checked_angles()
-        .map(|deg| {
-            let theta = deg.to_radians();
-            let e_facets = facets.directional_hemispherical_reflectance(theta, &quadrature);
-            let e_total = model.directional_hemispherical_reflectance(theta, &quadrature);
+    let limit: Vec<Result<f64, (f64, f64)>> = totals
+        .iter()
+        .zip(reflectances(&facets))
+        .map(|(&(deg, e_total), (_, e_facets))| {
             let per_unit = if rho > 0.0 {
                 (e_total - e_facets) / rho
             } else {
@@ -87,7 +95,7 @@ pub fn check_energy(space: &ModelSpace, values: &ParameterValues) -> EnergyCheck
                 Ok(f64::INFINITY)
             }
         })
-        .collect::<Vec<_>>();
+        .collect();
     if let Some(&Err((theta_deg, reflectance))) = limit.iter().find(|r| r.is_err()) {
         return EnergyCheck::FacetsExceed {
             theta_deg,
