@@ -33,6 +33,30 @@ pub fn shown_at_most(text: &str, max_chars: usize) -> String {
     out
 }
 
+/// Characters of a file path kept in a message: a real path fits whole; a longer one keeps its
+/// start and its end (the file's name), cut in the middle with '…'.
+pub const SHOWN_PATH_CHARS: usize = 160;
+
+/// A file path as a message shows it: control characters escaped and at most
+/// [`SHOWN_PATH_CHARS`] characters, its start and its end kept.
+pub fn path(path: &std::path::Path) -> String {
+    let text = path.to_string_lossy();
+    let count = text.chars().count();
+    if count <= SHOWN_PATH_CHARS {
+        return shown_at_most(&text, SHOWN_PATH_CHARS);
+    }
+    let head: String = text.chars().take(SHOWN_PATH_CHARS / 4).collect();
+    let tail: String = text
+        .chars()
+        .skip(count - SHOWN_PATH_CHARS * 3 / 4)
+        .collect();
+    format!(
+        "{}…{}",
+        shown_at_most(&head, SHOWN_PATH_CHARS),
+        shown_at_most(&tail, SHOWN_PATH_CHARS)
+    )
+}
+
 /// A number as a message shows it: plainly within 1e-4 ≤ |x| < 1e6 (and 0, NaN, ±inf), in
 /// exponent form beyond, where Rust's plain form of 1e308 is 309 digits long.
 pub fn number(x: f64) -> String {
@@ -117,6 +141,17 @@ mod tests {
         assert_eq!(shown_at_most("abcdef", 3), "abc…");
         assert_eq!(shown("plain, text"), "plain, text");
         assert_eq!(number(1e308), "1e308");
+        let deep = std::path::PathBuf::from(format!("data/{}/m\u{1b}.csv", "d".repeat(500)));
+        let cut = path(&deep);
+        assert!(
+            cut.starts_with("data/dd") && cut.ends_with("dm\\u{1b}.csv"),
+            "{cut}"
+        );
+        assert!(cut.chars().count() < SHOWN_PATH_CHARS + 20, "{cut}");
+        assert_eq!(
+            path(std::path::Path::new("fits/paint.toml")),
+            "fits/paint.toml"
+        );
         assert_eq!(number(-1e-300), "-1e-300");
         assert_eq!(number(-0.1), "-0.1");
         assert_eq!(number(f64::NAN), "NaN");

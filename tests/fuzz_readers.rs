@@ -489,3 +489,21 @@ fn the_seeds_are_read() {
         );
     }
 }
+
+/// The case the fuzzer found: a scene naming a weather file by a path of thousands of characters
+/// (or holding a control character) gets a short one-line message; the path is cut in the middle.
+#[test]
+fn long_file_paths_are_cut_in_messages() {
+    let long_name = format!("mun{}\\u001e.csv", "!".repeat(5000)); // TOML escape: a real \x1e
+    let scene = String::from_utf8(scene_seeds().remove(1))
+        .unwrap()
+        .replace("munich.csv", &long_name);
+    let message = load_scene_text(Path::new("fuzz/scene.toml"), &scene)
+        .unwrap_err()
+        .to_string();
+    check_message(&message).unwrap();
+    assert!(
+        message.contains("fuzz/mun!!!") && message.contains("!\\u{1e}.csv"),
+        "{message}"
+    );
+}

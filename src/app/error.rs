@@ -58,32 +58,32 @@ pub enum AppError {
     Image(#[from] image::ImageError),
 
     // --- files the application reads or writes ---
-    #[error("{}: cannot open", path.display())]
+    #[error("{}: cannot open", crate::text::path(path))]
     Open {
         path: PathBuf,
         #[source]
         source: io::Error,
     },
-    #[error("{}: cannot read", path.display())]
+    #[error("{}: cannot read", crate::text::path(path))]
     Read {
         path: PathBuf,
         #[source]
         source: io::Error,
     },
-    #[error("{}: cannot read", path.display())]
+    #[error("{}: cannot read", crate::text::path(path))]
     ReadImage {
         path: PathBuf,
         #[source]
         source: image::ImageError,
     },
-    #[error("{}: cannot write", path.display())]
+    #[error("{}: cannot write", crate::text::path(path))]
     Write {
         path: PathBuf,
         #[source]
         source: io::Error,
     },
     /// The fit's library entries, reports and index could not be put in place together.
-    #[error("{}: cannot write the fit's outputs", dir.display())]
+    #[error("{}: cannot write the fit's outputs", crate::text::path(dir))]
     WriteFit {
         dir: PathBuf,
         #[source]
@@ -100,14 +100,14 @@ pub enum AppError {
     Invalid(String),
     /// A geometry CSV of `irpol eval`; `at` is the `:line` or `:line:column` after the path, or
     /// nothing for the whole file.
-    #[error("{}{at}: {message}", path.display())]
+    #[error("{}{at}: {message}", crate::text::path(path))]
     Geometry {
         path: PathBuf,
         at: String,
         message: String,
     },
     /// A bad line of a `--times-file`.
-    #[error("{}:{line}", path.display())]
+    #[error("{}:{line}", crate::text::path(path))]
     TimesLine {
         path: PathBuf,
         line: usize,
@@ -116,14 +116,14 @@ pub enum AppError {
     },
     #[error(
         "{}: no times (expected one RFC 3339 instant per line, e.g. 2026-06-21T10:00:00Z)",
-        .0.display()
+        crate::text::path(.0)
     )]
     NoTimes(PathBuf),
     #[error("--time-utc")]
     TimeFlag(#[source] crate::emitter::SunError),
 
     // --- thermal scenes ---
-    #[error("{}: thermal run", path.display())]
+    #[error("{}: thermal run", crate::text::path(path))]
     ThermalRun {
         path: PathBuf,
         #[source]
@@ -132,19 +132,19 @@ pub enum AppError {
     #[error(
         "{}: has a [thermal] section: say when to render it with --time SECONDS, --time-utc \
          INSTANT or --times START:STOP:STEP (seconds from thermal.start_utc)",
-        .0.display()
+        crate::text::path(.0)
     )]
     ThermalNeedsInstant(PathBuf),
     #[error(
         "{}: --time/--times need temperatures from the thermal model, but the scene has no \
          [thermal] section",
-        .0.display()
+        crate::text::path(.0)
     )]
     InstantNeedsThermal(PathBuf),
     #[error("t = {} s is not an instant of the thermal run", crate::text::number(*.0))]
     NotAnInstant(f64),
     /// The scene at an instant of its thermal run could not be built.
-    #[error("{}: {message}", path.display())]
+    #[error("{}: {message}", crate::text::path(path))]
     SceneAt { path: PathBuf, message: String },
 }
 

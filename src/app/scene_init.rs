@@ -15,10 +15,10 @@ pub enum SceneInitError {
     #[error(
         "{} already exists; irpol scene init never overwrites a file (remove it or give \
          --out another name)",
-        .0.display()
+        crate::text::path(.0)
     )]
     Exists(PathBuf),
-    #[error("{}: cannot write: {source}", path.display())]
+    #[error("{}: cannot write: {source}", crate::text::path(path))]
     Write {
         path: PathBuf,
         source: std::io::Error,

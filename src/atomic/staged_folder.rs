@@ -90,7 +90,7 @@ impl StagedFolder {
         if !self.target.is_dir() {
             return Err(io::Error::other(format!(
                 "{} exists and is not a folder",
-                self.target.display()
+                crate::text::path(&self.target)
             )));
         }
         self.carry_over_foreign_files(earlier_output)?;

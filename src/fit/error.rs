@@ -13,7 +13,7 @@ pub enum FitError {
     #[error(transparent)]
     Selection(#[from] crate::measure::SelectionError),
     /// A measurement set that cannot be fitted.
-    #[error("{}: {message}", file.display())]
+    #[error("{}: {message}", crate::text::path(file))]
     Measurement { file: PathBuf, message: String },
     /// Inconsistent or invalid fit options.
     #[error("invalid fit options: {0}")]
@@ -22,7 +22,7 @@ pub enum FitError {
     #[error(transparent)]
     Merge(#[from] crate::measure::MergeError),
     /// An optimizer failed (a bug or a degenerate problem, not bad input).
-    #[error("{}: the {stage} stage failed: {message}", file.display())]
+    #[error("{}: the {stage} stage failed: {message}", crate::text::path(file))]
     Optimizer {
         file: PathBuf,
         stage: String,

@@ -166,7 +166,7 @@ fn check_folder_materials(folder: &Path, sets: &[MeasurementSet]) -> Result<(), 
             message: format!(
                 "has no '# material:' line, and the folder {} holds {} measurement files: add \
                  '# material: NAME' to each so that irpol knows which belong to one material",
-                folder.display(),
+                crate::text::path(&folder),
                 files.len()
             ),
         }),
@@ -237,7 +237,7 @@ fn check_consistent(first: &MeasurementSet, other: &MeasurementSet) -> Result<()
                      '{}'",
                     crate::text::shown(b.map_or("", |v| v.as_str())),
                     crate::text::shown(a.map_or("", |v| v.as_str())),
-                    first.source.display(),
+                    crate::text::path(&first.source),
                     first.material
                 ),
             });

@@ -67,7 +67,7 @@ pub enum SceneMaterialError {
     /// A library name with no file in the library.
     #[error(
         "{error}; define it inline under [materials.{name}] in {} or set material_library",
-        scene.display()
+        crate::text::path(scene)
     )]
     NotFound {
         name: String,

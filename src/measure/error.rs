@@ -9,7 +9,7 @@ use std::path::PathBuf;
 /// file as the caller gave it. Whole-file problems point at line 1 column 1 (or at the header
 /// row when they concern the columns).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{}:{}:{}: {}", .file.display(), .line, .column, .kind)]
+#[error("{}:{}:{}: {}", crate::text::path(file), .line, .column, .kind)]
 pub struct MeasureError {
     /// The path as given by the caller (not canonicalized).
     pub file: PathBuf,

@@ -11,7 +11,7 @@ pub const SAME_WAVELENGTH_UM: f64 = 1e-6;
 
 /// Why two files of one material cannot be merged into one set.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{} and {} both hold material '{material}' but cannot be merged as repeat measurements: {reason}", first.display(), second.display())]
+#[error("{} and {} both hold material '{material}' but cannot be merged as repeat measurements: {reason}", crate::text::path(first), crate::text::path(second))]
 pub struct MergeError {
     pub material: String,
     pub first: PathBuf,
@@ -56,7 +56,11 @@ pub fn merge_repeat_measurements(
 }
 
 fn describe(path: &std::path::Path, rows: usize) -> String {
-    format!("{} ({})", path.display(), crate::text::counted(rows, "row"))
+    format!(
+        "{} ({})",
+        crate::text::path(&path),
+        crate::text::counted(rows, "row")
+    )
 }
 
 /// Refuses a set that cannot be concatenated with `first`.

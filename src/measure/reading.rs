@@ -42,8 +42,8 @@ pub fn parse_measurement_file(
                 parse_with_layout(source, bytes, given)
             } else {
                 Err(at.refusal(MeasureErrorKind::LayoutsDisagree {
-                    named: named.source.display().to_string(),
-                    given: given.source.display().to_string(),
+                    named: crate::text::path(&named.source),
+                    given: crate::text::path(&given.source),
                 }))
             }
         }
@@ -104,7 +104,7 @@ fn named_layout<'a>(
         Err(error) if error.is_unreadable_path() => {
             Err(at.refusal(MeasureErrorKind::NamedLayoutUnreadable {
                 value: shown(value),
-                path: path.display().to_string(),
+                path: crate::text::path(&path),
                 reason: error.kind.to_string(),
             }))
         }

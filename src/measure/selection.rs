@@ -39,13 +39,13 @@ pub enum SelectionError {
     BadWavelength { value: String, reason: &'static str },
     #[error("selected incidence angle {value}°: not a zenith angle in [0°, 90°)")]
     BadThetaI { value: String },
-    #[error("{}: holds no rows at the selected wavelength {wanted} µm; it holds {present} µm: select one of those", file.display())]
+    #[error("{}: holds no rows at the selected wavelength {wanted} µm; it holds {present} µm: select one of those", crate::text::path(file))]
     WavelengthAbsent {
         file: PathBuf,
         wanted: String,
         present: String,
     },
-    #[error("{}: no row has θ_i within {THETA_I_TOLERANCE_DEG}° of the selected {wanted}°; its rows have θ_i = {present}°: select among those", file.display())]
+    #[error("{}: no row has θ_i within {THETA_I_TOLERANCE_DEG}° of the selected {wanted}°; its rows have θ_i = {present}°: select among those", crate::text::path(file))]
     ThetaIAbsent {
         file: PathBuf,
         wanted: String,

@@ -110,7 +110,10 @@ pub fn write_thermal_outputs(
     seconds: f64,
 ) -> io::Result<ThermalSummary> {
     let setup = scene.thermal.as_deref().ok_or_else(|| {
-        io::Error::other(format!("{} has no [thermal] section", scene.path.display()))
+        io::Error::other(format!(
+            "{} has no [thermal] section",
+            crate::text::path(&scene.path)
+        ))
     })?;
     let parts = part_series(scene, solution);
     let staged = StagedFolder::begin(out_dir)?;

@@ -44,7 +44,7 @@ pub enum RenderError {
         origin: String,
         source: ModelError,
     },
-    #[error("{}: cannot write: {source}", path.display())]
+    #[error("{}: cannot write: {source}", crate::text::path(path))]
     Write {
         path: PathBuf,
         source: std::io::Error,

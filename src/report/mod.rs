@@ -26,7 +26,7 @@ pub enum ReportError {
     Measure(#[from] crate::measure::MeasureError),
     #[error(transparent)]
     Fit(#[from] crate::fit::FitError),
-    #[error("{material}: a spectral material's report is written by `irpol fit`; run it again on its measurements ({csv}, with the same options) to rebuild it", csv = .csv.display())]
+    #[error("{material}: a spectral material's report is written by `irpol fit`; run it again on its measurements ({csv}, with the same options) to rebuild it", csv = crate::text::path(csv))]
     SpectralRebuild {
         material: std::path::PathBuf,
         csv: std::path::PathBuf,

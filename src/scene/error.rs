@@ -31,7 +31,7 @@ impl From<&str> for InvalidSetting {
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file cannot be read.
-    #[error("{}: cannot read the scene", file.display())]
+    #[error("{}: cannot read the scene", crate::text::path(file))]
     Read {
         file: PathBuf,
         #[source]
@@ -39,7 +39,7 @@ pub enum SceneError {
     },
     /// The scene file is not valid TOML or has wrong keys; `line` and `column` (from 1) point at
     /// the fault when the TOML reader knows it.
-    #[error("{}: not a valid scene: {}{}", file.display(), at(*line, *column), one_line(message))]
+    #[error("{}: not a valid scene: {}{}", crate::text::path(file), at(*line, *column), one_line(message))]
     Parse {
         file: PathBuf,
         line: Option<usize>,
@@ -47,7 +47,7 @@ pub enum SceneError {
         message: String,
     },
     /// A material cannot be resolved; `item` is the object part (or thermal part) that uses it.
-    #[error("{}: {}", file.display(), one_line(&labelled(item, error)))]
+    #[error("{}: {}", crate::text::path(file), one_line(&labelled(item, error)))]
     Material {
         file: PathBuf,
         item: Option<String>,
@@ -55,13 +55,13 @@ pub enum SceneError {
         error: Box<SceneMaterialError>,
     },
     /// The `[sun]` table.
-    #[error("{}: {}", file.display(), one_line(&error.to_string()))]
+    #[error("{}: {}", crate::text::path(file), one_line(&error.to_string()))]
     Sun {
         file: PathBuf,
         error: SunConfigError,
     },
     /// A mesh file (`file`) of object `item` cannot be read.
-    #[error("{}: cannot read the mesh (in {item})", file.display())]
+    #[error("{}: cannot read the mesh (in {item})", crate::text::path(file))]
     MeshRead {
         file: PathBuf,
         item: String,
@@ -69,20 +69,20 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// A mesh file's content (OBJ, PLY) or the shaded mesh is unusable.
-    #[error("{}: {} (in {item})", file.display(), one_line(&error.to_string()))]
+    #[error("{}: {} (in {item})", crate::text::path(file), one_line(&error.to_string()))]
     Mesh {
         file: PathBuf,
         item: String,
         error: MeshError,
     },
     /// The `[thermal]` section or a part's thermal keys.
-    #[error("{}: {}", file.display(), one_line(&error.to_string()))]
+    #[error("{}: {}", crate::text::path(file), one_line(&error.to_string()))]
     Thermal {
         file: PathBuf,
         error: ThermalSetupError,
     },
     /// Any other value out of its range or keys that do not fit together.
-    #[error("{}: {}", file.display(), one_line(message))]
+    #[error("{}: {}", crate::text::path(file), one_line(message))]
     Invalid { file: PathBuf, message: String },
 }
 

@@ -132,9 +132,9 @@ pub struct WeatherSample {
 /// Everything wrong with weather input or a request for it; each message is one complete line.
 #[derive(Debug, thiserror::Error)]
 pub enum WeatherError {
-    #[error("{}: cannot read the weather file: {reason}", .file.display())]
+    #[error("{}: cannot read the weather file: {reason}", crate::text::path(file))]
     Read { file: PathBuf, reason: String },
-    #[error("{}:{line}:{column}: {message}", .file.display())]
+    #[error("{}:{line}:{column}: {message}", crate::text::path(file))]
     Csv {
         file: PathBuf,
         line: u64,

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 /// Why a scene cannot be shown at an instant of its thermal run.
 #[derive(Debug, thiserror::Error)]
 pub enum InstantError {
-    #[error("{} has no [thermal] section", path.display())]
+    #[error("{} has no [thermal] section", crate::text::path(path))]
     NoThermal { path: PathBuf },
     /// The sky at the instant's air temperature.
     #[error("{0}")]

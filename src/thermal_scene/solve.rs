@@ -263,7 +263,7 @@ pub fn solve_scene(
     let setup = scene
         .thermal
         .as_deref()
-        .ok_or_else(|| ThermalRunError::NotThermal(scene.path.display().to_string()))?;
+        .ok_or_else(|| ThermalRunError::NotThermal(crate::text::path(&scene.path)))?;
     if let Some(&t) = extra_times_s
         .iter()
         .find(|&&t| !(t.is_finite() && (0.0..=setup.duration_s).contains(&t)))

@@ -182,7 +182,7 @@ fn resolve_header(line: u64, fields: &[Field<'_>], layout: &Layout) -> Result<Re
             1,
             MeasureErrorKind::ElementPatternMatchesNothing {
                 pattern: shown(pattern),
-                layout: layout.source.display().to_string(),
+                layout: crate::text::path(&layout.source),
                 names: pattern_names(&roles.elements),
             },
         ));
@@ -548,7 +548,7 @@ fn file_notes(file: &str, parsed: &ParsedTable, layout: &Layout) -> Vec<String> 
     if !done.is_empty() {
         notes.push(format!(
             "{file}: read through the layout {}: {}",
-            layout.source.display(),
+            crate::text::path(&layout.source),
             done.join("; ")
         ));
     }
