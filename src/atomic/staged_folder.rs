@@ -4,7 +4,8 @@
 //! `renameat2(RENAME_EXCHANGE)` (Linux; a plain rename where there is no target yet), so a reader
 //! or a killed run sees the complete old set or the complete new one, never a mix. Entries of the
 //! target that belong to no set (a user's notes: neither written now nor listed by the caller as
-//! an earlier output) are carried over first, files by hard link.
+//! an earlier output) are carried over first, files by hard link and folders rebuilt of hard links,
+//! so that they are in the target before the swap and after it.
 //! The staging folder is removed when the set is dropped uncommitted (an error), by the binary's
 //! SIGINT/SIGTERM handler ([`staging_folder`] names it), and, after a SIGKILL, by the next run
 //! into the same target.
@@ -107,7 +108,9 @@ impl StagedFolder {
     }
 
     /// Hard-links into the staging folder every entry of the target that is neither written now
-    /// nor an earlier output.
+    /// nor an earlier output; a folder is rebuilt there with its files hard-linked, so that the
+    /// user's entries stay in the target until the swap and exist in both sets after it (a kill at
+    /// any instant loses none of them).
     fn carry_over_foreign_files(&self, earlier_output: &dyn Fn(&str) -> bool) -> io::Result<()> {
         for entry in fs::read_dir(&self.target)? {
             let entry = entry?;
@@ -115,14 +118,27 @@ impl StagedFolder {
             if staged.exists() || earlier_output(&entry.file_name().to_string_lossy()) {
                 continue;
             }
-            if entry.file_type()?.is_dir() {
-                // Folders move in the same step as the swap would: renamed just before it.
-                fs::rename(entry.path(), staged)?;
-            } else {
-                fs::hard_link(entry.path(), staged)?;
-            }
+            link_entry(&entry.path(), &staged)?;
         }
         Ok(())
+    }
+}
+
+/// `to` as a copy of `from` that shares its files' data: folders recreated, files hard-linked,
+/// symbolic links recreated pointing where they pointed.
+fn link_entry(from: &Path, to: &Path) -> io::Result<()> {
+    let kind = fs::symlink_metadata(from)?.file_type();
+    if kind.is_symlink() {
+        std::os::unix::fs::symlink(fs::read_link(from)?, to)
+    } else if kind.is_dir() {
+        fs::create_dir(to)?;
+        for entry in fs::read_dir(from)? {
+            let entry = entry?;
+            link_entry(&entry.path(), &to.join(entry.file_name()))?;
+        }
+        Ok(())
+    } else {
+        fs::hard_link(from, to)
     }
 }
 
@@ -170,6 +186,8 @@ mod tests {
         first.write("b.txt", b"1").unwrap();
         first.commit(&|_| false).unwrap();
         fs::write(target.join("notes.md"), b"mine").unwrap();
+        fs::create_dir_all(target.join("analysis/plots")).unwrap();
+        fs::write(target.join("analysis/plots/p.txt"), b"plot").unwrap();
         let second = StagedFolder::begin(&target).unwrap();
         second.write("a.txt", b"2").unwrap();
         second.commit(&|name| name.ends_with(".txt")).unwrap();
@@ -179,6 +197,11 @@ mod tests {
             "the old set is gone as a whole"
         );
         assert_eq!(fs::read(target.join("notes.md")).unwrap(), b"mine");
+        assert_eq!(
+            fs::read(target.join("analysis/plots/p.txt")).unwrap(),
+            b"plot",
+            "a user's folder is carried over whole"
+        );
         let leftovers: Vec<_> = fs::read_dir(dir.path()).unwrap().flatten().collect();
         assert_eq!(leftovers.len(), 1, "no staging folder left");
     }
