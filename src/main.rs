@@ -874,6 +874,14 @@ fn demo_day(out: &Path) -> anyhow::Result<()> {
     let day = Path::new("scenes/car_day.toml");
     say!("the car through a clear summer day, temperatures from the thermal model:");
     let (thermal_out, render_out) = (out.join("car_day_thermal"), out.join("car_day"));
+    let pid = std::process::id();
+    cli::signals::remove_on_interrupt(
+        vec![
+            staging_folder(&thermal_out, pid),
+            staging_folder(&render_out, pid),
+        ],
+        vec![],
+    );
     let (summary, renders) = run_thermal_and_render(
         day,
         &thermal_out,

@@ -7,39 +7,60 @@ use signal_hook::consts::{SIGINT, SIGTERM};
 use signal_hook::iterator::Signals;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
+use std::sync::{Mutex, Once};
 
-/// Watches for SIGINT/SIGTERM on a background thread; on one, removes the folders `staging` and,
-/// in each folder of `temporaries_in`, this process's staged files (`.<name>.<pid>.tmp`, see
-/// `irpol::atomic`), then exits.
+/// What an interrupt removes: staging folders, and the folders whose staged files
+/// (`.<name>.<pid>.tmp`) of this process go. Steps of one command (the demo fits, renders and runs
+/// a thermal day) each add theirs; one handler removes them all.
+static TO_REMOVE: Mutex<(Vec<PathBuf>, Vec<PathBuf>)> = Mutex::new((Vec::new(), Vec::new()));
+
+/// Adds the folders `staging` and, in each folder of `temporaries_in`, this process's staged files
+/// (see `irpol::atomic`) to what an interrupt removes, and starts watching for SIGINT/SIGTERM on a
+/// background thread the first time: on a signal, everything added so far is removed, then the
+/// process exits.
 pub fn remove_on_interrupt(staging: Vec<PathBuf>, temporaries_in: Vec<PathBuf>) {
-    let Ok(mut signals) = Signals::new([SIGINT, SIGTERM]) else {
+    if let Ok(mut lists) = TO_REMOVE.lock() {
+        lists.0.extend(staging);
+        lists.1.extend(temporaries_in);
+    }
+    static WATCHING: Once = Once::new();
+    WATCHING.call_once(|| {
+        let Ok(mut signals) = Signals::new([SIGINT, SIGTERM]) else {
+            return;
+        };
+        std::thread::spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                clean_up_after_interrupt();
+                std::process::exit(128 + signal);
+            }
+        });
+    });
+}
+
+fn clean_up_after_interrupt() {
+    // No write starts from now on; one under way (a staged file, a commit) finishes, so the
+    // outputs are the complete old or new set and no temporary appears after the clean-up below.
+    INTERRUPTED.store(true, Ordering::SeqCst);
+    while WRITES_IN_PROGRESS.load(Ordering::SeqCst) > 0 {
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    let Ok(lists) = TO_REMOVE.lock() else {
         return;
     };
-    std::thread::spawn(move || {
-        if let Some(signal) = signals.forever().next() {
-            // No write starts from now on; one under way (a staged file, a commit) finishes, so
-            // the outputs are the complete old or new set and no temporary appears after the
-            // clean-up below.
-            INTERRUPTED.store(true, Ordering::SeqCst);
-            while WRITES_IN_PROGRESS.load(Ordering::SeqCst) > 0 {
-                std::thread::sleep(std::time::Duration::from_millis(1));
+    let (staging, temporaries_in) = &*lists;
+    for path in staging {
+        let _ = std::fs::remove_dir_all(path);
+    }
+    let suffix = format!(".{}.tmp", std::process::id());
+    for dir in temporaries_in {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name.starts_with('.') && name.ends_with(&suffix) {
+                let _ = std::fs::remove_file(entry.path());
             }
-            for path in &staging {
-                let _ = std::fs::remove_dir_all(path);
-            }
-            let suffix = format!(".{}.tmp", std::process::id());
-            for dir in &temporaries_in {
-                let Ok(entries) = std::fs::read_dir(dir) else {
-                    continue;
-                };
-                for entry in entries.flatten() {
-                    let name = entry.file_name().to_string_lossy().into_owned();
-                    if name.starts_with('.') && name.ends_with(&suffix) {
-                        let _ = std::fs::remove_file(entry.path());
-                    }
-                }
-            }
-            std::process::exit(128 + signal);
         }
-    });
+    }
 }
