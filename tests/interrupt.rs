@@ -314,3 +314,64 @@ fn an_interrupted_fit_leaves_the_old_or_the_new_library() {
         assert!(temporaries(&[&fits, &reports]).is_empty());
     }
 }
+
+/// Copies the folder `from` (files and subfolders) to `to`.
+fn copy_folder(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap().flatten() {
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_folder(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+/// Staging folders (and staged files) anywhere under `dir`.
+fn staged_under(dir: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut found = Vec::new();
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if name.contains("irpol-staging") || name.ends_with(".tmp") {
+            found.push(name);
+        } else if entry.file_type().unwrap().is_dir() {
+            found.extend(staged_under(&entry.path()));
+        }
+    }
+    found
+}
+
+/// `irpol demo` runs several steps (fits, a render, a thermal day); SIGTERM while its day is being
+/// staged removes that day's staging folders too, and the process exits with 128 + SIGTERM.
+#[test]
+fn an_interrupted_demo_leaves_no_staging_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for folder in ["measurements", "fits", "scenes"] {
+        copy_folder(&root.join(folder), &dir.path().join(folder));
+    }
+    let mut child = Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .arg("demo")
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let demo = dir.path().join("out/demo");
+    while !staged_under(&demo).iter().any(|n| n.starts_with(".car_day")) {
+        let ended = child.try_wait().unwrap();
+        assert!(ended.is_none(), "the demo ended before its day was staged");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert_eq!(child.wait().unwrap().code(), Some(128 + 15));
+    let left = staged_under(dir.path());
+    assert!(left.is_empty(), "left {left:?}");
+}
