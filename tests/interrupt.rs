@@ -362,7 +362,10 @@ fn an_interrupted_demo_leaves_no_staging_folder() {
         .spawn()
         .unwrap();
     let demo = dir.path().join("out/demo");
-    while !staged_under(&demo).iter().any(|n| n.starts_with(".car_day")) {
+    while !staged_under(&demo)
+        .iter()
+        .any(|n| n.starts_with(".car_day"))
+    {
         let ended = child.try_wait().unwrap();
         assert!(ended.is_none(), "the demo ended before its day was staged");
         std::thread::sleep(Duration::from_millis(2));

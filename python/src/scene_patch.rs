@@ -4,6 +4,7 @@
 //! error, never a new, silently ignored entry. The edit keeps the rest of the text as it was.
 
 use crate::errors::{bad_argument, raised};
+use irpol::text::{parser_message, shown};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyString};
 use std::path::{Path, PathBuf};
@@ -48,7 +49,7 @@ fn place(parts: &[&str], depth: usize) -> String {
     if depth == 0 {
         "the top level".into()
     } else {
-        format!("'{}'", parts[..depth].join("."))
+        format!("'{}'", shown(&parts[..depth].join(".")))
     }
 }
 
@@ -56,13 +57,16 @@ fn place(parts: &[&str], depth: usize) -> String {
 /// ([`place`]).
 #[derive(Debug, thiserror::Error)]
 pub enum KeyError {
-    #[error("'{index}' is not an index of the array {place} ({len} entries)")]
+    #[error(
+        "'{}' is not an index of the array {place} ({len} entries)",
+        shown(index)
+    )]
     NotAnIndex {
         index: String,
         place: String,
         len: usize,
     },
-    #[error("no '{key}' in {place}")]
+    #[error("no '{}' in {place}", shown(key))]
     NoKey { key: String, place: String },
     #[error("no {0}")]
     NoEntry(String),
@@ -76,9 +80,13 @@ pub enum KeyError {
 /// Python's `ValueError` carries.
 #[derive(Debug, thiserror::Error)]
 pub enum PatchError {
-    #[error("{}: not a valid scene: {message}", path.display())]
+    #[error(
+        "{}: not a valid scene: {}",
+        irpol::text::path(path),
+        parser_message(message, 300)
+    )]
     Parse { path: PathBuf, message: String },
-    #[error("{}: scene key '{key}': {error}", path.display())]
+    #[error("{}: scene key '{}': {error}", irpol::text::path(path), shown(key))]
     Key {
         path: PathBuf,
         key: String,

@@ -166,6 +166,22 @@ def test_spectral_fit_equals_irpol_fit(tmp_path):
     assert np.isclose(chi2, result.chi2, rtol=1e-12)
 
 
+def test_fit_with_volume_terms_equals_irpol_fit(tmp_path):
+    """Data made by the independent numpy implementation (scripts/make_volume_measurements.py):
+    an internal facet term (σ 0.8, n 1.35) and a subsurface term (ρ_s 0.6, d 0.1)."""
+    source = ROOT / "tests" / "data" / "volume" / "internal_subsurface.csv"
+    terms = "internal+subsurface"
+    cli_output("fit", source, "--terms", terms, "--out", tmp_path / "fits", "--reports",
+               tmp_path / "r")
+    [result] = irpol.fit(source, terms=terms)
+    assert result.toml == (tmp_path / "fits" / source.with_suffix(".toml").name).read_text()
+    model = result.material
+    assert 'facet = "internal"' in result.toml
+    assert model.n == pytest.approx(1.35, abs=0.005) and model.sigma == pytest.approx(0.8, abs=0.01)
+    with pytest.raises(ValueError, match="one set of terms at a time"):
+        irpol.fit(source, terms="all")
+
+
 def test_fit_options_are_refused_with_the_cli_message(tmp_path):
     source = MEASUREMENTS / "rough_paint.csv"
     for flags, kwargs in [(["--optimizer", "ga+xx"], {"optimizer": "ga+xx"}),
