@@ -596,6 +596,11 @@ fn fit_through_the_layout_records_it_and_report_rebuilds_the_same_figure() {
             "the page lacks: {note}"
         );
     }
+    // The notes are those of the kept wavelength, each once: not the other wavelength's.
+    assert!(!stderr.contains("0.351 µm"), "{stderr}");
+    let notes: Vec<&str> = stderr.lines().filter(|l| l.contains("note:")).collect();
+    let once: std::collections::BTreeSet<&&str> = notes.iter().collect();
+    assert_eq!(once.len(), notes.len(), "{stderr}");
     let entry = dir.path().join("fits/PTFE_351_1064.toml");
     let material = irpol::material::Material::load(&entry).unwrap();
     let record = material.fit.unwrap();

@@ -31,16 +31,20 @@ impl MaterialFit {
         }
     }
 
-    /// What the reader did that the user should know, one line each.
+    /// What the reader did that the user should know, one line each and each once (the sets
+    /// of one file carry the file's notes alike).
     pub fn notes(&self) -> Vec<String> {
-        match self {
-            MaterialFit::Grey(o) => o.measurement.notes.clone(),
-            MaterialFit::Spectral(o) => o
-                .measurements
-                .iter()
-                .flat_map(|m| m.notes.clone())
-                .collect(),
+        let all: Vec<&String> = match self {
+            MaterialFit::Grey(o) => o.measurement.notes.iter().collect(),
+            MaterialFit::Spectral(o) => o.measurements.iter().flat_map(|m| &m.notes).collect(),
+        };
+        let mut once: Vec<String> = Vec::new();
+        for note in all {
+            if !once.contains(note) {
+                once.push(note.clone());
+            }
         }
+        once
     }
 }
 

@@ -89,10 +89,9 @@ fn parse_sets(
             .map(|stem| stem.to_string_lossy().into_owned())
             .unwrap_or_default(),
     };
-    let mut notes: Vec<String> =
-        signed_zenith_note(&source.display().to_string(), parsed.signed_rows)
-            .into_iter()
-            .collect();
+    let notes: Vec<String> = signed_zenith_note(&source.display().to_string(), parsed.signed_rows)
+        .into_iter()
+        .collect();
     Ok(groups
         .into_iter()
         .map(|(wavelength_um, points)| MeasurementSet {
@@ -104,8 +103,9 @@ fn parse_sets(
             elements: parsed.layout.elements.clone(),
             points,
             merged: Vec::new(),
-            // The file's notes go with its first set.
-            notes: std::mem::take(&mut notes),
+            // The file's notes go with every set (a set chosen by wavelength keeps them); the
+            // fit says each note once.
+            notes: notes.clone(),
         })
         .collect())
 }

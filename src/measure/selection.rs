@@ -153,41 +153,28 @@ impl RowSelection {
     }
 }
 
-/// The one set of `sets` at `um`, with the file's notes (which go with its first set).
+/// The one set of `sets` at `um` (with the file's notes, which every set carries).
 fn keep_wavelength(
     file: &Path,
     sets: Vec<MeasurementSet>,
     um: f64,
 ) -> Result<Vec<MeasurementSet>, SelectionError> {
     let same = |w: f64| (w - um).abs() <= WAVELENGTH_RELATIVE_TOLERANCE * um;
-    let Some(index) = sets.iter().position(|s| same(s.wavelength_um)) else {
-        let present: Vec<f64> = sets.iter().map(|s| s.wavelength_um).collect();
+    let total = sets.len();
+    let present: Vec<f64> = sets.iter().map(|s| s.wavelength_um).collect();
+    let Some(mut set) = sets.into_iter().find(|s| same(s.wavelength_um)) else {
         return Err(SelectionError::WavelengthAbsent {
             file: file.to_path_buf(),
             wanted: short(um),
             present: listed(&present),
         });
     };
-    let total = sets.len();
-    let mut notes = Vec::new();
-    let mut kept = None;
-    for (i, mut set) in sets.into_iter().enumerate() {
-        if i == index {
-            kept = Some(set);
-        } else if i == 0 {
-            // The file's own notes (the layout's conversion, folded angles) go with its first set.
-            notes.append(&mut set.notes);
-        }
-    }
-    let mut set = kept.expect("the position was found");
     if total > 1 {
-        notes.append(&mut set.notes);
-        notes.push(format!(
+        set.notes.push(format!(
             "{}: kept the rows at {} µm, one of its {total} wavelengths",
-            file.display(),
+            crate::text::path(file),
             short(set.wavelength_um)
         ));
-        set.notes = notes;
     }
     Ok(vec![set])
 }

@@ -496,7 +496,7 @@ fn build_sets(
             .map(|stem| stem.to_string_lossy().into_owned())
             .unwrap_or_default(),
     };
-    let mut file_notes = file_notes(&file, &parsed, layout);
+    let file_notes = file_notes(&file, &parsed, layout);
     let mut metadata = parsed.metadata.entries.clone();
     metadata.insert("layout".to_string(), layout.source.display().to_string());
     let groups = wavelength_groups(parsed.points, parsed.wavelengths);
@@ -507,8 +507,9 @@ fn build_sets(
                 apply_uncertainty_model(layout.uncertainty, &mut points, &parsed.elements);
             let mut metadata = metadata.clone();
             metadata.insert("uncertainty_model".to_string(), applied.label.clone());
-            // The file's notes go with its first set, as read_measurement_sets does.
-            let mut notes = std::mem::take(&mut file_notes);
+            // The file's notes go with every set, as read_measurement_sets does (a set chosen by
+            // wavelength keeps them; the fit says each note once).
+            let mut notes = file_notes.clone();
             notes.push(format!("{file} at {wavelength_um} µm: {}", applied.note));
             MeasurementSet {
                 source: source.to_path_buf(),
