@@ -9,10 +9,13 @@ mod fit_support;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fit_support::{goniometer_geometry, model, synthetic_set, LINEAR_ELEMENTS};
 use irpol::fit::{
-    fit_measurement, fit_spectral, Dispersion, DistributionKind, FitOptions, MeasurementData,
-    ModelSpace, Objective, Parameter, ParameterBounds, ParameterValues,
+    fit_grey, fit_measurement, fit_spectral, subset, validate_model, Dispersion, DistributionKind,
+    FitOptions, MeasurementData, ModelSpace, Objective, Parameter, ParameterBounds,
+    ParameterValues,
 };
-use irpol::measure::{read_measurement_csv, read_measurement_sets, MeasurementSet};
+use irpol::measure::{
+    read_measurement_csv, read_measurement_sets, read_with_layout, Layout, MeasurementSet,
+};
 use irpol::pbrdf::{ModelTerms, Shadowing, SlopeDistribution};
 use std::path::Path;
 use std::time::Duration;
@@ -143,5 +146,45 @@ fn spectral_fit(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, objective, default_fit, spectral_fit);
+/// NIST's measured PTFE at 1.064 µm (1824 rows × 16 elements, read through its layout): the fit
+/// with the volume terms (internal facet + polarized subsurface; Cauchy and Gaussian, energy
+/// constraint, uncertainties) and its 5-fold cross-validation, and `validate` of that model on
+/// 2000 rows. Targets (docs/design.md §1.10): the fit ≤ 2 s, the validation ≤ 0.2 s.
+fn ptfe_volume_fit(c: &mut Criterion) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/ptfe");
+    let layout = Layout::read(&root.join("layout.toml")).unwrap();
+    let set = read_with_layout(&root.join("PTFE_351_1064.csv"), &layout)
+        .unwrap()
+        .into_iter()
+        .find(|s| (s.wavelength_um - 1.064).abs() < 1e-9)
+        .unwrap();
+    let options = FitOptions {
+        terms: ModelTerms::parse("internal+subsurface").unwrap(),
+        cv_folds: Some(5),
+        ..FitOptions::default()
+    };
+    let mut group = c.benchmark_group("ptfe_volume");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(30));
+    group.bench_function("fit_1824x16_cv5", |b| {
+        b.iter(|| fit_grey(black_box(&set), &options).unwrap())
+    });
+    let outcome = fit_grey(&set, &options).unwrap();
+    let model = outcome.material.grey_model().unwrap().pbrdf().unwrap();
+    let rows: Vec<usize> = (0..2000).map(|i| i % set.points.len()).collect();
+    let validation_set = subset(&set, &rows);
+    group.bench_function("validate_2000x16", |b| {
+        b.iter(|| validate_model(black_box(&model), &validation_set).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    objective,
+    default_fit,
+    spectral_fit,
+    ptfe_volume_fit
+);
 criterion_main!(benches);

@@ -116,8 +116,9 @@ struct Iterate {
     s: Vec<f64>,
     r: DVector<f64>,
     cost: f64,
-    /// ∂r/∂s at `s`, evaluated again after each accepted step.
-    jacobian: Option<DMatrix<f64>>,
+    /// The normal equations (JᵀJ, Jᵀr) of the Jacobian J = ∂r/∂s at `s`, evaluated again after
+    /// each accepted step; a rejected step reuses them with more damping.
+    normal_equations: Option<(DMatrix<f64>, DVector<f64>)>,
     damping: Damping,
     history: StageHistory,
 }
@@ -147,7 +148,7 @@ pub(crate) fn levenberg_marquardt(
         s,
         r,
         cost,
-        jacobian: None,
+        normal_equations: None,
         damping: Damping::new(),
         history,
     };
@@ -176,28 +177,29 @@ impl Iterate {
         let columns = problem.jacobian_evaluations();
         for _ in 0..settings.max_iterations {
             self.history.iterations += 1;
-            if self.jacobian.is_none() {
-                self.jacobian = problem.jacobian(&self.s, &self.r);
+            if self.normal_equations.is_none() {
+                self.normal_equations = problem
+                    .jacobian(&self.s, &self.r)
+                    .map(|j| (j.tr_mul(&j), j.tr_mul(&self.r)));
                 self.history.evaluations += columns;
             }
-            let Some(j) = &self.jacobian else {
+            let Some((a, g)) = &self.normal_equations else {
                 return "the Jacobian could not be evaluated";
             };
-            let a = j.transpose() * j;
-            let g = j.transpose() * &self.r;
-            let free = free_parameters(&self.s, &g, lower, upper);
+            let free = free_parameters(&self.s, g, lower, upper);
             if free.is_empty() {
                 return "every parameter rests on a bound";
             }
-            let Some(step) = damped_step(&a, &g, &free, self.damping.lambda) else {
+            let Some(step) = damped_step(a, g, &free, self.damping.lambda) else {
                 self.damping.increase();
                 self.history.best_cost.push(self.cost);
                 continue;
             };
             let trial = step_in_box(&self.s, &step, &free, lower, upper);
             let delta: DVector<f64> = DVector::from_fn(self.s.len(), |i, _| trial[i] - self.s[i]);
-            // Gain ratio: actual decrease over the decrease the linear model predicts.
-            let predicted = -(2.0 * g.dot(&delta) + (j * &delta).norm_squared());
+            // Gain ratio: actual decrease over the decrease the linear model predicts,
+            // −(2 gᵀδ + |Jδ|²) with |Jδ|² = δᵀ(JᵀJ)δ.
+            let predicted = -(2.0 * g.dot(&delta) + delta.dot(&(a * &delta)));
             let stop = self.accept_or_reject(problem, trial, &delta, predicted, settings);
             if let Some(reason) = stop {
                 return reason;
@@ -234,7 +236,7 @@ impl Iterate {
                 self.r = r;
             }
             self.cost = trial_cost;
-            self.jacobian = None;
+            self.normal_equations = None;
             self.history.best_cost.push(self.cost);
             (decrease <= settings.relative_tolerance * self.cost)
                 .then_some("converged (relative decrease below tolerance)")
