@@ -170,7 +170,7 @@ fn check_folder_materials(folder: &Path, sets: &[MeasurementSet]) -> Result<(), 
             message: format!(
                 "has no '# material:' line, and the folder {} holds {} measurement files: add \
                  '# material: NAME' to each so that irpol knows which belong to one material",
-                crate::text::path(&folder),
+                crate::text::path(folder),
                 files.len()
             ),
         }),

@@ -58,7 +58,7 @@ pub fn merge_repeat_measurements(
 fn describe(path: &std::path::Path, rows: usize) -> String {
     format!(
         "{} ({})",
-        crate::text::path(&path),
+        crate::text::path(path),
         crate::text::counted(rows, "row")
     )
 }
