@@ -28,10 +28,15 @@ element in the column order m00, m01, ..., m33, each over all rows.
 fits each written file with the numpy model (scipy least_squares, weighted by the u_ columns; free sigma,
 q for the Cauchy, n, k, rho_s, d; the true distribution, both facet sides, two starts) and prints the
 estimates with their 1-sigma errors and chi^2/dof: what the data can support, independently of irpol.
-For a truth with k = 0 it also fits with k held at 0: with the principal root of eps - sin^2 beta and
-eps = 1/N^2 (Im eps < 0 for k > 0), any k > 0 reverses the sign of the retardance of totally
-internally reflecting facets (m23, m32), so a least-squares search with k free leaves k = 0 for a wrong
-minimum (internal_subsurface: chi^2/dof 341 with k free, 0.96 with k = 0).
+For a truth with k = 0 it also fits with k held at 0.  (With eps = 1/N^2, Im eps < 0 for k > 0, any k > 0
+reversed the sign of the retardance of totally internally reflecting facets (m23, m32) and a search with
+k free left k = 0 for a wrong minimum, chi^2/dof 341; with eps = conj(1/N^2) the coefficients are
+continuous in k and internal_subsurface gives chi^2/dof 0.963 with k free, 0.962 with k = 0.)
+
+The subsurface term is the one with its residual polarization D referred to the scattering plane
+(pbrdf_volume_numpy.py); the files were regenerated for it with the same truths and seeds (only the
+out-of-plane ring rows changed: in the plane of incidence the scattering plane's frames are the psps
+frames up to sign, C = 1, S = 0).
 """
 
 from __future__ import annotations

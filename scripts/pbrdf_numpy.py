@@ -67,6 +67,49 @@ def global_frames(theta_i, phi_i, theta_r, phi_r):
     return w_i, w_r, k_in, k_out, s_in, p_in, s_out, p_out
 
 
+def facet_frame_projections(theta_i, phi_i, theta_r, phi_r):
+    """The facet term's change of frames (docs/design.md §1.3), angles in radians.
+
+    Returns (h, cos_beta, out_proj, in_proj): the half vector h (..., 3), cos_beta = h . w_i clipped to
+    [0, 1], and the 2x2 projections between the psps frames g = (s, p) of the global geometry and the
+    facet-local frames f = (s_loc, p_loc), s_loc = unit(h x k_in) (the normal of the plane of w_i and
+    w_r, the same vector on both sides), p_loc = k x s_loc:
+        out_proj[a, c] = g_out_a . f_out_c,   in_proj[c, b] = f_in_c . g_in_b,
+    so that a Jones matrix diag(r_s, r_p) in the facet frames is out_proj @ diag(r_s, r_p) @ in_proj in
+    the psps frames.  Both are rotations (the frames share k and are right-handed)."""
+    w_i, w_r, k_in, k_out, s_in, p_in, s_out, p_out = global_frames(theta_i, phi_i, theta_r, phi_r)
+
+    h = _unit(w_i + w_r)
+    cos_b = np.clip(_dot(h, w_i), 0.0, 1.0)
+
+    # Facet frames: s_loc = unit(h x k_in) (the same vector on both sides), p_loc = k x s_loc.
+    # At exact retro-reflection h || k_in; then r_p = -r_s makes the result frame independent,
+    # so any s_loc perpendicular to k_in works: take the global s_in.
+    hxk = np.cross(h, k_in)
+    norm = np.linalg.norm(hxk, axis=-1, keepdims=True)
+    # |h x k_in| of unit vectors: at exact retro-reflection rounding leaves ~1e-17, not 0.
+    degenerate = norm[..., 0] < 1e-12
+    s_loc = np.where(degenerate[..., None], s_in, hxk / np.where(norm > 0, norm, 1.0))
+    p_loc_in = np.cross(k_in, s_loc)
+    p_loc_out = np.cross(k_out, s_loc)
+
+    out_proj = np.stack(
+        [
+            np.stack([_dot(s_out, s_loc), _dot(s_out, p_loc_out)], axis=-1),
+            np.stack([_dot(p_out, s_loc), _dot(p_out, p_loc_out)], axis=-1),
+        ],
+        axis=-2,
+    )
+    in_proj = np.stack(
+        [
+            np.stack([_dot(s_loc, s_in), _dot(s_loc, p_in)], axis=-1),
+            np.stack([_dot(p_loc_in, s_in), _dot(p_loc_in, p_in)], axis=-1),
+        ],
+        axis=-2,
+    )
+    return h, cos_b, out_proj, in_proj
+
+
 # ---------------------------------------------------------------------------------------------
 # Fresnel (docs/design.md §1.3), exp(-i w t) convention, N = n + i k
 # ---------------------------------------------------------------------------------------------
@@ -187,38 +230,11 @@ def mueller_brdf(
         for x in (theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg)
     )
     ti, pi_, tr, pr = np.broadcast_arrays(ti, pi_, tr, pr)
-    w_i, w_r, k_in, k_out, s_in, p_in, s_out, p_out = global_frames(ti, pi_, tr, pr)
-
-    h = _unit(w_i + w_r)
+    h, cos_b, out_proj, in_proj = facet_frame_projections(ti, pi_, tr, pr)
     cos_t = h[..., 2]
-    cos_b = np.clip(_dot(h, w_i), 0.0, 1.0)
-
-    # Facet frames: s_loc = unit(h x k_in) (the same vector on both sides), p_loc = k x s_loc.
-    # At exact retro-reflection h || k_in; then r_p = -r_s makes the result frame independent,
-    # so any s_loc perpendicular to k_in works: take the global s_in.
-    hxk = np.cross(h, k_in)
-    norm = np.linalg.norm(hxk, axis=-1, keepdims=True)
-    degenerate = norm[..., 0] < 1e-300
-    s_loc = np.where(degenerate[..., None], s_in, hxk / np.where(norm > 0, norm, 1.0))
-    p_loc_in = np.cross(k_in, s_loc)
-    p_loc_out = np.cross(k_out, s_loc)
 
     r_s, r_p = fresnel(cos_b, n, k, facet)
     # J[a, b] = sum_c (g_out_a . f_out_c) r_c (f_in_c . g_in_b), g = global (s, p), f = facet (s, p)
-    out_proj = np.stack(
-        [
-            np.stack([_dot(s_out, s_loc), _dot(s_out, p_loc_out)], axis=-1),
-            np.stack([_dot(p_out, s_loc), _dot(p_out, p_loc_out)], axis=-1),
-        ],
-        axis=-2,
-    )
-    in_proj = np.stack(
-        [
-            np.stack([_dot(s_loc, s_in), _dot(s_loc, p_in)], axis=-1),
-            np.stack([_dot(p_loc_in, s_in), _dot(p_loc_in, p_in)], axis=-1),
-        ],
-        axis=-2,
-    )
     r = np.stack([r_s, r_p], axis=-1)
     J = out_proj @ (r[..., :, None] * in_proj)
     M = mueller_from_jones(J)

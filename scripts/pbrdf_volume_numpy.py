@@ -3,17 +3,31 @@ interface and the polarized subsurface term, added to the facet term of pbrdf_nu
 
     F = F_facet(facet side) + rho_d/pi diag(1,0,0,0) + F_ss
 
-    F_ss(w_i -> w_r) = rho_s / (pi Z) * T(theta_r) D T(theta_i)        (psps frames, macro normal z)
+    F_ss(w_i -> w_r) = rho_s / (pi Z) * T(theta_r) D_plane T(theta_i)        (psps frames, macro normal z)
 
 * T(theta): smooth-interface Fresnel transmission Mueller matrix at cos(theta), eps = N^2 (air ->
   material): R_s = |r_s|^2, R_p = |r_p|^2, t_s = 1 - R_s, t_p = 1 - R_p, T+- = (t_s +- t_p)/2,
   X = sqrt(t_s t_p), T = [[T+, T-, 0, 0], [T-, T+, 0, 0], [0, 0, X, 0], [0, 0, 0, X]].
   In the psps frames of docs/design.md §1.3 the plane of incidence of the macro surface is the
   global frame's own s/p plane, so T needs no rotation.
-* D = diag(1, d, -d, -d), d in [0, 1] the residual polarization after volume scattering.
+* D_plane: the residual polarization d in [0, 1] left after volume scattering, referred to the
+  SCATTERING PLANE (the plane of w_i and w_r), not to the macro surface.  Built here as a mixture
+      D_plane = (1 - d) diag(1, 0, 0, 0) + d M_mirror,
+      M_mirror = mueller_from_jones(out_proj @ diag(1, -1) @ in_proj),
+  a perfect mirror in the facet term's local frames (s_loc = unit(h x k_in), the normal of the
+  scattering plane; pbrdf_numpy.facet_frame_projections): Jones diag(r_s, r_p) = diag(1, -1), whose
+  Mueller matrix in those frames is diag(1, 1, -1, -1) (m22 = Re(r_s* r_p) = -1 in pbrdf_numpy's
+  convention, the sign a metal's r_s -> -1, r_p -> +1 gives up to a global phase).  The rotations
+  leave diag(1,0,0,0) alone, so D_plane = L_out diag(1, d, -d, -d) L_in, the old diagonal D turned
+  from the psps frames into the scattering plane's.  Written out (subsurface_elements), with
+  C + iS = exp(i(2a - 2b)), a, b the rotation angles of in_proj, out_proj = [[cos, sin], [-sin, cos]]:
+      D_plane = [[1, 0, 0, 0], [0, dC, dS, 0], [0, dS, -dC, 0], [0, 0, 0, -d]].
+  The term now depends on the azimuths too (at normal incidence C + iS follows 2(phi_r - phi_i)).
 * Z = (1 - Rbar) + |d| |Abar|, Rbar = 2 int_0^1 R(mu) mu dmu (R = (R_s + R_p)/2),
   Abar = 2 int_0^1 T-(mu) mu dmu, both by adaptive quadrature to ~1e-14 with a break point at the
-  square-root kink mu_c = sqrt(1 - Re eps) when Re eps < 1.
+  square-root kink mu_c = sqrt(1 - Re eps) when Re eps < 1.  For d = 0 the directional-hemispherical
+  reflectance is rho_s (1 - R(theta_i)) exactly; for d > 0 it is at most rho_s I_t, I_t the intensity
+  after the interface, since |C| <= 1 (no closed form: C varies with phi_r).
 
 Written from docs/design.md and the formulas of the model's specification, not from the Rust code.
 The internal facet is pbrdf_numpy.mueller_brdf(..., facet="internal") (eps = 1/N^2).
@@ -90,31 +104,58 @@ def normalization(n: float, k: float, d: float) -> float:
     return (1.0 - r_bar) + abs(d) * abs(a_bar)
 
 
-def subsurface_mueller(theta_i_deg, theta_r_deg, *, n, k, rho_s, d):
-    """F_ss (N, 4, 4) in sr^-1; depends on the zenith angles only (azimuths enter through the frames,
-    which are the macro surface's own)."""
-    ti = np.radians(np.atleast_1d(np.asarray(theta_i_deg, dtype=float)))
-    tr = np.radians(np.atleast_1d(np.asarray(theta_r_deg, dtype=float)))
-    ti, tr = np.broadcast_arrays(ti, tr)
+def _radians(*angles_deg):
+    return np.broadcast_arrays(*(np.radians(np.atleast_1d(np.asarray(x, dtype=float))) for x in angles_deg))
+
+
+def scattering_plane_mirror(ti, pi_, tr, pr):
+    """M_mirror (..., 4, 4): a perfect mirror, Jones diag(1, -1) in the facet-local s/p frames of the
+    scattering plane, seen in the psps frames (angles in radians)."""
+    _h, _cos_b, out_proj, in_proj = pn.facet_frame_projections(ti, pi_, tr, pr)
+    J = out_proj @ (np.array([1.0, -1.0])[:, None] * in_proj)
+    return pn.mueller_from_jones(J.astype(complex))
+
+
+def scattering_plane_cos_sin(ti, pi_, tr, pr):
+    """(C, S) = cos, sin of 2a - 2b, a and b the angles of the rotations in_proj, out_proj =
+    [[cos, sin], [-sin, cos]] (angles in radians): by double angles from their first rows."""
+    _h, _cos_b, out_proj, in_proj = pn.facet_frame_projections(ti, pi_, tr, pr)
+    ca, sa = in_proj[..., 0, 0], in_proj[..., 0, 1]
+    cb, sb = out_proj[..., 0, 0], out_proj[..., 0, 1]
+    c2a, s2a = ca * ca - sa * sa, 2.0 * ca * sa
+    c2b, s2b = cb * cb - sb * sb, 2.0 * cb * sb
+    return c2a * c2b + s2a * s2b, s2a * c2b - c2a * s2b
+
+
+def subsurface_mueller(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, *, n, k, rho_s, d):
+    """F_ss (N, 4, 4) in sr^-1: rho_s/(pi Z) T(theta_r) [(1 - d) diag(1,0,0,0) + d M_mirror] T(theta_i)."""
+    ti, pi_, tr, pr = _radians(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg)
     K = rho_s / (math.pi * normalization(n, k, d))
-    D = np.diag([1.0, d, -d, -d])
+    depolarizer = np.zeros(ti.shape + (4, 4))
+    depolarizer[..., 0, 0] = 1.0
+    D = (1.0 - d) * depolarizer + d * scattering_plane_mirror(ti, pi_, tr, pr)
     return K * (transmission_mueller(np.cos(tr), n, k) @ D @ transmission_mueller(np.cos(ti), n, k))
 
 
-def subsurface_elements(theta_i_deg, theta_r_deg, *, n, k, rho_s, d):
+def subsurface_elements(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, *, n, k, rho_s, d):
     """The same matrix from its written-out elements (the specification's check of the product)."""
-    ti = np.radians(np.atleast_1d(np.asarray(theta_i_deg, dtype=float)))
-    tr = np.radians(np.atleast_1d(np.asarray(theta_r_deg, dtype=float)))
-    ti, tr = np.broadcast_arrays(ti, tr)
-    pi_, mi, xi = transmission_parts(np.cos(ti), n, k)
-    pr, mr, xr = transmission_parts(np.cos(tr), n, k)
+    ti, pi_, tr, pr = _radians(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg)
+    C, S = scattering_plane_cos_sin(ti, pi_, tr, pr)
+    pi_i, mi, xi = transmission_parts(np.cos(ti), n, k)
+    pr_, mr, xr = transmission_parts(np.cos(tr), n, k)
     K = rho_s / (math.pi * normalization(n, k, d))
+    dC, dS = d * C, d * S
     M = np.zeros(ti.shape + (4, 4))
-    M[..., 0, 0] = (pr * pi_ + d * mr * mi) * K
-    M[..., 0, 1] = (pr * mi + d * mr * pi_) * K
-    M[..., 1, 0] = (mr * pi_ + d * pr * mi) * K
-    M[..., 1, 1] = (mr * mi + d * pr * pi_) * K
-    M[..., 2, 2] = M[..., 3, 3] = -d * xr * xi * K
+    M[..., 0, 0] = K * (pr_ * pi_i + dC * mr * mi)
+    M[..., 0, 1] = K * (pr_ * mi + dC * mr * pi_i)
+    M[..., 0, 2] = K * dS * mr * xi
+    M[..., 1, 0] = K * (mr * pi_i + dC * pr_ * mi)
+    M[..., 1, 1] = K * (mr * mi + dC * pr_ * pi_i)
+    M[..., 1, 2] = K * dS * pr_ * xi
+    M[..., 2, 0] = K * dS * xr * mi
+    M[..., 2, 1] = K * dS * xr * pi_i
+    M[..., 2, 2] = -K * dC * xr * xi
+    M[..., 3, 3] = -K * d * xr * xi
     return M
 
 
@@ -124,9 +165,7 @@ def mueller_brdf(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, *, distribution
     M = pn.mueller_brdf(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, distribution=distribution,
                         sigma=sigma, q=q, n=n, k=k, shadowing=shadowing, rho_d=rho_d, facet=facet)
     if rho_s != 0.0:
-        ti, _, tr, _ = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
-                                             for x in (theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg)))
-        M = M + subsurface_mueller(ti, tr, n=n, k=k, rho_s=rho_s, d=d)
+        M = M + subsurface_mueller(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, n=n, k=k, rho_s=rho_s, d=d)
     return M
 
 

@@ -82,7 +82,13 @@ pub fn significant(value: f64, digits: i32) -> String {
     if value == 0.0 || !value.is_finite() {
         return format!("{value}");
     }
-    let decimals = (digits - 1 - value.abs().log10().floor() as i32).clamp(0, 15) as usize;
+    let decimals = digits - 1 - value.abs().log10().floor() as i32;
+    if decimals > 15 {
+        // Below ~1e-13 plain notation would print only zeros ("d < 0.000000000000000").
+        let mantissa = (digits - 1).max(0) as usize;
+        return format!("{value:.mantissa$e}");
+    }
+    let decimals = decimals.max(0) as usize;
     format!("{value:.decimals$}")
 }
 
@@ -141,6 +147,8 @@ mod tests {
         assert_eq!(shown_at_most("abcdef", 3), "abc…");
         assert_eq!(shown("plain, text"), "plain, text");
         assert_eq!(number(1e308), "1e308");
+        assert_eq!(significant(6.1e-6, 2), "0.0000061");
+        assert_eq!(significant(3.2e-17, 3), "3.20e-17");
         let deep = std::path::PathBuf::from(format!("data/{}/m\u{1b}.csv", "d".repeat(500)));
         let cut = path(&deep);
         assert!(

@@ -16,7 +16,7 @@
 //! angles instead of 1e-5.
 //! The diffuse term (ρ_d/π) ∫ L cosθ_i dΩ_i uses a cosine-weighted (projected disk) rule.
 
-use super::{ModelError, Pbrdf};
+use super::{ModelError, Pbrdf, ScatteringGeometry};
 use crate::optics::frame::{double_angle, facet_axis_in_scattered_frame, Direction};
 use crate::optics::{FresnelFractions, Stokes};
 use gauss_quad::legendre::GaussLegendre;
@@ -195,14 +195,12 @@ impl Pbrdf {
         if self.subsurface().is_some() {
             // The subsurface term (docs/design.md §1.10) is smooth over ω_i like the ideal
             // depolarizer, so it shares its cosine-weighted rule.
-            let cos_r = scattered.cos_theta();
+            let depolarized = Stokes::new(self.rho_d() * FRAC_1_PI, 0.0, 0.0, 0.0);
             for (w_i, weight) in quadrature.cosine_weighted_nodes() {
-                let [s0, s1] = self.subsurface_first_column(w_i.z, cos_r);
-                let depolarized = self.rho_d() * FRAC_1_PI;
-                visit(
-                    w_i,
-                    Stokes::new((depolarized + s0) * weight, s1 * weight, 0.0, 0.0),
-                );
+                let incident = Direction::from_unit_vector(*w_i);
+                let subsurface = ScatteringGeometry::new(&incident, scattered)
+                    .map_or_else(Stokes::zeros, |g| self.subsurface_first_column(&g));
+                visit(w_i, (depolarized + subsurface) * *weight);
             }
         } else if self.rho_d() > 0.0 {
             for (w_i, weight) in quadrature.cosine_weighted_nodes() {

@@ -176,6 +176,15 @@ impl ScatteringGeometry {
         )
     }
 
+    /// (cos, sin) of 2η_i + 2η_r: how far the scattering plane's frames turn from the psps
+    /// frames, as the subsurface term needs them (docs/design.md §1.10).
+    #[inline]
+    pub(super) fn scattering_plane_turn(&self) -> (f64, f64) {
+        let (ci, si) = self.incident_rotation;
+        let (cr, sr) = self.scattered_rotation;
+        (cr * ci - sr * si, sr * ci + cr * si)
+    }
+
     /// cos θ_i, the argument of the incident direction's [`Pbrdf::masking`].
     pub fn cos_incident(&self) -> f64 {
         self.facet.cos_i
@@ -272,18 +281,31 @@ impl Pbrdf {
 
     /// The subsurface term's Mueller matrix at cos θ_i, cos θ_r, if the model has one.
     #[inline]
-    fn subsurface_mueller(&self, cos_i: f64, cos_r: f64) -> Option<Mueller> {
+    fn subsurface_mueller(&self, geometry: &ScatteringGeometry) -> Option<Mueller> {
         let s = self.subsurface.as_ref()?;
-        Some(s.mueller(s.transmission(cos_i), s.transmission(cos_r)))
+        let facet = &geometry.facet;
+        Some(s.mueller(
+            s.transmission(facet.cos_i),
+            s.transmission(facet.cos_r),
+            geometry.scattering_plane_turn(),
+        ))
     }
 
-    /// (m00, m10) of the subsurface term for incidence from ω_i (cos θ_i = `cos_i`) onto ω_r,
-    /// zero without one: the term's weight in a hemispherical integral over ω_i.
+    /// (m00, m10, m20) of the subsurface term from ω_i onto ω_r, zero without one: its Stokes
+    /// BRDF for unpolarized light, and its weight in a hemispherical integral over ω_i.
     #[inline]
-    pub(super) fn subsurface_first_column(&self, cos_i: f64, cos_r: f64) -> [f64; 2] {
+    pub(super) fn subsurface_first_column(&self, geometry: &ScatteringGeometry) -> Stokes {
         match &self.subsurface {
-            Some(s) => s.first_column(s.transmission(cos_i), s.transmission(cos_r)),
-            None => [0.0, 0.0],
+            Some(s) => {
+                let facet = &geometry.facet;
+                let [s0, s1, s2] = s.first_column(
+                    s.transmission(facet.cos_i),
+                    s.transmission(facet.cos_r),
+                    geometry.scattering_plane_turn(),
+                );
+                Stokes::new(s0, s1, s2, 0.0)
+            }
+            None => Stokes::zeros(),
         }
     }
     pub(crate) fn prepared_distribution(&self) -> &PreparedDistribution {
@@ -421,8 +443,7 @@ impl Pbrdf {
         let s = facet.cross.im * facet.scale;
         let facets_and_depolarizer =
             geometry.assemble_mueller([a, b, c, s], self.rho_d * FRAC_1_PI);
-        let facet = &geometry.facet;
-        match self.subsurface_mueller(facet.cos_i, facet.cos_r) {
+        match self.subsurface_mueller(geometry) {
             Some(subsurface) => facets_and_depolarizer + subsurface,
             None => facets_and_depolarizer,
         }
@@ -432,19 +453,27 @@ impl Pbrdf {
     /// thermal scenes need. Skips the incident-frame rotation: (A, cos2η_r B, sin2η_r B, 0).
     #[inline]
     pub fn first_column(&self, incident: &Direction, scattered: &Direction) -> Stokes {
+        if self.subsurface.is_some() {
+            // The subsurface term turns with the scattering plane: both rotations are needed.
+            return match ScatteringGeometry::new(incident, scattered) {
+                Some(geometry) => self
+                    .mueller_for_geometry(
+                        &geometry,
+                        self.masking(geometry.facet.cos_i),
+                        self.masking(geometry.facet.cos_r),
+                    )
+                    .column(0)
+                    .into_owned(),
+                None => Stokes::zeros(),
+            };
+        }
         let Some(geometry) = FacetGeometry::new(incident, scattered) else {
             return Stokes::zeros();
         };
         let facet = self.facet_reflection(&geometry, self.masking_of(&geometry));
         let (cr, sr) = double_angle(facet_axis_in_scattered_frame(&incident.vector, scattered));
         let (a, b) = facet.scaled_a_and_b();
-        let facets_and_depolarizer = Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0);
-        let [s0, s1] = self.subsurface_first_column(geometry.cos_i, geometry.cos_r);
-        if self.subsurface.is_some() {
-            facets_and_depolarizer + Stokes::new(s0, s1, 0.0, 0.0)
-        } else {
-            facets_and_depolarizer
-        }
+        Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
     }
 }
 

@@ -1,27 +1,35 @@
 //! The volume-scattering terms of docs/design.md §1.10: which side of the facets reflects
 //! ([`FacetSide`]), and the polarized subsurface term
-//!     F_ss(ω_i→ω_r) = (ρ_s / (π Z)) · T(θ_r) · D(d) · T(θ_i),
+//!     F_ss(ω_i→ω_r) = (ρ_s / (π Z)) · T(θ_r) · L(−η_r) D(d) L(η_i) · T(θ_i),
 //! light refracted into the material through a smooth interface, scattered inside with a residual
-//! polarization d, and refracted out.
+//! polarization d referred to the scattering plane, and refracted out.
 //!
 //! - T(θ) is the Fresnel transmission Mueller matrix of the macro surface at cos θ, air → material
 //!   (ε = N²), in the psps frame of its direction: t_s,p = 1 − R_s,p, T± = (t_s ± t_p)/2,
 //!   X = √(t_s t_p); T = [[T+, T−, 0, 0], [T−, T+, 0, 0], [0, 0, X, 0], [0, 0, 0, X]]. For a
 //!   dielectric t_p ≥ t_s, so the light leaves p-polarized — as thermal emission does.
 //! - D(d) = diag(1, d, −d, −d): the polarization that survives volume scattering, with the signs of
-//!   a mirror in psps frames (a perfect mirror is diag(1, 1, −1, −1) there), so d = 1 on an
-//!   index-matched surface behaves like one. D is realizable (Cloude) for −1/3 ≤ d ≤ 1; the model
-//!   accepts d ∈ [0, 1].
+//!   a mirror (a perfect mirror is diag(1, 1, −1, −1) in s/p frames). Like single scattering by a
+//!   particle, it is referred to the scattering plane (the plane of ω_i and ω_r), not to the
+//!   macro surface: L(η_i), L(−η_r) are the rotations of the facet term (§1.3) from the psps
+//!   frames into the frames of that plane (whose normal is ω_i × ω_r, the facet's s axis).
+//!   Multiplied out, L(−η_r) D L(η_i) = [[1,0,0,0], [0,dC,dS,0], [0,dS,−dC,0], [0,0,0,−d]] with
+//!   C + iS = e^{i(2η_i + 2η_r)}. NIST's sintered PTFE shows why: at normal incidence its residual
+//!   polarization follows cos 2φ_r, sin 2φ_r (m11 = −m22 = ±0.05 at φ_r = 0°, 90°), which a
+//!   matrix fixed in the macro frames cannot give. D is realizable (Cloude) for −1/3 ≤ d ≤ 1;
+//!   the model accepts d ∈ [0, 1].
 //! - The interface has the material's index N, or n_sub + ik where given ([`Subsurface`]).
 //! - Z = (1 − R̄) + |d|·|Ā|, R̄ = 2∫₀¹ R(μ) μ dμ, Ā = 2∫₀¹ T−(μ) μ dμ, the normalization that
-//!   conserves energy: the term's directional-hemispherical reflectance is
-//!   (ρ_s/Z)[T+(θ_i)(1 − R̄) + d T−(θ_i) Ā] ≤ ρ_s T+(θ_i) = ρ_s (1 − R(θ_i)) — at most a
-//!   fraction ρ_s of what the smooth interface lets in comes out.
+//!   conserves energy: for light of intensity I_t after the interface (I_t = T+(θ_i) unpolarized)
+//!   the term's directional-hemispherical reflectance is at most
+//!   (ρ_s/Z)[(1 − R̄) I_t + |d| |Ā| I_t] = ρ_s I_t, since |C|, |S| ≤ 1 and the transmitted Stokes
+//!   vector's polarized part is at most I_t — at most a fraction ρ_s of what the smooth interface
+//!   lets in comes out.
 //!
-//! Reciprocity: T is symmetric and D diagonal, so F_ss(ω_r→ω_i) = F_ss(ω_i→ω_r)ᵀ, and the
-//! diagonal Q of Sekera's relation commutes with both; the term is reciprocal like the facet term.
-//! With N = 1 and d = 0 every R is exactly 0, Z exactly 1 and the term is (ρ_s/π) diag(1,0,0,0)
-//! bit for bit: today's ideal depolarizer (§1.3's ρ_d).
+//! Reciprocity: T is symmetric, and the rotated D has the structure of the facet term's Fresnel
+//! matrix between the same rotations, so F_ss obeys the facet term's Sekera relation
+//! F(ω_r→ω_i) = Q F(ω_i→ω_r)ᵀ Q. With N = 1 and d = 0 every R is exactly 0, Z exactly 1 and the
+//! term is (ρ_s/π) diag(1,0,0,0) bit for bit: today's ideal depolarizer (§1.3's ρ_d).
 
 use crate::optics::{FresnelFractions, Mueller, RefractiveIndex};
 use num_complex::Complex64;
@@ -136,27 +144,46 @@ impl PreparedSubsurface {
         Transmission::at(cos_theta, self.permittivity)
     }
 
-    /// The term's Mueller matrix from T(θ_i) and T(θ_r) (module docs).
+    /// The term's Mueller matrix from T(θ_i), T(θ_r) and `plane` = (C, S) = (cos, sin) of
+    /// 2η_i + 2η_r, the turn of the scattering plane against the psps frames (module docs).
     #[inline]
-    pub(super) fn mueller(&self, incident: Transmission, scattered: Transmission) -> Mueller {
-        let (i, r, d, k) = (incident, scattered, self.terms.d, self.scale);
+    pub(super) fn mueller(
+        &self,
+        incident: Transmission,
+        scattered: Transmission,
+        plane: (f64, f64),
+    ) -> Mueller {
+        let (i, r, k) = (incident, scattered, self.scale);
+        let (dc, ds) = (self.terms.d * plane.0, self.terms.d * plane.1);
         let mut m = Mueller::zeros();
-        m[(0, 0)] = k * (r.plus * i.plus + d * r.minus * i.minus);
-        m[(0, 1)] = k * (r.plus * i.minus + d * r.minus * i.plus);
-        m[(1, 0)] = k * (r.minus * i.plus + d * r.plus * i.minus);
-        m[(1, 1)] = k * (r.minus * i.minus + d * r.plus * i.plus);
-        m[(2, 2)] = -k * d * r.cross * i.cross;
-        m[(3, 3)] = m[(2, 2)];
+        // T(θ_r) · [[1,0,0,0],[0,dC,dS,0],[0,dS,−dC,0],[0,0,0,−d]] · T(θ_i), multiplied out.
+        m[(0, 0)] = k * (r.plus * i.plus + dc * r.minus * i.minus);
+        m[(0, 1)] = k * (r.plus * i.minus + dc * r.minus * i.plus);
+        m[(0, 2)] = k * ds * r.minus * i.cross;
+        m[(1, 0)] = k * (r.minus * i.plus + dc * r.plus * i.minus);
+        m[(1, 1)] = k * (r.minus * i.minus + dc * r.plus * i.plus);
+        m[(1, 2)] = k * ds * r.plus * i.cross;
+        m[(2, 0)] = k * ds * r.cross * i.minus;
+        m[(2, 1)] = k * ds * r.cross * i.plus;
+        m[(2, 2)] = -k * dc * r.cross * i.cross;
+        m[(3, 3)] = -k * self.terms.d * r.cross * i.cross;
         m
     }
 
-    /// (m00, m10) of [`PreparedSubsurface::mueller`]: the Stokes BRDF for unpolarized light.
+    /// (m00, m10, m20) of [`PreparedSubsurface::mueller`]: the Stokes BRDF for unpolarized light.
     #[inline]
-    pub(super) fn first_column(&self, incident: Transmission, scattered: Transmission) -> [f64; 2] {
-        let (i, r, d, k) = (incident, scattered, self.terms.d, self.scale);
+    pub(super) fn first_column(
+        &self,
+        incident: Transmission,
+        scattered: Transmission,
+        plane: (f64, f64),
+    ) -> [f64; 3] {
+        let (i, r, k) = (incident, scattered, self.scale);
+        let (dc, ds) = (self.terms.d * plane.0, self.terms.d * plane.1);
         [
-            k * (r.plus * i.plus + d * r.minus * i.minus),
-            k * (r.minus * i.plus + d * r.plus * i.minus),
+            k * (r.plus * i.plus + dc * r.minus * i.minus),
+            k * (r.minus * i.plus + dc * r.plus * i.minus),
+            k * ds * r.cross * i.minus,
         ]
     }
 }

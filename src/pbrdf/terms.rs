@@ -40,7 +40,8 @@ pub enum Term {
     Facet,
     /// (ρ_d/π) diag(1, 0, 0, 0): unpolarized diffuse reflection.
     IdealDepolarizer,
-    /// (ρ_s/πZ) T(θ_r) D(d) T(θ_i): light refracted in, scattered inside and refracted out
+    /// (ρ_s/πZ) T(θ_r) L(−η_r) D(d) L(η_i) T(θ_i): light refracted in, scattered inside with a
+    /// residual polarization in the scattering plane, and refracted out
     /// (docs/design.md §1.10, `pbrdf::subsurface`).
     Subsurface,
 }
@@ -208,7 +209,7 @@ const REGISTRY: [ParameterInfo; 8] = [
         term: Term::Subsurface,
         domain: (0.0, 1.0, false),
         default_bounds: (0.0, 1.0),
-        comment: "residual polarization d (0–1) of the subsurface light: D = diag(1, d, −d, −d)",
+        comment: "residual polarization d (0–1) of the subsurface light: D = diag(1, d, −d, −d) in scattering-plane frames",
     },
     ParameterInfo {
         key: "n_sub",
