@@ -116,10 +116,16 @@ def draw_sets(rng: np.random.Generator, per_combo: int) -> list[dict]:
                 rho_s=float(rng.uniform(0.0, 1.0)), d=float(rng.uniform(0.0, 1.0)),
                 rho_d=0.0 if rng.uniform() < 0.5 else float(rng.uniform(0.0, 0.2)),
             ))
+            # Every other set with a circular residual polarization of its own, realizable:
+            # d_c in [2d - 1, 1].
+            d = sets[-1]["d"]
+            sets[-1]["d_c"] = float(rng.uniform(2.0 * d - 1.0, 1.0)) if j % 2 == 1 else None
     sets.append(dict(distribution="cauchy", shadowing="smith", facet="external", sigma=0.2, q=2.5, n=1.0, k=0.0,
-                     rho_s=0.5, d=0.0, rho_d=0.0))
+                     rho_s=0.5, d=0.0, rho_d=0.0, d_c=None))
     sets.append(dict(distribution="gaussian", shadowing="smith", facet="internal", sigma=0.25, q=0.0, n=1.35,
-                     k=0.0, rho_s=0.9, d=1.0, rho_d=0.0))
+                     k=0.0, rho_s=0.9, d=1.0, rho_d=0.0, d_c=None))
+    sets.append(dict(distribution="cauchy", shadowing="smith", facet="internal", sigma=0.87, q=2.4, n=1.23,
+                     k=0.075, rho_s=0.96, d=0.027, rho_d=0.0, d_c=-0.019))  # PTFE's fit
     return sets
 
 
@@ -142,7 +148,8 @@ def model(g: np.ndarray, p: dict) -> np.ndarray:
 def describe(p: dict) -> str:
     q = f" q={p['q']:.4g}" if p["distribution"] == "cauchy" else ""
     return (f"{p['distribution']} sigma={p['sigma']:.4g}{q} n={p['n']:.4g} k={p['k']:.4g} {p['shadowing']} "
-            f"{p['facet']} rho_s={p['rho_s']:.4g} d={p['d']:.4g} rho_d={p['rho_d']:.4g}")
+            f"{p['facet']} rho_s={p['rho_s']:.4g} d={p['d']:.4g} rho_d={p['rho_d']:.4g}"
+            + ("" if p.get("d_c") is None else f" d_c={p['d_c']:.4g}"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -154,9 +161,10 @@ def check_subsurface_algebra(res: Results, rng: np.random.Generator) -> None:
     worst = 0.0
     for _ in range(20):
         n, k, d = rng.uniform(0.6, 3.0), rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0)
+        d_c = float(rng.uniform(2.0 * d - 1.0, 1.0))
         g = draw_geometries(rng, 200)
-        a = pv.subsurface_mueller(*g.T, n=n, k=k, rho_s=0.8, d=d)
-        b = pv.subsurface_elements(*g.T, n=n, k=k, rho_s=0.8, d=d)
+        a = pv.subsurface_mueller(*g.T, n=n, k=k, rho_s=0.8, d=d, d_c=d_c)
+        b = pv.subsurface_elements(*g.T, n=n, k=k, rho_s=0.8, d=d, d_c=d_c)
         worst = max(worst, float((np.abs(a - b) / a[:, 0, 0][:, None, None]).max()))
     res.check("subsurface product = written-out elements", worst <= TOL_ELEMENTS, f"max |diff|/m00 = {worst:.2e}")
     g = draw_geometries(rng, 500)
@@ -258,7 +266,8 @@ def check_reciprocity(res: Results, rng: np.random.Generator, sets: list[dict]) 
     internal = [{**p, "facet": "internal"} for p in sets if p["n"] != 1.0]
     r_int = max(reciprocity_residual(p, g, Q, facet_only) for p in internal)
     res.check("reciprocity of the internal facet term", r_int <= TOL_RECIPROCITY, f"max residual / m00 = {r_int:.2e}")
-    subsurface = lambda gg, p: pv.subsurface_mueller(*gg.T, n=p["n"], k=p["k"], rho_s=1.0, d=p["d"])  # noqa: E731
+    subsurface = lambda gg, p: pv.subsurface_mueller(*gg.T, n=p["n"], k=p["k"], rho_s=1.0, d=p["d"],  # noqa: E731
+                                                     d_c=p.get("d_c"))
     r_ss = max(reciprocity_residual(p, g, Q, subsurface) for p in sets)
     any_q = max(reciprocity_residual(p, g, np.diag([1.0, *s]), subsurface) for p in sets[:4]
                 for s in itertools.product((1.0, -1.0), repeat=3))
@@ -352,8 +361,11 @@ def eval_flags(p: dict) -> list[str]:
     cmd = ["--distribution", p["distribution"], "--sigma", f[0]]
     if p["distribution"] == "cauchy":
         cmd += ["--q", f"{p['q']:.17g}"]
-    return cmd + ["--n", f[1], "--k", f[2], "--rho", f[3], "--shadowing", p["shadowing"], "--facet", p["facet"],
-                  "--rho-s", f[4], "--d", f[5]]
+    cmd += ["--n", f[1], "--k", f[2], "--rho", f[3], "--shadowing", p["shadowing"], "--facet", p["facet"],
+            "--rho-s", f[4], "--d", f[5]]
+    if p.get("d_c") is not None:
+        cmd += ["--d-c", f"{p['d_c']:.17g}"]
+    return cmd
 
 
 def run_eval(irpol: str, p: dict, geometry_csv: str) -> np.ndarray:
@@ -374,7 +386,7 @@ def require_flags(irpol: str) -> None:
         help_text = subprocess.run([irpol, "eval", "--help"], capture_output=True, text=True, timeout=60).stdout
     except OSError as e:
         raise SetupError(f"cannot run {irpol}: {e}") from e
-    lacking = [f for f in ("--facet", "--rho-s", "--d") if f not in help_text.split()]
+    lacking = [f for f in ("--facet", "--rho-s", "--d", "--d-c") if f not in help_text.split()]
     if lacking:
         raise SetupError(f"{irpol} eval has no {', '.join(lacking)} (build a version with the §1.10 terms)")
 

@@ -22,6 +22,8 @@ interface and the polarized subsurface term, added to the facet term of pbrdf_nu
   from the psps frames into the scattering plane's.  Written out (subsurface_elements), with
   C + iS = exp(i(2a - 2b)), a, b the rotation angles of in_proj, out_proj = [[cos, sin], [-sin, cos]]:
       D_plane = [[1, 0, 0, 0], [0, dC, dS, 0], [0, dS, -dC, 0], [0, 0, 0, -d]].
+  A circular residual polarization of its own, d_c (D's m33 = -d_c; realizable for
+  2d - 1 <= d_c <= 1), adds (d - d_c) diag(0, 0, 0, 1), which the rotations leave alone.
   The term now depends on the azimuths too (at normal incidence C + iS follows 2(phi_r - phi_i)).
 * Z = (1 - Rbar) + |d| |Abar|, Rbar = 2 int_0^1 R(mu) mu dmu (R = (R_s + R_p)/2),
   Abar = 2 int_0^1 T-(mu) mu dmu, both by adaptive quadrature to ~1e-14 with a break point at the
@@ -127,17 +129,23 @@ def scattering_plane_cos_sin(ti, pi_, tr, pr):
     return c2a * c2b + s2a * s2b, s2a * c2b - c2a * s2b
 
 
-def subsurface_mueller(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, *, n, k, rho_s, d):
-    """F_ss (N, 4, 4) in sr^-1: rho_s/(pi Z) T(theta_r) [(1 - d) diag(1,0,0,0) + d M_mirror] T(theta_i)."""
+def subsurface_mueller(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, *, n, k, rho_s, d, d_c=None):
+    """F_ss (N, 4, 4) in sr^-1: rho_s/(pi Z) T(theta_r) [(1 - d) diag(1,0,0,0) + d M_mirror
+    + (d - d_c) diag(0,0,0,1)] T(theta_i); d_c None means d_c = d.  The last part sets D's m33 to
+    -d_c; the frame rotations leave the circular component alone, so it needs no rotation."""
     ti, pi_, tr, pr = _radians(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg)
+    circular = d if d_c is None else d_c
     K = rho_s / (math.pi * normalization(n, k, d))
     depolarizer = np.zeros(ti.shape + (4, 4))
     depolarizer[..., 0, 0] = 1.0
-    D = (1.0 - d) * depolarizer + d * scattering_plane_mirror(ti, pi_, tr, pr)
+    helicity = np.zeros(ti.shape + (4, 4))
+    helicity[..., 3, 3] = 1.0
+    D = ((1.0 - d) * depolarizer + d * scattering_plane_mirror(ti, pi_, tr, pr)
+         + (d - circular) * helicity)
     return K * (transmission_mueller(np.cos(tr), n, k) @ D @ transmission_mueller(np.cos(ti), n, k))
 
 
-def subsurface_elements(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, *, n, k, rho_s, d):
+def subsurface_elements(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, *, n, k, rho_s, d, d_c=None):
     """The same matrix from its written-out elements (the specification's check of the product)."""
     ti, pi_, tr, pr = _radians(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg)
     C, S = scattering_plane_cos_sin(ti, pi_, tr, pr)
@@ -155,17 +163,18 @@ def subsurface_elements(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, *, n, k,
     M[..., 2, 0] = K * dS * xr * mi
     M[..., 2, 1] = K * dS * xr * pi_i
     M[..., 2, 2] = -K * dC * xr * xi
-    M[..., 3, 3] = -K * d * xr * xi
+    M[..., 3, 3] = -K * (d if d_c is None else d_c) * xr * xi
     return M
 
 
 def mueller_brdf(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, *, distribution, sigma, q=0.0, n, k,
-                 shadowing="none", rho_d=0.0, facet="external", rho_s=0.0, d=0.0):
+                 shadowing="none", rho_d=0.0, facet="external", rho_s=0.0, d=0.0, d_c=None):
     """Facet term on the given side + rho_d/pi diag(1,0,0,0) + subsurface term, (N, 4, 4) sr^-1."""
     M = pn.mueller_brdf(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, distribution=distribution,
                         sigma=sigma, q=q, n=n, k=k, shadowing=shadowing, rho_d=rho_d, facet=facet)
     if rho_s != 0.0:
-        M = M + subsurface_mueller(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, n=n, k=k, rho_s=rho_s, d=d)
+        M = M + subsurface_mueller(theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg, n=n, k=k, rho_s=rho_s, d=d,
+                                   d_c=d_c)
     return M
 
 

@@ -257,7 +257,11 @@ fn print_line(line: std::fmt::Arguments) {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli.command) {
+    let outcome = run(cli.command);
+    // A run that ends (refused a write, or just finished) while the interrupt handler clears up
+    // must not exit under it: the handler removes the temporaries and exits with 128 + signal.
+    cli::signals::wait_for_interrupt_handler();
+    match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) if is_broken_pipe(&error) => ExitCode::SUCCESS,
         Err(error) => {

@@ -36,6 +36,7 @@ fn subsurface(rho_s: f64, d: f64) -> Option<Subsurface> {
         rho_s,
         d,
         n_sub: None,
+        d_c: None,
     })
 }
 
@@ -97,8 +98,12 @@ fn every_term_is_reciprocal_with_the_facet_terms_q() {
 #[test]
 fn subsurface_term_conserves_energy_and_stays_realizable() {
     let quadrature = HemisphereQuadrature::default();
+    // d_c absent (= d) and at the edge of the realizable values, 2d − 1.
+    let cases = [0.0, 0.4, 1.0]
+        .into_iter()
+        .flat_map(|d| [(d, None), (d, Some(2.0 * d - 1.0))]);
     for n in [1.0, 1.3, 1.6, 2.4] {
-        for d in [0.0, 0.4, 1.0] {
+        for (d, d_c) in cases.clone() {
             let only_subsurface = Pbrdf::new(
                 SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 },
                 Shadowing::Smith,
@@ -112,6 +117,7 @@ fn subsurface_term_conserves_energy_and_stays_realizable() {
                     rho_s: 1.0,
                     d,
                     n_sub: Some(n),
+                    d_c,
                 }),
             )
             .unwrap();
@@ -122,7 +128,7 @@ fn subsurface_term_conserves_energy_and_stays_realizable() {
                 let bound = Transmission::at(theta.to_radians().cos(), eps).plus;
                 assert!(
                     albedo <= bound + 2e-4,
-                    "n {n} d {d} θ {theta}: {albedo} > {bound}"
+                    "n {n} d {d} d_c {d_c:?} θ {theta}: {albedo} > {bound}"
                 );
                 assert!(albedo <= 1.0);
             }
@@ -132,11 +138,38 @@ fn subsurface_term_conserves_energy_and_stays_realizable() {
                     let lowest = irpol::optics::coherency_eigenvalues(&m)
                         .into_iter()
                         .fold(f64::INFINITY, f64::min);
-                    assert!(lowest >= -1e-12 * m[(0, 0)], "n {n} d {d}: {lowest}");
+                    assert!(
+                        lowest >= -1e-12 * m[(0, 0)],
+                        "n {n} d {d} d_c {d_c:?}: {lowest}"
+                    );
                 }
             }
         }
     }
+}
+
+/// A circular residual polarization outside [2d − 1, 1] would make D unphysical: refused.
+#[test]
+fn an_unrealizable_subsurface_depolarizer_is_refused() {
+    let base = model(1.4, 0.0, 0.0, FacetSide::Internal, None);
+    let with = |d: f64, d_c: f64| {
+        base.clone().with_volume(
+            FacetSide::Internal,
+            Some(Subsurface {
+                rho_s: 0.5,
+                d,
+                n_sub: None,
+                d_c: Some(d_c),
+            }),
+        )
+    };
+    assert!(with(0.4, -0.19).is_ok());
+    let message = with(0.4, -0.21).unwrap_err().to_string();
+    assert!(
+        message.contains("d_c must be within [2d − 1, 1]"),
+        "{message}"
+    );
+    assert!(with(0.0, 1.5).is_err());
 }
 
 fn volume_data(name: &str) -> irpol::measure::MeasurementSet {
@@ -240,7 +273,7 @@ fn material_files_carry_the_volume_terms() {
 /// predict the incidences the fit did not see (15°, 45°) with less m00 error. Numbers in
 /// docs/measurements.md.
 #[test]
-fn ptfe_fits_conserve_energy_and_the_volume_model_predicts_m00_better() {
+fn ptfe_fits_conserve_energy_and_the_volume_model_predicts_better() {
     let dir = tempfile::tempdir().unwrap();
     let fit = |terms: &str, name: &str| {
         let (fits, reports) = (dir.path().join(name), dir.path().join("reports"));
@@ -300,26 +333,38 @@ fn ptfe_fits_conserve_energy_and_the_volume_model_predicts_m00_better() {
             "{}",
             String::from_utf8_lossy(&validation.stderr)
         );
-        let m00: f64 = stdout
-            .split("m00 relative RMS ")
-            .nth(1)
-            .and_then(|s| s.split_whitespace().next())
-            .and_then(|s| s.parse().ok())
-            .unwrap();
-        (material, m00)
+        let figure = |label: &str| -> f64 {
+            stdout
+                .split(label)
+                .nth(1)
+                .and_then(|s| s.split_whitespace().next())
+                .and_then(|s| s.parse().ok())
+                .unwrap_or_else(|| panic!("no '{label}' in {stdout}"))
+        };
+        (
+            material,
+            figure("m00 relative RMS "),
+            figure("m_ij/m00 RMS "),
+        )
     };
-    let (today, today_m00) = fit("external+depolarizer", "today");
+    let (today, today_m00, today_normalized) = fit("external+depolarizer", "today");
     let record = today.fit.as_ref().unwrap();
     assert!(
         record.settings["energy"].contains("rho_d held at"),
         "{record:?}"
     );
-    let (volume, volume_m00) = fit("internal+subsurface", "volume");
+    let (volume, volume_m00, volume_normalized) = fit("internal+subsurface", "volume");
     let spec = volume.grey_model().unwrap();
     assert!((1.15..1.45).contains(&spec.n), "{spec:?}");
+    // Measured on the unseen incidences: m00 3.8 % against 14.3 %, m_ij/m00 0.0194 against
+    // 0.0204 (docs/measurements.md).
     assert!(
         volume_m00 < 0.5 * today_m00,
         "{volume_m00} % vs {today_m00} %"
+    );
+    assert!(
+        volume_normalized < today_normalized,
+        "m_ij/m00 RMS {volume_normalized} vs {today_normalized}"
     );
 }
 

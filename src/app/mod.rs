@@ -60,6 +60,9 @@ pub struct ModelArgs {
     /// Real index of the subsurface term's interface (needs --rho-s; default --n).
     #[arg(long = "n-sub", allow_negative_numbers = true)]
     pub n_sub: Option<f64>,
+    /// Residual circular polarization d_c of the subsurface term (needs --rho-s; default --d).
+    #[arg(long = "d-c", allow_negative_numbers = true)]
+    pub d_c: Option<f64>,
     /// Shadowing: none, torrance-sparrow or smith (default smith, as `fit`; with --material,
     /// the material's own).
     #[arg(long)]
@@ -163,10 +166,11 @@ impl ModelArgs {
         self.with_volume_terms(model)
     }
 
-    /// `--facet`, `--rho-s` and `--d` applied to `model` (docs/design.md §1.10).
+    /// `--facet`, `--rho-s`, `--d`, `--n-sub` and `--d-c` applied to `model` (docs/design.md
+    /// §1.10).
     fn with_volume_terms(&self, model: Pbrdf) -> Result<Pbrdf, ModelArgsError> {
-        if self.facet.is_none() && self.rho_s.is_none() && self.d.is_none() && self.n_sub.is_none()
-        {
+        let subsurface_flags = self.d.is_some() || self.n_sub.is_some() || self.d_c.is_some();
+        if self.facet.is_none() && self.rho_s.is_none() && !subsurface_flags {
             return Ok(model);
         }
         let facet = match &self.facet {
@@ -176,14 +180,13 @@ impl ModelArgs {
             None => FacetSide::External,
         };
         let subsurface = match self.rho_s {
-            None if self.d.is_some() || self.n_sub.is_some() => {
-                return Err(ModelArgsError::PolarizationWithoutSubsurface)
-            }
+            None if subsurface_flags => return Err(ModelArgsError::PolarizationWithoutSubsurface),
             None => None,
             Some(rho_s) => Some(Subsurface {
                 rho_s,
                 d: self.d.unwrap_or(0.0),
                 n_sub: self.n_sub,
+                d_c: self.d_c,
             }),
         };
         Ok(model.with_volume(facet, subsurface)?)
@@ -203,6 +206,7 @@ impl ModelArgs {
             ("--rho-s", self.rho_s.is_some()),
             ("--d", self.d.is_some()),
             ("--n-sub", self.n_sub.is_some()),
+            ("--d-c", self.d_c.is_some()),
         ]
         .into_iter()
         .filter_map(|(flag, set)| set.then_some(flag))
@@ -267,6 +271,9 @@ pub fn model_header(model: &Pbrdf) -> String {
             header.push_str(&format!("; rho_s = {}, d = {}", s.rho_s, s.d));
             if let Some(n_sub) = s.n_sub {
                 header.push_str(&format!(", n_sub = {n_sub}"));
+            }
+            if let Some(d_c) = s.d_c {
+                header.push_str(&format!(", d_c = {d_c}"));
             }
         }
         header.push('\n');

@@ -37,6 +37,15 @@ pub fn remove_on_interrupt(staging: Vec<PathBuf>, temporaries_in: Vec<PathBuf>) 
     });
 }
 
+/// Waits for good once an interrupt is being handled: the handler's thread clears up and exits
+/// the process; returning from `main` first would cut its clean-up short (a run's own write,
+/// refused after the signal, ends the run with an error at once).
+pub fn wait_for_interrupt_handler() {
+    while INTERRUPTED.load(Ordering::SeqCst) {
+        std::thread::park_timeout(std::time::Duration::from_millis(100));
+    }
+}
+
 fn clean_up_after_interrupt() {
     // No write starts from now on; one under way (a staged file, a commit) finishes, so the
     // outputs are the complete old or new set and no temporary appears after the clean-up below.

@@ -15,6 +15,7 @@
 //! | ρ_d       | [0, 1]                              | ρ_d                | enters m00 linearly               |
 //! | ρ_s, d    | [0, 1]                              | ρ_s, d             | enter the subsurface term linearly |
 //! | n_sub     | [1, 4]                              | n_sub              | as n                              |
+//! | d_c       | [−1, 1]                             | d_c                | enters m33 linearly               |
 //!
 //! The genetic stage samples the search box; the local stages add a sine map on top of it
 //! (MINUIT's bounded transform) so that Nelder–Mead runs unconstrained and can settle exactly on
@@ -40,6 +41,7 @@ impl Parameter {
             Parameter::RhoS => 0.5,
             Parameter::D => 0.0,
             Parameter::NSub => 1.5,
+            Parameter::DC => 0.0,
         }
     }
 
@@ -55,13 +57,14 @@ impl Parameter {
             Parameter::RhoS => 0.5,
             Parameter::D => 0.1,
             Parameter::NSub => 1.4,
+            Parameter::DC => 0.0,
         }
     }
 }
 
 /// One value per [`Parameter`], in canonical order.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ParameterValues(pub [f64; 8]);
+pub struct ParameterValues(pub [f64; 9]);
 
 impl ParameterValues {
     pub fn get(&self, parameter: Parameter) -> f64 {
@@ -100,6 +103,7 @@ pub struct ParameterBounds {
     pub rho_s: Interval,
     pub d: Interval,
     pub n_sub: Interval,
+    pub d_c: Interval,
 }
 
 /// Lowest q searched with Smith shadowing: Λ of the Cauchy distribution exists only for q > 3/2
@@ -122,6 +126,7 @@ impl Default for ParameterBounds {
             rho_s: interval(Parameter::RhoS),
             d: interval(Parameter::D),
             n_sub: interval(Parameter::NSub),
+            d_c: interval(Parameter::DC),
         }
     }
 }
@@ -137,6 +142,7 @@ impl ParameterBounds {
             Parameter::RhoS => self.rho_s,
             Parameter::D => self.d,
             Parameter::NSub => self.n_sub,
+            Parameter::DC => self.d_c,
         }
     }
 
@@ -185,7 +191,12 @@ pub fn to_search(parameter: Parameter, value: f64) -> f64 {
     match parameter {
         Parameter::Sigma => value.ln(),
         Parameter::Q => (value - 1.0).ln(),
-        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D | Parameter::NSub => value,
+        Parameter::N
+        | Parameter::RhoD
+        | Parameter::RhoS
+        | Parameter::D
+        | Parameter::NSub
+        | Parameter::DC => value,
         Parameter::K => (value / K_SCALE).asinh(),
     }
 }
@@ -195,9 +206,12 @@ pub fn from_search(parameter: Parameter, coordinate: f64) -> f64 {
     match parameter {
         Parameter::Sigma => coordinate.exp(),
         Parameter::Q => 1.0 + coordinate.exp(),
-        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D | Parameter::NSub => {
-            coordinate
-        }
+        Parameter::N
+        | Parameter::RhoD
+        | Parameter::RhoS
+        | Parameter::D
+        | Parameter::NSub
+        | Parameter::DC => coordinate,
         Parameter::K => K_SCALE * coordinate.sinh(),
     }
 }
@@ -207,7 +221,12 @@ pub fn value_per_coordinate(parameter: Parameter, coordinate: f64) -> f64 {
     match parameter {
         Parameter::Sigma => coordinate.exp(),
         Parameter::Q => coordinate.exp(),
-        Parameter::N | Parameter::RhoD | Parameter::RhoS | Parameter::D | Parameter::NSub => 1.0,
+        Parameter::N
+        | Parameter::RhoD
+        | Parameter::RhoS
+        | Parameter::D
+        | Parameter::NSub
+        | Parameter::DC => 1.0,
         Parameter::K => K_SCALE * coordinate.cosh(),
     }
 }

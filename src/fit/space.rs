@@ -172,6 +172,7 @@ impl ModelSpace {
             rho_s: values.get(Parameter::RhoS),
             d: values.get(Parameter::D),
             n_sub: Some(values.get(Parameter::NSub)),
+            d_c: Some(values.get(Parameter::DC)),
         })
     }
 
@@ -186,6 +187,7 @@ impl ModelSpace {
             rho_s: self.subsurface(values).map(|s| s.rho_s),
             d: self.subsurface(values).map(|s| s.d),
             n_sub: self.subsurface(values).and_then(|s| s.n_sub),
+            d_c: self.subsurface(values).and_then(|s| s.d_c),
             wavelength_um,
         }
     }

@@ -88,6 +88,9 @@ pub struct ModelSpec {
     /// The subsurface interface's own index (absent: n).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub n_sub: Option<f64>,
+    /// The subsurface term's circular residual polarization (absent: d).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d_c: Option<f64>,
     pub wavelength_um: f64,
 }
 
@@ -102,6 +105,7 @@ impl ModelSpec {
             Parameter::RhoS => self.rho_s,
             Parameter::D => self.d,
             Parameter::NSub => self.rho_s.map(|_| self.n_sub.unwrap_or(self.n)),
+            Parameter::DC => self.subsurface().map(|s| s.circular()),
             slope => self.distribution.parameter(slope),
         }
     }
@@ -122,6 +126,7 @@ impl ModelSpec {
             rho_s,
             d: self.d.unwrap_or(0.0),
             n_sub: self.n_sub,
+            d_c: self.d_c,
         })
     }
 
@@ -520,6 +525,7 @@ mod tests {
                 rho_s: None,
                 d: None,
                 n_sub: None,
+                d_c: None,
                 wavelength_um: 9.925,
             }),
             fit: None,

@@ -28,6 +28,7 @@ pub(super) struct RawModel<V> {
     rho_s: Option<f64>,
     d: Option<f64>,
     n_sub: Option<f64>,
+    d_c: Option<f64>,
     wavelength_um: V,
     dispersion: Option<LorentzDispersion>,
 }
@@ -81,7 +82,7 @@ pub enum ModelTableError {
     DuplicateWavelength(f64, f64),
     #[error("dispersion: {0}")]
     Dispersion(#[source] crate::optics::LorentzError),
-    #[error("d and n_sub need rho_s: they belong to the subsurface term")]
+    #[error("d, n_sub and d_c need rho_s: they belong to the subsurface term")]
     PolarizationWithoutSubsurface,
     #[error(
         "facet = \"internal\", rho_s and d are grey-model terms: a spectral table cannot use \
@@ -107,7 +108,7 @@ impl TryFrom<RawModel<f64>> for ModelSpec {
         if raw.dispersion.is_some() {
             return Err(ModelTableError::GreyDispersion);
         }
-        if (raw.d.is_some() || raw.n_sub.is_some()) && raw.rho_s.is_none() {
+        if (raw.d.is_some() || raw.n_sub.is_some() || raw.d_c.is_some()) && raw.rho_s.is_none() {
             return Err(ModelTableError::PolarizationWithoutSubsurface);
         }
         Ok(ModelSpec {
@@ -120,6 +121,7 @@ impl TryFrom<RawModel<f64>> for ModelSpec {
             rho_s: raw.rho_s,
             d: raw.rho_s.map(|_| raw.d.unwrap_or(0.0)),
             n_sub: raw.n_sub,
+            d_c: raw.d_c,
             wavelength_um: check_wavelength(raw.wavelength_um)?,
         })
     }
@@ -142,12 +144,16 @@ impl TryFrom<RawModel<OneOrMany>> for MaterialModel {
             rho_s,
             d,
             n_sub,
+            d_c,
             wavelength_um,
             dispersion,
         } = raw;
         let rho_d = rho_d.unwrap_or(One(0.0));
-        let volume =
-            facet != FacetSide::External || rho_s.is_some() || d.is_some() || n_sub.is_some();
+        let volume = facet != FacetSide::External
+            || rho_s.is_some()
+            || d.is_some()
+            || n_sub.is_some()
+            || d_c.is_some();
         match (wavelength_um, n, k, rho_d) {
             (One(wavelength_um), One(n), One(k), One(rho_d)) => {
                 let grey = RawModel {
@@ -162,6 +168,7 @@ impl TryFrom<RawModel<OneOrMany>> for MaterialModel {
                     rho_s,
                     d,
                     n_sub,
+                    d_c,
                     wavelength_um,
                     dispersion,
                 };

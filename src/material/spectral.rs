@@ -139,6 +139,7 @@ impl SpectralModel {
             rho_s: None,
             d: None,
             n_sub: None,
+            d_c: None,
             wavelength_um,
         })
     }

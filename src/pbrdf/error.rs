@@ -34,6 +34,13 @@ pub enum ModelError {
          without it (`irpol eval` and `emissivity` evaluate it)"
     )]
     SubsurfaceNotRendered,
+    #[error(
+        "d = {}, d_c = {}: the subsurface term's D = diag(1, d, −d, −d_c) is not a physical \
+         (realizable) Mueller matrix; d_c must be within [2d − 1, 1]",
+        number(*.d),
+        number(*.d_c)
+    )]
+    UnrealizableSubsurface { d: f64, d_c: f64 },
     #[error(transparent)]
     Outside(#[from] super::OutsideDomain),
     #[error("a band material needs one model per wavelength node, all with the same slope distribution and shadowing")]

@@ -266,6 +266,15 @@ impl Pbrdf {
             if let Some(n_sub) = terms.n_sub {
                 Parameter::NSub.check(n_sub)?;
             }
+            if let Some(d_c) = terms.d_c {
+                Parameter::DC.check(d_c)?;
+            }
+            if !terms.is_realizable() {
+                return Err(ModelError::UnrealizableSubsurface {
+                    d: terms.d,
+                    d_c: terms.circular(),
+                });
+            }
         }
         self.facet_side = facet_side;
         self.permittivity = facet_side.facet_permittivity(self.index);

@@ -8,16 +8,19 @@
 //!   (ε = N²), in the psps frame of its direction: t_s,p = 1 − R_s,p, T± = (t_s ± t_p)/2,
 //!   X = √(t_s t_p); T = [[T+, T−, 0, 0], [T−, T+, 0, 0], [0, 0, X, 0], [0, 0, 0, X]]. For a
 //!   dielectric t_p ≥ t_s, so the light leaves p-polarized — as thermal emission does.
-//! - D(d) = diag(1, d, −d, −d): the polarization that survives volume scattering, with the signs of
-//!   a mirror (a perfect mirror is diag(1, 1, −1, −1) in s/p frames). Like single scattering by a
+//! - D(d) = diag(1, d, −d, −d_c): the polarization that survives volume scattering, with the signs
+//!   of a mirror (a perfect mirror is diag(1, 1, −1, −1) in s/p frames); d_c = d unless given. A
+//!   negative d_c keeps helicity, as forward multiple scattering by large grains does (sintered
+//!   PTFE: d ≈ 0.03, d_c ≈ −0.02). m33 takes no part in the reflectance, so d_c does not enter Z. Like single scattering by a
 //!   particle, it is referred to the scattering plane (the plane of ω_i and ω_r), not to the
 //!   macro surface: L(η_i), L(−η_r) are the rotations of the facet term (§1.3) from the psps
 //!   frames into the frames of that plane (whose normal is ω_i × ω_r, the facet's s axis).
-//!   Multiplied out, L(−η_r) D L(η_i) = [[1,0,0,0], [0,dC,dS,0], [0,dS,−dC,0], [0,0,0,−d]] with
+//!   Multiplied out, L(−η_r) D L(η_i) = [[1,0,0,0], [0,dC,dS,0], [0,dS,−dC,0], [0,0,0,−d_c]] with
 //!   C + iS = e^{i(2η_i + 2η_r)}. NIST's sintered PTFE shows why: at normal incidence its residual
 //!   polarization follows cos 2φ_r, sin 2φ_r (m11 = −m22 = ±0.05 at φ_r = 0°, 90°), which a
-//!   matrix fixed in the macro frames cannot give. D is realizable (Cloude) for −1/3 ≤ d ≤ 1;
-//!   the model accepts d ∈ [0, 1].
+//!   matrix fixed in the macro frames cannot give. D is realizable (Cloude) for
+//!   2|d| − 1 ≤ d_c ≤ 1 ([`Subsurface::is_realizable`]); the model accepts d ∈ [0, 1] and refuses
+//!   an unrealizable d_c.
 //! - The interface has the material's index N, or n_sub + ik where given ([`Subsurface`]).
 //! - Z = (1 − R̄) + |d|·|Ā|, R̄ = 2∫₀¹ R(μ) μ dμ, Ā = 2∫₀¹ T−(μ) μ dμ, the normalization that
 //!   conserves energy: for light of intensity I_t after the interface (I_t = T+(θ_i) unpolarized)
@@ -93,6 +96,22 @@ pub struct Subsurface {
     pub rho_s: f64,
     pub d: f64,
     pub n_sub: Option<f64>,
+    /// The circular residual polarization (D's m33 = −d_c); absent: d.
+    pub d_c: Option<f64>,
+}
+
+impl Subsurface {
+    /// d_c, or d where it is not given (the mirror-signed D of the module docs).
+    pub fn circular(&self) -> f64 {
+        self.d_c.unwrap_or(self.d)
+    }
+
+    /// Whether D = diag(1, d, −d, −d_c) is a sum of Jones matrices: its coherency eigenvalues
+    /// are (1 − d_c)/4 twice, (1 + 2d + d_c)/4 and (1 − 2d + d_c)/4, so d_c ∈ [2|d| − 1, 1].
+    pub fn is_realizable(&self) -> bool {
+        let d_c = self.circular();
+        d_c <= 1.0 && d_c >= 2.0 * self.d.abs() - 1.0
+    }
 }
 
 /// Fresnel transmission of the macro surface at one zenith angle: (T+, T−, X) of the module docs.
@@ -166,7 +185,7 @@ impl PreparedSubsurface {
         m[(2, 0)] = k * ds * r.cross * i.minus;
         m[(2, 1)] = k * ds * r.cross * i.plus;
         m[(2, 2)] = -k * dc * r.cross * i.cross;
-        m[(3, 3)] = -k * self.terms.d * r.cross * i.cross;
+        m[(3, 3)] = -k * self.terms.circular() * r.cross * i.cross;
         m
     }
 

@@ -31,6 +31,8 @@ pub enum Parameter {
     D,
     /// Real index of the interface the subsurface light crosses.
     NSub,
+    /// Residual circular polarization d_c of the subsurface light (D's m33 is −d_c).
+    DC,
 }
 
 /// A term of the model: F = facet term + ideal depolarizer (docs/design.md §1.3).
@@ -139,7 +141,7 @@ pub struct ParameterInfo {
 }
 
 /// Every parameter's entry, in [`Parameter::ALL`] order.
-const REGISTRY: [ParameterInfo; 8] = [
+const REGISTRY: [ParameterInfo; 9] = [
     ParameterInfo {
         key: "sigma",
         aliases: &[],
@@ -221,6 +223,16 @@ const REGISTRY: [ParameterInfo; 8] = [
         default_bounds: (1.0, 4.0),
         comment: "real index of the interface the subsurface light crosses (absent: n)",
     },
+    ParameterInfo {
+        key: "d_c",
+        aliases: &[],
+        label: "d_c",
+        unit: "dimensionless",
+        term: Term::Subsurface,
+        domain: (-1.0, 1.0, false),
+        default_bounds: (-1.0, 1.0),
+        comment: "residual circular polarization d_c (−1–1, at least 2d − 1) of the subsurface light: D's m33 = −d_c (absent: d, a mirror's sign; below 0 helicity is kept)",
+    },
 ];
 
 /// A parameter value outside the values a model accepts.
@@ -240,7 +252,7 @@ fn range(parameter: Parameter) -> String {
 
 impl Parameter {
     /// All parameters in their canonical order (the order of vectors and matrices in a fit).
-    pub const ALL: [Parameter; 8] = [
+    pub const ALL: [Parameter; 9] = [
         Parameter::Sigma,
         Parameter::Q,
         Parameter::N,
@@ -249,6 +261,7 @@ impl Parameter {
         Parameter::RhoS,
         Parameter::D,
         Parameter::NSub,
+        Parameter::DC,
     ];
 
     /// The parameter's entry in the registry.

@@ -69,6 +69,7 @@ pub fn write_truth_library(dir: &Path) {
                 rho_s: None,
                 d: None,
                 n_sub: None,
+                d_c: None,
                 wavelength_um,
             }),
             fit: None,

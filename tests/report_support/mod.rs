@@ -22,6 +22,7 @@ pub fn truth() -> ModelSpec {
         rho_s: None,
         d: None,
         n_sub: None,
+        d_c: None,
         wavelength_um: 9.925,
     }
 }

@@ -682,6 +682,7 @@ mod tests {
             rho_s: None,
             d: None,
             n_sub: None,
+            d_c: None,
             wavelength_um: 10.0,
         }
     }

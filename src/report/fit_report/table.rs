@@ -652,6 +652,7 @@ mod tests {
             rho_s: None,
             d: None,
             n_sub: None,
+            d_c: None,
             wavelength_um: 9.925,
         };
         Material {
