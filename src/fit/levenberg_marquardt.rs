@@ -45,6 +45,15 @@ pub(crate) trait LeastSquares: Sync {
     fn jacobian_evaluations(&self) -> u64 {
         self.lower().len() as u64
     }
+    /// The normal equations (JᵀJ, Jᵀr) of the Jacobian at `s`: all Levenberg–Marquardt needs of
+    /// it.
+    fn normal_equations(
+        &self,
+        s: &[f64],
+        r: &DVector<f64>,
+    ) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        self.jacobian(s, r).map(|j| (j.tr_mul(&j), j.tr_mul(r)))
+    }
 }
 
 /// The forward-difference step of coordinate `j` at `s`, pointing into the box at its upper end.
@@ -71,7 +80,34 @@ impl LeastSquares for Objective<'_> {
     }
     /// Forward differences, one column per thread task.
     fn jacobian(&self, s: &[f64], r: &DVector<f64>) -> Option<DMatrix<f64>> {
-        let columns: Option<Vec<DVector<f64>>> = (0..s.len())
+        Some(DMatrix::from_columns(&self.jacobian_columns(s, r)?))
+    }
+    /// From the columns without assembling J (a measurement's J is tens of thousands of rows):
+    /// JᵀJ is symmetric, so each pair of columns is multiplied once.
+    fn normal_equations(
+        &self,
+        s: &[f64],
+        r: &DVector<f64>,
+    ) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        let columns = self.jacobian_columns(s, r)?;
+        let n = columns.len();
+        let mut a = DMatrix::zeros(n, n);
+        for p in 0..n {
+            for q in p..n {
+                let product = columns[p].dot(&columns[q]);
+                a[(p, q)] = product;
+                a[(q, p)] = product;
+            }
+        }
+        let g = DVector::from_fn(n, |p, _| columns[p].dot(r));
+        Some((a, g))
+    }
+}
+
+impl Objective<'_> {
+    /// ∂r/∂s_j by forward differences, one column per thread task.
+    fn jacobian_columns(&self, s: &[f64], r: &DVector<f64>) -> Option<Vec<DVector<f64>>> {
+        (0..s.len())
             .into_par_iter()
             .map(|j| {
                 let mut shifted = s.to_vec();
@@ -79,8 +115,7 @@ impl LeastSquares for Objective<'_> {
                 shifted[j] += h;
                 self.residuals(&shifted).map(|rh| (rh - r) / h)
             })
-            .collect();
-        Some(DMatrix::from_columns(&columns?))
+            .collect()
     }
 }
 
@@ -178,9 +213,7 @@ impl Iterate {
         for _ in 0..settings.max_iterations {
             self.history.iterations += 1;
             if self.normal_equations.is_none() {
-                self.normal_equations = problem
-                    .jacobian(&self.s, &self.r)
-                    .map(|j| (j.tr_mul(&j), j.tr_mul(&self.r)));
+                self.normal_equations = problem.normal_equations(&self.s, &self.r);
                 self.history.evaluations += columns;
             }
             let Some((a, g)) = &self.normal_equations else {
