@@ -37,6 +37,8 @@ __all__ = [
     "Measurements",
     "fit",
     "FitResult",
+    "validate",
+    "Validation",
     "render",
 ]
 
@@ -176,6 +178,63 @@ def read_measurements(
         theta_i_deg=None if theta_i is None else [float(t) for t in theta_i],
     )
     return [Measurements._from_dict(d) for d in sets]
+
+
+@dataclass
+class Validation:
+    """How a material predicts one measurement set it was not fitted to (``irpol validate``,
+    docs/design.md §1.10): `m00_relative_rms` is the RMS of model/measured − 1 of m00 (a
+    fraction; ``irpol validate`` prints it in %), `normalized_rms` the RMS over the other
+    elements of m_ij/m00 (model) − m_ij/m00 (measured), `chi2_per_observation` the mean of
+    ((model − measured)/σ)², `elements` maps each element to (RMS in sr⁻¹, normalized RMS), and
+    `model_mueller` holds the model's matrices at every row, shape (rows, 4, 4)."""
+
+    measurements: Measurements
+    rows: int
+    m00_relative_rms: float
+    normalized_rms: float
+    chi2_per_observation: float
+    max_abs_residual: float
+    uncertainties_from_file: bool
+    elements: Dict[str, Tuple[float, float]]
+    model_mueller: np.ndarray
+
+    def __repr__(self) -> str:
+        return (
+            f"Validation(material={self.measurements.material!r}, rows={self.rows}, "
+            f"m00_relative_rms={self.m00_relative_rms:.4g}, "
+            f"normalized_rms={self.normalized_rms:.4g}, "
+            f"chi2_per_observation={self.chi2_per_observation:.4g})"
+        )
+
+
+def validate(
+    material: Union[Material, PathLike],
+    path: PathLike,
+    *,
+    layout: Optional[PathLike] = None,
+    wavelength: Optional[float] = None,
+    theta_i: Optional[Sequence[float]] = None,
+) -> List[Validation]:
+    """Scores `material` (a :class:`Material` or a material TOML) on every set of the measurement
+    file `path`, read as :func:`read_measurements` reads it (`layout`, `wavelength`, `theta_i`):
+    the numbers of ``irpol validate``, without its report page. One :class:`Validation` per set.
+    Raises OSError (unreadable) or ValueError (bad data, or a spectral material outside its
+    table)."""
+    results = _irpol.validate_material(
+        _material(material),
+        os.fspath(path),
+        layout=None if layout is None else os.fspath(layout),
+        wavelength_um=wavelength,
+        theta_i_deg=None if theta_i is None else [float(t) for t in theta_i],
+    )
+    out = []
+    for d in results:
+        d = dict(d)
+        d["measurements"] = Measurements._from_dict(d["measurements"])
+        d["model_mueller"] = np.asarray(d["model_mueller"]).reshape(-1, 4, 4)
+        out.append(Validation(**d))
+    return out
 
 
 from ._fit import FitResult, fit  # noqa: E402  (needs Measurements)

@@ -60,4 +60,15 @@ class FitResult:
     per_wavelength_errors: Optional[Dict[str, npt.NDArray[np.float64]]] = ...
 
 def fit(inputs: Union[PathLike, Sequence[PathLike]], *, distribution: Optional[str] = None, shadowing: str = "smith", free: Optional[Union[str, Sequence[str]]] = None, fix: Optional[Union[str, Mapping[str, float]]] = None, optimizer: str = "ga+lm", seed: Optional[int] = None, robust: Optional[str] = None, dispersion: str = "table", layout: Optional[PathLike] = None, wavelength: Optional[float] = None, theta_i: Optional[Sequence[float]] = None, terms: str = "external+depolarizer") -> List[FitResult]: ...
+class Validation:
+    measurements: Measurements
+    rows: int
+    m00_relative_rms: float
+    normalized_rms: float
+    chi2_per_observation: float
+    max_abs_residual: float
+    uncertainties_from_file: bool
+    elements: Dict[str, Tuple[float, float]]
+    model_mueller: npt.NDArray[np.float64]
+def validate(material: Union[Material, PathLike], path: PathLike, *, layout: Optional[PathLike] = None, wavelength: Optional[float] = None, theta_i: Optional[Sequence[float]] = None) -> List[Validation]: ...
 def render(scene: PathLike, *, resolution: Optional[Tuple[int, int]] = None, samples: Optional[int] = None, seed: Optional[int] = None, bounces: Optional[int] = None, time_s: Optional[float] = None, patch: Optional[Mapping[str, Any]] = None, out: Optional[PathLike] = None) -> Dict[str, Any]: ...
