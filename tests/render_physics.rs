@@ -69,20 +69,25 @@ fn isothermal_enclosure_has_no_contrast_and_no_polarization() {
     let band = Band::lwir();
     let l = band.radiance(300.0);
     for shading in ["pixel", "gouraud"] {
-        // A rough sphere and a glossy tilted plate in a 300 K enclosure, through a 300 K
-        // atmosphere: everything must read L_bb(300 K), unpolarized (docs/design.md §1.5).
+        // A rough sphere, a glossy tilted plate and a volume scatterer (internal facets and the
+        // polarized subsurface term of §1.10) in a 300 K enclosure, through a 300 K atmosphere:
+        // everything must read L_bb(300 K), unpolarized (docs/design.md §1.5).
         let text = format!(
             "{}{}[render]\nshading = \"{shading}\"\n[atmosphere]\nextinction_per_km = 50.0\n\
              temperature_k = 300.0\n{}{}\
              [materials.glass]\ndistribution = \"gaussian\"\nsigma = 0.03\nn = 2.2\nk = 0.1\nshadowing = \"smith\"\n\
              [[objects]]\nname = \"plate\"\nshape = {{ kind = \"plane\", size = [3.0, 3.0], divisions = [4, 4] }}\n\
-             material = \"glass\"\ntemperature_k = 300.0\ntranslate = [0.0, 1.5, -0.5]\nrotate_deg = [-60.0, 20.0, 0.0]\n",
+             material = \"glass\"\ntemperature_k = 300.0\ntranslate = [0.0, 1.5, -0.5]\nrotate_deg = [-60.0, 20.0, 0.0]\n\
+             [materials.ptfe]\ndistribution = \"cauchy\"\nsigma = 0.87\nq = 2.42\nn = 1.23\nk = 0.075\n\
+             shadowing = \"smith\"\nfacet = \"internal\"\nrho_s = 0.9\nd = 0.3\nd_c = -0.2\n\
+             [[objects]]\nname = \"volume\"\nshape = {{ kind = \"plane\", size = [2.0, 2.0], divisions = [4, 4] }}\n\
+             material = \"ptfe\"\ntemperature_k = 300.0\ntranslate = [-1.5, -1.0, 0.0]\nrotate_deg = [50.0, -30.0, 0.0]\n",
             camera_toml(96),
             uniform_environment_toml(300.0),
             material_toml(0.3, 2.5, 1.5, 0.2, 0.05),
             sphere_toml(3, 300.0),
         );
-        let (_, image) = render_text(&text);
+        let (scene, image) = render_text(&text);
         let mut count = 0;
         for (s, &surface) in image.stokes.iter().zip(&image.surface) {
             if surface == BACKGROUND {
@@ -94,6 +99,13 @@ fn isothermal_enclosure_has_no_contrast_and_no_polarization() {
         }
         println!("isothermal {shading}: {count} object pixels");
         assert!(count > 2000, "{count}");
+        // The volume scatterer (the third object) is in view.
+        let volume_pixels = image
+            .surface
+            .iter()
+            .filter(|&&s| s != BACKGROUND && scene.surfaces[s as usize].object == 2)
+            .count();
+        assert!(volume_pixels > 500, "{volume_pixels}");
     }
 }
 

@@ -10,7 +10,9 @@
 mod common;
 
 use irpol::optics::{Band, RefractiveIndex};
-use irpol::pbrdf::{Direction, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
+use irpol::pbrdf::{
+    Direction, FacetSide, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution, Subsurface,
+};
 use irpol::scene::config::{EnvironmentConfig, GroundConfig, SkyConfig};
 use irpol::scene::environment::Environment;
 use irpol::transport::kernel::{specular_kernel, KernelQuadrature};
@@ -128,6 +130,49 @@ fn materials() -> Vec<(String, Pbrdf)> {
             1.6,
             0.1,
             0.05,
+        ),
+    ));
+    // Volume scatterers (docs/design.md §1.10): PTFE's fit (internal facets, subsurface term with
+    // d and d_c), and a strongly polarizing subsurface term under external facets.
+    let volume = |d, n, k, side, rho_s, sub_d, d_c| {
+        Pbrdf::new(d, Shadowing::Smith, RefractiveIndex::new(n, k), 0.0)
+            .unwrap()
+            .with_volume(
+                side,
+                Some(Subsurface {
+                    rho_s,
+                    d: sub_d,
+                    n_sub: None,
+                    d_c,
+                }),
+            )
+            .unwrap()
+    };
+    materials.push((
+        "PTFE internal+subsurface σ0.87".into(),
+        volume(
+            SlopeDistribution::Cauchy {
+                sigma: 0.87,
+                q: 2.42,
+            },
+            1.23,
+            0.075,
+            FacetSide::Internal,
+            0.96,
+            0.027,
+            Some(-0.019),
+        ),
+    ));
+    materials.push((
+        "paint external+subsurface σ0.2 d0.6".into(),
+        volume(
+            SlopeDistribution::Gaussian { sigma: 0.2 },
+            1.5,
+            0.02,
+            FacetSide::External,
+            0.7,
+            0.6,
+            None,
         ),
     ));
     materials

@@ -34,9 +34,7 @@ pub fn validate_material<'py>(
     for set in &sets {
         let wavelength = material.model.spectral().map(|_| set.wavelength_um);
         let model = material_pbrdf(material, wavelength, None).map_err(raised)?;
-        let v = py
-            .detach(|| validate_model(&model, set))
-            .map_err(raised)?;
+        let v = py.detach(|| validate_model(&model, set)).map_err(raised)?;
         let d = PyDict::new(py);
         d.set_item("measurements", set_dict(py, set)?)?;
         d.set_item("rows", v.rows)?;

@@ -3,7 +3,9 @@
 
 use super::{find_material, BandModelError, Material, MaterialError, MaterialModel, SpectralModel};
 use crate::optics::{Band, RefractiveIndex, TableMissesBand};
-use crate::pbrdf::{slope_distribution, DistributionError, MaterialOptics, ModelError, Pbrdf};
+use crate::pbrdf::{
+    slope_distribution, DistributionError, FacetSide, MaterialOptics, ModelError, Pbrdf, Subsurface,
+};
 use serde::Deserialize;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -22,6 +24,13 @@ pub struct InlineMaterialConfig {
     /// Default Smith, as everywhere in irpol.
     #[serde(default = "smith")]
     pub shadowing: crate::pbrdf::Shadowing,
+    /// The volume-scattering terms of docs/design.md §1.10, as in a material file.
+    #[serde(default)]
+    pub facet: FacetSide,
+    pub rho_s: Option<f64>,
+    pub d: Option<f64>,
+    pub n_sub: Option<f64>,
+    pub d_c: Option<f64>,
 }
 
 fn smith() -> crate::pbrdf::Shadowing {
@@ -53,6 +62,8 @@ pub enum InlineMaterialError {
     Distribution(#[from] DistributionError),
     #[error("{0}")]
     Model(ModelError),
+    #[error("d, n_sub and d_c need rho_s: they belong to the subsurface term")]
+    PolarizationWithoutSubsurface,
 }
 
 /// A material of a scene cannot be used. The inner errors are part of the message (not a
@@ -279,11 +290,24 @@ pub fn share_wavelength_nodes(
 
 pub fn inline_pbrdf(m: &InlineMaterialConfig) -> Result<Pbrdf, InlineMaterialError> {
     let distribution = slope_distribution(&m.distribution, m.sigma, m.q)?;
+    let subsurface = match m.rho_s {
+        Some(rho_s) => Some(Subsurface {
+            rho_s,
+            d: m.d.unwrap_or(0.0),
+            n_sub: m.n_sub,
+            d_c: m.d_c,
+        }),
+        None if m.d.is_some() || m.n_sub.is_some() || m.d_c.is_some() => {
+            return Err(InlineMaterialError::PolarizationWithoutSubsurface)
+        }
+        None => None,
+    };
     Pbrdf::new(
         distribution,
         m.shadowing,
         RefractiveIndex::new(m.n, m.k),
         m.rho_d,
     )
+    .and_then(|model| model.with_volume(m.facet, subsurface))
     .map_err(InlineMaterialError::Model)
 }

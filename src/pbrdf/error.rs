@@ -30,11 +30,6 @@ pub enum ModelError {
         source: Box<ModelError>,
     },
     #[error(
-        "the renderer cannot use the subsurface term yet (rho_s, d): render with a model \
-         without it (`irpol eval` and `emissivity` evaluate it)"
-    )]
-    SubsurfaceNotRendered,
-    #[error(
         "d = {}, d_c = {}: the subsurface term's D = diag(1, d, −d, −d_c) is not a physical \
          (realizable) Mueller matrix; d_c must be within [2d − 1, 1]",
         number(*.d),

@@ -193,15 +193,7 @@ impl Pbrdf {
         }
         self.visit_specular_nodes(scattered, quadrature, &mut visit);
         if self.subsurface().is_some() {
-            // The subsurface term (docs/design.md §1.10) is smooth over ω_i like the ideal
-            // depolarizer, so it shares its cosine-weighted rule.
-            let depolarized = Stokes::new(self.rho_d() * FRAC_1_PI, 0.0, 0.0, 0.0);
-            for (w_i, weight) in quadrature.cosine_weighted_nodes() {
-                let incident = Direction::from_unit_vector(*w_i);
-                let subsurface = ScatteringGeometry::new(&incident, scattered)
-                    .map_or_else(Stokes::zeros, |g| self.subsurface_first_column(&g));
-                visit(w_i, (depolarized + subsurface) * *weight);
-            }
+            self.visit_subsurface_nodes(scattered, quadrature, self.rho_d(), &mut visit);
         } else if self.rho_d() > 0.0 {
             for (w_i, weight) in quadrature.cosine_weighted_nodes() {
                 visit(
@@ -209,6 +201,28 @@ impl Pbrdf {
                     Stokes::new(self.rho_d() * FRAC_1_PI * weight, 0.0, 0.0, 0.0),
                 );
             }
+        }
+    }
+
+    /// The subsurface part of [`Pbrdf::visit_reflection_nodes`] (nothing without the term), with
+    /// `rho_d`/π added to each node's S0 weight. The subsurface term (docs/design.md §1.10) is
+    /// smooth over ω_i like the ideal depolarizer, so it shares its cosine-weighted rule.
+    pub fn visit_subsurface_nodes(
+        &self,
+        scattered: &Direction,
+        quadrature: &HemisphereQuadrature,
+        rho_d: f64,
+        mut visit: impl FnMut(&Vector3<f64>, Stokes),
+    ) {
+        if self.subsurface().is_none() || scattered.cos_theta() <= 0.0 {
+            return;
+        }
+        let depolarized = Stokes::new(rho_d * FRAC_1_PI, 0.0, 0.0, 0.0);
+        for (w_i, weight) in quadrature.cosine_weighted_nodes() {
+            let incident = Direction::from_unit_vector(*w_i);
+            let subsurface = ScatteringGeometry::new(&incident, scattered)
+                .map_or_else(Stokes::zeros, |g| self.subsurface_first_column(&g));
+            visit(w_i, (depolarized + subsurface) * *weight);
         }
     }
 

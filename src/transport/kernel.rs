@@ -98,7 +98,10 @@ impl SpecularKernel {
 }
 
 /// The specular kernel of `pbrdf` for ω_r = (sinθ_r, 0, cosθ_r), 0 ≤ θ_r < π/2: the pBRDF's own
-/// reflection quadrature nodes ([`Pbrdf::visit_specular_nodes`]), merged by direction.
+/// reflection quadrature nodes ([`Pbrdf::visit_specular_nodes`]) and, for a material with the
+/// subsurface term, that term's nodes ([`Pbrdf::visit_subsurface_nodes`]: its reflection depends
+/// on ω_i and turns with the scattering plane, so it is tabulated like the facet term, not like
+/// the constant ρ_d/π of the diffuse table), merged by direction.
 pub fn specular_kernel(
     pbrdf: &Pbrdf,
     theta_r: f64,
@@ -109,10 +112,15 @@ pub fn specular_kernel(
         return SpecularKernel::default();
     }
     let mut nodes = NodeMerger::new(pbrdf, theta_r, quadrature, 1);
-    pbrdf.visit_specular_nodes(&scattered, &quadrature.hemisphere(), |w_i, k| {
+    let hemisphere = quadrature.hemisphere();
+    pbrdf.visit_specular_nodes(&scattered, &hemisphere, |w_i, k| {
         nodes.add(*w_i, k[0].abs(), &[[k[0], k[1], k[2]]])
     });
-    let (directions, weights) = nodes.finish();
+    let (mut directions, mut weights) = nodes.finish();
+    pbrdf.visit_subsurface_nodes(&scattered, &hemisphere, 0.0, |w_i, k| {
+        directions.push(*w_i);
+        weights.push([k[0], k[1], k[2]]);
+    });
     SpecularKernel {
         directions,
         weights,

@@ -265,11 +265,6 @@ impl MaterialTables {
         resolution: TableResolution,
         quadrature: &KernelQuadrature,
     ) -> Result<MaterialTables, ModelError> {
-        if pbrdf.subsurface().is_some() {
-            // The tables integrate the environment against a constant ρ/π; the subsurface term's
-            // angle-dependent transmission is not tabulated yet.
-            return Err(ModelError::SubsurfaceNotRendered);
-        }
         let (theta, tilt, phi) = table_grids(&resolution);
         let quadrature = merged_quadrature(&resolution, quadrature);
         let kernels: Vec<SpecularKernel> = (0..theta.len())
