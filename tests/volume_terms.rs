@@ -182,7 +182,7 @@ fn within(value: f64, truth: f64, relative: f64) -> bool {
 
 /// Data made by the numpy implementation with noise: each file's own terms are chosen by both
 /// AIC and 5-fold cross-validation, and its parameters recovered (σ, q within 2 %, n 1 %, ρ_s 2 %,
-/// d within 0.02).
+/// d and d_c within 0.02).
 #[test]
 fn synthetic_volume_scatterers_are_recovered_and_their_terms_chosen() {
     let cases = [
@@ -235,6 +235,9 @@ fn synthetic_volume_scatterers_are_recovered_and_their_terms_chosen() {
             "{file}: {model:?}"
         );
         assert!((model.d.unwrap() - d).abs() <= 0.02, "{file}: {model:?}");
+        // The data were made with D's circular part equal to d (d_c absent): the free d_c finds it.
+        let d_c = model.parameter(Parameter::DC).unwrap();
+        assert!((d_c - d).abs() <= 0.02, "{file}: d_c = {d_c}");
     }
 }
 

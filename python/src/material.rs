@@ -222,11 +222,12 @@ impl PyMaterial {
             .map_or(String::new(), |q| format!(", q={}", py_float(q)));
         let optics = match m {
             MaterialModel::Grey(g) => format!(
-                "n={}, k={}, rho_d={}, shadowing={}, wavelength_um={}",
+                "n={}, k={}, rho_d={}, shadowing={}{}, wavelength_um={}",
                 py_float(g.n),
                 py_float(g.k),
                 py_float(g.rho_d),
                 py_str(m.shadowing().name()),
+                volume_terms(g),
                 py_float(g.wavelength_um)
             ),
             MaterialModel::Spectral(s) => {
@@ -250,6 +251,29 @@ impl PyMaterial {
             py_float(m.distribution().sigma()),
         )
     }
+}
+
+/// The volume-scattering terms of docs/design.md §1.10 as a repr lists them (nothing for a
+/// model without them): `, facet='internal', rho_s=0.96, d=0.027, n_sub=1.04, d_c=-0.019`.
+fn volume_terms(model: &irpol::material::ModelSpec) -> String {
+    let mut text = String::new();
+    if !model.facet.is_external() {
+        text.push_str(&format!(", facet={}", py_str(model.facet.name())));
+    }
+    if let Some(s) = model.subsurface() {
+        text.push_str(&format!(
+            ", rho_s={}, d={}",
+            py_float(s.rho_s),
+            py_float(s.d)
+        ));
+        if let Some(n_sub) = s.n_sub {
+            text.push_str(&format!(", n_sub={}", py_float(n_sub)));
+        }
+        if let Some(d_c) = s.d_c {
+            text.push_str(&format!(", d_c={}", py_float(d_c)));
+        }
+    }
+    text
 }
 
 /// A string as Python's repr writes it (in single quotes, control characters escaped).

@@ -142,7 +142,7 @@ def test_material_round_trips_and_pickles(tmp_path):
     assert paint.fit_json is not None and irpol.Material(sigma=0.1, q=2, n=1.5, k=0.1).fit_json is None
 
 
-def test_repr_of_a_material_names_every_model_parameter():
+def test_repr_of_a_material_names_every_model_parameter(tmp_path):
     paint = irpol.Material.load(PAINT)
     text = repr(paint)
     for name in ("sigma", "q", "n", "k", "rho_d"):
@@ -155,3 +155,10 @@ def test_repr_of_a_material_names_every_model_parameter():
     glass = repr(irpol.Material.load(ROOT / "fits" / "silicate_glass.toml"))
     assert "n=0.5178–2.873, k=0.03596–2.121, rho_d=0.0–1.948e-06" in glass, glass
     assert "wavelength_um=8.0–14.0 (9 wavelengths)" in glass, glass
+    # A volume scatterer's terms (docs/design.md §1.10) are listed too.
+    volume = tmp_path / "ptfe.toml"
+    volume.write_text('name = "ptfe"\ntool_version = "irpol"\n[model]\ndistribution = "gaussian"\n'
+                      'sigma = 0.8\nshadowing = "smith"\nn = 1.35\nk = 0.0\nfacet = "internal"\n'
+                      'rho_s = 0.6\nd = 0.1\nd_c = -0.02\nwavelength_um = 1.064\n')
+    assert ("facet='internal', rho_s=0.6, d=0.1, d_c=-0.02, wavelength_um=1.064"
+            in repr(irpol.Material.load(volume)))

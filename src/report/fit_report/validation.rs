@@ -4,6 +4,8 @@
 //! the prediction errors.
 
 use super::data::ReportData;
+use super::style::incidence_color;
+use super::table::format_angle;
 use super::{draw_panel, encode_bitmap, report_stem, EncodedReport, PanelKind};
 use crate::material::Material;
 use crate::measure::MeasurementSet;
@@ -18,6 +20,33 @@ use std::path::Path;
 const PAGE: (u32, u32) = (2400, 1560);
 /// Height of the title block, pixels.
 const TITLE_BLOCK: u32 = 110;
+
+/// Where the key of the incidences' colours starts on the summary line, pixels from the left
+/// (the page has no ring panel, whose legend keys them in the fit report).
+const KEY_LEFT: i32 = 1560;
+
+/// "θ_i:" and each incidence angle in the colour its points and curves have in every panel.
+fn draw_incidence_key<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    data: &ReportData,
+    (mut x, y): (i32, i32),
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let font = |color: RGBColor| {
+        (FONT, 26.0)
+            .into_font()
+            .color(&color)
+            .pos(Pos::new(HPos::Left, VPos::Top))
+    };
+    area.draw_text("colours: θi =", &font(BLACK), (x, y))?;
+    x += 175;
+    for (incidence, slot) in data.incidences.iter().zip(&data.slot) {
+        let Some(slot) = slot else { continue };
+        let label = format!("● {}°", format_angle(*incidence));
+        area.draw_text(&label, &font(incidence_color(*slot)), (x, y))?;
+        x += 20 + 16 * label.chars().count() as i32;
+    }
+    Ok(())
+}
 
 /// Encodes `<out_dir>/<material>_validation_<data stem>.png`; `summary` is the line of errors
 /// printed under the title.
@@ -66,6 +95,7 @@ pub fn encode_validation_report(
             &style(26.0, false).into_text_style(&header),
             (24, 62),
         )?;
+        draw_incidence_key(&header, &data, (KEY_LEFT, 62))?;
         let panels = body.split_evenly((2, 2));
         let kinds = [
             PanelKind::InPlane,
