@@ -21,11 +21,23 @@ pub fn read_measurement_sets(
     wavelength_um: Option<f64>,
     theta_i_deg: Option<Vec<f64>>,
 ) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    let sets = read_sets(py, &path, layout, wavelength_um, theta_i_deg)?;
+    sets.iter().map(|set| set_dict(py, set)).collect()
+}
+
+/// The sets of `path` as the command line's reading flags of the same meaning read them, with
+/// the GIL released.
+pub fn read_sets(
+    py: Python<'_>,
+    path: &std::path::Path,
+    layout: Option<PathBuf>,
+    wavelength_um: Option<f64>,
+    theta_i_deg: Option<Vec<f64>>,
+) -> PyResult<Vec<MeasurementSet>> {
     let reading = measurement_args(layout, wavelength_um, theta_i_deg)
         .read_options()
         .map_err(raised)?;
-    let sets = py.detach(|| reading.read(&path)).map_err(raised)?;
-    sets.iter().map(|set| set_dict(py, set)).collect()
+    py.detach(|| reading.read(path)).map_err(raised)
 }
 
 /// The command line's reading flags from the Python arguments of the same meaning.

@@ -3,7 +3,7 @@
 
 use crate::errors::raised;
 use crate::material::PyMaterial;
-use crate::measurements::{measurement_args, set_dict};
+use crate::measurements::{read_sets, set_dict};
 use irpol::app::material_pbrdf;
 use irpol::fit::validate_model;
 use numpy::PyArray2;
@@ -25,10 +25,7 @@ pub fn validate_material<'py>(
     wavelength_um: Option<f64>,
     theta_i_deg: Option<Vec<f64>>,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let reading = measurement_args(layout, wavelength_um, theta_i_deg)
-        .read_options()
-        .map_err(raised)?;
-    let sets = py.detach(|| reading.read(&path)).map_err(raised)?;
+    let sets = read_sets(py, &path, layout, wavelength_um, theta_i_deg)?;
     let material = &material.inner;
     let mut out = Vec::new();
     for set in &sets {

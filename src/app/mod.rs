@@ -83,7 +83,7 @@ pub enum ModelArgsError {
     UnknownShadowing(String),
     #[error("unknown facet side '{}': use external or internal", crate::text::shown(.0))]
     UnknownFacet(String),
-    #[error("--d and --n-sub belong to the subsurface term: give --rho-s too")]
+    #[error("--d, --n-sub and --d-c belong to the subsurface term: give --rho-s too")]
     PolarizationWithoutSubsurface,
     #[error(
         "give either --material or model parameters (--distribution --sigma --q --n --k \
@@ -169,8 +169,9 @@ impl ModelArgs {
     /// `--facet`, `--rho-s`, `--d`, `--n-sub` and `--d-c` applied to `model` (docs/design.md
     /// §1.10).
     fn with_volume_terms(&self, model: Pbrdf) -> Result<Pbrdf, ModelArgsError> {
-        let subsurface_flags = self.d.is_some() || self.n_sub.is_some() || self.d_c.is_some();
-        if self.facet.is_none() && self.rho_s.is_none() && !subsurface_flags {
+        let subsurface = Subsurface::from_keys(self.rho_s, self.d, self.n_sub, self.d_c)
+            .map_err(|_| ModelArgsError::PolarizationWithoutSubsurface)?;
+        if self.facet.is_none() && subsurface.is_none() {
             return Ok(model);
         }
         let facet = match &self.facet {
@@ -178,16 +179,6 @@ impl ModelArgs {
                 FacetSide::parse(name).ok_or_else(|| ModelArgsError::UnknownFacet(name.clone()))?
             }
             None => FacetSide::External,
-        };
-        let subsurface = match self.rho_s {
-            None if subsurface_flags => return Err(ModelArgsError::PolarizationWithoutSubsurface),
-            None => None,
-            Some(rho_s) => Some(Subsurface {
-                rho_s,
-                d: self.d.unwrap_or(0.0),
-                n_sub: self.n_sub,
-                d_c: self.d_c,
-            }),
         };
         Ok(model.with_volume(facet, subsurface)?)
     }

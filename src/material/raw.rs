@@ -7,7 +7,10 @@
 use super::{MaterialModel, ModelSpec, SpectralModel};
 use crate::measure::SAME_WAVELENGTH_UM;
 use crate::optics::{LorentzDispersion, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
-use crate::pbrdf::{DistributionError, DistributionKind, FacetSide, Shadowing};
+use crate::pbrdf::{
+    DistributionError, DistributionKind, FacetSide, Shadowing, Subsurface,
+    SubsurfaceKeysWithoutRhoS,
+};
 use crate::text::number;
 use serde::Deserialize;
 
@@ -82,8 +85,8 @@ pub enum ModelTableError {
     DuplicateWavelength(f64, f64),
     #[error("dispersion: {0}")]
     Dispersion(#[source] crate::optics::LorentzError),
-    #[error("d, n_sub and d_c need rho_s: they belong to the subsurface term")]
-    PolarizationWithoutSubsurface,
+    #[error("{0}")]
+    PolarizationWithoutSubsurface(#[from] SubsurfaceKeysWithoutRhoS),
     #[error(
         "facet = \"internal\", rho_s and d are grey-model terms: a spectral table cannot use \
          them yet (fit each wavelength as a grey material)"
@@ -108,9 +111,8 @@ impl TryFrom<RawModel<f64>> for ModelSpec {
         if raw.dispersion.is_some() {
             return Err(ModelTableError::GreyDispersion);
         }
-        if (raw.d.is_some() || raw.n_sub.is_some() || raw.d_c.is_some()) && raw.rho_s.is_none() {
-            return Err(ModelTableError::PolarizationWithoutSubsurface);
-        }
+        // Refuses d, n_sub, d_c without rho_s; the spec keeps the keys as written.
+        Subsurface::from_keys(raw.rho_s, raw.d, raw.n_sub, raw.d_c)?;
         Ok(ModelSpec {
             distribution,
             shadowing: raw.shadowing,

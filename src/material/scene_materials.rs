@@ -4,7 +4,8 @@
 use super::{find_material, BandModelError, Material, MaterialError, MaterialModel, SpectralModel};
 use crate::optics::{Band, RefractiveIndex, TableMissesBand};
 use crate::pbrdf::{
-    slope_distribution, DistributionError, FacetSide, MaterialOptics, ModelError, Pbrdf, Subsurface,
+    slope_distribution, DistributionError, FacetSide, MaterialOptics, ModelError, Pbrdf,
+    Subsurface, SubsurfaceKeysWithoutRhoS,
 };
 use serde::Deserialize;
 use std::collections::{BTreeMap, HashMap};
@@ -62,8 +63,8 @@ pub enum InlineMaterialError {
     Distribution(#[from] DistributionError),
     #[error("{0}")]
     Model(ModelError),
-    #[error("d, n_sub and d_c need rho_s: they belong to the subsurface term")]
-    PolarizationWithoutSubsurface,
+    #[error("{0}")]
+    PolarizationWithoutSubsurface(#[from] SubsurfaceKeysWithoutRhoS),
 }
 
 /// A material of a scene cannot be used. The inner errors are part of the message (not a
@@ -290,18 +291,7 @@ pub fn share_wavelength_nodes(
 
 pub fn inline_pbrdf(m: &InlineMaterialConfig) -> Result<Pbrdf, InlineMaterialError> {
     let distribution = slope_distribution(&m.distribution, m.sigma, m.q)?;
-    let subsurface = match m.rho_s {
-        Some(rho_s) => Some(Subsurface {
-            rho_s,
-            d: m.d.unwrap_or(0.0),
-            n_sub: m.n_sub,
-            d_c: m.d_c,
-        }),
-        None if m.d.is_some() || m.n_sub.is_some() || m.d_c.is_some() => {
-            return Err(InlineMaterialError::PolarizationWithoutSubsurface)
-        }
-        None => None,
-    };
+    let subsurface = Subsurface::from_keys(m.rho_s, m.d, m.n_sub, m.d_c)?;
     Pbrdf::new(
         distribution,
         m.shadowing,

@@ -26,5 +26,5 @@ pub use geometry::{fold_signed_zenith, signed_zenith_note};
 pub use hemisphere::{cosine_hemisphere_rule, HemisphereQuadrature};
 pub use model::{Pbrdf, ScatteringGeometry};
 pub use shadowing::Shadowing;
-pub use subsurface::{FacetSide, Subsurface, Transmission};
+pub use subsurface::{FacetSide, Subsurface, SubsurfaceKeysWithoutRhoS, Transmission};
 pub use terms::{Body, ModelTerms, OutsideDomain, Parameter, ParameterInfo, Term};

@@ -304,18 +304,8 @@ impl Pbrdf {
     /// BRDF for unpolarized light, and its weight in a hemispherical integral over ω_i.
     #[inline]
     pub(super) fn subsurface_first_column(&self, geometry: &ScatteringGeometry) -> Stokes {
-        match &self.subsurface {
-            Some(s) => {
-                let facet = &geometry.facet;
-                let [s0, s1, s2] = s.first_column(
-                    s.transmission(facet.cos_i),
-                    s.transmission(facet.cos_r),
-                    geometry.scattering_plane_turn(),
-                );
-                Stokes::new(s0, s1, s2, 0.0)
-            }
-            None => Stokes::zeros(),
-        }
+        self.subsurface_mueller(geometry)
+            .map_or_else(Stokes::zeros, |m| m.column(0).into_owned())
     }
     pub(crate) fn prepared_distribution(&self) -> &PreparedDistribution {
         &self.prepared
@@ -462,27 +452,20 @@ impl Pbrdf {
     /// thermal scenes need. Skips the incident-frame rotation: (A, cos2η_r B, sin2η_r B, 0).
     #[inline]
     pub fn first_column(&self, incident: &Direction, scattered: &Direction) -> Stokes {
-        if self.subsurface.is_some() {
-            // The subsurface term turns with the scattering plane: both rotations are needed.
-            return match ScatteringGeometry::new(incident, scattered) {
-                Some(geometry) => self
-                    .mueller_for_geometry(
-                        &geometry,
-                        self.masking(geometry.facet.cos_i),
-                        self.masking(geometry.facet.cos_r),
-                    )
-                    .column(0)
-                    .into_owned(),
-                None => Stokes::zeros(),
-            };
-        }
         let Some(geometry) = FacetGeometry::new(incident, scattered) else {
             return Stokes::zeros();
         };
         let facet = self.facet_reflection(&geometry, self.masking_of(&geometry));
         let (cr, sr) = double_angle(facet_axis_in_scattered_frame(&incident.vector, scattered));
         let (a, b) = facet.scaled_a_and_b();
-        Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0)
+        let facets_and_depolarizer = Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0);
+        if self.subsurface.is_none() {
+            return facets_and_depolarizer;
+        }
+        // The subsurface term turns with the scattering plane: it needs the incident rotation too.
+        ScatteringGeometry::new(incident, scattered).map_or(facets_and_depolarizer, |g| {
+            facets_and_depolarizer + self.subsurface_first_column(&g)
+        })
     }
 }
 

@@ -100,7 +100,35 @@ pub struct Subsurface {
     pub d_c: Option<f64>,
 }
 
+/// d, n_sub or d_c given without ρ_s (in a material file, a scene's inline material or on the
+/// command line): they describe a subsurface term that is not there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("d, n_sub and d_c need rho_s: they belong to the subsurface term")]
+pub struct SubsurfaceKeysWithoutRhoS;
+
 impl Subsurface {
+    /// The subsurface term its keys describe, wherever they are written: none without ρ_s, d
+    /// absent is 0, n_sub and d_c absent take their defaults (n, d).
+    pub fn from_keys(
+        rho_s: Option<f64>,
+        d: Option<f64>,
+        n_sub: Option<f64>,
+        d_c: Option<f64>,
+    ) -> Result<Option<Subsurface>, SubsurfaceKeysWithoutRhoS> {
+        match rho_s {
+            Some(rho_s) => Ok(Some(Subsurface {
+                rho_s,
+                d: d.unwrap_or(0.0),
+                n_sub,
+                d_c,
+            })),
+            None if d.is_some() || n_sub.is_some() || d_c.is_some() => {
+                Err(SubsurfaceKeysWithoutRhoS)
+            }
+            None => Ok(None),
+        }
+    }
+
     /// d_c, or d where it is not given (the mirror-signed D of the module docs).
     pub fn circular(&self) -> f64 {
         self.d_c.unwrap_or(self.d)
@@ -187,23 +215,6 @@ impl PreparedSubsurface {
         m[(2, 2)] = -k * dc * r.cross * i.cross;
         m[(3, 3)] = -k * self.terms.circular() * r.cross * i.cross;
         m
-    }
-
-    /// (m00, m10, m20) of [`PreparedSubsurface::mueller`]: the Stokes BRDF for unpolarized light.
-    #[inline]
-    pub(super) fn first_column(
-        &self,
-        incident: Transmission,
-        scattered: Transmission,
-        plane: (f64, f64),
-    ) -> [f64; 3] {
-        let (i, r, k) = (incident, scattered, self.scale);
-        let (dc, ds) = (self.terms.d * plane.0, self.terms.d * plane.1);
-        [
-            k * (r.plus * i.plus + dc * r.minus * i.minus),
-            k * (r.minus * i.plus + dc * r.plus * i.minus),
-            k * ds * r.cross * i.minus,
-        ]
     }
 }
 
