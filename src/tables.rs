@@ -51,6 +51,34 @@ where
     table(deserializer).map(Some)
 }
 
+/// A sub-table that may also be written as a flag (`dofp = true`, the shorthand for a table of
+/// defaults; `dofp = false` for none): `#[serde(default, deserialize_with = "table_or_flag")]`.
+pub fn table_or_flag<'de, D, T>(deserializer: D) -> Result<Option<T>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de> + Default,
+{
+    struct FlagVisitor<T>(PhantomData<T>);
+
+    impl<'de, T: Deserialize<'de> + Default> Visitor<'de> for FlagVisitor<T> {
+        type Value = Option<T>;
+
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str("true, false or a table")
+        }
+
+        fn visit_bool<E: serde::de::Error>(self, flag: bool) -> Result<Option<T>, E> {
+            Ok(flag.then(T::default))
+        }
+
+        fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Option<T>, A::Error> {
+            T::deserialize(MapAccessDeserializer::new(map)).map(Some)
+        }
+    }
+
+    deserializer.deserialize_any(FlagVisitor(PhantomData))
+}
+
 /// Tables by name (`[materials.NAME]`, `[objects.parts.NAME]`, `[thermal.layers.NAME]`).
 pub fn table_map<'de, D, T>(deserializer: D) -> Result<BTreeMap<String, T>, D::Error>
 where

@@ -412,3 +412,63 @@ fn likely_mistakes_are_warned_once_and_listed() {
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["warnings"].as_array().unwrap().len(), 5);
 }
+
+/// The camera's sub-tables (`[sensor.optics]`, `[sensor.detector]`, `[sensor.dofp]`) refuse
+/// settings that mean nothing, naming the key and what to write instead.
+#[test]
+fn camera_settings_are_checked_by_key() {
+    let files = [("panel.obj", TRIANGLE_OBJ)];
+    let base = scene_with_mesh("panel.obj", "");
+    let cases: [(&str, &[&str]); 10] = [
+        (
+            "[sensor.optics]\nf_number = 1.0\n",
+            &["sensor.optics.f_number needs pixel_pitch_um"],
+        ),
+        (
+            "[sensor.optics]\npixel_pitch_um = 17.0\n",
+            &["pixel_pitch_um is only used with f_number"],
+        ),
+        (
+            "[sensor.optics]\nfill_factor = 1.5\n",
+            &["sensor.optics.fill_factor = 1.5 must be within [0, 1]"],
+        ),
+        (
+            "[sensor.optics]\nblur_sigma_px = nan\n",
+            &["sensor.optics.blur_sigma_px = NaN"],
+        ),
+        (
+            "[sensor.optics]\nfocal_mm = 25.0\n",
+            &["unknown field `focal_mm`"],
+        ),
+        (
+            "[sensor.detector]\nbits = 40\n",
+            &["sensor.detector.bits = 40 must be within [0, 32]"],
+        ),
+        (
+            "[sensor.detector]\nrange_k = [350.0, 250.0]\n",
+            &[
+                "sensor.detector.range_k = [350, 250]",
+                "the first below the second",
+            ],
+        ),
+        (
+            "[sensor.dofp]\nextinction_ratio = 0.5\n",
+            &["sensor.dofp.extinction_ratio = 0.5 must be ≥ 1"],
+        ),
+        (
+            "[sensor.dofp]\ndemosaic = \"cubic\"\n",
+            &[
+                "sensor.dofp.demosaic = \"cubic\"",
+                "\"bilinear\", \"newton\" or \"residual\"",
+            ],
+        ),
+        (
+            "[sensor]\ndofp = \"yes\"\n",
+            &["expected true, false or a table"],
+        ),
+    ];
+    for (table, pieces) in cases {
+        let text = refuse(&format!("{table}{base}"), &files);
+        expect(&text, pieces);
+    }
+}

@@ -12,6 +12,7 @@ pub mod thermal_plot;
 
 use crate::atomic::{StagedDir, StagedFolder};
 use crate::optics::TemperatureLookup;
+use crate::render::camera::{metrics::CameraMetrics, DofpImages};
 use crate::render::film::{dolp_aop, polarizer, StokesImage, BACKGROUND};
 use crate::render::TableResolution;
 use crate::render::{RenderError, Rendered, Timings};
@@ -237,6 +238,10 @@ pub struct RenderSummary {
     pub warnings: Vec<String>,
     /// Intrinsics and pose (ground truth).
     pub camera: CameraSummary,
+    /// Reconstruction quality of the camera (optics, detector, DoFP) against the noise-free
+    /// radiance; absent for the ideal camera.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reconstruction: Option<CameraMetrics>,
     /// What the IDs of `object_id.tif` and `part_id.tif` are.
     pub ids: IdMaps,
     pub materials: Vec<MaterialSummary>,
@@ -333,8 +338,8 @@ impl<'a> ImageFiles<'a> {
     ) -> ImageFiles<'a> {
         let previews = figure::Previews::new(scene, image);
         let mut truth = truth_images(scene, image);
-        if scene.sensor.dofp {
-            truth.extend(dofp_images(image));
+        if let Some(dofp) = &image.dofp {
+            truth.extend(dofp_images(dofp));
         }
         ImageFiles {
             scene,
@@ -447,6 +452,7 @@ fn summarize(
         thermal_instant: scene.thermal_instant.clone(),
         warnings,
         camera,
+        reconstruction: image.camera_metrics.clone(),
         ids: id_maps(scene),
         materials: material_summaries(scene, rendered),
         timings_s: rendered.timings,
@@ -573,25 +579,10 @@ fn listed_files(path: &Path) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// `[sensor] dofp = true`: the raw division-of-focal-plane mosaic and the Stokes, DoLP and AoP
-/// images demosaicked from it (`render::dofp`).
-fn dofp_images(image: &StokesImage) -> Vec<TruthImage> {
-    use crate::render::dofp::{demosaic, mosaic, stokes_from_polarizers};
-    let polarizers: Vec<[f32; 4]> = if image.recorded_polarizers.is_empty() {
-        let exact = [Channel::I0, Channel::I45, Channel::I90, Channel::I135];
-        image
-            .stokes
-            .iter()
-            .map(|&s| exact.map(|c| c.value(s) as f32))
-            .collect()
-    } else {
-        image.recorded_polarizers.clone()
-    };
-    let raw = mosaic(image.width, &polarizers);
-    let stokes: Vec<[f32; 3]> = demosaic(image.width, image.height, &raw)
-        .into_iter()
-        .map(stokes_from_polarizers)
-        .collect();
+/// `[sensor.dofp]`: the raw division-of-focal-plane mosaic and the Stokes, DoLP and AoP images
+/// demosaicked from it (`render::camera`).
+fn dofp_images(dofp: &DofpImages) -> Vec<TruthImage> {
+    let (raw, stokes) = (dofp.mosaic.clone(), &dofp.stokes);
     let derived = |f: fn([f64; 4]) -> f64| {
         stokes
             .iter()

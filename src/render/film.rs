@@ -16,10 +16,15 @@ pub struct StokesImage {
     pub surface: Vec<u32>,
     /// Ground truth of the visible point at each pixel (zeros for the background).
     pub truth: Vec<SurfaceTruth>,
-    /// With detector noise: the noisy polarizer images I0, I45, I90, I135 per pixel as the camera
-    /// records them (each with its own noise; the Stokes vectors are re-estimated from them).
-    /// Empty without noise, where I(α) follows from the Stokes vector exactly.
+    /// With detector noise or a detector pattern: the polarizer images I0, I45, I90, I135 per pixel
+    /// as the camera records them (the Stokes vectors are re-estimated from them). Empty for an
+    /// ideal camera, where I(α) follows from the Stokes vector exactly.
     pub recorded_polarizers: Vec<[f32; 4]>,
+    /// With `[sensor.dofp]`: the raw mosaic and the Stokes images demosaicked from it.
+    pub dofp: Option<super::camera::DofpImages>,
+    /// Reconstruction quality of the camera against the noise-free radiance (`None` for the
+    /// ideal camera).
+    pub camera_metrics: Option<super::camera::metrics::CameraMetrics>,
 }
 
 /// The visible point at a pixel, for users who train or validate algorithms.

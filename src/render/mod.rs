@@ -1,9 +1,10 @@
 //! LWIR polarimetric rendering of a scene held in memory (docs/design.md §1.5–1.7, §2.3): primary
 //! visibility by z-buffered rasterization ([`raster`]), the Stokes vector leaving each visible
 //! point from the scene's integrator ([`crate::transport`]), Gouraud or per-pixel shading, then
-//! the atmosphere and detector noise ([`sensor`]) onto the [`film`]. Nothing here writes files
+//! the atmosphere ([`sensor`]) and the camera ([`camera`]) onto the [`film`]. Nothing here writes files
 //! (that is [`crate::output`]) or prints (progress goes to a [`Progress`] callback).
 
+pub mod camera;
 pub mod dofp;
 pub mod film;
 pub mod raster;
@@ -27,7 +28,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use raster::{rasterize, FragmentBuffer, NO_TRIANGLE};
 use rayon::prelude::*;
-use sensor::{through_atmosphere, Noise};
+use sensor::through_atmosphere;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -279,46 +280,34 @@ fn shade_image(
             .atmosphere
             .map(|a| scene.sensor.band.radiance(a.temperature_k)),
     };
-    let noise = Noise::of_sensor(&scene.sensor);
     let mut stokes = vec![[0.0f64; 4]; width * height];
     let mut standard_error = vec![[0.0f64; 4]; width * height];
     let mut surface = vec![BACKGROUND; width * height];
     let mut truth = vec![SurfaceTruth::default(); width * height];
-    let recorded_len = if noise.is_noisy() { width * height } else { 0 };
-    let mut recorded = vec![[0.0f32; 4]; recorded_len];
-    // Without noise `recorded` is empty: each row gets an empty slice.
-    let mut recorded_rows: Vec<&mut [[f32; 4]]> = if recorded_len > 0 {
-        recorded.chunks_mut(width).collect()
-    } else {
-        (0..height).map(|_| &mut [][..]).collect()
-    };
     stokes
         .par_chunks_mut(width)
         .zip(standard_error.par_chunks_mut(width))
         .zip(surface.par_chunks_mut(width))
         .zip(truth.par_chunks_mut(width))
-        .zip(recorded_rows.par_iter_mut())
         .enumerate()
-        .for_each(
-            |(y, ((((row, row_error), row_surface), row_truth), row_recorded))| {
-                for x in 0..width {
-                    let fragment = fragments.fragments[y * width + x];
-                    if fragment.triangle == NO_TRIANGLE {
-                        // The sky or ground of the environment model, seen directly.
-                        let ray = scene.camera.ray_direction(x as f64 + 0.5, y as f64 + 0.5);
-                        row[x] = [scene.environment.radiance(&ray), 0.0, 0.0, 0.0];
-                        continue;
-                    }
-                    let t = fragment.triangle as usize;
-                    let pixel = (y * width + x) as u64;
-                    (row[x], row_error[x], row_truth[x]) =
-                        shader.shade(t, fragment.b1 as f64, fragment.b2 as f64, pixel);
-                    row_surface[x] = scene.mesh.triangle_surface[t];
+        .for_each(|(y, (((row, row_error), row_surface), row_truth))| {
+            for x in 0..width {
+                let fragment = fragments.fragments[y * width + x];
+                if fragment.triangle == NO_TRIANGLE {
+                    // The sky or ground of the environment model, seen directly.
+                    let ray = scene.camera.ray_direction(x as f64 + 0.5, y as f64 + 0.5);
+                    row[x] = [scene.environment.radiance(&ray), 0.0, 0.0, 0.0];
+                    continue;
                 }
-                noise.apply_to_row(y, row, row_recorded);
-                tick();
-            },
-        );
+                let t = fragment.triangle as usize;
+                let pixel = (y * width + x) as u64;
+                (row[x], row_error[x], row_truth[x]) =
+                    shader.shade(t, fragment.b1 as f64, fragment.b2 as f64, pixel);
+                row_surface[x] = scene.mesh.triangle_surface[t];
+            }
+            tick();
+        });
+    let recording = camera::record(&scene.sensor, width, height, &mut stokes);
     StokesImage {
         width,
         height,
@@ -326,6 +315,8 @@ fn shade_image(
         standard_error,
         surface,
         truth,
-        recorded_polarizers: recorded,
+        recorded_polarizers: recording.polarizers,
+        dofp: recording.dofp,
+        camera_metrics: recording.metrics,
     }
 }

@@ -65,7 +65,7 @@
 
 pub use crate::emitter::SunConfig;
 pub use crate::material::InlineMaterialConfig;
-use crate::tables::{optional_table, table, table_list, table_map};
+use crate::tables::{optional_table, table, table_list, table_map, table_or_flag};
 pub use crate::thermal::config::{
     BackConfig, BackKeyword, ConvectiveBack, FixedBack, GeneratedWeather, InternalHeatConfig,
     LayerMaterialConfig, PartThermalConfig, ThermalConfig, WeatherConfig,
@@ -165,9 +165,98 @@ pub struct SensorConfig {
     pub seed: u64,
     /// Temperature at which NETD is converted to radiance (dL/dT); default the air temperature.
     pub netd_reference_k: Option<f64>,
-    /// Also write the raw division-of-focal-plane mosaic and the Stokes images demosaicked from it.
+    /// `[sensor.optics]`: the lens and the pixel aperture (docs/design.md §1.11); none = point samples.
+    #[serde(default, deserialize_with = "optional_table")]
+    pub optics: Option<OpticsConfig>,
+    /// `[sensor.detector]`: fixed-pattern noise and quantization; none = an ideal detector.
+    #[serde(default, deserialize_with = "optional_table")]
+    pub detector: Option<DetectorConfig>,
+    /// `[sensor.dofp]` (or `dofp = true`, an ideal one): also write the raw division-of-focal-plane
+    /// mosaic and the Stokes images demosaicked from it.
+    #[serde(default, deserialize_with = "table_or_flag")]
+    pub dofp: Option<DofpConfig>,
+}
+
+/// `[sensor.optics]` as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OpticsConfig {
+    /// Diffraction of a circular aperture; none = no diffraction.
+    pub f_number: Option<f64>,
+    /// Pixel pitch (µm): the scale of the diffraction pattern in pixels; needed with `f_number`.
+    pub pixel_pitch_um: Option<f64>,
+    /// The pixel's square aperture as a fraction of its area (0 = point samples).
+    #[serde(default = "one")]
+    pub fill_factor: f64,
+    /// Gaussian blur (defocus, jitter), σ in pixels.
     #[serde(default)]
-    pub dofp: bool,
+    pub blur_sigma_px: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// `[sensor.detector]` as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DetectorConfig {
+    /// Residual gain non-uniformity after NUC, a fraction (σ of the per-pixel gain).
+    #[serde(default)]
+    pub fpn_gain_sigma: f64,
+    /// Residual offset non-uniformity, mK at `netd_reference_k` (σ of the per-pixel offset).
+    #[serde(default)]
+    pub fpn_offset_mk: f64,
+    /// Quantization to this many bits over `range_k`; 0 = none.
+    #[serde(default)]
+    pub bits: u32,
+    /// The scene temperatures (K) that map to the first and last digital number.
+    #[serde(default = "detector_range_k", deserialize_with = "exactly")]
+    pub range_k: [f64; 2],
+}
+
+fn detector_range_k() -> [f64; 2] {
+    [250.0, 350.0]
+}
+
+/// `[sensor.dofp]` as written; `Default` is the ideal camera of `dofp = true`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DofpConfig {
+    /// Each pixel polarizer's extinction ratio; none (or `inf`) = a perfect polarizer.
+    pub extinction_ratio: Option<f64>,
+    /// σ of each pixel polarizer's orientation error (degrees), fixed per seed.
+    #[serde(default)]
+    pub orientation_sigma_deg: f64,
+    /// Fraction of a pixel's signal recorded by each of its four neighbours.
+    #[serde(default)]
+    pub crosstalk: f64,
+    /// "bilinear", "newton" or "residual".
+    #[serde(default = "bilinear")]
+    pub demosaic: String,
+    /// Reconstruct the Stokes images with the known diattenuation and orientations.
+    #[serde(default = "yes")]
+    pub calibrated: bool,
+}
+
+fn bilinear() -> String {
+    "bilinear".into()
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl Default for DofpConfig {
+    fn default() -> Self {
+        DofpConfig {
+            extinction_ratio: None,
+            orientation_sigma_deg: 0.0,
+            crosstalk: 0.0,
+            demosaic: bilinear(),
+            calibrated: true,
+        }
+    }
 }
 
 fn lwir_band() -> [f64; 2] {
@@ -182,7 +271,9 @@ impl Default for SensorConfig {
             netd_mk: 0.0,
             seed: 0,
             netd_reference_k: None,
-            dofp: false,
+            optics: None,
+            detector: None,
+            dofp: None,
         }
     }
 }

@@ -24,13 +24,13 @@ mod object;
 pub mod ply;
 pub mod procedural;
 mod render_settings;
+pub mod sensor;
 pub mod thermal;
 mod viewing;
 mod warnings;
 
 use crate::emitter::Sun;
 use crate::material::MaterialResolver;
-use crate::optics::Band;
 use camera::Camera;
 use config::{ObjectConfig, SceneConfig, Shading, WeatherConfig};
 use environment::Environment;
@@ -44,6 +44,7 @@ pub use crate::material::SceneMaterial;
 pub use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
 pub use error::SceneError;
 pub use render_settings::{PathSettings, Transport};
+pub use sensor::{Demosaic, Detector, Diffraction, Dofp, Optics, Sensor};
 
 /// One part of one object: what `ShadedMesh::triangle_surface` indexes.
 #[derive(Clone, Debug)]
@@ -51,16 +52,6 @@ pub struct Surface {
     pub object: usize,
     pub part: String,
     pub material: usize,
-}
-
-#[derive(Clone, Debug)]
-pub struct Sensor {
-    pub band: Band,
-    pub netd_mk: f64,
-    pub seed: u64,
-    pub netd_reference_k: f64,
-    /// Write the division-of-focal-plane mosaic and its demosaicked Stokes images too.
-    pub dofp: bool,
 }
 
 /// Optional atmospheric path: S_sensor = τ S + (1 − τ) L_bb(T_path) δ_j0, τ = exp(−β·range).

@@ -4,8 +4,9 @@
 use super::camera::Camera;
 use super::config::{AtmosphereConfig, SceneConfig};
 use super::environment::Environment;
-use super::{Atmosphere, SceneError, Sensor};
-use crate::optics::{valid_temperature, Band, MAX_TEMPERATURE_K};
+use super::sensor::{resolve_sensor, Sensor};
+use super::{Atmosphere, SceneError};
+use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
 use crate::text::number;
 use nalgebra::Vector3;
 use std::path::Path;
@@ -57,45 +58,6 @@ pub(super) fn resolve_viewing(path: &Path, config: &SceneConfig) -> Result<Viewi
         environment,
         atmosphere,
         aop_mask_dolp: mask,
-    })
-}
-
-/// `[sensor]`: the band, NETD and its reference temperature (default the air's).
-fn resolve_sensor(path: &Path, config: &SceneConfig) -> Result<Sensor, SceneError> {
-    let fail = |message: String| SceneError::new(path, message);
-    let s = &config.sensor;
-    let band = Band::new(
-        s.band_um[0],
-        s.band_um[1],
-        s.response
-            .as_ref()
-            .map(|r| r.iter().map(|&[w, v]| (w, v)).collect()),
-    )
-    .map_err(|e| fail(format!("sensor: {e}")))?;
-    let netd_reference_k = s
-        .netd_reference_k
-        .unwrap_or(config.environment.air_temperature_k);
-    if !(s.netd_mk.is_finite() && s.netd_mk >= 0.0) {
-        return Err(fail(format!(
-            "sensor.netd_mk = {} must be ≥ 0",
-            number(s.netd_mk)
-        )));
-    }
-    // An explicit reference is checked here; the default (the air) by the environment.
-    if s.netd_reference_k.is_some()
-        && !(valid_temperature(netd_reference_k) && netd_reference_k > 0.0)
-    {
-        return Err(fail(format!(
-            "sensor.netd_reference_k = {} must be within (0, {MAX_TEMPERATURE_K}] K",
-            number(netd_reference_k)
-        )));
-    }
-    Ok(Sensor {
-        band,
-        netd_mk: s.netd_mk,
-        seed: s.seed,
-        netd_reference_k,
-        dofp: s.dofp,
     })
 }
 
