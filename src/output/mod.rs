@@ -576,7 +576,7 @@ fn listed_files(path: &Path) -> Vec<String> {
 /// `[sensor] dofp = true`: the raw division-of-focal-plane mosaic and the Stokes, DoLP and AoP
 /// images demosaicked from it (`render::dofp`).
 fn dofp_images(image: &StokesImage) -> Vec<TruthImage> {
-    use crate::render::dofp::{demosaic, mosaic, stokes_from_polarizers};
+    use crate::render::dofp::{demosaic, mosaic, stokes_from_polarizers, Demosaic};
     let polarizers: Vec<[f32; 4]> = if image.recorded_polarizers.is_empty() {
         let exact = [Channel::I0, Channel::I45, Channel::I90, Channel::I135];
         image
@@ -588,7 +588,7 @@ fn dofp_images(image: &StokesImage) -> Vec<TruthImage> {
         image.recorded_polarizers.clone()
     };
     let raw = mosaic(image.width, &polarizers);
-    let stokes: Vec<[f32; 3]> = demosaic(image.width, image.height, &raw)
+    let stokes: Vec<[f32; 3]> = demosaic(image.width, image.height, &raw, Demosaic::Bilinear)
         .into_iter()
         .map(stokes_from_polarizers)
         .collect();
