@@ -582,7 +582,9 @@ fn listed_files(path: &Path) -> Vec<String> {
 /// `[sensor.dofp]`: the raw division-of-focal-plane mosaic and the Stokes, DoLP and AoP images
 /// demosaicked from it (`render::camera`).
 fn dofp_images(dofp: &DofpImages) -> Vec<TruthImage> {
-    let (raw, stokes) = (dofp.mosaic.clone(), &dofp.stokes);
+    // The images are single precision; the camera works in double.
+    let raw = dofp.mosaic.iter().map(|&v| v as f32).collect();
+    let stokes: Vec<[f32; 3]> = dofp.stokes.iter().map(|s| s.map(|v| v as f32)).collect();
     let derived = |f: fn([f64; 4]) -> f64| {
         stokes
             .iter()

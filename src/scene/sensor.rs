@@ -62,13 +62,18 @@ pub struct Dofp {
     pub calibrated: bool,
 }
 
-/// How the three missing polarizer images of each pixel are interpolated (`render::dofp`).
+/// How the three missing polarizer images of each pixel are interpolated (`render::dofp`, the
+/// scene key `[sensor.dofp] demosaic`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Demosaic {
+    /// Each orientation's lattice bilinearly interpolated (the baseline; the default).
     #[default]
     Bilinear,
+    /// Newton's polynomial interpolation in the polarization-difference domain with an edge
+    /// classifier (Li, Zhao, Pan & Kong 2019).
     Newton,
+    /// Guided-filter residual interpolation (after Ahmed et al. 2017).
     Residual,
 }
 

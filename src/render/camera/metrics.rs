@@ -97,10 +97,35 @@ impl CameraMetrics {
         let four: Vec<[f64; 3]> = stokes.iter().map(|s| [s[0], s[1], s[2]]).collect();
         CameraMetrics {
             stokes: Reconstruction::of(truth, &four),
-            dofp: dofp.map(|d| {
-                let e: Vec<[f64; 3]> = d.stokes.iter().map(|s| s.map(f64::from)).collect();
-                Reconstruction::of(truth, &e)
-            }),
+            dofp: dofp.map(|d| Reconstruction::of(truth, &d.stokes)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn psnr_follows_its_definition() {
+        // Peak 2 (the largest |value|, here negative), MSE = (0.1² + 0.2²) / 2 = 0.025.
+        let p = psnr(&[1.0, -2.0], &[1.1, -1.8]).unwrap();
+        assert!((p - 10.0 * (4.0f64 / 0.025).log10()).abs() < 1e-12, "{p}");
+        assert_eq!(psnr(&[1.0, 2.0], &[1.0, 2.0]), None);
+        assert_eq!(psnr(&[0.0, 0.0], &[0.1, 0.0]), None);
+    }
+
+    #[test]
+    fn aop_error_wraps_at_the_axis() {
+        // AoP 89° against −89°: 2° apart, not 178°; DoLP 0.5 % pixels are not counted.
+        let at = |deg: f64, dolp: f64| {
+            let a = 2.0 * deg.to_radians();
+            [1.0, dolp * a.cos(), dolp * a.sin(), 0.0]
+        };
+        let truth = [at(89.0, 0.5), at(10.0, 0.005)];
+        let estimate = [at(-89.0, 0.5), at(50.0, 0.005)].map(|s| [s[0], s[1], s[2]]);
+        let r = Reconstruction::of(&truth, &estimate);
+        assert_eq!(r.aop_pixels, 1);
+        assert!((r.aop_rmse_deg.unwrap() - 2.0).abs() < 1e-9);
     }
 }

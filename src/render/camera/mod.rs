@@ -28,9 +28,9 @@ use rayon::prelude::*;
 /// What the DoFP camera delivers.
 pub struct DofpImages {
     /// Each pixel's recorded value at its own polarizer, row-major.
-    pub mosaic: Vec<f32>,
+    pub mosaic: Vec<f64>,
     /// Stokes (S0, S1, S2) per pixel, demosaicked and reconstructed.
-    pub stokes: Vec<[f32; 3]>,
+    pub stokes: Vec<[f64; 3]>,
 }
 
 /// The camera's records of one render.
@@ -128,7 +128,7 @@ fn record_dofp(
 ) -> DofpImages {
     let (width, height) = array.size();
     let signals = array.signals(stokes);
-    let mut mosaic = vec![0.0f32; stokes.len()];
+    let mut mosaic = vec![0.0f64; stokes.len()];
     mosaic
         .par_chunks_mut(width)
         .enumerate()
@@ -141,10 +141,10 @@ fn record_dofp(
                 if let (Some(d), Some(p)) = (detector, &pattern) {
                     v = d.read(v, &p[x], k);
                 }
-                *value = v as f32;
+                *value = v;
             }
         });
-    let polarizers = demosaic(width, height, &mosaic);
+    let polarizers = demosaic(width, height, &mosaic, array.dofp.demosaic);
     DofpImages {
         stokes: array.reconstruct(&polarizers),
         mosaic,
@@ -179,7 +179,7 @@ mod tests {
         }
     }
 
-    fn dofp_of(sensor: &Sensor, w: usize, h: usize, stokes: &[[f64; 4]]) -> Vec<[f32; 3]> {
+    fn dofp_of(sensor: &Sensor, w: usize, h: usize, stokes: &[[f64; 4]]) -> Vec<[f64; 3]> {
         let mut copy = stokes.to_vec();
         record(sensor, w, h, &mut copy).dofp.unwrap().stokes
     }
@@ -203,12 +203,12 @@ mod tests {
             ..array(10.0, 0.0, 0.0, true)
         };
         let got = dofp_of(&sensor(perfect), w, h, &truth);
-        // Exact between lattice samples (to f32 rounding), not beyond the last one.
+        // Exact between lattice samples (to rounding), not beyond the last one.
         for y in 1..h - 1 {
             for x in 1..w - 1 {
                 let (s, t) = (got[y * w + x], truth[y * w + x]);
                 for j in 0..3 {
-                    assert!((s[j] as f64 - t[j]).abs() < 1e-5, "({x},{y}) S{j}");
+                    assert!((s[j] - t[j]).abs() < 1e-9, "({x},{y}) S{j}");
                 }
             }
         }
@@ -221,12 +221,12 @@ mod tests {
         let field = vec![[2.0, 2.0, 0.0, 0.0]; w * h];
         let d = 9.0 / 11.0;
         for s in dofp_of(&sensor(array(10.0, 0.0, 0.0, false)), w, h, &field) {
-            let dolp = (s[1] as f64).hypot(s[2] as f64) / s[0] as f64;
-            assert!((dolp - d).abs() < 1e-6, "{dolp}");
+            let dolp = s[1].hypot(s[2]) / s[0];
+            assert!((dolp - d).abs() < 1e-9, "{dolp}");
         }
         for s in dofp_of(&sensor(array(10.0, 0.0, 0.0, true)), w, h, &field) {
-            let dolp = (s[1] as f64).hypot(s[2] as f64) / s[0] as f64;
-            assert!((dolp - 1.0).abs() < 1e-6, "{dolp}");
+            let dolp = s[1].hypot(s[2]) / s[0];
+            assert!((dolp - 1.0).abs() < 1e-9, "{dolp}");
         }
     }
 
@@ -246,9 +246,9 @@ mod tests {
             &field,
         );
         let truth = field[0];
-        let worst = |v: &[[f32; 3]]| {
+        let worst = |v: &[[f64; 3]]| {
             v.iter()
-                .flat_map(|s| (0..3).map(move |j| (s[j] as f64 - truth[j]).abs()))
+                .flat_map(|s| (0..3).map(move |j| (s[j] - truth[j]).abs()))
                 .fold(0.0, f64::max)
         };
         assert!(
@@ -256,7 +256,7 @@ mod tests {
             "the flaws show: {}",
             worst(&uncalibrated)
         );
-        assert!(worst(&calibrated) < 1e-5, "{}", worst(&calibrated));
+        assert!(worst(&calibrated) < 1e-9, "{}", worst(&calibrated));
     }
 
     #[test]
@@ -266,7 +266,7 @@ mod tests {
         let mut copy = field.clone();
         let recording = record(&sensor(array(1e9, 0.0, 0.2, false)), w, h, &mut copy);
         for v in recording.dofp.unwrap().mosaic {
-            assert!((v as f64 - 2.0).abs() < 1e-6);
+            assert!((v - 2.0).abs() < 1e-12);
         }
     }
 

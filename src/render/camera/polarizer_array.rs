@@ -14,7 +14,7 @@
 //! fully polarized field's DoLP as D.
 
 use crate::render::dofp::{demosaic, orientation};
-use crate::scene::{Dofp, Sensor};
+use crate::scene::{Demosaic, Dofp, Sensor};
 use nalgebra::{Matrix3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -127,7 +127,7 @@ impl PolarizerArray {
     }
 
     /// The effective analyzer A_p of every pixel (crosstalk included), one mosaic per component.
-    fn effective_analyzers(&self) -> [Vec<f32>; 3] {
+    fn effective_analyzers(&self) -> [Vec<f64>; 3] {
         let c = self.dofp.crosstalk;
         let rows: Vec<[f64; 3]> = (0..self.analyzers.len())
             .map(|p| {
@@ -139,11 +139,11 @@ impl PolarizerArray {
                 [0, 1, 2].map(|j| (1.0 - count * c) * own[j] + c * leaked[j])
             })
             .collect();
-        [0, 1, 2].map(|j| rows.iter().map(|a| a[j] as f32).collect())
+        [0, 1, 2].map(|j| rows.iter().map(|a| a[j]).collect())
     }
 
     /// Stokes (S0, S1, S2) per pixel from the demosaicked polarizer images `polarizers`.
-    pub fn reconstruct(&self, polarizers: &[[f32; 4]]) -> Vec<[f32; 3]> {
+    pub fn reconstruct(&self, polarizers: &[[f64; 4]]) -> Vec<[f64; 3]> {
         if !self.dofp.calibrated || self.is_ideal() {
             // Uncalibrated, or a perfect array, where the least-squares solution is this one.
             return polarizers
@@ -152,9 +152,9 @@ impl PolarizerArray {
                 .collect();
         }
         let components = self.effective_analyzers();
-        let interpolated: Vec<Vec<[f32; 4]>> = components
+        let interpolated: Vec<Vec<[f64; 4]>> = components
             .iter()
-            .map(|mosaic| demosaic(self.width, self.height, mosaic))
+            .map(|mosaic| demosaic(self.width, self.height, mosaic, Demosaic::Bilinear))
             .collect();
         polarizers
             .par_iter()
@@ -162,9 +162,9 @@ impl PolarizerArray {
             .map(|(p, i)| {
                 let rows = [0, 1, 2, 3].map(|k| {
                     Vector3::new(
-                        interpolated[0][p][k] as f64,
-                        interpolated[1][p][k] as f64,
-                        interpolated[2][p][k] as f64,
+                        interpolated[0][p][k],
+                        interpolated[1][p][k],
+                        interpolated[2][p][k],
                     )
                 });
                 least_squares_stokes(&rows, i)
@@ -175,17 +175,17 @@ impl PolarizerArray {
 
 /// The S minimizing Σ_k (A_k·S − I_k)², by the normal equations (3 × 3, well conditioned for any
 /// array that polarizes: the four orientations span the linear Stokes space).
-fn least_squares_stokes(rows: &[Vector3<f64>; 4], i: &[f32; 4]) -> [f32; 3] {
+fn least_squares_stokes(rows: &[Vector3<f64>; 4], i: &[f64; 4]) -> [f64; 3] {
     let mut normal = Matrix3::zeros();
     let mut right = Vector3::zeros();
     for (a, &value) in rows.iter().zip(i) {
         normal += a * a.transpose();
-        right += a * value as f64;
+        right += a * value;
     }
     match normal.try_inverse() {
         Some(inverse) => {
             let s = inverse * right;
-            [s[0] as f32, s[1] as f32, s[2] as f32]
+            [s[0], s[1], s[2]]
         }
         None => crate::render::dofp::stokes_from_polarizers(*i),
     }
