@@ -324,6 +324,7 @@ fn malformed_tables_are_refused_with_file_line_and_fix() {
         (format!("{band}0,1,0\n10,-0.1,1\n"), ":3: ", "column 'transmittance': -0.1 is outside [0, 1]"),
         (format!("{band}0,1,0\n10,0.5,-1\n"), ":3: ", "column 'path_radiance_w_m2_sr': -1 must be ≥ 0 (a radiance)"),
         (over_band("11.0,0,1,-2\n11.0,10,1,0\n"), ":4: ", "column 'path_radiance_w_m2_sr_um': -2 must be ≥ 0"),
+        (format!("{band}0,1,0\n10,0.5,3e9\n"), ":3: ", "column 'path_radiance_w_m2_sr': 3e9 is beyond 1e9: not a radiance in W·m⁻²·sr⁻¹"),
         (format!("{band}0,1,0\n10,NaN,1\n"), ":3: ", "column 'transmittance': 'NaN' is not a finite number"),
         (format!("{band}0,1,0\ninf,0.5,1\n"), ":3: ", "column 'range_m': 'inf' is not a finite number"),
         (format!("{band}0,1,0\n10,0.5,\n"), ":3: ", "column 'path_radiance_w_m2_sr': empty, expected a number"),
@@ -421,4 +422,37 @@ fn atmosphere_keys_that_do_not_fit_are_refused() {
         stderr.contains("path.csv:3: column 'transmittance': 1.5 is outside [0, 1]"),
         "{stderr}"
     );
+}
+
+#[test]
+fn a_thermal_instant_moves_the_path_with_the_air() {
+    // The extinction path's temperature and a spectral table's weighting (the NETD reference)
+    // follow the air of the instant, as they default to the air's.
+    let dir = tempfile::tempdir().unwrap();
+    let k = |w: f64| 0.01 + 0.4 / (1.0 + (-(w - 11.0) / 0.5).exp());
+    let tau = |w: f64, r: f64| (-k(w) * r).exp();
+    let table = spectral_table(&fine_wavelengths(), &[0.0, 5.0, 20.0], tau, |_, _| 0.0);
+    std::fs::write(dir.path().join("s.csv"), table).unwrap();
+    for atmosphere in ["extinction_per_km = 50.0", "table = \"s.csv\""] {
+        let text = thermal_plate_scene(|t| format!("{t}\n[atmosphere]\n{atmosphere}\n"));
+        let scene = load_scene(&write_scene(dir.path(), &text)).unwrap();
+        let solution = irpol::thermal_scene::solve_scene(&scene, &[3600.0], &Silent).unwrap();
+        let i = solution.times_s.iter().position(|&t| t == 3600.0).unwrap();
+        let air = solution.weather[i].air_k;
+        assert!((air - 290.0).abs() > 0.5, "{air}");
+        let at = irpol::thermal_scene::scene_at(&scene, &solution, i).unwrap();
+        let path = at.atmosphere.as_ref().unwrap();
+        if atmosphere.starts_with("extinction") {
+            assert_eq!(path.temperature_k(), Some(air));
+            let tau = (-0.05f64 * 20.0).exp();
+            let expected = (1.0 - tau) * Band::lwir().radiance(air);
+            assert!((path.path_radiance(20.0) - expected).abs() < 1e-12 * expected);
+        } else {
+            let direct = direct_band_tau(air, 5.0, &tau);
+            assert!((path.transmittance(5.0) - direct).abs() < 2e-7, "{air} K");
+            let loaded = scene.atmosphere.as_ref().unwrap().transmittance(5.0);
+            assert!((loaded - direct_band_tau(290.0, 5.0, &tau)).abs() < 2e-7);
+            assert!((loaded - direct).abs() > 1e-4);
+        }
+    }
 }

@@ -167,7 +167,7 @@ impl Atmosphere {
         }
     }
 
-    /// What `summary.json` reports; `shown_file` is the table as the scene names it.
+    /// What `summary.json` reports.
     pub fn summary(&self) -> AtmosphereSummary {
         match &self.path {
             Path::Extinction { .. } => AtmosphereSummary {

@@ -10,7 +10,8 @@
 //!   by wavelength (ascending), every wavelength with the same ranges.
 //!
 //! Ranges ≥ 0 m and strictly increasing (within each wavelength), at least two; transmittance
-//! within [0, 1]; radiances ≥ 0; wavelengths > 0; every value a finite number; UTF-8 text.
+//! within [0, 1]; radiances within 0…1e9; wavelengths > 0; every value a finite number; UTF-8
+//! text.
 
 use super::{integrate_spectral, BandRows};
 use crate::optics::Band;
@@ -19,6 +20,11 @@ use std::path::{Path, PathBuf};
 
 /// Characters of a `# source:` or `# geometry:` line kept.
 const NOTE_CHARS: usize = 300;
+
+/// Largest radiance of a table (W·m⁻²·sr⁻¹, or per µm): a blackbody at irpol's hottest 10⁴ K
+/// emits ~1e4 W·m⁻²·sr⁻¹·µm⁻¹ at 10 µm and 2e7 W·m⁻²·sr⁻¹ over all wavelengths, so any real
+/// path is far below, and band integrals of the table stay finite.
+const MAX_RADIANCE: f64 = 1e9;
 
 /// What is wrong with an atmosphere table; each message is one line naming the file.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -216,6 +222,9 @@ impl Column {
             Column::BandRadiance | Column::SpectralRadiance if value < 0.0 => {
                 Some(format!("{v} must be ≥ 0 (a radiance)"))
             }
+            Column::BandRadiance | Column::SpectralRadiance if value > MAX_RADIANCE => Some(
+                format!("{v} is beyond 1e9: not a radiance in W·m⁻²·sr⁻¹ (per µm if spectral)"),
+            ),
             _ => None,
         }
     }
