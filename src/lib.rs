@@ -12,6 +12,7 @@
 //! public for the physics (`optics`, `pbrdf`) and for tests that reach inside.
 
 pub mod app;
+pub mod atmosphere;
 pub mod atomic;
 pub mod elementary;
 pub mod emitter;

@@ -1,6 +1,6 @@
 //! Bounded fuzzing of every reader of user files and flags: the measurement CSV reader, the OBJ
 //! and PLY mesh readers, the material TOML loader (grey and spectral), the eval geometry reader,
-//! the thermal weather CSV reader, the scene loader (a thermal scene's keys), the `--times`
+//! the thermal weather CSV reader, the atmosphere table reader, the scene loader (a thermal scene's keys), the `--times`
 //! sweep and the `sun --times-file` reader get random bytes and mutations of real inputs (the
 //! shipped measurements and materials, excerpts of the car mesh, small PLY files, weather CSVs, a
 //! thermal scene, sweeps and instants), some with runs of thousands of one character. Whatever
@@ -17,6 +17,7 @@
 use irpol::app::evaluate::{parse_geometry_csv, write_mueller_csv};
 use irpol::app::sun::parse_times;
 use irpol::app::{one_line, parse_sweep, MAX_SWEEP_VALUES};
+use irpol::atmosphere::table::parse_table;
 use irpol::material::Material;
 use irpol::measure::parse_measurement_csv;
 use irpol::optics::RefractiveIndex;
@@ -322,6 +323,17 @@ fn weather_seeds() -> Vec<Vec<u8>> {
     ]
 }
 
+fn atmosphere_seeds() -> Vec<Vec<u8>> {
+    vec![
+        b"# source: a code\n# geometry: horizontal\nrange_m,transmittance,path_radiance_w_m2_sr\n\
+          100,0.97,1.2\n\n1000,0.8,8.4\r\n5000,0,20.7\n"
+            .to_vec(),
+        b"wavelength_um,range_m,transmittance,path_radiance_w_m2_sr_um\n7.5,0,1,0\n7.5,50,0.9,0.5\n\
+          11,0,1,0\n11,50,0.2,6\n14.5,0,1,0\n14.5,50,0.95,0.3\n"
+            .to_vec(),
+    ]
+}
+
 fn material_seeds() -> Vec<Vec<u8>> {
     ["paper_paint", "anodized_panel", "silicate_glass"]
         .iter()
@@ -469,6 +481,25 @@ proptest! {
     }
 
     #[test]
+    fn atmosphere_table_reader_never_panics(
+        bytes in prop_oneof![mutated(atmosphere_seeds()), noise()]
+    ) {
+        let band = irpol::optics::Band::lwir();
+        let read = parse_table(Path::new("fuzz.csv"), &bytes)
+            .and_then(|table| table.band_rows(&band, 290.0));
+        match read {
+            Ok(rows) => {
+                for r in [0.0, 0.5, 99.0, 1000.0, 3000.0, 1e7] {
+                    let (tau, path) = rows.at(r);
+                    prop_assert!((0.0..=1.0).contains(&tau), "τ {tau} at {r} m");
+                    prop_assert!(path.is_finite() && path >= 0.0, "L {path} at {r} m");
+                }
+            }
+            Err(e) => check_message(&e.to_string())?,
+        }
+    }
+
+    #[test]
     fn weather_reader_never_panics(bytes in prop_oneof![mutated(weather_seeds()), noise()]) {
         let site = Site {
             latitude_deg: 48.14,
@@ -489,6 +520,12 @@ proptest! {
 /// The seeds are valid input, so the mutations start from text that reaches every check.
 #[test]
 fn the_seeds_are_read() {
+    for seed in atmosphere_seeds() {
+        parse_table(Path::new("t.csv"), &seed)
+            .unwrap()
+            .band_rows(&irpol::optics::Band::lwir(), 290.0)
+            .unwrap();
+    }
     load_scene_text(Path::new("fuzz/scene.toml"), &text(&scene_seeds()[0])).unwrap();
     for seed in sweep_seeds() {
         parse_sweep(&text(&seed), "times").unwrap();

@@ -231,6 +231,9 @@ pub struct RenderSummary {
     /// Brightness temperature of S0 over object pixels (K).
     pub apparent_temperature_k: Option<Stats>,
     pub transport: TransportSummary,
+    /// The atmospheric path, if the scene has one (`kind`, and a table's file, source, geometry).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub atmosphere: Option<crate::atmosphere::AtmosphereSummary>,
     /// The instant of the thermal run shown (`render --time`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub thermal_instant: Option<crate::scene::ThermalInstant>,
@@ -449,6 +452,7 @@ fn summarize(
         channels: channel_summaries(image, channels),
         apparent_temperature_k: apparent_temperature(scene, image, &channels[0].1),
         transport: transport_summary(scene),
+        atmosphere: scene.atmosphere.as_ref().map(|a| a.summary()),
         thermal_instant: scene.thermal_instant.clone(),
         warnings,
         camera,

@@ -195,7 +195,6 @@ struct PixelShader<'a> {
     tracer: Option<&'a PathTracer<'a>>,
     /// Gouraud: the open-world Stokes vector at each vertex (empty for per-pixel shading).
     vertex_stokes: Vec<[f64; 4]>,
-    path_radiance: Option<f64>,
 }
 
 impl PixelShader<'_> {
@@ -227,11 +226,8 @@ impl PixelShader<'_> {
                 (total.into(), e.standard_error.into())
             }
         };
-        if let (Some(atmosphere), Some(path)) = (&scene.atmosphere, self.path_radiance) {
-            let range = to_camera.norm();
-            s = through_atmosphere(s, range, atmosphere, path);
-            let tau = atmosphere.transmittance(range);
-            error = error.map(|e| e * tau);
+        if let Some(atmosphere) = &scene.atmosphere {
+            (s, error) = through_atmosphere(s, error, to_camera.norm(), atmosphere);
         }
         (s, error, truth)
     }
@@ -276,9 +272,6 @@ fn shade_image(
             Shading::Pixel => Vec::new(),
             Shading::Gouraud => vertex_stokes(scene, open_world),
         },
-        path_radiance: scene
-            .atmosphere
-            .map(|a| scene.sensor.band.radiance(a.temperature_k)),
     };
     let mut stokes = vec![[0.0f64; 4]; width * height];
     let mut standard_error = vec![[0.0f64; 4]; width * height];

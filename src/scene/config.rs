@@ -27,6 +27,7 @@
 //!
 //! [atmosphere]                        # optional: S_sensor = τS + (1−τ) L_bb(T_air) δ_j0
 //! extinction_per_km = 0.2             # τ = exp(−β·range)
+//! # table = "path.csv"                # or a radiative-transfer table (docs/design.md §2.9)
 //!
 //! [render]                            # optional
 //! shading = "pixel"                   # or "gouraud"
@@ -312,10 +313,12 @@ pub struct GroundConfig {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AtmosphereConfig {
-    /// Extinction coefficient β (per km); τ = exp(−β·range).
-    pub extinction_per_km: f64,
-    /// Path temperature; default the air temperature.
+    /// Extinction coefficient β (per km); τ = exp(−β·range). This or `table`.
+    pub extinction_per_km: Option<f64>,
+    /// Path temperature of `extinction_per_km`; default the air temperature.
     pub temperature_k: Option<f64>,
+    /// A radiative-transfer table (CSV, relative to the scene file; docs/design.md §2.9).
+    pub table: Option<String>,
 }
 
 #[derive(Debug, Deserialize, Default, Clone, Copy, PartialEq, Eq, serde::Serialize)]

@@ -81,6 +81,12 @@ pub enum SceneError {
         file: PathBuf,
         error: ThermalSetupError,
     },
+    /// The `[atmosphere]` table.
+    #[error("{}: atmosphere.table: {}", crate::text::path(file), one_line(&error.to_string()))]
+    Atmosphere {
+        file: PathBuf,
+        error: crate::atmosphere::AtmosphereTableError,
+    },
     /// Any other value out of its range or keys that do not fit together.
     #[error("{}: {}", crate::text::path(file), one_line(message))]
     Invalid { file: PathBuf, message: String },
@@ -114,6 +120,7 @@ impl SceneError {
             | SceneError::MeshRead { file, .. }
             | SceneError::Mesh { file, .. }
             | SceneError::Thermal { file, .. }
+            | SceneError::Atmosphere { file, .. }
             | SceneError::Invalid { file, .. } => file,
         }
     }

@@ -38,8 +38,9 @@ use mesh::ShadedMesh;
 use object::{build_object, ObjectSink};
 use std::path::{Path, PathBuf};
 use viewing::resolve_viewing;
-use warnings::{likely_mistakes, CELSIUS_SUSPECT_K};
+use warnings::{beyond_atmosphere_table, likely_mistakes, CELSIUS_SUSPECT_K};
 
+pub use crate::atmosphere::Atmosphere;
 pub use crate::material::SceneMaterial;
 pub use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
 pub use error::SceneError;
@@ -52,21 +53,6 @@ pub struct Surface {
     pub object: usize,
     pub part: String,
     pub material: usize,
-}
-
-/// Optional atmospheric path: S_sensor = τ S + (1 − τ) L_bb(T_path) δ_j0, τ = exp(−β·range).
-#[derive(Clone, Copy, Debug)]
-pub struct Atmosphere {
-    pub extinction_per_m: f64,
-    pub temperature_k: f64,
-}
-
-impl Atmosphere {
-    /// τ = exp(−β·range) over `range` metres.
-    #[inline]
-    pub fn transmittance(&self, range: f64) -> f64 {
-        (-self.extinction_per_m * range).exp()
-    }
 }
 
 #[derive(Clone, Debug)]
@@ -185,6 +171,11 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         _ => None,
     };
     warnings.extend(likely_mistakes(&config, &materials, band, weather_air));
+    warnings.extend(beyond_atmosphere_table(
+        viewing.atmosphere.as_ref(),
+        &viewing.camera.position,
+        &mesh.positions,
+    ));
     let (thermal, thermal_rebuild) = match thermal_run {
         Some((mut run, instants, _)) => {
             run.surfaces =

@@ -2,9 +2,10 @@
 //! each once and `summary.json` lists them.
 
 use super::config::{BackConfig, PartThermalConfig, SceneConfig, SkyConfig, WeatherConfig};
-use super::SceneMaterial;
+use super::{Atmosphere, SceneMaterial};
 use crate::optics::Band;
 use crate::text::{number, shown};
+use nalgebra::Vector3;
 
 /// Below this a temperature is probably in °C (the coldest natural surface, Antarctic snow at
 /// night, is ~180 K; nothing a thermal camera images is colder in an irpol scene).
@@ -64,6 +65,33 @@ pub(super) fn likely_mistakes(
         }
     }
     warnings
+}
+
+/// An atmosphere table that ends before the farthest object point (a mesh vertex: a triangle's
+/// farthest point from the camera is one of its corners): beyond its last range the render holds
+/// the last row's τ and path radiance, which a user should know of rather than find.
+pub(super) fn beyond_atmosphere_table(
+    atmosphere: Option<&Atmosphere>,
+    camera: &Vector3<f64>,
+    positions: &[Vector3<f64>],
+) -> Option<String> {
+    let atmosphere = atmosphere?;
+    let last = atmosphere.last_range_m()?;
+    let farthest = positions
+        .iter()
+        .map(|p| (p - camera).norm())
+        .fold(0.0, f64::max);
+    (farthest > last).then(|| {
+        format!(
+            "atmosphere.table '{}' ends at {} m but objects reach {} m from the camera: beyond \
+             {} m τ and path radiance are those of its last row (extend the table to the \
+             farthest range)",
+            crate::text::path(atmosphere.table_file().unwrap_or(std::path::Path::new(""))),
+            number(last),
+            crate::text::about(farthest),
+            number(last)
+        )
+    })
 }
 
 /// `key = t K looks like °C …`, the one wording of every such warning.

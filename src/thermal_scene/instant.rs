@@ -41,9 +41,15 @@ pub fn scene_at(
     environment.air_temperature_k = w.air_k;
     at.environment =
         Environment::new(&environment, &scene.sensor.band).map_err(InstantError::Environment)?;
-    if !instants.atmosphere_temperature_given {
-        if let Some(a) = &mut at.atmosphere {
-            a.temperature_k = w.air_k;
+    let band = &scene.sensor.band;
+    if let Some(a) = &mut at.atmosphere {
+        // The path follows the air unless the scene fixes its temperature; a spectral table's
+        // weight follows the NETD reference as the sensor's does below.
+        if !instants.atmosphere_temperature_given {
+            *a = a.with_path_temperature(w.air_k, band);
+        }
+        if !instants.netd_reference_given {
+            *a = a.with_reference_temperature(w.air_k, band);
         }
     }
     if !instants.netd_reference_given {
