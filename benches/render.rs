@@ -57,5 +57,29 @@ fn car(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, car);
+/// The 1080p car through the ideal camera and through a real one (f/1 optics with a 17 µm pixel,
+/// FPN and 14-bit quantization, a DoFP array with ER 30, 1° orientation errors, 2 % crosstalk,
+/// Newton demosaicking and calibration), measured in one run so their ratio is the camera's cost.
+fn camera(c: &mut Criterion) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut group = c.benchmark_group("render_car_camera");
+    group.sample_size(10);
+    let path = common::car_scene_with_shipped_fits(dir.path(), 1920, 1080, "pixel");
+    let ideal = std::fs::read_to_string(&path).unwrap();
+    let camera = ideal.replace(
+        "[environment]",
+        "[sensor.optics]\nf_number = 1.0\npixel_pitch_um = 17.0\nfill_factor = 0.8\n\
+         blur_sigma_px = 0.3\n\n[sensor.detector]\nfpn_gain_sigma = 0.01\nfpn_offset_mk = 20.0\n\
+         bits = 14\n\n[sensor.dofp]\nextinction_ratio = 30.0\norientation_sigma_deg = 1.0\n\
+         crosstalk = 0.02\ndemosaic = \"newton\"\n\n[environment]",
+    );
+    assert_ne!(camera, ideal, "the car scene changed");
+    for (name, text) in [("ideal_1920x1080", ideal), ("camera_1920x1080", camera)] {
+        let scene = irpol::scene::load_scene_text(&path, &text).unwrap();
+        group.bench_function(name, |b| b.iter(|| render(&scene, &Silent).unwrap()));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, car, camera);
 criterion_main!(benches);

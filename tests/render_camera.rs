@@ -1,34 +1,15 @@
 //! The camera of docs/design.md §1.11 on rendered scenes: the optics' MTF measured on a rendered
 //! slanted edge by the ISO 12233 method against the closed form, and a uniform scene's mean.
 
-mod common;
+#[path = "camera_support/mod.rs"]
+mod support;
 
-use common::*;
 use irpol::progress::Silent;
+use irpol::render::camera::slanted_edge::{slanted_edge_mtf, EdgeMtf};
 use irpol::render::render;
 use irpol::scene::load_scene_text;
 use std::f64::consts::PI;
-
-/// A hot plate whose edge crosses the image centre 5° from the vertical, seen straight down from
-/// 50 m against a black ground at 260 K (open world: no noise, no occlusion).
-fn slanted_edge_scene(optics: &str) -> String {
-    let angle = 5f64.to_radians();
-    format!(
-        "[camera]\nposition = [0.0, 0.0, 50.0]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
-         fov_deg = 3.0\nresolution = [160, 160]\n\n\
-         [sensor]\nnetd_reference_k = 300.0\n{optics}\n\
-         [environment]\nair_temperature_k = 283.15\n\
-         sky = {{ model = \"window\", zenith_emissivity = 0.75 }}\n\
-         ground = {{ temperature_k = 260.0, emissivity = 1.0 }}\n\n\
-         [render]\nopen_world = true\n\n{}\
-         [[objects]]\nname = \"plate\"\nshape = {{ kind = \"plane\", size = [40.0, 40.0], divisions = [1, 1] }}\n\
-         material = \"m\"\ntemperature_k = 330.0\nrotate_deg = [0.0, 0.0, 5.0]\n\
-         translate = [{}, {}, 0.0]\n",
-        material_toml(0.3, 2.0, 1.5, 0.05, 0.0),
-        20.0 * angle.cos(),
-        20.0 * angle.sin(),
-    )
-}
+use support::slanted_edge_scene;
 
 fn render_s0(text: &str) -> (usize, usize, Vec<f64>) {
     let dir = tempfile::tempdir().unwrap();
@@ -36,100 +17,6 @@ fn render_s0(text: &str) -> (usize, usize, Vec<f64>) {
     let image = render(&scene, &Silent).unwrap().image;
     let s0 = image.stokes.iter().map(|s| s[0]).collect();
     (image.width, image.height, s0)
-}
-
-/// ISO 12233 slanted-edge MTF of the rows `rows` of an image (`width` columns): edge located per
-/// row by the centroid of the row's derivative, a line fitted through them, the pixels binned by
-/// their distance to it (⅛ pixel, finer than ISO's ¼ to keep the binning's aliasing small, over
-/// ±64 pixels), differentiated and Fourier transformed, the binning's and the difference's own
-/// transfer divided out. Returns (edge slope dx/dy, MTF at
-/// each of `frequencies` in cycles per pixel along the edge normal).
-fn slanted_edge_mtf(
-    width: usize,
-    image: &[f64],
-    rows: std::ops::Range<usize>,
-    frequencies: &[f64],
-) -> (f64, Vec<f64>) {
-    // Edge position in each row: centroid of |Δ| at the half-integer positions (pixel centres
-    // are at x + ½).
-    let (ys, xs): (Vec<f64>, Vec<f64>) = rows
-        .clone()
-        .map(|y| {
-            let row = &image[y * width..(y + 1) * width];
-            let (mut sum, mut weighted) = (0.0, 0.0);
-            for x in 0..width - 1 {
-                let d = (row[x + 1] - row[x]).abs();
-                sum += d;
-                weighted += d * (x as f64 + 1.0);
-            }
-            (y as f64 + 0.5, weighted / sum)
-        })
-        .unzip();
-    let n = ys.len() as f64;
-    let (my, mx) = (ys.iter().sum::<f64>() / n, xs.iter().sum::<f64>() / n);
-    let slope = ys
-        .iter()
-        .zip(&xs)
-        .map(|(y, x)| (y - my) * (x - mx))
-        .sum::<f64>()
-        / ys.iter().map(|y| (y - my).powi(2)).sum::<f64>();
-    let norm = (1.0 + slope * slope).sqrt();
-    // Edge spread function in ⅛-pixel bins of the normal distance.
-    const BIN: f64 = 0.125;
-    const HALF: usize = 512;
-    let mut sums = vec![0.0; 2 * HALF];
-    let mut counts = vec![0usize; 2 * HALF];
-    for y in rows {
-        let edge = mx + slope * (y as f64 + 0.5 - my);
-        for x in 0..width {
-            let d = (x as f64 + 0.5 - edge) / norm;
-            let bin = (d / BIN).floor() + HALF as f64;
-            if (0.0..(2 * HALF) as f64).contains(&bin) {
-                sums[bin as usize] += image[y * width + x];
-                counts[bin as usize] += 1;
-            }
-        }
-    }
-    assert!(
-        counts.iter().all(|&c| c > 0),
-        "every ¼-pixel bin holds samples"
-    );
-    let esf: Vec<f64> = sums
-        .iter()
-        .zip(&counts)
-        .map(|(s, &c)| s / c as f64)
-        .collect();
-    // Line spread by the central difference. No Hamming window: the data have no noise, and the
-    // window would cut the Airy pattern's long tails (0.7 % too high an MTF at low frequencies).
-    let lsf: Vec<f64> = (0..esf.len())
-        .map(|i| match i {
-            0 => 0.0,
-            i if i + 1 == esf.len() => 0.0,
-            i => 0.5 * (esf[i + 1] - esf[i - 1]),
-        })
-        .collect();
-    let transform = |f: f64| {
-        let (mut re, mut im) = (0.0, 0.0);
-        for (i, v) in lsf.iter().enumerate() {
-            let phase = 2.0 * PI * f * (i as f64 * BIN);
-            re += v * phase.cos();
-            im -= v * phase.sin();
-        }
-        re.hypot(im)
-    };
-    let zero = transform(0.0);
-    let sinc = |u: f64| {
-        if u == 0.0 {
-            1.0
-        } else {
-            (PI * u).sin() / (PI * u)
-        }
-    };
-    let mtf = frequencies
-        .iter()
-        .map(|&f| transform(f) / zero / (sinc(f * BIN) * sinc(2.0 * f * BIN)))
-        .collect();
-    (slope, mtf)
 }
 
 /// The closed form of docs/design.md §1.11 at frequency f along the direction (cos θ, sin θ):
@@ -173,7 +60,9 @@ fn slanted_edge_mtf_is_the_closed_form_up_to_nyquist() {
     // The ideal camera's point samples: the edge is a step, its MTF 1 at every frequency (the
     // method's own error on a step is 0.2 % at Nyquist; with ISO's ¼-pixel bins it was 3 %).
     let (w, _, ideal) = render_s0(&slanted_edge_scene(""));
-    let (_, flat) = slanted_edge_mtf(w, &ideal, 24..136, &frequencies);
+    let flat = slanted_edge_mtf(&ideal, w, 24..136, &frequencies)
+        .unwrap()
+        .mtf;
     for (f, m) in frequencies.iter().zip(&flat) {
         assert!((m - 1.0).abs() < 0.005, "ideal camera: MTF({f}) = {m}");
     }
@@ -188,7 +77,7 @@ fn slanted_edge_mtf_is_the_closed_form_up_to_nyquist() {
              fill_factor = {fill}\nblur_sigma_px = {sigma}\n"
         );
         let (w, _, s0) = render_s0(&slanted_edge_scene(&optics));
-        let (slope, mtf) = slanted_edge_mtf(w, &s0, 24..136, &frequencies);
+        let EdgeMtf { slope, mtf } = slanted_edge_mtf(&s0, w, 24..136, &frequencies).unwrap();
         let theta = slope.atan();
         for (&f, &measured) in frequencies.iter().zip(&mtf) {
             let want = closed_form_mtf(f, theta, f_number, pitch, fill, sigma);

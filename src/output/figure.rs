@@ -11,6 +11,8 @@
 use super::colormap::{cyclic, ColorMap, Lut, DIVERGING, GRAY, MASKED, SEQUENTIAL, THERMAL};
 use crate::optics::TemperatureLookup;
 use crate::plot_style::{register_fonts, FONT};
+use crate::render::camera::metrics::{aop_difference, AOP_DOLP_THRESHOLD};
+use crate::render::camera::DofpImages;
 use crate::render::film::{dolp_aop, StokesImage, BACKGROUND};
 use crate::scene::config::{PreviewConfig, PreviewRange, S0Colormap};
 use crate::scene::{Scene, Transport};
@@ -131,15 +133,7 @@ impl Previews {
     /// 480 pixels wide and tall.
     pub fn composite_png(&self) -> io::Result<Vec<u8>> {
         register_fonts();
-        // At most 480 pixels wide and tall per panel, so an extreme aspect ratio (20 × 200000)
-        // does not make a sheet of hundreds of megabytes.
-        let scale = (480.0 / self.width as f64)
-            .min(480.0 / self.height as f64)
-            .min(1.0);
-        let (img_w, img_h) = (
-            ((self.width as f64 * scale).round() as usize).max(1),
-            ((self.height as f64 * scale).round() as usize).max(1),
-        );
+        let (img_w, img_h) = cell_size(self.width, self.height);
         // S0, S1, S2, DoLP, AoP (the paper's Fig. 5); S3 has its own preview only.
         let cells: Vec<Canvas> = self
             .panels
@@ -176,6 +170,101 @@ impl Previews {
         }
         sheet.png()
     }
+}
+
+/// `dofp_error.png` (with `[sensor.dofp]`): the DoLP of the noise-free radiance and of the DoFP
+/// camera on one colour range, their difference, and the AoP error where the true DoLP exceeds
+/// 1 % (elsewhere the angle is noise), in a 2 × 2 sheet.
+pub fn dofp_error_png(
+    scene: &Scene,
+    image: &StokesImage,
+    dofp: &DofpImages,
+) -> io::Result<Vec<u8>> {
+    let ranged = ranged_pixels(image);
+    let polarization = |s: &[f64; 3]| dolp_aop([s[0], s[1], s[2], 0.0]);
+    let truth: Vec<(f64, f64)> = dofp.truth.par_iter().map(polarization).collect();
+    let camera: Vec<(f64, f64)> = dofp.stokes.par_iter().map(polarization).collect();
+    let dolp_percent = |v: &[(f64, f64)]| v.iter().map(|p| 100.0 * p.0).collect::<Vec<f64>>();
+    let true_dolp = dolp_percent(&truth);
+    let ranging: Vec<f64> = true_dolp
+        .iter()
+        .zip(&ranged)
+        .filter(|(_, &r)| r)
+        .map(|(&v, _)| v)
+        .collect();
+    let top = widen(0.0, robust_range(ranging, 0.0, 0.999, 0.0).1).1;
+    let dolp_panel = |title: String, values| LinearPanel {
+        file: "dofp_error.png",
+        title,
+        values,
+        fixed: Some([0.0, top]),
+        symmetric: false,
+        map: &SEQUENTIAL,
+        format: |v| format!("{v:.2}"),
+    };
+    let method = scene.sensor.dofp.map_or("bilinear", |d| d.demosaic.name());
+    let difference = LinearPanel {
+        file: "dofp_error.png",
+        title: "DoLP error, camera − truth (%)".into(),
+        values: dolp_percent(&camera)
+            .iter()
+            .zip(&true_dolp)
+            .map(|(c, t)| c - t)
+            .collect(),
+        fixed: None,
+        symmetric: true,
+        map: &DIVERGING,
+        format: format_signed,
+    };
+    let aop_error = LinearPanel {
+        file: "dofp_error.png",
+        title: "AoP error (°) where the true DoLP > 1 %".into(),
+        values: truth
+            .iter()
+            .zip(&camera)
+            .map(|(t, c)| match t.0 > AOP_DOLP_THRESHOLD {
+                true => aop_difference(c.1, t.1).to_degrees(),
+                false => f64::NAN,
+            })
+            .collect(),
+        fixed: Some([-45.0, 45.0]),
+        symmetric: true,
+        map: &DIVERGING,
+        format: format_signed,
+    };
+    let panels = [
+        dolp_panel("DoLP, noise-free truth (%)".into(), true_dolp.clone()),
+        dolp_panel(
+            format!("DoLP, DoFP camera, {method} (%)"),
+            dolp_percent(&camera),
+        ),
+        difference,
+        aop_error,
+    ]
+    .map(|p| p.panel(&ranged, &scene.preview));
+    let cells: Vec<Canvas> = panels
+        .iter()
+        .map(|p| {
+            let (w, h) = cell_size(image.width, image.height);
+            draw_panel(p, image.width, image.height, w, h)
+        })
+        .collect::<io::Result<_>>()?;
+    let (cell_w, cell_h) = (cells[0].width, cells[0].height);
+    let mut sheet = Canvas::white(2 * cell_w, 2 * cell_h);
+    for (i, cell) in cells.iter().enumerate() {
+        sheet.blit(cell, (i % 2) * cell_w, (i / 2) * cell_h);
+    }
+    sheet.png()
+}
+
+/// A sheet cell's image size: at most 480 pixels wide and tall, so an extreme aspect ratio
+/// (20 × 200000) does not make a sheet of hundreds of megabytes.
+fn cell_size(width: usize, height: usize) -> (usize, usize) {
+    let scale = (480.0 / width as f64).min(480.0 / height as f64).min(1.0);
+    (
+        ((width as f64 * scale).round() as usize).max(1),
+        ((height as f64 * scale).round() as usize).max(1),
+    )
 }
 
 impl LinearPanel {
@@ -234,6 +323,7 @@ impl LinearPanel {
             .par_iter()
             .zip(ranged)
             .map(|(&v, &r)| match v {
+                v if v.is_nan() => MASKED,
                 v if v < lo && r => self.map.under,
                 v if v > hi && r => self.map.over,
                 v if v < lo => lut.at(0.0),

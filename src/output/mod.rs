@@ -319,6 +319,7 @@ enum ImageJob {
     Exr,
     Panel(usize),
     Composite,
+    DofpError,
 }
 
 /// The image files of a render: channel and ground-truth TIFFs, `stokes.exr`, the PNG previews
@@ -361,6 +362,9 @@ impl<'a> ImageFiles<'a> {
         jobs.push(ImageJob::Exr);
         jobs.extend((0..self.previews.len()).map(ImageJob::Panel));
         jobs.push(ImageJob::Composite);
+        if self.image.dofp.is_some() {
+            jobs.push(ImageJob::DofpError);
+        }
         jobs
     }
 
@@ -423,6 +427,15 @@ impl<'a> ImageFiles<'a> {
                 self.previews.panel_png(*i),
             ),
             ImageJob::Composite => ("composite.png".to_owned(), self.previews.composite_png()),
+            ImageJob::DofpError => {
+                let dofp = self
+                    .image
+                    .dofp
+                    .as_ref()
+                    .expect("a DoFP job has DoFP images");
+                let bytes = figure::dofp_error_png(self.scene, self.image, dofp);
+                ("dofp_error.png".to_owned(), bytes)
+            }
         }
     }
 }

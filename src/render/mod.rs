@@ -59,6 +59,8 @@ pub struct Timings {
     pub tables: f64,
     pub raster: f64,
     pub shade: f64,
+    /// The camera: optics, detector, DoFP array, metrics.
+    pub camera: f64,
     pub write: f64,
     pub total: f64,
 }
@@ -111,9 +113,15 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
             Some(PathTracer::new(scene, &open_world, &accel, settings))
         }
     };
-    let image = shade_image(scene, &open_world, tracer.as_ref(), &fragments, &tick);
+    let mut image = shade_image(scene, &open_world, tracer.as_ref(), &fragments, &tick);
     progress.end();
     timings.shade = shade_start.elapsed().as_secs_f64();
+    let camera_start = Instant::now();
+    let recording = camera::record(&scene.sensor, image.width, image.height, &mut image.stokes);
+    image.recorded_polarizers = recording.polarizers;
+    image.dofp = recording.dofp;
+    image.camera_metrics = recording.metrics;
+    timings.camera = camera_start.elapsed().as_secs_f64();
     timings.total = start.elapsed().as_secs_f64();
     Ok(Rendered {
         image,
@@ -255,7 +263,8 @@ impl PixelShader<'_> {
     }
 }
 
-/// Shades every pixel (per-pixel or Gouraud), adds the background, the atmosphere and the noise.
+/// Shades every pixel (per-pixel or Gouraud), adds the background and the atmosphere: the
+/// radiance the camera receives.
 fn shade_image(
     scene: &Scene,
     open_world: &OpenWorld,
@@ -300,7 +309,6 @@ fn shade_image(
             }
             tick();
         });
-    let recording = camera::record(&scene.sensor, width, height, &mut stokes);
     StokesImage {
         width,
         height,
@@ -308,8 +316,8 @@ fn shade_image(
         standard_error,
         surface,
         truth,
-        recorded_polarizers: recording.polarizers,
-        dofp: recording.dofp,
-        camera_metrics: recording.metrics,
+        recorded_polarizers: Vec::new(),
+        dofp: None,
+        camera_metrics: None,
     }
 }

@@ -4,22 +4,37 @@
 
 use super::DofpImages;
 use crate::render::film::dolp_aop;
+use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::PI;
 
 /// True DoLP above which the AoP error is counted.
 pub const AOP_DOLP_THRESHOLD: f64 = 0.01;
 
+/// `estimate − truth` of two AoPs (radians), wrapped into (−π/2, π/2]: the AoP is an axis.
+pub fn aop_difference(estimate: f64, truth: f64) -> f64 {
+    let d = (estimate - truth).rem_euclid(PI);
+    if d > PI / 2.0 {
+        d - PI
+    } else {
+        d
+    }
+}
+
 /// PSNR = 10 log10(peak²/MSE) dB, peak the truth's largest magnitude; `None` when the estimate is
 /// exact (MSE = 0) or the truth is all zeros.
 pub fn psnr(truth: &[f64], estimate: &[f64]) -> Option<f64> {
     let peak = truth.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let mse = truth
+    let squared: f64 = truth
         .iter()
         .zip(estimate)
         .map(|(t, e)| (t - e).powi(2))
-        .sum::<f64>()
-        / truth.len().max(1) as f64;
+        .sum();
+    psnr_db(peak, squared / truth.len().max(1) as f64)
+}
+
+/// 10 log10(peak²/MSE); `None` for an exact estimate or a zero peak.
+fn psnr_db(peak: f64, mse: f64) -> Option<f64> {
     (mse > 0.0 && peak > 0.0).then(|| 10.0 * (peak * peak / mse).log10())
 }
 
@@ -37,48 +52,62 @@ pub struct Reconstruction {
 }
 
 impl Reconstruction {
-    /// Compares `estimate` (S0, S1, S2 per pixel) with `truth`.
+    /// Compares `estimate` (S0, S1, S2 per pixel) with `truth`, in one parallel pass.
     pub fn of(truth: &[[f64; 4]], estimate: &[[f64; 3]]) -> Reconstruction {
-        let channel = |c: usize| {
-            let t: Vec<f64> = truth.iter().map(|s| s[c]).collect();
-            let e: Vec<f64> = estimate.iter().map(|s| s[c]).collect();
-            psnr(&t, &e)
-        };
-        let polarization = |s: [f64; 3]| dolp_aop([s[0], s[1], s[2], 0.0]);
-        // (DoLP, AoP) of the truth and of the estimate at each pixel.
-        type Polarization = Vec<(f64, f64)>;
-        let (true_pol, est_pol): (Polarization, Polarization) = truth
-            .iter()
+        let sums = truth
+            .par_iter()
             .zip(estimate)
-            .map(|(t, e)| (polarization([t[0], t[1], t[2]]), polarization(*e)))
-            .unzip();
-        let dolp = |v: &[(f64, f64)]| v.iter().map(|p| p.0).collect::<Vec<f64>>();
-        let aop_errors: Vec<f64> = true_pol
-            .iter()
-            .zip(&est_pol)
-            .filter(|(t, _)| t.0 > AOP_DOLP_THRESHOLD)
-            .map(|(t, e)| {
-                // The AoP is an axis: wrap the difference into (−π/2, π/2].
-                let d = (e.1 - t.1).rem_euclid(PI);
-                if d > PI / 2.0 {
-                    d - PI
-                } else {
-                    d
-                }
-            })
-            .collect();
-        let aop_rmse_deg = (!aop_errors.is_empty()).then(|| {
-            (aop_errors.iter().map(|d| d * d).sum::<f64>() / aop_errors.len() as f64)
-                .sqrt()
-                .to_degrees()
-        });
+            .fold(ErrorSums::default, |sums, (t, e)| sums.add(t, e))
+            .reduce(ErrorSums::default, ErrorSums::merge);
+        let n = truth.len().max(1) as f64;
+        let psnr_of = |peak: f64, squared: f64| psnr_db(peak, squared / n);
         Reconstruction {
-            psnr_s0_db: channel(0),
-            psnr_s1_db: channel(1),
-            psnr_s2_db: channel(2),
-            psnr_dolp_db: psnr(&dolp(&true_pol), &dolp(&est_pol)),
-            aop_rmse_deg,
-            aop_pixels: aop_errors.len(),
+            psnr_s0_db: psnr_of(sums.peak[0], sums.squared[0]),
+            psnr_s1_db: psnr_of(sums.peak[1], sums.squared[1]),
+            psnr_s2_db: psnr_of(sums.peak[2], sums.squared[2]),
+            psnr_dolp_db: psnr_of(sums.peak[3], sums.squared[3]),
+            aop_rmse_deg: (sums.aop_pixels > 0).then(|| {
+                (sums.aop_squared / sums.aop_pixels as f64)
+                    .sqrt()
+                    .to_degrees()
+            }),
+            aop_pixels: sums.aop_pixels,
+        }
+    }
+}
+
+/// Running peaks and squared errors of S0, S1, S2, DoLP, and the squared AoP error where the true
+/// DoLP exceeds [`AOP_DOLP_THRESHOLD`].
+#[derive(Clone, Copy, Default)]
+struct ErrorSums {
+    peak: [f64; 4],
+    squared: [f64; 4],
+    aop_squared: f64,
+    aop_pixels: usize,
+}
+
+impl ErrorSums {
+    fn add(mut self, t: &[f64; 4], e: &[f64; 3]) -> ErrorSums {
+        let (true_dolp, true_aop) = dolp_aop([t[0], t[1], t[2], 0.0]);
+        let (dolp, aop) = dolp_aop([e[0], e[1], e[2], 0.0]);
+        let pairs = [(t[0], e[0]), (t[1], e[1]), (t[2], e[2]), (true_dolp, dolp)];
+        for (j, (truth, estimate)) in pairs.into_iter().enumerate() {
+            self.peak[j] = self.peak[j].max(truth.abs());
+            self.squared[j] += (truth - estimate).powi(2);
+        }
+        if true_dolp > AOP_DOLP_THRESHOLD {
+            self.aop_squared += aop_difference(aop, true_aop).powi(2);
+            self.aop_pixels += 1;
+        }
+        self
+    }
+
+    fn merge(a: ErrorSums, b: ErrorSums) -> ErrorSums {
+        ErrorSums {
+            peak: [0, 1, 2, 3].map(|j| a.peak[j].max(b.peak[j])),
+            squared: [0, 1, 2, 3].map(|j| a.squared[j] + b.squared[j]),
+            aop_squared: a.aop_squared + b.aop_squared,
+            aop_pixels: a.aop_pixels + b.aop_pixels,
         }
     }
 }

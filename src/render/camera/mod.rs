@@ -2,7 +2,8 @@
 //! polarizer images ([`otf`]), the detector adds temporal noise (`render::sensor`), its fixed
 //! pattern and quantization ([`detector`]), and a division-of-focal-plane array records one
 //! imperfect polarizer per pixel ([`polarizer_array`]) to be demosaicked (`render::dofp`).
-//! [`metrics`] compares what the camera delivers with the noise-free truth.
+//! [`metrics`] compares what the camera delivers with the noise-free truth; [`slanted_edge`]
+//! measures an image's MTF.
 //!
 //! Two cameras are simulated from the same optics and detector: the four-image polarimeter whose
 //! Stokes images are the render's S0–S3 (each pixel sees all four polarizer images, each with its
@@ -15,12 +16,13 @@ pub mod detector;
 pub mod metrics;
 pub mod otf;
 pub mod polarizer_array;
+pub mod slanted_edge;
 
 use super::dofp::{demosaic, orientation};
 use super::film::polarizer;
 use super::sensor::Noise;
 use crate::scene::Sensor;
-use detector::DetectorModel;
+use detector::{DetectorModel, PixelPattern};
 use metrics::CameraMetrics;
 use polarizer_array::{PolarizerArray, ORIENTATIONS};
 use rayon::prelude::*;
@@ -31,6 +33,8 @@ pub struct DofpImages {
     pub mosaic: Vec<f64>,
     /// Stokes (S0, S1, S2) per pixel, demosaicked and reconstructed.
     pub stokes: Vec<[f64; 3]>,
+    /// (S0, S1, S2) of the noise-free radiance before the optics, what `stokes` estimates.
+    pub truth: Vec<[f64; 3]>,
 }
 
 /// The camera's records of one render.
@@ -55,25 +59,36 @@ pub fn record(sensor: &Sensor, width: usize, height: usize, stokes: &mut [[f64; 
     let measured = !is_ideal(sensor) || sensor.dofp.is_some();
     let truth = measured.then(|| stokes.to_vec());
     if let Some(optics) = sensor.optics {
-        otf::filter_stokes(
-            &otf::TransferFunction::new(sensor, optics),
-            width,
-            height,
-            stokes,
-        );
+        let otf = otf::TransferFunction::new(sensor, optics);
+        otf::filter_stokes(&otf, width, height, stokes);
     }
-    let noise = Noise::of_sensor(sensor);
-    let detector = sensor.detector.map(|d| DetectorModel::new(sensor, d));
-    let dofp = sensor.dofp.map(|d| {
-        let array = PolarizerArray::new(sensor, d, width, height);
-        record_dofp(&array, &noise, detector.as_ref(), stokes)
-    });
-    let polarizers = if noise.is_noisy() || detector.is_some() {
-        record_four_images(&noise, detector.as_ref(), width, stokes)
-    } else {
-        Vec::new()
+    let detector = Detection {
+        noise: Noise::of_sensor(sensor),
+        pattern: sensor.detector.map(|d| DetectorModel::new(sensor, d)),
     };
-    let metrics = truth.map(|truth| CameraMetrics::of(&truth, stokes, dofp.as_ref()));
+    let array = sensor
+        .dofp
+        .map(|d| PolarizerArray::new(sensor, d, width, height));
+    // Every pixel's signal through its own polarizer, from the radiance before any noise.
+    let signals = array.as_ref().map(|a| a.signals(stokes));
+    let four_images = detector.noise.is_noisy() || detector.pattern.is_some();
+    let (polarizers, mosaic) =
+        record_rows(&detector, signals.as_deref(), four_images, width, stokes);
+    let dofp = array.map(|array| {
+        let polarizers = demosaic(width, height, &mosaic, array.dofp.demosaic);
+        DofpImages {
+            stokes: array.reconstruct(&polarizers),
+            mosaic,
+            truth: Vec::new(),
+        }
+    });
+    let metrics = truth
+        .as_ref()
+        .map(|truth| CameraMetrics::of(truth, stokes, dofp.as_ref()));
+    let dofp = dofp.map(|d| DofpImages {
+        truth: truth.iter().flatten().map(|s| [s[0], s[1], s[2]]).collect(),
+        ..d
+    });
     Recording {
         polarizers,
         dofp,
@@ -81,74 +96,86 @@ pub fn record(sensor: &Sensor, width: usize, height: usize, stokes: &mut [[f64; 
     }
 }
 
-/// The four-image camera: each polarizer image of each pixel with its noise and pattern; the
-/// Stokes vectors re-estimated from them, S0 = ½ΣI, S1 = I0 − I90, S2 = I45 − I135 (S3 is not
-/// measured by linear polarizers and is left as it is).
-fn record_four_images(
-    noise: &Noise,
-    detector: Option<&DetectorModel>,
-    width: usize,
-    stokes: &mut [[f64; 4]],
-) -> Vec<[f32; 4]> {
-    let mut recorded = vec![[0.0f32; 4]; stokes.len()];
-    stokes
-        .par_chunks_mut(width)
-        .zip(recorded.par_chunks_mut(width))
-        .enumerate()
-        .for_each(|(y, (row, row_recorded))| {
-            let normals = noise.row_normals(y, width);
-            let pattern = detector.map(|d| d.pattern_row(y, width));
-            for (x, s) in row.iter_mut().enumerate() {
-                let mut i = [0, 1, 2, 3].map(|k| {
-                    polarizer(*s, ORIENTATIONS[k]) + noise.sigma_polarizer * normals[x][k]
-                });
-                if let (Some(d), Some(p)) = (detector, &pattern) {
-                    i = [0, 1, 2, 3].map(|k| d.read(i[k], &p[x], k));
-                }
-                row_recorded[x] = i.map(|v| v as f32);
-                *s = [
-                    0.5 * (i[0] + i[1] + i[2] + i[3]),
-                    i[0] - i[2],
-                    i[1] - i[3],
-                    s[3],
-                ];
-            }
-        });
-    recorded
+/// The detector: temporal noise and, optionally, its fixed pattern and quantizer.
+struct Detection {
+    noise: Noise,
+    pattern: Option<DetectorModel>,
 }
 
-/// The DoFP camera: every pixel's signal through its own polarizer (crosstalk included), with
-/// the noise draw of that polarizer image and the pixel's pattern; then demosaicked and
-/// reconstructed.
-fn record_dofp(
-    array: &PolarizerArray,
-    noise: &Noise,
-    detector: Option<&DetectorModel>,
-    stokes: &[[f64; 4]],
-) -> DofpImages {
-    let (width, height) = array.size();
-    let signals = array.signals(stokes);
-    let mut mosaic = vec![0.0f64; stokes.len()];
-    mosaic
+impl Detection {
+    /// What polarizer image `k` of pixel `x` in a row reads for `signal`, given the row's noise
+    /// draws and pattern.
+    #[inline]
+    fn read(
+        &self,
+        signal: f64,
+        normals: &[f64; 4],
+        pattern: Option<&PixelPattern>,
+        k: usize,
+    ) -> f64 {
+        let value = signal + self.noise.sigma_polarizer * normals[k];
+        match (&self.pattern, pattern) {
+            (Some(d), Some(p)) => d.read(value, p, k),
+            _ => value,
+        }
+    }
+}
+
+/// Both cameras, row by row with one set of noise draws and one pattern per row:
+/// - the four-image camera (when `four_images`): each polarizer image of each pixel with its noise
+///   and pattern, returned per pixel; the Stokes vectors in `stokes` re-estimated from them,
+///   S0 = ½ΣI, S1 = I0 − I90, S2 = I45 − I135 (S3 is not measured by linear polarizers and is
+///   left as it is);
+/// - the DoFP camera (with `signals`): each pixel's signal through its own polarizer with the
+///   noise draw and pattern of that polarizer image, returned as the mosaic.
+fn record_rows(
+    detector: &Detection,
+    signals: Option<&[f64]>,
+    four_images: bool,
+    width: usize,
+    stokes: &mut [[f64; 4]],
+) -> (Vec<[f32; 4]>, Vec<f64>) {
+    let rows: Vec<(Vec<[f32; 4]>, Vec<f64>)> = stokes
         .par_chunks_mut(width)
         .enumerate()
-        .for_each(|(y, row)| {
-            let normals = noise.row_normals(y, width);
-            let pattern = detector.map(|d| d.pattern_row(y, width));
-            for (x, value) in row.iter_mut().enumerate() {
-                let k = orientation(x, y);
-                let mut v = signals[y * width + x] + noise.sigma_polarizer * normals[x][k];
-                if let (Some(d), Some(p)) = (detector, &pattern) {
-                    v = d.read(v, &p[x], k);
-                }
-                *value = v;
+        .map(|(y, row)| {
+            let normals = detector.noise.row_normals(y, width);
+            let pattern = detector.pattern.as_ref().map(|d| d.pattern_row(y, width));
+            let pixel_pattern = |x: usize| pattern.as_ref().map(|p| &p[x]);
+            let raw: Vec<f64> = match signals {
+                None => Vec::new(),
+                Some(signals) => (0..width)
+                    .map(|x| {
+                        let (signal, k) = (signals[y * width + x], orientation(x, y));
+                        detector.read(signal, &normals[x], pixel_pattern(x), k)
+                    })
+                    .collect(),
+            };
+            if !four_images {
+                return (Vec::new(), raw);
             }
-        });
-    let polarizers = demosaic(width, height, &mosaic, array.dofp.demosaic);
-    DofpImages {
-        stokes: array.reconstruct(&polarizers),
-        mosaic,
-    }
+            let recorded = row
+                .iter_mut()
+                .enumerate()
+                .map(|(x, s)| {
+                    let i = [0, 1, 2, 3].map(|k| {
+                        let ideal = polarizer(*s, ORIENTATIONS[k]);
+                        detector.read(ideal, &normals[x], pixel_pattern(x), k)
+                    });
+                    *s = [
+                        0.5 * (i[0] + i[1] + i[2] + i[3]),
+                        i[0] - i[2],
+                        i[1] - i[3],
+                        s[3],
+                    ];
+                    i.map(|v| v as f32)
+                })
+                .collect();
+            (recorded, raw)
+        })
+        .collect();
+    let (recorded, mosaic): (Vec<_>, Vec<_>) = rows.into_iter().unzip();
+    (recorded.concat(), mosaic.concat())
 }
 
 #[cfg(test)]
@@ -278,9 +305,13 @@ mod tests {
         };
         let (w, n) = (20_000, 20_000.0);
         let mut row = vec![[5.0, 0.2, -0.1, 0.0]; w];
-        let recorded = record_four_images(&noise, None, w, &mut row);
+        let detector = Detection {
+            noise,
+            pattern: None,
+        };
+        let (recorded, _) = record_rows(&detector, None, true, w, &mut row);
         let mut again = vec![[5.0, 0.2, -0.1, 0.0]; w];
-        record_four_images(&noise, None, w, &mut again);
+        record_rows(&detector, None, true, w, &mut again);
         assert_eq!(row, again);
         // The Stokes vectors are the re-estimate from the recorded polarizer images.
         for (s, i) in row.iter().zip(&recorded).take(100) {

@@ -168,20 +168,19 @@ pub fn filter_stokes(otf: &TransferFunction, width: usize, height: usize, stokes
 }
 
 /// The OTF at the DFT frequencies of a `pw` × `ph` grid, in the transposed (column-major) layout
-/// the 2-D transform leaves its spectrum in.
+/// the 2-D transform leaves its spectrum in. The OTF is even in f_x and f_y, so it is evaluated on
+/// one quadrant of frequencies (|k| ≤ n/2) and read from there.
 fn otf_grid(otf: &TransferFunction, pw: usize, ph: usize) -> Vec<f64> {
-    let frequency = |k: usize, n: usize| {
-        let k = k as f64;
-        let n_f = n as f64;
-        if k < n_f / 2.0 {
-            k / n_f
-        } else {
-            (k - n_f) / n_f
-        }
-    };
+    let (qw, qh) = (pw / 2 + 1, ph / 2 + 1);
+    let quadrant: Vec<f64> = (0..qw * qh)
+        .into_par_iter()
+        .map(|i| otf.at((i / qh) as f64 / pw as f64, (i % qh) as f64 / ph as f64))
+        .collect();
+    // DFT index k stands for the frequency k/n or (k − n)/n, whose magnitude is min(k, n − k)/n.
+    let folded = |k: usize, n: usize| k.min(n - k);
     (0..pw * ph)
         .into_par_iter()
-        .map(|i| otf.at(frequency(i / ph, pw), frequency(i % ph, ph)))
+        .map(|i| quadrant[folded(i / ph, pw) * qh + folded(i % ph, ph)])
         .collect()
 }
 

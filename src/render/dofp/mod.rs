@@ -259,7 +259,7 @@ mod tests {
                 .into_iter()
                 .map(|p| {
                     let s = stokes_from_polarizers(p);
-                    (s[1] * s[1] + s[2] * s[2]) as f64
+                    s[1] * s[1] + s[2] * s[2]
                 })
                 .sum::<f64>()
         };

@@ -160,7 +160,7 @@ pub(super) fn demosaic(width: usize, height: usize, raw: &[f64]) -> Vec<[f64; 4]
     (0..width * height)
         .map(|p| {
             let i = (p / width + PAD) * pw + p % width + PAD;
-            [0, 1, 2, 3].map(|k| planes[k].values[i] as f64)
+            [0, 1, 2, 3].map(|k| planes[k].values[i])
         })
         .collect()
 }

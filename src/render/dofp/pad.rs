@@ -68,7 +68,7 @@ pub(super) fn padded(width: usize, height: usize, raw: &[f64], pad: usize) -> Gr
         let row = &raw[y * width..(y + 1) * width];
         for x in 0..pw {
             let (p, m) = reflect(x as isize - offset, width);
-            wide[y * pw + x] = 2.0 * row[p] as f64 - row[m] as f64;
+            wide[y * pw + x] = 2.0 * row[p] - row[m];
         }
     }
     let mut grid = Grid::filled(pw, ph, 0.0);
@@ -92,7 +92,7 @@ mod tests {
         let raw: Vec<f64> = (0..w * h)
             .map(|i| {
                 let (x, y) = (i % w, i / w);
-                channel(super::super::orientation(x, y), x as f64, y as f64) as f64
+                channel(super::super::orientation(x, y), x as f64, y as f64)
             })
             .collect();
         let grid = padded(w, h, &raw, pad);

@@ -108,11 +108,11 @@ fn orientation_plane(raw: &Grid, g: &Grid, k: usize, eps: f64, out: &mut [[f64; 
     for (index, pixel) in out.iter_mut().enumerate() {
         let (x, y) = (index % width + PAD, index / width + PAD);
         if super::orientation(x, y) == k {
-            pixel[k] = raw.at(x, y, 0, 0) as f64;
+            pixel[k] = raw.at(x, y, 0, 0);
             continue;
         }
         let tentative = lattice.at(&a, x, y) * g.at(x, y, 0, 0) + lattice.at(&b, x, y);
-        pixel[k] = (tentative + lattice.at(&residual, x, y)) as f64;
+        pixel[k] = tentative + lattice.at(&residual, x, y);
     }
 }
 
@@ -120,7 +120,7 @@ fn orientation_plane(raw: &Grid, g: &Grid, k: usize, eps: f64, out: &mut [[f64; 
 pub(super) fn demosaic(width: usize, height: usize, raw: &[f64]) -> Vec<[f64; 4]> {
     let grid = padded(width, height, raw, PAD);
     let g = guide(width, height, raw);
-    let peak = raw.iter().fold(0.0f64, |m, v| m.max(v.abs() as f64));
+    let peak = raw.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let eps = (EPS_RELATIVE * peak).powi(2) + f64::MIN_POSITIVE;
     let mut out = vec![[0.0f64; 4]; width * height];
     for k in 0..4 {
