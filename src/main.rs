@@ -163,6 +163,22 @@ enum Command {
         #[arg(long)]
         clear_sky: bool,
     },
+    /// An EPW or TMY3 weather file as irpol reads it, as CSV on stdout: a row per hour (the label
+    /// in UTC, the fields in SI units, empty where missing, the sun at the file's site), or with
+    /// --step the thermal model's forcing every STEP seconds.
+    Weather {
+        /// The weather file (.epw, or a TMY3 CSV).
+        file: PathBuf,
+        /// The format, when the file name and header do not tell: epw or tmy3.
+        #[arg(long, value_parser = ["epw", "tmy3"])]
+        format: Option<String>,
+        /// Read every row in this year (a typical-year file mixes years).
+        #[arg(long)]
+        year: Option<i32>,
+        /// Print the forcing (air, wind, DNI, DHI, long-wave, sun) every STEP seconds instead.
+        #[arg(long)]
+        step: Option<f64>,
+    },
     /// A table of the materials in a library folder.
     Library {
         /// The library folder (`irpol fit --out`'s folder).
@@ -341,6 +357,12 @@ fn run(command: Command) -> anyhow::Result<()> {
             let times = given_times(time_utc.as_deref(), times_file.as_deref())?;
             sun(latitude, longitude, &times, clear_sky)
         }
+        Command::Weather {
+            file,
+            format,
+            year,
+            step,
+        } => weather(&file, format.as_deref(), year, step),
         Command::Library { dir, dir_flag } => print_library(&dir_flag.unwrap_or(dir)),
         Command::Demo => demo(),
     }
@@ -439,6 +461,27 @@ fn sun(
 ) -> anyhow::Result<()> {
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     write_sun_csv(latitude, longitude, times, clear_sky, &mut out)?;
+    Ok(out.flush()?)
+}
+
+/// `irpol weather`: the CSV on stdout.
+fn weather(
+    file: &Path,
+    format: Option<&str>,
+    year: Option<i32>,
+    step: Option<f64>,
+) -> anyhow::Result<()> {
+    let format = match format {
+        Some("epw") => Some(irpol::thermal::WeatherFormat::Epw),
+        Some(_) => Some(irpol::thermal::WeatherFormat::Tmy3),
+        None => None,
+    };
+    let station = irpol::app::weather::read_station(file, format, year)?;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    match step {
+        Some(step_s) => irpol::app::weather::write_forcing(&station, step_s, &mut out)?,
+        None => irpol::app::weather::write_hourly(&station, &mut out)?,
+    }
     Ok(out.flush()?)
 }
 

@@ -25,7 +25,7 @@ use irpol::pbrdf::{Pbrdf, Shadowing, SlopeDistribution};
 use irpol::scene::load_scene_text;
 use irpol::scene::obj::parse_obj;
 use irpol::scene::ply::parse_ply;
-use irpol::thermal::{Site, Weather};
+use irpol::thermal::{Site, StationFormat, StationWeather, Weather};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use std::path::Path;
@@ -323,6 +323,28 @@ fn weather_seeds() -> Vec<Vec<u8>> {
     ]
 }
 
+/// The shipped sample weather cut to its header and a day, EPW and TMY3.
+fn station_seeds() -> Vec<(Vec<u8>, StationFormat)> {
+    let cut = |path: &str, lines: usize| {
+        let text = String::from_utf8(shipped(path)).unwrap();
+        text.lines()
+            .take(lines)
+            .collect::<Vec<_>>()
+            .join("\n")
+            .into_bytes()
+    };
+    vec![
+        (
+            cut("data/weather/munich_3days.epw", 8 + 26),
+            StationFormat::Epw,
+        ),
+        (
+            cut("data/weather/munich_3days_tmy3.csv", 2 + 26),
+            StationFormat::Tmy3,
+        ),
+    ]
+}
+
 fn atmosphere_seeds() -> Vec<Vec<u8>> {
     vec![
         b"# source: a code\n# geometry: horizontal\nrange_m,transmittance,path_radiance_w_m2_sr\n\
@@ -500,6 +522,34 @@ proptest! {
     }
 
     #[test]
+    fn station_readers_never_panic(
+        (seed, format) in prop_oneof![Just(0usize), Just(1usize)]
+            .prop_map(|i| station_seeds().swap_remove(i)),
+        mutations in proptest::collection::vec(mutation(), 1..6),
+        year in proptest::option::of(-5i32..10_005),
+    ) {
+        let bytes = apply(seed, &mutations);
+        match StationWeather::parse(Path::new("fuzz.epw"), &bytes, format, year) {
+            Ok(file) => {
+                let site = Site {
+                    latitude_deg: file.station.latitude_deg,
+                    longitude_deg: file.station.longitude_deg,
+                    start_utc: file.first_utc(),
+                };
+                match file.to_weather(&site, None) {
+                    Ok(weather) => {
+                        let (first, last) = weather.span_s();
+                        let middle = weather.at(0.5 * first + 0.5 * last).unwrap();
+                        prop_assert!(middle.air_k.is_finite() && middle.longwave_down_w_m2 >= 0.0);
+                    }
+                    Err(e) => check_message(&e.to_string())?,
+                }
+            }
+            Err(e) => check_message(&e.to_string())?,
+        }
+    }
+
+    #[test]
     fn weather_reader_never_panics(bytes in prop_oneof![mutated(weather_seeds()), noise()]) {
         let site = Site {
             latitude_deg: 48.14,
@@ -520,6 +570,15 @@ proptest! {
 /// The seeds are valid input, so the mutations start from text that reaches every check.
 #[test]
 fn the_seeds_are_read() {
+    for (seed, format) in station_seeds() {
+        let file = StationWeather::parse(Path::new("w"), &seed, format, None).unwrap();
+        let site = Site {
+            latitude_deg: file.station.latitude_deg,
+            longitude_deg: file.station.longitude_deg,
+            start_utc: file.first_utc(),
+        };
+        file.to_weather(&site, None).unwrap();
+    }
     for seed in atmosphere_seeds() {
         parse_table(Path::new("t.csv"), &seed)
             .unwrap()

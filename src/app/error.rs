@@ -50,6 +50,9 @@ pub enum AppError {
     Report(Box<ReportError>),
     #[error(transparent)]
     Sun(#[from] crate::emitter::SunError),
+    /// A weather file refused (`irpol weather`).
+    #[error(transparent)]
+    Weather(Box<crate::thermal::WeatherError>),
     /// Writing a table to the output stream (stdout for the CLI); kept as the bare I/O error so
     /// that the CLI can tell a reader that went away (`irpol eval … | head`) from a failure.
     #[error(transparent)]
@@ -217,6 +220,12 @@ impl AppError {
             },
             _ => None,
         }
+    }
+}
+
+impl From<crate::thermal::WeatherError> for AppError {
+    fn from(error: crate::thermal::WeatherError) -> AppError {
+        AppError::Weather(Box::new(error))
     }
 }
 

@@ -10,6 +10,7 @@ pub mod selection;
 pub mod sun;
 pub mod thermal;
 pub mod validate;
+pub mod weather;
 
 pub use error::{one_line, AppError};
 pub use selection::{MeasurementArgs, SelectionArgs};

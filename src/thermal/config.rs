@@ -11,10 +11,16 @@ use std::collections::BTreeMap;
 #[serde(deny_unknown_fields)]
 pub struct ThermalConfig {
     pub weather: WeatherConfig,
-    /// RFC 3339 instant of time_s = 0 (the weather file's origin).
-    pub start_utc: String,
-    pub latitude_deg: f64,
-    pub longitude_deg: f64,
+    /// The weather file's format; default from the file (`.epw`, a TMY3 header, else irpol's CSV).
+    pub weather_format: Option<crate::thermal::WeatherFormat>,
+    /// Read every row of an EPW or TMY3 file in this year (typical-year files mix years).
+    pub weather_year: Option<i32>,
+    /// RFC 3339 instant of time_s = 0 (the weather file's origin); an EPW or TMY3 file's first
+    /// hour when not given.
+    pub start_utc: Option<String>,
+    /// The site; an EPW or TMY3 file's own when not given (required otherwise).
+    pub latitude_deg: Option<f64>,
+    pub longitude_deg: Option<f64>,
     /// Length of the run; default the weather file's span (24 h for `clear_day`).
     pub duration_h: Option<f64>,
     /// Surface temperatures are recorded (CSV, PLY, plot) every `output_step_s`.

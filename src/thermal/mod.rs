@@ -26,5 +26,5 @@ pub use solver::{
 };
 pub use weather::{
     simplified_solis, swinbank_longwave_w_m2, ClearDay, ClearSkyIrradiance, Site, SolisAtmosphere,
-    Weather, WeatherError, WeatherSample,
+    StationFormat, StationWeather, Weather, WeatherError, WeatherFormat, WeatherSample,
 };

@@ -7,7 +7,10 @@ use super::config::{
     BackConfig, InternalHeatConfig, LayerMaterialConfig, PartThermalConfig, ThermalConfig,
     WeatherConfig,
 };
-use super::{Back, Layer, LayerMaterial, LayerStack, Site, ThermalError, Weather, WeatherError};
+use super::{
+    Back, Layer, LayerMaterial, LayerStack, Site, StationFormat, StationWeather, ThermalError,
+    Weather, WeatherError, WeatherFormat,
+};
 use crate::emitter::{parse_time_utc, SunError};
 use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
 use crate::text::{about, number};
@@ -86,6 +89,13 @@ impl Schedule {
 pub enum ThermalSetupError {
     #[error("thermal.start_utc: {0}")]
     StartUtc(SunError),
+    #[error(
+        "thermal.{key} is required with a weather CSV or a clear day (an EPW or TMY3 weather \
+         file gives it)"
+    )]
+    Required { key: &'static str },
+    #[error("thermal.{key} applies only to {} weather file: remove it", if *key == "weather_year" { "an EPW or TMY3" } else { "a" })]
+    StationOnly { key: &'static str },
     #[error("thermal.latitude_deg = {} must be within [-90°, 90°]", number(*.0))]
     Latitude(f64),
     #[error("thermal.longitude_deg = {} must be within [-180°, 360°]", number(*.0))]
@@ -192,7 +202,6 @@ pub fn resolve_run(
     dir: &Path,
     default_ground_k: f64,
 ) -> Result<ThermalSetup, ThermalSetupError> {
-    let site = resolve_site(config)?;
     if config.spinup_days > MAX_SPINUP_DAYS {
         return Err(ThermalSetupError::Spinup(config.spinup_days));
     }
@@ -201,7 +210,7 @@ pub fn resolve_run(
         Some(h) => return Err(ThermalSetupError::Duration(h)),
         None => None,
     };
-    let weather = resolve_weather(config, dir, &site, requested_s)?;
+    let (site, weather) = resolve_weather(config, dir, requested_s)?;
     let (first, last) = weather.span_s();
     let duration_s = requested_s.unwrap_or(last);
     if first > 0.0 || last < duration_s {
@@ -235,10 +244,27 @@ pub fn resolve_run(
     })
 }
 
-/// Where and when the run is.
-fn resolve_site(config: &ThermalConfig) -> Result<Site, ThermalSetupError> {
-    let start_utc = parse_time_utc(&config.start_utc).map_err(ThermalSetupError::StartUtc)?;
-    let (lat, lon) = (config.latitude_deg, config.longitude_deg);
+/// Where and when the run is: the scene's keys, each defaulting to the station file's (its site,
+/// its first hour) when the weather is one.
+fn resolve_site(
+    config: &ThermalConfig,
+    station: Option<&StationWeather>,
+) -> Result<Site, ThermalSetupError> {
+    let required = |key: &'static str| ThermalSetupError::Required { key };
+    let start_utc = match (&config.start_utc, station) {
+        (Some(text), _) => parse_time_utc(text).map_err(ThermalSetupError::StartUtc)?,
+        (None, Some(file)) => file.first_utc(),
+        (None, None) => return Err(required("start_utc")),
+    };
+    let file = station.map(|f| f.station);
+    let lat = config
+        .latitude_deg
+        .or(file.map(|s| s.latitude_deg))
+        .ok_or(required("latitude_deg"))?;
+    let lon = config
+        .longitude_deg
+        .or(file.map(|s| s.longitude_deg))
+        .ok_or(required("longitude_deg"))?;
     if !(lat.is_finite() && (-90.0..=90.0).contains(&lat)) {
         return Err(ThermalSetupError::Latitude(lat));
     }
@@ -252,23 +278,64 @@ fn resolve_site(config: &ThermalConfig) -> Result<Site, ThermalSetupError> {
     })
 }
 
-/// The weather file (relative to `dir`), or a generated clear day long enough for the run and
-/// its spin-up day.
+/// The site and the weather: a file (relative to `dir`) in its format, or a generated clear day
+/// long enough for the run and its spin-up day.
 fn resolve_weather(
     config: &ThermalConfig,
     dir: &Path,
-    site: &Site,
     requested_s: Option<f64>,
-) -> Result<Weather, ThermalSetupError> {
-    match &config.weather {
-        WeatherConfig::File(file) => {
-            Weather::read_csv(&dir.join(file), site).map_err(ThermalSetupError::Weather)
-        }
+) -> Result<(Site, Weather), ThermalSetupError> {
+    let days = config.spinup_days as f64 * DAY_S;
+    let file = match &config.weather {
+        WeatherConfig::File(file) => dir.join(file),
         WeatherConfig::Generated(g) => {
-            let days = config.spinup_days as f64 * DAY_S;
-            Weather::clear_day(&g.clear_day, site, requested_s.unwrap_or(DAY_S).max(days))
-                .map_err(ThermalSetupError::ClearDay)
+            if let Some(key) = station_only_key(config) {
+                return Err(ThermalSetupError::StationOnly { key });
+            }
+            let site = resolve_site(config, None)?;
+            let weather =
+                Weather::clear_day(&g.clear_day, &site, requested_s.unwrap_or(DAY_S).max(days))
+                    .map_err(ThermalSetupError::ClearDay)?;
+            return Ok((site, weather));
         }
+    };
+    let weather_error = ThermalSetupError::Weather;
+    let bytes = std::fs::read(&file).map_err(|e| {
+        weather_error(WeatherError::Read {
+            file: file.clone(),
+            reason: e.to_string(),
+        })
+    })?;
+    let station_format = match WeatherFormat::detect(&file, &bytes, config.weather_format) {
+        WeatherFormat::Epw => StationFormat::Epw,
+        WeatherFormat::Tmy3 => StationFormat::Tmy3,
+        WeatherFormat::Csv => {
+            if config.weather_year.is_some() {
+                return Err(ThermalSetupError::StationOnly {
+                    key: "weather_year",
+                });
+            }
+            let site = resolve_site(config, None)?;
+            let weather = Weather::parse_csv(&file, &bytes, &site).map_err(weather_error)?;
+            return Ok((site, weather));
+        }
+    };
+    let station = StationWeather::parse(&file, &bytes, station_format, config.weather_year)
+        .map_err(weather_error)?;
+    let site = resolve_site(config, Some(&station))?;
+    let span = requested_s.map(|s| s.max(if days > 0.0 { DAY_S } else { 0.0 }));
+    let weather = station.to_weather(&site, span).map_err(weather_error)?;
+    Ok((site, weather))
+}
+
+/// A key that only a station file (EPW, TMY3) uses, given with a clear day.
+fn station_only_key(config: &ThermalConfig) -> Option<&'static str> {
+    if config.weather_format.is_some() {
+        Some("weather_format")
+    } else if config.weather_year.is_some() {
+        Some("weather_year")
+    } else {
+        None
     }
 }
 

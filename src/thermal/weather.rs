@@ -29,9 +29,16 @@
 
 mod clear_day;
 mod csv_file;
+pub mod epw;
 pub mod solis;
+pub mod station;
+mod tmy3;
 
 pub use solis::{simplified_solis, ClearSkyIrradiance, SolisAtmosphere};
+pub use station::{
+    clark_allen_longwave_w_m2, kasten_czeplak, Field, HourRecord, Station, StationFormat,
+    StationWeather, STATION_STEP_S,
+};
 
 use crate::emitter::{format_time_utc, SunError};
 use crate::text::number;
@@ -134,6 +141,13 @@ pub struct WeatherSample {
 pub enum WeatherError {
     #[error("{}: cannot read the weather file: {reason}", crate::text::path(file))]
     Read { file: PathBuf, reason: String },
+    /// An EPW or TMY3 file refused at a line; the message names the field.
+    #[error("{}:{line}: {message}", crate::text::path(file))]
+    Station {
+        file: PathBuf,
+        line: u64,
+        message: String,
+    },
     #[error("{}:{line}:{column}: {message}", crate::text::path(file))]
     Csv {
         file: PathBuf,
@@ -176,6 +190,65 @@ impl WeatherError {
             WeatherError::InvalidClearDay(message) => message.clone(),
             WeatherError::Sun(error) => error.to_string(),
             other => other.to_string(),
+        }
+    }
+}
+
+/// The format of a weather file: `weather_format = "epw" | "tmy3" | "csv"` in a scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WeatherFormat {
+    /// EnergyPlus weather ([`epw`]).
+    Epw,
+    /// NREL TMY3 CSV.
+    Tmy3,
+    /// irpol's weather CSV (docs/design.md §2.5).
+    Csv,
+}
+
+impl WeatherFormat {
+    /// The format a file is read in: `given`, else `.epw` (any case) is EPW, and any other file
+    /// whose second line starts with TMY3's `Date (MM/DD/YYYY)` column is TMY3, else irpol's CSV.
+    pub fn detect(path: &Path, bytes: &[u8], given: Option<WeatherFormat>) -> WeatherFormat {
+        if let Some(format) = given {
+            return format;
+        }
+        let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if extension.eq_ignore_ascii_case("epw") {
+            WeatherFormat::Epw
+        } else if tmy3::sniff(bytes) {
+            WeatherFormat::Tmy3
+        } else {
+            WeatherFormat::Csv
+        }
+    }
+}
+
+impl StationWeather {
+    /// Reads an EPW or TMY3 file (`format` [`StationFormat`]); `year`, when given, replaces every
+    /// row's year (a typical-year file mixes years).
+    pub fn read(
+        path: &Path,
+        format: StationFormat,
+        year: Option<i32>,
+    ) -> Result<StationWeather, WeatherError> {
+        let bytes = std::fs::read(path).map_err(|e| WeatherError::Read {
+            file: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        StationWeather::parse(path, &bytes, format, year)
+    }
+
+    /// [`StationWeather::read`] of a file's bytes; `source` names it in messages.
+    pub fn parse(
+        source: &Path,
+        bytes: &[u8],
+        format: StationFormat,
+        year: Option<i32>,
+    ) -> Result<StationWeather, WeatherError> {
+        match format {
+            StationFormat::Epw => epw::parse(source, bytes, year),
+            StationFormat::Tmy3 => tmy3::parse(source, bytes, year),
         }
     }
 }

@@ -1,0 +1,268 @@
+//! EnergyPlus weather files (EPW), as the EnergyPlus Auxiliary Programs documentation defines
+//! them: eight header lines, the first `LOCATION,city,state,country,source,WMO,latitude,longitude,
+//! time zone,elevation` (° north, ° east, hours east of UTC, m), then one comma-separated row per
+//! hour: year, month, day, hour (1…24, the end of the hour in local standard time), minute, the
+//! data source flags, and the fields below (1-based positions); a value at or above its missing
+//! marker is missing. Fields beyond 24 (visibility, precipitation, …) are not read.
+
+use super::station::{
+    check_sequence, check_station, field_value, label, Field, HourRecord, LineRefusal, Missing,
+    Station, StationFormat, StationWeather, FIELDS,
+};
+use super::{WeatherError, MAX_WEATHER_ROWS};
+use crate::text::shown;
+use std::path::Path;
+
+/// Each [`Field`]: its 1-based position in a data row, its name, its missing marker.
+const LAYOUT: [(Field, usize, &str, f64); FIELDS] = [
+    (Field::DryBulb, 7, "dry bulb temperature (°C)", 99.9),
+    (Field::DewPoint, 8, "dew point temperature (°C)", 99.9),
+    (Field::RelativeHumidity, 9, "relative humidity (%)", 999.0),
+    (
+        Field::Pressure,
+        10,
+        "atmospheric station pressure (Pa)",
+        999_999.0,
+    ),
+    (
+        Field::Infrared,
+        13,
+        "horizontal infrared radiation intensity (Wh/m²)",
+        9999.0,
+    ),
+    (
+        Field::Global,
+        14,
+        "global horizontal radiation (Wh/m²)",
+        9999.0,
+    ),
+    (
+        Field::DirectNormal,
+        15,
+        "direct normal radiation (Wh/m²)",
+        9999.0,
+    ),
+    (
+        Field::DiffuseHorizontal,
+        16,
+        "diffuse horizontal radiation (Wh/m²)",
+        9999.0,
+    ),
+    (Field::WindDirection, 21, "wind direction (°)", 999.0),
+    (Field::WindSpeed, 22, "wind speed (m/s)", 999.0),
+    (Field::TotalCover, 23, "total sky cover (tenths)", 99.0),
+    (Field::OpaqueCover, 24, "opaque sky cover (tenths)", 99.0),
+];
+
+/// Header lines before the first data row.
+const HEADER_LINES: usize = 8;
+
+/// Reads an EPW file's bytes; `year` replaces every row's year (a typical-year file).
+pub(super) fn parse(
+    path: &Path,
+    bytes: &[u8],
+    year: Option<i32>,
+) -> Result<StationWeather, WeatherError> {
+    let text = String::from_utf8_lossy(bytes);
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let (station, records) =
+        parse_text(text, year).map_err(|(line, message)| WeatherError::Station {
+            file: path.to_path_buf(),
+            line,
+            message,
+        })?;
+    let field_names = LAYOUT.map(|(_, position, name, _)| format!("field {position} ({name})"));
+    Ok(StationWeather {
+        source: path.to_path_buf(),
+        format: StationFormat::Epw,
+        station,
+        records,
+        field_names,
+    })
+}
+
+fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), LineRefusal> {
+    let mut lines = text.lines().enumerate().map(|(i, l)| (i as u64 + 1, l));
+    let Some((_, first)) = lines.next() else {
+        return Err((
+            1,
+            "empty file: an EPW file starts with a LOCATION line".into(),
+        ));
+    };
+    let station = location(first).map_err(|message| (1, message))?;
+    for _ in 1..HEADER_LINES {
+        if lines.next().is_none() {
+            let message = format!(
+                "the file ends inside its {HEADER_LINES} header lines (LOCATION … DATA PERIODS)"
+            );
+            return Err((text.lines().count() as u64, message));
+        }
+    }
+    let mut records = Vec::new();
+    let mut last_line = HEADER_LINES as u64;
+    for (line, row) in lines {
+        if row.trim().is_empty() {
+            continue;
+        }
+        if records.len() == MAX_WEATHER_ROWS {
+            let message =
+                format!("more than {MAX_WEATHER_ROWS} rows: split the weather or thin it out");
+            return Err((line, message));
+        }
+        records.push(record(row, year, &station).map_err(|message| (line, message))?);
+        if let Some(r) = records.last_mut() {
+            r.line = line;
+        }
+        last_line = line;
+    }
+    check_sequence(&records, last_line)?;
+    Ok((station, records))
+}
+
+/// The LOCATION line's site.
+fn location(line: &str) -> Result<Station, String> {
+    let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+    if !fields[0].eq_ignore_ascii_case("LOCATION") || fields.len() < 10 {
+        return Err(format!(
+            "the first line must be LOCATION,city,state,country,source,WMO,latitude,longitude,\
+             time zone,elevation; got '{}'",
+            crate::text::shown_at_most(line, 80)
+        ));
+    }
+    let number = |index: usize, what: &str| -> Result<f64, String> {
+        fields[index]
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                format!(
+                    "LOCATION field {} ({what}): '{}' is not a number",
+                    index + 1,
+                    shown(fields[index])
+                )
+            })
+    };
+    let station = Station {
+        latitude_deg: number(6, "latitude")?,
+        longitude_deg: number(7, "longitude")?,
+        time_zone_h: number(8, "time zone")?,
+        elevation_m: number(9, "elevation")?,
+    };
+    check_station(&station).map_err(|e| format!("LOCATION: {e}"))?;
+    Ok(station)
+}
+
+/// One data row.
+fn record(row: &str, year: Option<i32>, station: &Station) -> Result<HourRecord, String> {
+    let fields: Vec<&str> = row.split(',').collect();
+    let needed = LAYOUT.iter().map(|l| l.1).max().unwrap_or(0);
+    if fields.len() < needed {
+        return Err(format!(
+            "{} fields, an EPW data row has at least {needed} (year, month, day, hour, minute, \
+             flags, dry bulb, …, opaque sky cover)",
+            fields.len()
+        ));
+    }
+    let integer = |index: usize, what: &str| -> Result<i64, String> {
+        let text = fields[index].trim();
+        text.parse::<i64>().map_err(|_| {
+            format!(
+                "field {} ({what}): '{}' is not a whole number",
+                index + 1,
+                shown(text)
+            )
+        })
+    };
+    let file_year = integer(0, "year")?;
+    let month = integer(1, "month")?;
+    let day = integer(2, "day")?;
+    let hour = integer(3, "hour")?;
+    if !(1..=24).contains(&hour) {
+        return Err(format!("field 4 (hour): {hour} is outside 1…24"));
+    }
+    let year = year.map_or(file_year, i64::from);
+    let fits = |v: i64, low: i64, high: i64| (low..=high).contains(&v);
+    if !(fits(year, 1, 9999) && fits(month, 1, 12) && fits(day, 1, 31)) {
+        return Err(format!("{year}-{month}-{day} is not a date (fields 1-3)"));
+    }
+    let (end_local, end_utc) = label(
+        year as i32,
+        month as u32,
+        day as u32,
+        hour as u32,
+        station.time_zone_h,
+    )?;
+    let mut values = [None; FIELDS];
+    for (field, position, name, marker) in LAYOUT {
+        let name = format!("field {position} ({name})");
+        values[field as usize] = field_value(
+            field,
+            &name,
+            fields[position - 1],
+            Missing::AtOrAbove(marker),
+            1.0,
+        )?;
+    }
+    Ok(HourRecord {
+        line: 0,
+        end_local,
+        end_utc,
+        values,
+    })
+}
+
+/// The EPW text of a station's rows (the fields irpol reads; the others at their missing
+/// markers), with `comment` in COMMENTS 1: how a shipped sample or a test writes one.
+pub fn write(station: &Station, records: &[HourRecord], comment: &str) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    let s = station;
+    let _ = writeln!(
+        out,
+        "LOCATION,irpol,-,-,irpol,000000,{},{},{},{}",
+        s.latitude_deg, s.longitude_deg, s.time_zone_h, s.elevation_m
+    );
+    out.push_str("DESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\n");
+    out.push_str("HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\n");
+    let _ = writeln!(out, "COMMENTS 1,{}", comment.replace(['\n', '\r'], " "));
+    out.push_str("COMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n");
+    for r in records {
+        let mut fields: Vec<String> = vec![String::new(); 35];
+        // The hour-ending label: 00:00 is hour 24 of the day before.
+        let start = r.end_local - chrono::TimeDelta::hours(1);
+        use chrono::{Datelike, Timelike};
+        fields[0] = start.year().to_string();
+        fields[1] = start.month().to_string();
+        fields[2] = start.day().to_string();
+        fields[3] = (start.hour() + 1).to_string();
+        fields[4] = "0".into();
+        fields[5] = "?9?9?9?9E0?9?9?9?9?9?9?9?9?9?9?9?9?9?9?9*9*9?9?9?9".into();
+        for (i, text) in [(10, "9999"), (11, "9999"), (16, "999999"), (17, "999999")] {
+            fields[i] = text.into();
+        }
+        for (i, text) in [(18, "999999"), (19, "9999"), (24, "9999"), (25, "99999")] {
+            fields[i] = text.into();
+        }
+        for (i, text) in [(26, "9"), (27, "999999999"), (28, "999"), (29, ".999")] {
+            fields[i] = text.into();
+        }
+        for (i, text) in [
+            (30, "999"),
+            (31, "99"),
+            (32, "999"),
+            (33, "999"),
+            (34, "99"),
+        ] {
+            fields[i] = text.into();
+        }
+        for (field, position, _, marker) in LAYOUT {
+            fields[position - 1] = match r.values[field as usize] {
+                Some(v) => format!("{v}"),
+                None => format!("{marker}"),
+            };
+        }
+        out.push_str(&fields.join(","));
+        out.push('\n');
+    }
+    out
+}
