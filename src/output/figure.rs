@@ -181,73 +181,11 @@ pub fn dofp_error_png(
     dofp: &DofpImages,
 ) -> io::Result<Vec<u8>> {
     let ranged = ranged_pixels(image);
-    let polarization = |s: &[f64; 3]| dolp_aop([s[0], s[1], s[2], 0.0]);
-    let truth: Vec<(f64, f64)> = dofp.truth.par_iter().map(polarization).collect();
-    let camera: Vec<(f64, f64)> = dofp.stokes.par_iter().map(polarization).collect();
-    let dolp_percent = |v: &[(f64, f64)]| v.iter().map(|p| 100.0 * p.0).collect::<Vec<f64>>();
-    let true_dolp = dolp_percent(&truth);
-    let ranging: Vec<f64> = true_dolp
-        .iter()
-        .zip(&ranged)
-        .filter(|(_, &r)| r)
-        .map(|(&v, _)| v)
-        .collect();
-    let top = widen(0.0, robust_range(ranging, 0.0, 0.999, 0.0).1).1;
-    let dolp_panel = |title: String, values| LinearPanel {
-        file: "dofp_error.png",
-        title,
-        values,
-        fixed: Some([0.0, top]),
-        symmetric: false,
-        map: &SEQUENTIAL,
-        format: |v| format!("{v:.2}"),
-    };
-    let method = scene.sensor.dofp.map_or("bilinear", |d| d.demosaic.name());
-    let difference = LinearPanel {
-        file: "dofp_error.png",
-        title: "DoLP error, camera − truth (%)".into(),
-        values: dolp_percent(&camera)
-            .iter()
-            .zip(&true_dolp)
-            .map(|(c, t)| c - t)
-            .collect(),
-        fixed: None,
-        symmetric: true,
-        map: &DIVERGING,
-        format: format_signed,
-    };
-    let aop_error = LinearPanel {
-        file: "dofp_error.png",
-        title: "AoP error (°) where the true DoLP > 1 %".into(),
-        values: truth
-            .iter()
-            .zip(&camera)
-            .map(|(t, c)| match t.0 > AOP_DOLP_THRESHOLD {
-                true => aop_difference(c.1, t.1).to_degrees(),
-                false => f64::NAN,
-            })
-            .collect(),
-        fixed: Some([-45.0, 45.0]),
-        symmetric: true,
-        map: &DIVERGING,
-        format: format_signed,
-    };
-    let panels = [
-        dolp_panel("DoLP, noise-free truth (%)".into(), true_dolp.clone()),
-        dolp_panel(
-            format!("DoLP, DoFP camera, {method} (%)"),
-            dolp_percent(&camera),
-        ),
-        difference,
-        aop_error,
-    ]
-    .map(|p| p.panel(&ranged, &scene.preview));
+    let panels = dofp_panels(scene, dofp, &ranged).map(|p| p.panel(&ranged, &scene.preview));
+    let (w, h) = cell_size(image.width, image.height);
     let cells: Vec<Canvas> = panels
         .iter()
-        .map(|p| {
-            let (w, h) = cell_size(image.width, image.height);
-            draw_panel(p, image.width, image.height, w, h)
-        })
+        .map(|p| draw_panel(p, image.width, image.height, w, h))
         .collect::<io::Result<_>>()?;
     let (cell_w, cell_h) = (cells[0].width, cells[0].height);
     let mut sheet = Canvas::white(2 * cell_w, 2 * cell_h);
@@ -255,6 +193,81 @@ pub fn dofp_error_png(
         sheet.blit(cell, (i % 2) * cell_w, (i / 2) * cell_h);
     }
     sheet.png()
+}
+
+/// The four panels of [`dofp_error_png`]; the two DoLP panels share the truth's range over the
+/// `ranged` pixels.
+fn dofp_panels(scene: &Scene, dofp: &DofpImages, ranged: &[bool]) -> [LinearPanel; 4] {
+    let polarization = |s: &[f64; 3]| dolp_aop([s[0], s[1], s[2], 0.0]);
+    let truth: Vec<(f64, f64)> = dofp.truth.par_iter().map(polarization).collect();
+    let camera: Vec<(f64, f64)> = dofp.stokes.par_iter().map(polarization).collect();
+    let dolp_percent = |v: &[(f64, f64)]| v.iter().map(|p| 100.0 * p.0).collect::<Vec<f64>>();
+    let (true_dolp, camera_dolp) = (dolp_percent(&truth), dolp_percent(&camera));
+    let ranging: Vec<f64> = true_dolp
+        .iter()
+        .zip(ranged)
+        .filter(|(_, &r)| r)
+        .map(|(&v, _)| v)
+        .collect();
+    let top = widen(0.0, robust_range(ranging, 0.0, 0.999, 0.0).1).1;
+    let panel = |title: String, values, fixed, symmetric, map| LinearPanel {
+        file: "dofp_error.png",
+        title,
+        values,
+        fixed,
+        symmetric,
+        map,
+        format: if symmetric {
+            format_signed
+        } else {
+            |v| format!("{v:.2}")
+        },
+    };
+    let method = scene.sensor.dofp.map_or("bilinear", |d| d.demosaic.name());
+    let difference = camera_dolp
+        .iter()
+        .zip(&true_dolp)
+        .map(|(c, t)| c - t)
+        .collect();
+    let aop_error = truth
+        .iter()
+        .zip(&camera)
+        .map(|(t, c)| match t.0 > AOP_DOLP_THRESHOLD {
+            true => aop_difference(c.1, t.1).to_degrees(),
+            false => f64::NAN,
+        })
+        .collect();
+    let dolp_range = Some([0.0, top]);
+    [
+        panel(
+            "DoLP, noise-free truth (%)".into(),
+            true_dolp,
+            dolp_range,
+            false,
+            &SEQUENTIAL,
+        ),
+        panel(
+            format!("DoLP, DoFP camera, {method} (%)"),
+            camera_dolp,
+            dolp_range,
+            false,
+            &SEQUENTIAL,
+        ),
+        panel(
+            "DoLP error, camera − truth (%)".into(),
+            difference,
+            None,
+            true,
+            &DIVERGING,
+        ),
+        panel(
+            "AoP error (°) where the true DoLP > 1 %".into(),
+            aop_error,
+            Some([-45.0, 45.0]),
+            true,
+            &DIVERGING,
+        ),
+    ]
 }
 
 /// A sheet cell's image size: at most 480 pixels wide and tall, so an extreme aspect ratio

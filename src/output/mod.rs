@@ -290,7 +290,7 @@ pub fn stage_outputs(
     let camera = camera_summary(scene);
     // Each file goes into the staging folder as soon as it is encoded (the folder is swapped in
     // as a whole at the end), so no more than a file per thread is held in memory.
-    let images = ImageFiles::new(scene, image, &channels, &camera);
+    let images = ImageFiles::new(scene, rendered, &channels, &camera);
     let mut files = images.stage(staged, out_dir)?;
     files.push("summary.json".into());
     let mut timings = rendered.timings;
@@ -327,6 +327,7 @@ enum ImageJob {
 struct ImageFiles<'a> {
     scene: &'a Scene,
     image: &'a StokesImage,
+    dofp: Option<&'a DofpImages>,
     channels: &'a [(Channel, Vec<f32>)],
     camera: &'a CameraSummary,
     truth: Vec<TruthImage>,
@@ -336,18 +337,20 @@ struct ImageFiles<'a> {
 impl<'a> ImageFiles<'a> {
     fn new(
         scene: &'a Scene,
-        image: &'a StokesImage,
+        rendered: &'a Rendered,
         channels: &'a [(Channel, Vec<f32>)],
         camera: &'a CameraSummary,
     ) -> ImageFiles<'a> {
+        let image = &rendered.image;
         let previews = figure::Previews::new(scene, image);
         let mut truth = truth_images(scene, image);
-        if let Some(dofp) = &image.dofp {
+        if let Some(dofp) = &rendered.dofp {
             truth.extend(dofp_images(dofp));
         }
         ImageFiles {
             scene,
             image,
+            dofp: rendered.dofp.as_ref(),
             channels,
             camera,
             truth,
@@ -362,7 +365,7 @@ impl<'a> ImageFiles<'a> {
         jobs.push(ImageJob::Exr);
         jobs.extend((0..self.previews.len()).map(ImageJob::Panel));
         jobs.push(ImageJob::Composite);
-        if self.image.dofp.is_some() {
+        if self.dofp.is_some() {
             jobs.push(ImageJob::DofpError);
         }
         jobs
@@ -428,11 +431,7 @@ impl<'a> ImageFiles<'a> {
             ),
             ImageJob::Composite => ("composite.png".to_owned(), self.previews.composite_png()),
             ImageJob::DofpError => {
-                let dofp = self
-                    .image
-                    .dofp
-                    .as_ref()
-                    .expect("a DoFP job has DoFP images");
+                let dofp = self.dofp.expect("a DoFP job has DoFP images");
                 let bytes = figure::dofp_error_png(self.scene, self.image, dofp);
                 ("dofp_error.png".to_owned(), bytes)
             }
@@ -469,7 +468,7 @@ fn summarize(
         thermal_instant: scene.thermal_instant.clone(),
         warnings,
         camera,
-        reconstruction: image.camera_metrics.clone(),
+        reconstruction: rendered.camera_metrics.clone(),
         ids: id_maps(scene),
         materials: material_summaries(scene, rendered),
         timings_s: rendered.timings,

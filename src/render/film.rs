@@ -20,11 +20,6 @@ pub struct StokesImage {
     /// as the camera records them (the Stokes vectors are re-estimated from them). Empty for an
     /// ideal camera, where I(α) follows from the Stokes vector exactly.
     pub recorded_polarizers: Vec<[f32; 4]>,
-    /// With `[sensor.dofp]`: the raw mosaic and the Stokes images demosaicked from it.
-    pub dofp: Option<super::camera::DofpImages>,
-    /// Reconstruction quality of the camera against the noise-free radiance (`None` for the
-    /// ideal camera).
-    pub camera_metrics: Option<super::camera::metrics::CameraMetrics>,
 }
 
 /// The visible point at a pixel, for users who train or validate algorithms.

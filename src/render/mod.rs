@@ -68,6 +68,11 @@ pub struct Timings {
 /// A render held in memory, before anything is written.
 pub struct Rendered {
     pub image: StokesImage,
+    /// With `[sensor.dofp]`: the raw mosaic and the Stokes images demosaicked from it.
+    pub dofp: Option<camera::DofpImages>,
+    /// Reconstruction quality of the camera against the noise-free radiance (`None` for the
+    /// ideal camera).
+    pub camera_metrics: Option<camera::metrics::CameraMetrics>,
     pub timings: Timings,
     pub table_resolutions: Vec<TableResolution>,
 }
@@ -119,12 +124,12 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
     let camera_start = Instant::now();
     let recording = camera::record(&scene.sensor, image.width, image.height, &mut image.stokes);
     image.recorded_polarizers = recording.polarizers;
-    image.dofp = recording.dofp;
-    image.camera_metrics = recording.metrics;
     timings.camera = camera_start.elapsed().as_secs_f64();
     timings.total = start.elapsed().as_secs_f64();
     Ok(Rendered {
         image,
+        dofp: recording.dofp,
+        camera_metrics: recording.metrics,
         timings,
         table_resolutions: resolutions,
     })
@@ -317,7 +322,5 @@ fn shade_image(
         surface,
         truth,
         recorded_polarizers: Vec::new(),
-        dofp: None,
-        camera_metrics: None,
     }
 }

@@ -162,14 +162,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
     let materials = materials
         .finish()
         .map_err(|error| SceneError::material(path, None, error))?;
-    // The air of a weather file (a clear day's is its own keys, warned about as such).
-    let weather_air = match (&config.thermal, &thermal_run) {
-        (Some(t), Some((run, _, _))) => match &t.weather {
-            WeatherConfig::File(file) => Some((file.as_str(), run.weather.coldest_air_k())),
-            WeatherConfig::Generated(_) => None,
-        },
-        _ => None,
-    };
+    let weather_air = weather_file_air(&config, thermal_run.as_ref().map(|(run, _, _)| run));
     warnings.extend(likely_mistakes(&config, &materials, band, weather_air));
     warnings.extend(beyond_atmosphere_table(
         viewing.atmosphere.as_ref(),
@@ -205,6 +198,21 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         thermal_instant: None,
         warnings,
     })
+}
+
+/// The weather file and its coldest air, for the warnings (a clear day's air is its own keys,
+/// warned about as such).
+fn weather_file_air<'a>(
+    config: &'a SceneConfig,
+    run: Option<&thermal::ThermalSetup>,
+) -> Option<(&'a str, f64)> {
+    match (&config.thermal, run) {
+        (Some(t), Some(run)) => match &t.weather {
+            WeatherConfig::File(file) => Some((file.as_str(), run.weather.coldest_air_k())),
+            WeatherConfig::Generated(_) => None,
+        },
+        _ => None,
+    }
 }
 
 /// Every object, named (given, else its mesh file's stem, else `objectN`), in one mesh.
