@@ -47,6 +47,12 @@ impl OptimizerSettings {
 /// ≥ 20 000 observations for ≤ 9 parameters).
 pub const COARSE_POINTS: usize = 20_000;
 
+/// Every how many points the global search of a set of `points` points uses ([`minimize`]): 1
+/// up to [`COARSE_POINTS`].
+pub fn coarse_stride(points: usize) -> usize {
+    points.div_ceil(COARSE_POINTS).max(1)
+}
+
 /// Minimizes `objective` from the search-box point `start` (the first point of the GA's initial
 /// population, or where a local first stage starts). Returns the best point found and the
 /// history of every stage.
@@ -70,7 +76,7 @@ pub(crate) fn minimize(
     let points = objective.data().points();
     let mut tried = Vec::new();
     if points > COARSE_POINTS && !local.is_empty() {
-        let coarse_data = objective.data().every_nth(points.div_ceil(COARSE_POINTS));
+        let coarse_data = objective.data().every_nth(coarse_stride(points));
         let coarse = Objective::new(&coarse_data, objective.space(), objective.robust());
         let stages = optimizer.stages();
         run_stages(&coarse, stages, &mut point, seed, settings, &mut history)?;
