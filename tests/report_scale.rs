@@ -3,7 +3,6 @@
 //! angles the file holds. The old report drew a curve per incidence angle in five panels and a
 //! circle per residual, about 200 KB of SVG per angle.
 
-#[allow(dead_code)]
 mod common;
 mod fit_support;
 #[allow(dead_code)]
