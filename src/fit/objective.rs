@@ -111,14 +111,20 @@ impl<'a> Objective<'a> {
     fn fill_residuals(&self, pbrdf: &Pbrdf, out: &mut [f64], map: impl Fn(f64) -> f64 + Sync) {
         let masking = self.masking(pbrdf);
         let width = self.data.elements.len();
-        out.par_chunks_mut(CHUNK_POINTS * width)
-            .enumerate()
-            .for_each(|(chunk, block)| {
-                let first = chunk * CHUNK_POINTS;
-                for (p, values) in block.chunks_mut(width).enumerate() {
-                    self.point_residuals(pbrdf, &masking, first + p, |e, r| values[e] = map(r));
-                }
-            });
+        let fill = |(chunk, block): (usize, &mut [f64])| {
+            let first = chunk * CHUNK_POINTS;
+            for (p, values) in block.chunks_mut(width).enumerate() {
+                self.point_residuals(pbrdf, &masking, first + p, |e, r| values[e] = map(r));
+            }
+        };
+        // One block (every shipped file) runs on the calling thread: no task to hand out.
+        if self.data.points() <= CHUNK_POINTS {
+            fill((0, out));
+        } else {
+            out.par_chunks_mut(CHUNK_POINTS * width)
+                .enumerate()
+                .for_each(fill);
+        }
     }
 
     /// Σ map(r) over every normalized residual of the model `pbrdf`: partial sums over blocks of
@@ -127,15 +133,19 @@ impl<'a> Objective<'a> {
     fn sum_residuals(&self, pbrdf: &Pbrdf, map: impl Fn(f64) -> f64 + Sync) -> f64 {
         let masking = self.masking(pbrdf);
         let points = self.data.points();
+        let block = |chunk: usize| {
+            let mut total = 0.0;
+            for point in chunk * CHUNK_POINTS..((chunk + 1) * CHUNK_POINTS).min(points) {
+                self.point_residuals(pbrdf, &masking, point, |_, r| total += map(r));
+            }
+            total
+        };
+        if points <= CHUNK_POINTS {
+            return block(0);
+        }
         let partial: Vec<f64> = (0..points.div_ceil(CHUNK_POINTS))
             .into_par_iter()
-            .map(|chunk| {
-                let mut total = 0.0;
-                for point in chunk * CHUNK_POINTS..((chunk + 1) * CHUNK_POINTS).min(points) {
-                    self.point_residuals(pbrdf, &masking, point, |_, r| total += map(r));
-                }
-                total
-            })
+            .map(block)
             .collect();
         partial.iter().sum()
     }
