@@ -3,6 +3,8 @@
 //! angles the file holds. The old report drew a curve per incidence angle in five panels and a
 //! circle per residual, about 200 KB of SVG per angle.
 
+mod common;
+mod fit_support;
 #[allow(dead_code)]
 mod report_support;
 
@@ -170,4 +172,70 @@ fn a_mid_size_file_draws_its_residual_scatter_as_one_image_in_the_svg() {
     eprintln!("mid-size SVG: {} bytes, {circles} circles", svg.len());
     // 2.7 MB; with the 18 000 residual dots as SVG circles it was 4.3 MB.
     assert!(svg.len() < 3_000_000, "SVG of {} bytes", svg.len());
+}
+
+/// A dense goniometer scan through `irpol fit`: beyond `fit::COARSE_POINTS` rows the search
+/// runs on a subsample and the figure thins what it draws, and says both, while every statistic
+/// it prints counts every row: the points and residuals, and the χ², recomputed here from the
+/// fitted model over all rows (on the subsample alone it would be about half).
+#[test]
+fn a_dense_scan_is_drawn_thinned_but_its_statistics_use_every_row() {
+    use fit_support::{dense_geometry, dense_truth, synthetic_set, to_csv, LINEAR_ELEMENTS};
+    use irpol::material::{Material, MaterialModel};
+    let rows = 24_000;
+    assert!(rows > irpol::fit::COARSE_POINTS);
+    let set = synthetic_set(
+        "dense_scan",
+        &dense_truth(0.01),
+        &dense_geometry(rows),
+        &LINEAR_ELEMENTS,
+        1.0,
+        7,
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("dense_scan.csv");
+    std::fs::write(&csv, to_csv(&set, true)).unwrap();
+    let (ok, _, stderr) = common::fit_into(dir.path(), &[&csv], &["--distribution", "cauchy"]);
+    assert!(ok, "{stderr}");
+    let material = Material::load(&dir.path().join("fits/dense_scan.toml")).unwrap();
+    let MaterialModel::Grey(spec) = &material.model else {
+        panic!("a grey material")
+    };
+    let pbrdf = spec.pbrdf().unwrap();
+    let chi2: f64 = set
+        .points
+        .iter()
+        .map(|p| {
+            let m = pbrdf.mueller(
+                &Direction::from_degrees(p.theta_i_deg, p.phi_i_deg),
+                &Direction::from_degrees(p.theta_r_deg, p.phi_r_deg),
+            );
+            LINEAR_ELEMENTS
+                .iter()
+                .zip(p.values.iter().zip(&p.uncertainties))
+                .map(|(&e, (v, u))| ((m[(e / 4, e % 4)] - v) / u.unwrap()).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    let fit = material.fit.as_ref().unwrap();
+    assert!(
+        (fit.cost / chi2 - 1.0).abs() < 1e-6,
+        "{} vs {chi2}",
+        fit.cost
+    );
+    assert_eq!(fit.points, rows);
+
+    let svg = std::fs::read_to_string(dir.path().join("reports/dense_scan.svg")).unwrap();
+    let residuals = rows * LINEAR_ELEMENTS.len();
+    for every_row in [
+        format!("{rows} points × 9 elements"),
+        format!("residuals, N = {residuals}"),
+        format!("{residuals} residuals, all elements: count per"),
+        format!("{:.3e}", chi2),
+    ] {
+        assert!(svg.contains(&every_row), "{every_row}");
+    }
+    // Thinned, and said so: most ring points only in (g), and the search's subsample.
+    assert!(svg.contains(" pts on"), "rings not drawn are counted");
+    assert!(svg.contains("(search on 1 point in 2, then on all)"));
 }

@@ -130,6 +130,35 @@ impl MeasurementData {
     pub fn observation(&self, index: usize) -> (f64, f64) {
         (self.values[index], 1.0 / self.inverse_sigma[index])
     }
+
+    /// Every `stride`-th point, from the first, with the same standard deviations (the default
+    /// noise model's floor stays the whole file's) and the zenith list of those points only, so
+    /// that an evaluation costs what the subsample holds.
+    pub(crate) fn every_nth(&self, stride: usize) -> MeasurementData {
+        let width = self.elements.len();
+        let mut zeniths = DistinctCosines::default();
+        let mut geometry = Vec::with_capacity(self.points().div_ceil(stride));
+        let mut values = Vec::with_capacity(geometry.capacity() * width);
+        let mut inverse_sigma = Vec::with_capacity(values.capacity());
+        for (point, g) in self.geometry.iter().enumerate().step_by(stride) {
+            geometry.push(PreparedGeometry {
+                scattering: g.scattering,
+                incident_zenith: zeniths.index(self.zenith_cosines[g.incident_zenith]),
+                scattered_zenith: zeniths.index(self.zenith_cosines[g.scattered_zenith]),
+            });
+            let rows = point * width..(point + 1) * width;
+            values.extend_from_slice(&self.values[rows.clone()]);
+            inverse_sigma.extend_from_slice(&self.inverse_sigma[rows]);
+        }
+        MeasurementData {
+            geometry,
+            zenith_cosines: zeniths.cosines,
+            elements: self.elements.clone(),
+            values,
+            inverse_sigma,
+            error_sources: self.error_sources.clone(),
+        }
+    }
 }
 
 /// The refusal of `set` for `message`.

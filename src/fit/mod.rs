@@ -54,7 +54,7 @@ pub use levenberg_marquardt::LevenbergMarquardtSettings;
 pub use model_fit::ModelFit;
 pub use nelder_mead::NelderMeadSettings;
 pub use objective::{BoxCost, Objective};
-pub use optimize::OptimizerSettings;
+pub use optimize::{coarse_stride, OptimizerSettings, COARSE_POINTS};
 pub use option_error::OptionError;
 pub use options::{parse_parameter_list, parse_parameter_values, FitOptions};
 pub use outcome::{fit_measurement, FitOutcome};

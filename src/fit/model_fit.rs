@@ -165,10 +165,16 @@ impl ModelFit {
         let best = space.search(&values);
         let settings = &options.settings.levenberg_marquardt;
         let reduced_chi2 = self.reduced_chi2;
-        self.uncertainty.profile_bounds = parameters_to_profile(&space, &values, &self.uncertainty)
+        let uncertainty = &self.uncertainty;
+        self.uncertainty.profile_bounds = parameters_to_profile(&space, &values, uncertainty)
             .par_iter()
             .map(|&p| {
-                let bound = profile_bounds(&objective, &best, reduced_chi2, p, settings);
+                let error = uncertainty.errors[uncertainty
+                    .parameters
+                    .iter()
+                    .position(|&q| q == p)
+                    .expect("a profiled parameter has an error")];
+                let bound = profile_bounds(&objective, &best, reduced_chi2, (p, error), settings);
                 (p, bound)
             })
             .collect();

@@ -2,7 +2,7 @@
 //! r = (F_model − F_measured)/σ over every Mueller element present, and the cost Σ r² = χ², or
 //! Σ ρ(r) with a [`RobustLoss`]. The model is the pBRDF of `pbrdf` (docs/design.md §1.3); nothing here
 //! re-derives physics. One evaluation builds the model once, computes the shadowing factor once
-//! per distinct zenith angle and one Mueller matrix per point.
+//! per distinct zenith angle and one Mueller matrix per point, in parallel over blocks of points.
 
 use super::data::MeasurementData;
 use super::parameters::ParameterValues;
@@ -11,7 +11,13 @@ use super::space::ModelSpace;
 use crate::optics::Mueller;
 use crate::pbrdf::Pbrdf;
 use argmin::core::{CostFunction, Error};
+use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Points per block of an evaluation run in parallel: more than the shipped measurements hold
+/// (≤ 4000 rows), so their costs are summed exactly as serially, and enough work per block
+/// (≈ 0.4 ms) that the threads' overhead does not show.
+const CHUNK_POINTS: usize = 4096;
 
 /// The objective of one model family on one measurement, as a function of search coordinates
 /// ([`ModelSpace`]). Thread-safe: the genetic stage evaluates it in parallel.
@@ -54,33 +60,94 @@ impl<'a> Objective<'a> {
         self.evaluations.load(Ordering::Relaxed)
     }
 
-    /// Calls `visit(observation, r)` with every normalized residual of the model `pbrdf`.
-    #[inline]
-    fn for_each_residual(&self, pbrdf: &Pbrdf, mut visit: impl FnMut(usize, f64)) {
+    /// Counts `count` evaluations made elsewhere on this objective's behalf (the search on a
+    /// subsample of a large set, [`super::optimize`]).
+    pub(crate) fn add_evaluations(&self, count: u64) {
+        self.evaluations.fetch_add(count, Ordering::Relaxed);
+    }
+
+    /// Smith's G1 per distinct zenith angle (an incomplete beta for the Cauchy Λ), counting one
+    /// model evaluation.
+    fn masking(&self, pbrdf: &Pbrdf) -> Vec<f64> {
         self.evaluations.fetch_add(1, Ordering::Relaxed);
-        // Smith's G1 per distinct zenith angle (an incomplete beta for the Cauchy Λ).
-        let masking: Vec<f64> = self
-            .data
+        self.masking_factors(pbrdf)
+    }
+
+    fn masking_factors(&self, pbrdf: &Pbrdf) -> Vec<f64> {
+        self.data
             .zenith_cosines
             .iter()
             .map(|&c| pbrdf.masking_without_table(c))
-            .collect();
-        let width = self.data.elements.len();
-        for (point, g) in self.data.geometry.iter().enumerate() {
-            let m = pbrdf.mueller_for_geometry(
-                &g.scattering,
-                masking[g.incident_zenith],
-                masking[g.scattered_zenith],
+            .collect()
+    }
+
+    /// Calls `visit(offset, r)` with the normalized residual of each element of `point`.
+    #[inline]
+    fn point_residuals(
+        &self,
+        pbrdf: &Pbrdf,
+        masking: &[f64],
+        point: usize,
+        mut visit: impl FnMut(usize, f64),
+    ) {
+        let g = &self.data.geometry[point];
+        let m = pbrdf.mueller_for_geometry(
+            &g.scattering,
+            masking[g.incident_zenith],
+            masking[g.scattered_zenith],
+        );
+        let start = point * self.data.elements.len();
+        for (offset, &(row, column)) in self.data.elements.iter().enumerate() {
+            let i = start + offset;
+            visit(
+                offset,
+                (m[(row, column)] - self.data.values[i]) * self.data.inverse_sigma[i],
             );
-            let start = point * width;
-            for (offset, &(row, column)) in self.data.elements.iter().enumerate() {
-                let i = start + offset;
-                visit(
-                    i,
-                    (m[(row, column)] - self.data.values[i]) * self.data.inverse_sigma[i],
-                );
-            }
         }
+    }
+
+    /// Writes `map(r)` of every normalized residual of the model `pbrdf` into `out`, in parallel
+    /// over blocks of [`CHUNK_POINTS`] points (each value is the same whatever the threads).
+    fn fill_residuals(&self, pbrdf: &Pbrdf, out: &mut [f64], map: impl Fn(f64) -> f64 + Sync) {
+        let masking = self.masking(pbrdf);
+        let width = self.data.elements.len();
+        let fill = |(chunk, block): (usize, &mut [f64])| {
+            let first = chunk * CHUNK_POINTS;
+            for (p, values) in block.chunks_mut(width).enumerate() {
+                self.point_residuals(pbrdf, &masking, first + p, |e, r| values[e] = map(r));
+            }
+        };
+        // One block (every shipped file) runs on the calling thread: no task to hand out.
+        if self.data.points() <= CHUNK_POINTS {
+            fill((0, out));
+        } else {
+            out.par_chunks_mut(CHUNK_POINTS * width)
+                .enumerate()
+                .for_each(fill);
+        }
+    }
+
+    /// Σ map(r) over every normalized residual of the model `pbrdf`: partial sums over blocks of
+    /// [`CHUNK_POINTS`] points in parallel, added in block order, so that the sum does not depend
+    /// on the thread count (and is the serial sum for a set of one block).
+    fn sum_residuals(&self, pbrdf: &Pbrdf, map: impl Fn(f64) -> f64 + Sync) -> f64 {
+        let masking = self.masking(pbrdf);
+        let points = self.data.points();
+        let block = |chunk: usize| {
+            let mut total = 0.0;
+            for point in chunk * CHUNK_POINTS..((chunk + 1) * CHUNK_POINTS).min(points) {
+                self.point_residuals(pbrdf, &masking, point, |_, r| total += map(r));
+            }
+            total
+        };
+        if points <= CHUNK_POINTS {
+            return block(0);
+        }
+        let partial: Vec<f64> = (0..points.div_ceil(CHUNK_POINTS))
+            .into_par_iter()
+            .map(block)
+            .collect();
+        partial.iter().sum()
     }
 
     /// The model at `values`, or `None` if they do not make a valid one (cannot happen inside
@@ -94,12 +161,10 @@ impl<'a> Objective<'a> {
         let Some(pbrdf) = self.model(values) else {
             return f64::INFINITY;
         };
-        let mut total = 0.0;
         match self.robust {
-            None => self.for_each_residual(&pbrdf, |_, r| total += r * r),
-            Some(loss) => self.for_each_residual(&pbrdf, |_, r| total += loss.rho(r)),
+            None => self.sum_residuals(&pbrdf, |r| r * r),
+            Some(loss) => self.sum_residuals(&pbrdf, |r| loss.rho(r)),
         }
-        total
     }
 
     /// Cost at search coordinates (clamped into the box).
@@ -115,8 +180,8 @@ impl<'a> Objective<'a> {
             return false;
         };
         match self.robust {
-            None => self.for_each_residual(&pbrdf, |i, r| out[i] = r),
-            Some(loss) => self.for_each_residual(&pbrdf, |i, r| out[i] = loss.pseudo_residual(r)),
+            None => self.fill_residuals(&pbrdf, out, |r| r),
+            Some(loss) => self.fill_residuals(&pbrdf, out, |r| loss.pseudo_residual(r)),
         }
         true
     }
@@ -125,24 +190,24 @@ impl<'a> Objective<'a> {
     pub fn normalized_residuals(&self, values: &ParameterValues) -> Option<Vec<f64>> {
         let pbrdf = self.model(values)?;
         let mut out = vec![0.0; self.observations()];
-        self.for_each_residual(&pbrdf, |i, r| out[i] = r);
+        self.fill_residuals(&pbrdf, &mut out, |r| r);
         Some(out)
     }
 
     /// The model's full Mueller matrix (sr⁻¹) at every point.
     pub fn model_muellers(&self, values: &ParameterValues) -> Option<Vec<Mueller>> {
         let pbrdf = self.model(values)?;
+        let masking = self.masking_factors(&pbrdf);
         Some(
             self.data
                 .geometry
-                .iter()
+                .par_iter()
                 .map(|g| {
-                    let s = &g.scattering;
-                    let masking = [
-                        pbrdf.masking_without_table(s.cos_incident()),
-                        pbrdf.masking_without_table(s.cos_scattered()),
-                    ];
-                    pbrdf.mueller_for_geometry(s, masking[0], masking[1])
+                    pbrdf.mueller_for_geometry(
+                        &g.scattering,
+                        masking[g.incident_zenith],
+                        masking[g.scattered_zenith],
+                    )
                 })
                 .collect(),
         )

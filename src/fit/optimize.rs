@@ -41,9 +41,28 @@ impl OptimizerSettings {
     }
 }
 
+/// Sets with more points than this search on a subsample first ([`minimize`]): far more than
+/// the shipped measurements (≤ 4000 rows), so their fits do not change, and enough that the
+/// subsample's minimum lies in the whole set's basin (20 000 geometries × the elements are
+/// ≥ 20 000 observations for ≤ 9 parameters).
+pub const COARSE_POINTS: usize = 20_000;
+
+/// Every how many points the global search of a set of `points` points uses ([`minimize`]): 1
+/// up to [`COARSE_POINTS`].
+pub fn coarse_stride(points: usize) -> usize {
+    points.div_ceil(COARSE_POINTS).max(1)
+}
+
 /// Minimizes `objective` from the search-box point `start` (the first point of the GA's initial
 /// population, or where a local first stage starts). Returns the best point found and the
 /// history of every stage.
+///
+/// A set of more than [`COARSE_POINTS`] points runs every stage and the trap restarts on every
+/// n-th point (at most [`COARSE_POINTS`]), then the local stages once more on every point from
+/// there: the global search only has to find the basin, which a dense scan's subsample shows as
+/// well as the whole, and each of its hundreds of evaluations then costs a fixed amount
+/// however many rows the file has. The subsample's costs in the history are scaled by the ratio
+/// of observations, so that the convergence trace reads on the whole set's scale.
 pub(crate) fn minimize(
     objective: &Objective,
     optimizer: &Optimizer,
@@ -53,23 +72,53 @@ pub(crate) fn minimize(
 ) -> Result<(Vec<f64>, ConvergenceHistory), (Stage, argmin::core::Error)> {
     let mut point = start.to_vec();
     let mut history = ConvergenceHistory::default();
-    run_stages(
-        objective,
-        optimizer.stages(),
-        &mut point,
-        seed,
-        settings,
-        &mut history,
-    )?;
+    let local = local_stages(optimizer);
+    let points = objective.data().points();
+    let mut tried = Vec::new();
+    if points > COARSE_POINTS && !local.is_empty() {
+        let coarse_data = objective.data().every_nth(coarse_stride(points));
+        let coarse = Objective::new(&coarse_data, objective.space(), objective.robust());
+        let stages = optimizer.stages();
+        run_stages(&coarse, stages, &mut point, seed, settings, &mut history)?;
+        tried = escape_traps(
+            &coarse,
+            &local,
+            &mut point,
+            seed,
+            settings,
+            &mut history,
+            tried,
+        )?;
+        let scale = objective.observations() as f64 / coarse.observations() as f64;
+        for stage in &mut history.stages {
+            stage.best_cost.iter_mut().for_each(|cost| *cost *= scale);
+        }
+        objective.add_evaluations(coarse.evaluations());
+        run_stages(objective, &local, &mut point, seed, settings, &mut history)?;
+    } else {
+        let stages = optimizer.stages();
+        run_stages(objective, stages, &mut point, seed, settings, &mut history)?;
+    }
     escape_traps(
         objective,
-        optimizer,
+        &local,
         &mut point,
         seed,
         settings,
         &mut history,
+        tried,
     )?;
     Ok((point, history))
+}
+
+/// The stages of `optimizer` other than the GA.
+fn local_stages(optimizer: &Optimizer) -> Vec<Stage> {
+    optimizer
+        .stages()
+        .iter()
+        .copied()
+        .filter(|&s| s != Stage::Ga)
+        .collect()
 }
 
 /// Restart points of the local stages (physical σ, q, n, k, ρ_d, ρ_s, d, n_sub, d_c in [`Parameter::ALL`]
@@ -136,30 +185,25 @@ fn trap_at(objective: &Objective, point: &[f64]) -> Option<Trap> {
 /// When the local stages end in a [`Trap`], runs them again from other starts and keeps the
 /// best result: from the same point with k moved to each of [`EXTINCTION_RESTARTS`] for the
 /// k = 0 trap, from each of the [`RESTARTS`] for a pinned shape. Each remedy is tried at most
-/// once (escaping one trap can land in the other). Deterministic.
+/// once (escaping one trap can land in the other), `tried` holding those already tried (on a
+/// subsample, [`minimize`]); returns them with the new ones. Deterministic.
 fn escape_traps(
     objective: &Objective,
-    optimizer: &Optimizer,
+    local: &[Stage],
     point: &mut Vec<f64>,
     seed: u64,
     settings: &OptimizerSettings,
     history: &mut ConvergenceHistory,
-) -> Result<(), (Stage, argmin::core::Error)> {
-    let local: Vec<Stage> = optimizer
-        .stages()
-        .iter()
-        .copied()
-        .filter(|&s| s != Stage::Ga)
-        .collect();
+    mut tried: Vec<Trap>,
+) -> Result<Vec<Trap>, (Stage, argmin::core::Error)> {
     if local.is_empty() {
-        return Ok(());
+        return Ok(tried);
     }
-    let mut tried = Vec::new();
     while let Some(trap) = trap_at(objective, point).filter(|t| !tried.contains(t)) {
         tried.push(trap);
-        escape(objective, &local, trap, point, seed, settings, history)?;
+        escape(objective, local, trap, point, seed, settings, history)?;
     }
-    Ok(())
+    Ok(tried)
 }
 
 /// One remedy of [`escape_traps`].

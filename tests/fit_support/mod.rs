@@ -143,3 +143,46 @@ pub fn to_csv(set: &MeasurementSet, with_uncertainties: bool) -> String {
     }
     text
 }
+
+/// A dense goniometer scan of exactly `rows` geometries (θ_i, φ_i, θ_r, φ_r in degrees), as an
+/// archive of a scanning instrument holds: 8 incidence angles 5°…75°, and for each a raster of
+/// detector directions over the hemisphere, θ_r in 0.5° steps to 84.75° by φ_r stepped finely
+/// enough to give that angle its share of the rows. Detector positions within 3° of the source
+/// (where the detector would shadow it) move 6° outward in θ_r, as an instrument skips them.
+pub fn dense_geometry(rows: usize) -> Vec<[f64; 4]> {
+    const THETA_I: [f64; 8] = [5.0, 15.0, 25.0, 35.0, 45.0, 55.0, 65.0, 75.0];
+    const THETA_R_STEPS: usize = 170;
+    let mut out = Vec::with_capacity(rows);
+    for (a, &theta_i) in THETA_I.iter().enumerate() {
+        // the first angles take the remainder, so the total is exactly `rows`
+        let share = rows / THETA_I.len() + usize::from(a < rows % THETA_I.len());
+        let azimuths = share.div_ceil(THETA_R_STEPS).max(1);
+        for j in 0..share {
+            let mut theta_r = 0.25 + 0.5 * (j % THETA_R_STEPS) as f64;
+            let phi_r = 360.0 * (j / THETA_R_STEPS) as f64 / azimuths as f64;
+            let retro = Direction::from_angles(theta_i.to_radians(), 0.0);
+            let detector = Direction::from_angles(theta_r.to_radians(), phi_r.to_radians());
+            if retro.vector.dot(&detector.vector) > 3f64.to_radians().cos() {
+                theta_r = (theta_r + 6.0).min(84.75);
+            }
+            out.push([theta_i, 0.0, theta_r, phi_r]);
+        }
+    }
+    out
+}
+
+/// The paint that [`dense_geometry`] files are made of: Cauchy σ = 0.15, q = 2.5, Smith,
+/// N = 1.6 + 0.05i and a diffuse term `rho_d` (0.01 is the fit bench's synthetic truth; 0 puts
+/// ρ_d on its bound, so the fit adds profile-likelihood bounds).
+pub fn dense_truth(rho_d: f64) -> Pbrdf {
+    model(
+        SlopeDistribution::Cauchy {
+            sigma: 0.15,
+            q: 2.5,
+        },
+        Shadowing::Smith,
+        1.6,
+        0.05,
+        rho_d,
+    )
+}

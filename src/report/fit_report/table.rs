@@ -324,6 +324,18 @@ fn caveat_rows(fit: &FitRecord) -> Vec<Row> {
     rows
 }
 
+/// Where the search ran on a subsample of a large set (`fit::COARSE_POINTS`): which, so
+/// that the convergence panel's early costs (scaled to the whole set) are read as estimates.
+fn subsample_note(fit: &FitRecord) -> String {
+    let stride = crate::fit::coarse_stride(fit.points);
+    let local = fit.optimizer.split('+').any(|stage| stage != "ga");
+    if stride > 1 && local {
+        format!(" (search on 1 point in {stride}, then on all)")
+    } else {
+        String::new()
+    }
+}
+
 /// "Data and optimizer": what was fitted, how, and the source files with their SHA-256 prefixes.
 fn provenance_rows(fit: &FitRecord) -> Vec<Row> {
     let rmse = fit
@@ -357,12 +369,13 @@ fn provenance_rows(fit: &FitRecord) -> Vec<Row> {
         ),
         Row::Text(
             format!(
-                "{}, seed {}: {} generations + {} local iterations, {} evaluations; {}",
+                "{}, seed {}: {} generations + {} local iterations, {} evaluations{}; {}",
                 fit.optimizer,
                 fit.seed,
                 fit.global_iterations,
                 local,
                 fit.evaluations,
+                subsample_note(fit),
                 fit.termination
             ),
             Tone::Normal,
