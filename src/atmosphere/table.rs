@@ -384,15 +384,27 @@ fn parse_row(text: &str, line: usize, layout: &Layout) -> Result<[f64; 4], Refus
     Ok(values)
 }
 
+/// Why a field is not a finite number.
+struct NotANumber(String);
+
+impl std::fmt::Display for NotANumber {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
 /// A field as a finite number, or why not.
-fn parse_number(text: &str) -> Result<f64, String> {
+fn parse_number(text: &str) -> Result<f64, NotANumber> {
     if text.is_empty() {
-        return Err("empty, expected a number".into());
+        return Err(NotANumber("empty, expected a number".into()));
     }
     match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(format!("'{}' is not a finite number", shown(text))),
-        Err(_) => Err(format!("'{}' is not a number", shown(text))),
+        Ok(_) => Err(NotANumber(format!(
+            "'{}' is not a finite number",
+            shown(text)
+        ))),
+        Err(_) => Err(NotANumber(format!("'{}' is not a number", shown(text)))),
     }
 }
 

@@ -4,6 +4,7 @@
 //! (point samples, perfect polarizers, no fixed pattern), which renders today's images bit for bit.
 
 use super::config::{DetectorConfig, DofpConfig, OpticsConfig, SceneConfig};
+use super::error::InvalidSetting;
 use super::SceneError;
 use crate::optics::{valid_temperature, Band, MAX_TEMPERATURE_K};
 use crate::text::number;
@@ -134,24 +135,24 @@ pub(super) fn resolve_sensor(path: &Path, config: &SceneConfig) -> Result<Sensor
             .as_ref()
             .map(resolve_optics)
             .transpose()
-            .map_err(fail)?,
+            .map_err(|e: InvalidSetting| fail(e.0))?,
         detector: s
             .detector
             .as_ref()
             .map(resolve_detector)
             .transpose()
-            .map_err(fail)?,
+            .map_err(|e: InvalidSetting| fail(e.0))?,
         dofp: s
             .dofp
             .as_ref()
             .map(resolve_dofp)
             .transpose()
-            .map_err(fail)?,
+            .map_err(|e: InvalidSetting| fail(e.0))?,
     })
 }
 
 /// A value that must be finite and within [lo, hi]; the message names the key.
-fn within(key: &str, value: f64, lo: f64, hi: f64) -> Result<f64, String> {
+fn within(key: &str, value: f64, lo: f64, hi: f64) -> Result<f64, InvalidSetting> {
     if value.is_finite() && (lo..=hi).contains(&value) {
         Ok(value)
     } else {
@@ -160,11 +161,12 @@ fn within(key: &str, value: f64, lo: f64, hi: f64) -> Result<f64, String> {
             number(value),
             number(lo),
             number(hi)
-        ))
+        )
+        .into())
     }
 }
 
-fn resolve_optics(o: &OpticsConfig) -> Result<Optics, String> {
+fn resolve_optics(o: &OpticsConfig) -> Result<Optics, InvalidSetting> {
     let diffraction = match (o.f_number, o.pixel_pitch_um) {
         (None, None) => None,
         (Some(f_number), Some(pitch)) => Some(Diffraction {
@@ -194,7 +196,7 @@ fn resolve_optics(o: &OpticsConfig) -> Result<Optics, String> {
     })
 }
 
-fn resolve_detector(d: &DetectorConfig) -> Result<Detector, String> {
+fn resolve_detector(d: &DetectorConfig) -> Result<Detector, InvalidSetting> {
     let [lo, hi] = d.range_k;
     if !(valid_temperature(lo) && valid_temperature(hi) && lo < hi) {
         return Err(format!(
@@ -202,13 +204,15 @@ fn resolve_detector(d: &DetectorConfig) -> Result<Detector, String> {
              {MAX_TEMPERATURE_K}] K, the first below the second",
             number(lo),
             number(hi)
-        ));
+        )
+        .into());
     }
     if d.bits > 32 {
         return Err(format!(
             "sensor.detector.bits = {} must be within [0, 32] (0 = no quantization)",
             d.bits
-        ));
+        )
+        .into());
     }
     Ok(Detector {
         fpn_gain_sigma: within("sensor.detector.fpn_gain_sigma", d.fpn_gain_sigma, 0.0, 1.0)?,
@@ -218,7 +222,7 @@ fn resolve_detector(d: &DetectorConfig) -> Result<Detector, String> {
     })
 }
 
-fn resolve_dofp(d: &DofpConfig) -> Result<Dofp, String> {
+fn resolve_dofp(d: &DofpConfig) -> Result<Dofp, InvalidSetting> {
     let diattenuation = match d.extinction_ratio {
         None => 1.0,
         Some(er) if er == f64::INFINITY => 1.0,
@@ -228,15 +232,16 @@ fn resolve_dofp(d: &DofpConfig) -> Result<Dofp, String> {
                 "sensor.dofp.extinction_ratio = {} must be ≥ 1 (a polarizer passes its own \
                  orientation best; inf = perfect)",
                 number(er)
-            ))
+            )
+            .into())
         }
     };
     let demosaic = Demosaic::from_name(&d.demosaic).ok_or_else(|| {
-        format!(
+        InvalidSetting(format!(
             "sensor.dofp.demosaic = \"{}\" is not a method irpol knows; use \"bilinear\", \
              \"newton\" or \"residual\"",
             crate::text::shown(&d.demosaic)
-        )
+        ))
     })?;
     Ok(Dofp {
         diattenuation,

@@ -34,6 +34,29 @@ pub mod solis;
 pub mod station;
 mod tmy3;
 
+/// What is wrong with one field or line of a weather file: the message of a refusal at its line
+/// (and column), said once by the reader that knows where it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldProblem(pub String);
+
+impl From<String> for FieldProblem {
+    fn from(message: String) -> Self {
+        FieldProblem(message)
+    }
+}
+
+impl From<&str> for FieldProblem {
+    fn from(message: &str) -> Self {
+        FieldProblem(message.to_owned())
+    }
+}
+
+impl std::fmt::Display for FieldProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
 pub use solis::{simplified_solis, ClearSkyIrradiance, SolisAtmosphere};
 pub use station::{
     clark_allen_longwave_w_m2, kasten_czeplak, Field, HourRecord, Station, StationFormat,

@@ -10,6 +10,7 @@
 //! (0, 10⁴] K, wind within 0…150 m/s, irradiances within 0…1e5 W/m², elevations within
 //! [−90°, 90°]; at least two rows and at most [`MAX_WEATHER_ROWS`].
 
+use super::FieldProblem;
 use super::{
     nlerp_defined, swinbank_longwave_w_m2, Site, Weather, WeatherError, WeatherSample,
     MAX_IRRADIANCE_W_M2, MAX_WEATHER_ROWS, MAX_WIND_M_S,
@@ -83,10 +84,6 @@ impl Column {
         Err(FieldProblem(format!("column '{}': {problem}", self.name())))
     }
 }
-
-/// What is wrong with one field: the message of a refusal at its line and column.
-#[derive(Debug)]
-struct FieldProblem(String);
 
 /// Where each column is in the records.
 struct Layout {

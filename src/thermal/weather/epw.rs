@@ -9,6 +9,7 @@ use super::station::{
     check_sequence, check_station, field_value, label, Field, HourRecord, LineRefusal, Missing,
     Station, StationFormat, StationWeather, FIELDS,
 };
+use super::FieldProblem;
 use super::{WeatherError, MAX_WEATHER_ROWS};
 use crate::text::shown;
 use std::path::Path;
@@ -89,7 +90,7 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
             "empty file: an EPW file starts with a LOCATION line".into(),
         ));
     };
-    let station = location(first).map_err(|message| (1, message))?;
+    let station = location(first).map_err(|problem| (1, problem.0))?;
     for _ in 1..HEADER_LINES {
         if lines.next().is_none() {
             let message = format!(
@@ -109,7 +110,7 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
                 format!("more than {MAX_WEATHER_ROWS} rows: split the weather or thin it out");
             return Err((line, message));
         }
-        records.push(record(row, year, &station).map_err(|message| (line, message))?);
+        records.push(record(row, year, &station).map_err(|problem| (line, problem.0))?);
         if let Some(r) = records.last_mut() {
             r.line = line;
         }
@@ -120,26 +121,26 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
 }
 
 /// The LOCATION line's site.
-fn location(line: &str) -> Result<Station, String> {
+fn location(line: &str) -> Result<Station, FieldProblem> {
     let fields: Vec<&str> = line.split(',').map(str::trim).collect();
     if !fields[0].eq_ignore_ascii_case("LOCATION") || fields.len() < 10 {
-        return Err(format!(
+        return Err(FieldProblem(format!(
             "the first line must be LOCATION,city,state,country,source,WMO,latitude,longitude,\
              time zone,elevation; got '{}'",
             crate::text::shown_at_most(line, 80)
-        ));
+        )));
     }
-    let number = |index: usize, what: &str| -> Result<f64, String> {
+    let number = |index: usize, what: &str| -> Result<f64, FieldProblem> {
         fields[index]
             .parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
             .ok_or_else(|| {
-                format!(
+                FieldProblem(format!(
                     "LOCATION field {} ({what}): '{}' is not a number",
                     index + 1,
                     shown(fields[index])
-                )
+                ))
             })
     };
     let station = Station {
@@ -148,29 +149,29 @@ fn location(line: &str) -> Result<Station, String> {
         time_zone_h: number(8, "time zone")?,
         elevation_m: number(9, "elevation")?,
     };
-    check_station(&station).map_err(|e| format!("LOCATION: {e}"))?;
+    check_station(&station).map_err(|e| FieldProblem(format!("LOCATION: {e}")))?;
     Ok(station)
 }
 
 /// One data row.
-fn record(row: &str, year: Option<i32>, station: &Station) -> Result<HourRecord, String> {
+fn record(row: &str, year: Option<i32>, station: &Station) -> Result<HourRecord, FieldProblem> {
     let fields: Vec<&str> = row.split(',').collect();
     let needed = LAYOUT.iter().map(|l| l.1).max().unwrap_or(0);
     if fields.len() < needed {
-        return Err(format!(
+        return Err(FieldProblem(format!(
             "{} fields, an EPW data row has at least {needed} (year, month, day, hour, minute, \
              flags, dry bulb, …, opaque sky cover)",
             fields.len()
-        ));
+        )));
     }
-    let integer = |index: usize, what: &str| -> Result<i64, String> {
+    let integer = |index: usize, what: &str| -> Result<i64, FieldProblem> {
         let text = fields[index].trim();
         text.parse::<i64>().map_err(|_| {
-            format!(
+            FieldProblem(format!(
                 "field {} ({what}): '{}' is not a whole number",
                 index + 1,
                 shown(text)
-            )
+            ))
         })
     };
     let file_year = integer(0, "year")?;
@@ -178,12 +179,16 @@ fn record(row: &str, year: Option<i32>, station: &Station) -> Result<HourRecord,
     let day = integer(2, "day")?;
     let hour = integer(3, "hour")?;
     if !(1..=24).contains(&hour) {
-        return Err(format!("field 4 (hour): {hour} is outside 1…24"));
+        return Err(FieldProblem(format!(
+            "field 4 (hour): {hour} is outside 1…24"
+        )));
     }
     let year = year.map_or(file_year, i64::from);
     let fits = |v: i64, low: i64, high: i64| (low..=high).contains(&v);
     if !(fits(year, 1, 9999) && fits(month, 1, 12) && fits(day, 1, 31)) {
-        return Err(format!("{year}-{month}-{day} is not a date (fields 1-3)"));
+        return Err(FieldProblem(format!(
+            "{year}-{month}-{day} is not a date (fields 1-3)"
+        )));
     }
     let (end_local, end_utc) = label(
         year as i32,

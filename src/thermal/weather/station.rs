@@ -30,6 +30,7 @@
 //! the run needs (a knot of a row the run uses, of a quantity with no fallback, or of a fallback's
 //! inputs) is refused, naming file, line and field; missing values outside the run are ignored.
 
+use super::FieldProblem;
 use super::{simplified_solis, Site, SolisAtmosphere, Weather, WeatherError, WeatherSample};
 use crate::emitter::sun_position;
 use crate::text::number;
@@ -331,14 +332,16 @@ pub(super) fn field_value(
     text: &str,
     missing: Missing,
     scale: f64,
-) -> Result<Option<f64>, String> {
+) -> Result<Option<f64>, FieldProblem> {
     let text = text.trim();
     let shown = crate::text::shown(text);
     let v: f64 = text
         .parse()
-        .map_err(|_| format!("{name}: '{shown}' is not a number"))?;
+        .map_err(|_| FieldProblem(format!("{name}: '{shown}' is not a number")))?;
     if !v.is_finite() {
-        return Err(format!("{name}: '{shown}' is not a finite number"));
+        return Err(FieldProblem(format!(
+            "{name}: '{shown}' is not a finite number"
+        )));
     }
     let (is_missing, marker) = match missing {
         Missing::AtOrAbove(m) => (v >= m, m),
@@ -349,13 +352,13 @@ pub(super) fn field_value(
     }
     let (low, high) = field.range();
     if !(low..=high).contains(&(v * scale)) {
-        return Err(format!(
+        return Err(FieldProblem(format!(
             "{name}: {} is outside {}…{} (mark a missing value with {})",
             number(v),
             number(low / scale),
             number(high / scale),
             number(marker)
-        ));
+        )));
     }
     Ok(Some(v * scale))
 }
@@ -368,26 +371,34 @@ pub(super) fn label(
     day: u32,
     hour: u32,
     time_zone_h: f64,
-) -> Result<(NaiveDateTime, DateTime<Utc>), String> {
+) -> Result<(NaiveDateTime, DateTime<Utc>), FieldProblem> {
     let date = chrono::NaiveDate::from_ymd_opt(year, month, day)
-        .ok_or_else(|| format!("{year:04}-{month:02}-{day:02} is not a date"))?;
+        .ok_or_else(|| FieldProblem(format!("{year:04}-{month:02}-{day:02} is not a date")))?;
     if hour > 24 {
-        return Err(format!("hour {hour} is outside 1…24 (hour-ending labels)"));
+        return Err(FieldProblem(format!(
+            "hour {hour} is outside 1…24 (hour-ending labels)"
+        )));
     }
     let local = date
         .and_hms_opt(0, 0, 0)
         .and_then(|midnight| midnight.checked_add_signed(TimeDelta::hours(hour as i64)))
-        .ok_or_else(|| format!("{year:04}-{month:02}-{day:02} is beyond the calendar"))?;
+        .ok_or_else(|| {
+            FieldProblem(format!(
+                "{year:04}-{month:02}-{day:02} is beyond the calendar"
+            ))
+        })?;
     let zone = TimeDelta::seconds((time_zone_h * 3600.0).round() as i64);
-    let utc = local
-        .checked_sub_signed(zone)
-        .ok_or_else(|| format!("{year:04}-{month:02}-{day:02} is beyond the calendar"))?;
+    let utc = local.checked_sub_signed(zone).ok_or_else(|| {
+        FieldProblem(format!(
+            "{year:04}-{month:02}-{day:02} is beyond the calendar"
+        ))
+    })?;
     Ok((local, utc.and_utc()))
 }
 
 /// Checks the header's site: latitude within ±90°, longitude within ±180°, time zone within
 /// −12…+14 h, elevation within −1000…9000 m.
-pub(super) fn check_station(station: &Station) -> Result<(), String> {
+pub(super) fn check_station(station: &Station) -> Result<(), FieldProblem> {
     let checks = [
         ("latitude", station.latitude_deg, -90.0, 90.0, "°"),
         ("longitude", station.longitude_deg, -180.0, 180.0, "°"),
@@ -396,12 +407,12 @@ pub(super) fn check_station(station: &Station) -> Result<(), String> {
     ];
     for (name, v, low, high, unit) in checks {
         if !(v.is_finite() && (low..=high).contains(&v)) {
-            return Err(format!(
+            return Err(FieldProblem(format!(
                 "the {name} {}{unit} is outside {}…{}{unit}",
                 number(v),
                 number(low),
                 number(high)
-            ));
+            )));
         }
     }
     Ok(())

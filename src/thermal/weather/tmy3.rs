@@ -9,6 +9,7 @@ use super::station::{
     check_sequence, check_station, field_value, label, Field, HourRecord, LineRefusal, Missing,
     Station, StationFormat, StationWeather, FIELDS,
 };
+use super::FieldProblem;
 use super::{WeatherError, MAX_WEATHER_ROWS};
 use crate::text::shown;
 use std::path::Path;
@@ -85,7 +86,7 @@ fn split(line: &str) -> Vec<String> {
 fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), LineRefusal> {
     let mut lines = text.lines().enumerate().map(|(i, l)| (i as u64 + 1, l));
     let station = match lines.next() {
-        Some((_, first)) => site(&split(first)).map_err(|m| (1, m))?,
+        Some((_, first)) => site(&split(first)).map_err(|problem| (1, problem.0))?,
         None => {
             return Err((
                 1,
@@ -123,7 +124,7 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
         }
         let fields = split(row);
         let record = record(&fields, date, time, &index, year, &station);
-        let mut record = record.map_err(|message| (line, message))?;
+        let mut record = record.map_err(|problem| (line, problem.0))?;
         record.line = line;
         records.push(record);
         last_line = line;
@@ -133,25 +134,25 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
 }
 
 /// The site line: USAF, name, state, time zone, latitude, longitude, elevation.
-fn site(fields: &[String]) -> Result<Station, String> {
+fn site(fields: &[String]) -> Result<Station, FieldProblem> {
     if fields.len() < 7 {
-        return Err(format!(
+        return Err(FieldProblem(format!(
             "the first line must be USAF,name,state,time zone,latitude,longitude,elevation; got \
              {} field(s)",
             fields.len()
-        ));
+        )));
     }
-    let number = |index: usize, what: &str| -> Result<f64, String> {
+    let number = |index: usize, what: &str| -> Result<f64, FieldProblem> {
         fields[index]
             .parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
             .ok_or_else(|| {
-                format!(
+                FieldProblem(format!(
                     "site line field {} ({what}): '{}' is not a number",
                     index + 1,
                     shown(&fields[index])
-                )
+                ))
             })
     };
     let station = Station {
@@ -160,7 +161,7 @@ fn site(fields: &[String]) -> Result<Station, String> {
         longitude_deg: number(5, "longitude")?,
         elevation_m: number(6, "elevation")?,
     };
-    check_station(&station).map_err(|e| format!("site line: {e}"))?;
+    check_station(&station).map_err(|e| FieldProblem(format!("site line: {e}")))?;
     Ok(station)
 }
 
@@ -172,9 +173,14 @@ fn record(
     index: &[usize; FIELDS - 1],
     year: Option<i32>,
     station: &Station,
-) -> Result<HourRecord, String> {
+) -> Result<HourRecord, FieldProblem> {
     let get = |i: usize| fields.get(i).map(String::as_str).unwrap_or("");
-    let bad_date = || format!("column '{DATE}': '{}' is not MM/DD/YYYY", shown(get(date)));
+    let bad_date = || {
+        FieldProblem(format!(
+            "column '{DATE}': '{}' is not MM/DD/YYYY",
+            shown(get(date))
+        ))
+    };
     let parts: Vec<&str> = get(date).split('/').collect();
     let [month, day, file_year] = parts.as_slice() else {
         return Err(bad_date());
@@ -187,10 +193,15 @@ fn record(
         Some((h, "00")) => h.parse::<u32>().ok(),
         _ => None,
     }
-    .ok_or_else(|| format!("column '{TIME}': '{}' is not HH:00", shown(get(time))))?;
+    .ok_or_else(|| {
+        FieldProblem(format!(
+            "column '{TIME}': '{}' is not HH:00",
+            shown(get(time))
+        ))
+    })?;
     let year = year.unwrap_or(file_year);
     let (end_local, end_utc) = label(year, month, day, hour, station.time_zone_h)
-        .map_err(|e| format!("columns '{DATE}', '{TIME}': {e}"))?;
+        .map_err(|e| FieldProblem(format!("columns '{DATE}', '{TIME}': {e}")))?;
     let mut values = [None; FIELDS];
     for (i, (field, name, scale)) in COLUMNS.iter().enumerate() {
         let name = format!("column '{name}'");
