@@ -78,19 +78,7 @@ impl DetectorModel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optics::Band;
-
-    fn sensor() -> Sensor {
-        Sensor {
-            band: Band::lwir(),
-            netd_mk: 0.0,
-            seed: 5,
-            netd_reference_k: 300.0,
-            optics: None,
-            detector: None,
-            dofp: None,
-        }
-    }
+    use crate::render::camera::ideal_sensor as sensor;
 
     #[test]
     fn the_pattern_has_its_stated_spread_and_is_fixed_per_seed() {

@@ -178,21 +178,29 @@ fn record_rows(
     (recorded.concat(), mosaic.concat())
 }
 
+/// An LWIR sensor with the ideal camera and no noise, referred to 300 K, for the camera's tests.
+#[cfg(test)]
+pub(crate) fn ideal_sensor() -> Sensor {
+    Sensor {
+        band: crate::optics::Band::lwir(),
+        netd_mk: 0.0,
+        seed: 9,
+        netd_reference_k: 300.0,
+        optics: None,
+        detector: None,
+        dofp: None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optics::Band;
     use crate::scene::{Demosaic, Dofp};
 
     fn sensor(dofp: Dofp) -> Sensor {
         Sensor {
-            band: Band::lwir(),
-            netd_mk: 0.0,
-            seed: 9,
-            netd_reference_k: 300.0,
-            optics: None,
-            detector: None,
             dofp: Some(dofp),
+            ..ideal_sensor()
         }
     }
 

@@ -242,20 +242,8 @@ fn transpose(grid: &[Complex<f64>], w: usize, h: usize) -> Vec<Complex<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optics::Band;
+    use crate::render::camera::ideal_sensor as sensor;
     use crate::scene::Diffraction;
-
-    fn sensor() -> Sensor {
-        Sensor {
-            band: Band::lwir(),
-            netd_mk: 0.0,
-            seed: 0,
-            netd_reference_k: 300.0,
-            optics: None,
-            detector: None,
-            dofp: None,
-        }
-    }
 
     fn optics(f_number: f64, pitch: f64, fill: f64, sigma: f64) -> Optics {
         Optics {
