@@ -6,11 +6,11 @@
 //! marker is missing. Fields beyond 24 (visibility, precipitation, …) are not read.
 
 use super::station::{
-    check_sequence, check_station, field_value, label, Field, HourRecord, LineRefusal, Missing,
+    check_station, field_value, label, read_records, Field, HourRecord, LineRefusal, Missing,
     Station, StationFormat, StationWeather, FIELDS,
 };
 use super::FieldProblem;
-use super::{WeatherError, MAX_WEATHER_ROWS};
+use super::WeatherError;
 use crate::text::shown;
 use std::path::Path;
 
@@ -99,24 +99,9 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
             return Err((text.lines().count() as u64, message));
         }
     }
-    let mut records = Vec::new();
-    let mut last_line = HEADER_LINES as u64;
-    for (line, row) in lines {
-        if row.trim().is_empty() {
-            continue;
-        }
-        if records.len() == MAX_WEATHER_ROWS {
-            let message =
-                format!("more than {MAX_WEATHER_ROWS} rows: split the weather or thin it out");
-            return Err((line, message));
-        }
-        records.push(record(row, year, &station).map_err(|problem| (line, problem.0))?);
-        if let Some(r) = records.last_mut() {
-            r.line = line;
-        }
-        last_line = line;
-    }
-    check_sequence(&records, last_line)?;
+    let records = read_records(lines, HEADER_LINES as u64, |row| {
+        record(row, year, &station)
+    })?;
     Ok((station, records))
 }
 

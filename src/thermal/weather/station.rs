@@ -31,7 +31,9 @@
 //! inputs) is refused, naming file, line and field; missing values outside the run are ignored.
 
 use super::FieldProblem;
-use super::{simplified_solis, Site, SolisAtmosphere, Weather, WeatherError, WeatherSample};
+use super::{
+    simplified_solis, Site, SolisAtmosphere, Weather, WeatherError, WeatherSample, MAX_WEATHER_ROWS,
+};
 use crate::emitter::sun_position;
 use crate::text::number;
 use chrono::{DateTime, NaiveDateTime, TimeDelta, Utc};
@@ -416,6 +418,34 @@ pub(super) fn check_station(station: &Station) -> Result<(), FieldProblem> {
         }
     }
     Ok(())
+}
+
+/// The hourly records of a file's data `lines` (numbered from 1; `header_end` the last header
+/// line), each parsed by `parse` and stamped with its line: blank lines skipped, at most
+/// [`MAX_WEATHER_ROWS`], then [`check_sequence`].
+pub(super) fn read_records<'a>(
+    lines: impl Iterator<Item = (u64, &'a str)>,
+    header_end: u64,
+    mut parse: impl FnMut(&str) -> Result<HourRecord, FieldProblem>,
+) -> Result<Vec<HourRecord>, LineRefusal> {
+    let mut records = Vec::new();
+    let mut last_line = header_end;
+    for (line, row) in lines {
+        if row.trim().is_empty() {
+            continue;
+        }
+        if records.len() == MAX_WEATHER_ROWS {
+            let message =
+                format!("more than {MAX_WEATHER_ROWS} rows: split the weather or thin it out");
+            return Err((line, message));
+        }
+        let mut record = parse(row).map_err(|problem| (line, problem.0))?;
+        record.line = line;
+        records.push(record);
+        last_line = line;
+    }
+    check_sequence(&records, last_line)?;
+    Ok(records)
 }
 
 /// Rows must follow each other by exactly one hour (a typical-year file mixes years: then give

@@ -6,11 +6,11 @@
 //! no infrared column: the sky's long-wave is always Clark & Allen's. −9900 (NSRDB) is missing.
 
 use super::station::{
-    check_sequence, check_station, field_value, label, Field, HourRecord, LineRefusal, Missing,
+    check_station, field_value, label, read_records, Field, HourRecord, LineRefusal, Missing,
     Station, StationFormat, StationWeather, FIELDS,
 };
 use super::FieldProblem;
-use super::{WeatherError, MAX_WEATHER_ROWS};
+use super::WeatherError;
 use crate::text::shown;
 use std::path::Path;
 
@@ -111,25 +111,9 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
     for (i, (_, name, _)) in COLUMNS.iter().enumerate() {
         index[i] = find(name)?;
     }
-    let mut records = Vec::new();
-    let mut last_line = 2;
-    for (line, row) in lines {
-        if row.trim().is_empty() {
-            continue;
-        }
-        if records.len() == MAX_WEATHER_ROWS {
-            let message =
-                format!("more than {MAX_WEATHER_ROWS} rows: split the weather or thin it out");
-            return Err((line, message));
-        }
-        let fields = split(row);
-        let record = record(&fields, date, time, &index, year, &station);
-        let mut record = record.map_err(|problem| (line, problem.0))?;
-        record.line = line;
-        records.push(record);
-        last_line = line;
-    }
-    check_sequence(&records, last_line)?;
+    let records = read_records(lines, 2, |row| {
+        record(&split(row), date, time, &index, year, &station)
+    })?;
     Ok((station, records))
 }
 
