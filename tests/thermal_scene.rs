@@ -164,6 +164,70 @@ fn shadowed_ground_is_cooler_and_a_plate_cools_below_the_air_at_night() {
     }
 }
 
+/// The ground's afternoon temperature at each of its vertices `inside_m` or more inside the ball's
+/// shadow, for the ground typed with `divisions`.
+fn ground_in_shadow(
+    dir: &std::path::Path,
+    divisions: &str,
+    inside_m: f64,
+) -> Vec<(Vector3<f64>, f64)> {
+    let path = write_scene(
+        dir,
+        &scene_text("").replace("divisions = [16, 16]", divisions),
+    );
+    let scene = load_scene(&path).unwrap();
+    let solution = solve_scene(&scene, &[], &Silent).unwrap();
+    let afternoon = record(&solution, 13.0 * 3600.0);
+    let sun = solution.weather[afternoon].sun_direction;
+    let centre = Vector3::from(BALL);
+    vertices_of(&scene, "ground")
+        .into_iter()
+        .filter_map(|v| {
+            let p = scene.mesh.positions[v];
+            // In the shadow: the ray toward the sun passes `inside_m` inside the ball's rim.
+            let to_centre = centre - p;
+            let miss = (to_centre - sun * to_centre.dot(&sun)).norm();
+            (miss < 0.5 - inside_m).then_some((p, solution.surface_k[afternoon][v]))
+        })
+        .collect()
+}
+
+/// A ground plane typed with `divisions = [1, 1]` (what `scene init` writes) is solved on
+/// `thermal.plane_cell_m` cells, so the ball's shadow appears in it as in a [200, 200] plane.
+#[test]
+fn a_plane_of_one_cell_shows_the_shadow_of_a_fine_plane() {
+    let dir = tempfile::tempdir().unwrap();
+    let coarse = ground_in_shadow(dir.path(), "divisions = [1, 1]", 0.1);
+    let fine = ground_in_shadow(dir.path(), "divisions = [200, 200]", 0.0);
+    assert!(
+        coarse.len() >= 4,
+        "{} coarse vertices in shadow",
+        coarse.len()
+    );
+    // The fine plane's vertices lie on a 0.04 m grid from −4 m: interpolate it bilinearly.
+    let cell = 8.0 / 200.0;
+    let grid = |x: f64| (x + 4.0) / cell;
+    let fine_at: std::collections::HashMap<(i64, i64), f64> = fine
+        .iter()
+        .map(|(q, t)| ((grid(q.x).round() as i64, grid(q.y).round() as i64), *t))
+        .collect();
+    let mut worst: f64 = 0.0;
+    for (p, t) in &coarse {
+        let (gx, gy) = (grid(p.x), grid(p.y));
+        let (i, j) = (gx.floor() as i64, gy.floor() as i64);
+        let (fx, fy) = (gx - i as f64, gy - j as f64);
+        let corner = |di: i64, dj: i64| fine_at[&(i + di, j + dj)];
+        let t_fine = (1.0 - fy) * ((1.0 - fx) * corner(0, 0) + fx * corner(1, 0))
+            + fy * ((1.0 - fx) * corner(0, 1) + fx * corner(1, 1));
+        worst = worst.max((t - t_fine).abs());
+    }
+    println!(
+        "{} vertices in the shadow: [1, 1] vs [200, 200] worst {worst:.3} K",
+        coarse.len()
+    );
+    assert!(worst < 0.5, "{worst} K");
+}
+
 /// Acceptance 5 at scene level: halving the forcing step changes no surface temperature of the
 /// day by 0.01 K or more.
 #[test]
@@ -204,7 +268,8 @@ fn identical_vertices_are_solved_once() {
     let dir = tempfile::tempdir().unwrap();
     let (scene, solution) = solved(dir.path(), "", &[]);
     let plate = vertices_of(&scene, "plate");
-    assert_eq!(plate.len(), 4);
+    // The 0.5 m plate of divisions [1, 1] is solved on 0.25 m cells: 3 × 3 vertices.
+    assert_eq!(plate.len(), 9);
     for row in &solution.surface_k {
         assert!(plate.iter().all(|&v| row[v] == row[plate[0]]));
     }
@@ -371,7 +436,7 @@ fn a_series_replaces_the_earlier_series_and_keeps_the_users_files() {
 /// Bad thermal input: one-line errors naming the key, and nothing written.
 #[test]
 fn bad_thermal_input_is_refused_by_name_and_writes_nothing() {
-    let cases: [(&str, &str, &str); 7] = [
+    let cases: [(&str, &str, &str); 8] = [
         (
             "[[\"paint\", 0.0001], [\"stel\", 0.001]]",
             "",
@@ -397,6 +462,11 @@ fn bad_thermal_input_is_refused_by_name_and_writes_nothing() {
             "[[\"paint\", 0.001]]",
             "shadow_step_s = 0",
             "thermal.shadow_step_s = 0 must be positive",
+        ),
+        (
+            "[[\"paint\", 0.001]]",
+            "plane_cell_m = -0.5",
+            "thermal.plane_cell_m = -0.5 must be positive",
         ),
         (
             "[[\"paint\", 0.001]]",

@@ -157,6 +157,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         surfaces: &mut surfaces,
         warnings: &mut warnings,
         thermal_start_air_k: start_air_k,
+        thermal_plane_cell_m: config.thermal.as_ref().map(|t| t.plane_cell_m),
     };
     let (object_names, mesh) = build_objects(&config.objects, &mut sink)?;
     let materials = materials

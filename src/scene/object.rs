@@ -16,6 +16,8 @@ pub(super) struct ObjectSink<'s, 'a> {
     pub warnings: &'s mut Vec<String>,
     /// With `[thermal]`: the air temperature at the run's start (§1.8 initial state).
     pub thermal_start_air_k: Option<f64>,
+    /// With `[thermal]`: the largest cell of a procedural plane the model solves on.
+    pub thermal_plane_cell_m: Option<f64>,
 }
 
 /// An object's mesh and where it came from, with what messages call them.
@@ -38,7 +40,11 @@ pub(super) fn build_object(
 ) -> Result<ShadedMesh, SceneError> {
     let scene = sink.materials.scene;
     let fail = |message: String| SceneError::new(scene, format!("{label}: {message}"));
-    let loaded = load_object_mesh(object, sink.materials.dir, scene, label)?;
+    // Only a plane whose surface temperatures come from the model needs the finer grid.
+    let plane_cell_m = sink
+        .thermal_plane_cell_m
+        .filter(|_| thermal::part_thermal(object, procedural::SHAPE_PART).is_some());
+    let loaded = load_object_mesh(object, sink.materials.dir, scene, label, plane_cell_m)?;
     sink.warnings.extend(mesh_warnings(&loaded, label));
     check_parts(object, &loaded, &fail)?;
     let (part_temperature, part_surface) =
@@ -208,12 +214,14 @@ fn resolve_parts(
     Ok((part_temperature, part_surface))
 }
 
-/// The object's mesh: its file (relative to `dir`, OBJ or PLY) or its procedural shape.
+/// The object's mesh: its file (relative to `dir`, OBJ or PLY) or its procedural shape (a plane
+/// cut into cells no larger than `plane_cell_m` when given).
 fn load_object_mesh(
     object: &ObjectConfig,
     dir: &Path,
     scene: &Path,
     label: &str,
+    plane_cell_m: Option<f64>,
 ) -> Result<LoadedMesh, SceneError> {
     let invalid = |message: String| SceneError::new(scene, format!("{label}: {message}"));
     let file = match (&object.mesh, &object.shape) {
@@ -221,7 +229,7 @@ fn load_object_mesh(
         (None, None) => return Err(invalid("needs a mesh file or a shape".into())),
         (None, Some(shape)) => {
             return Ok(LoadedMesh {
-                raw: procedural_shape(shape, &invalid)?,
+                raw: procedural_shape(shape, plane_cell_m, &invalid)?,
                 file: None,
                 name: "the shape".to_owned(),
             })
@@ -260,7 +268,11 @@ fn parse_mesh(file: &Path, bytes: Vec<u8>) -> Result<RawMesh, MeshError> {
     }
 }
 
-fn procedural_shape(shape: &ShapeConfig, invalid: Invalid) -> Result<RawMesh, SceneError> {
+fn procedural_shape(
+    shape: &ShapeConfig,
+    plane_cell_m: Option<f64>,
+    invalid: Invalid,
+) -> Result<RawMesh, SceneError> {
     match *shape {
         ShapeConfig::Sphere {
             radius,
@@ -286,6 +298,9 @@ fn procedural_shape(shape: &ShapeConfig, invalid: Invalid) -> Result<RawMesh, Sc
             if !divisions.iter().all(|d| (1..=4096).contains(d)) {
                 return Err(invalid("shape.divisions must be within 1…4096".into()));
             }
+            let divisions = plane_cell_m.map_or(divisions, |cell| {
+                procedural::divisions_for_cell(size, divisions, cell)
+            });
             Ok(procedural::plane(size, divisions))
         }
     }

@@ -88,6 +88,15 @@ pub fn icosphere(radius: f64, subdivisions: u32) -> RawMesh {
     mesh
 }
 
+/// At least `divisions`, and enough that no cell of a `size` plane is longer than `cell_m`
+/// (at most 4096 a side).
+pub fn divisions_for_cell(size: [f64; 2], divisions: [u32; 2], cell_m: f64) -> [u32; 2] {
+    [0, 1].map(|axis| {
+        let needed = (size[axis] / cell_m).ceil().min(4096.0) as u32;
+        divisions[axis].max(needed)
+    })
+}
+
 /// A `size[0]` × `size[1]` plane in z = 0 centred at the origin, facing +z, cut into
 /// `divisions[0]` × `divisions[1]` squares of two triangles each.
 pub fn plane(size: [f64; 2], divisions: [u32; 2]) -> RawMesh {
@@ -149,6 +158,15 @@ mod tests {
             .positions
             .iter()
             .all(|p| (p.norm() - 2.0).abs() < 1e-12));
+    }
+
+    #[test]
+    fn a_plane_cell_raises_divisions_but_never_lowers_them() {
+        assert_eq!(divisions_for_cell([20.0, 0.5], [1, 1], 0.25), [80, 2]);
+        assert_eq!(divisions_for_cell([20.0, 0.5], [200, 1], 0.25), [200, 2]);
+        // An exact multiple needs no extra cell; a sliver more needs one.
+        assert_eq!(divisions_for_cell([1.0, 1.0 + 1e-9], [1, 1], 0.25), [4, 5]);
+        assert_eq!(divisions_for_cell([1e6, 1.0], [1, 1], 0.25), [4096, 4]);
     }
 
     #[test]

@@ -38,6 +38,11 @@ pub struct ThermalConfig {
     /// Shadow rays toward the sun every `shadow_step_s` (linear in between).
     #[serde(default = "default_shadow_step")]
     pub shadow_step_s: f64,
+    /// A procedural plane with a thermal stack is solved on cells no larger than this (m): its
+    /// `divisions` are raised to reach it, because the model solves per vertex and a shadow
+    /// smaller than a cell would fall between vertices (docs/design.md §1.8).
+    #[serde(default = "default_plane_cell")]
+    pub plane_cell_m: f64,
     /// Layer materials by name.
     #[serde(default, deserialize_with = "table_map")]
     pub layers: BTreeMap<String, LayerMaterialConfig>,
@@ -45,6 +50,10 @@ pub struct ThermalConfig {
 
 fn default_output_step() -> f64 {
     600.0
+}
+
+fn default_plane_cell() -> f64 {
+    0.25
 }
 
 fn default_time_step() -> f64 {

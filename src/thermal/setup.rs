@@ -339,8 +339,8 @@ fn station_only_key(config: &ThermalConfig) -> Option<&'static str> {
     }
 }
 
-/// The three time steps are positive and the run has no more of each than its limit, checked
-/// before anything is allocated (a 1e-300 s output step once asked for 1e304 recorded instants).
+/// The three time steps (and the plane cell) are positive and the run has no more of each step
+/// than its limit, checked before anything is allocated (a 1e-300 s output step once asked for 1e304 recorded instants).
 fn check_steps(config: &ThermalConfig, duration_s: f64) -> Result<(), ThermalSetupError> {
     // Weather and shadow samples run through the spun-up first day too.
     let sampled_s = if config.spinup_days > 0 {
@@ -358,6 +358,12 @@ fn check_steps(config: &ThermalConfig, duration_s: f64) -> Result<(), ThermalSet
         ("time_step_s", config.time_step_s, sampled_s, MAX_STEPS),
         ("shadow_step_s", config.shadow_step_s, sampled_s, MAX_STEPS),
     ];
+    if !(config.plane_cell_m.is_finite() && config.plane_cell_m > 0.0) {
+        return Err(ThermalSetupError::Step {
+            key: "plane_cell_m",
+            step: config.plane_cell_m,
+        });
+    }
     for (key, step_s, span_s, limit) in steps {
         if !(step_s.is_finite() && step_s > 0.0) {
             return Err(ThermalSetupError::Step { key, step: step_s });
