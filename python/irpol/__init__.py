@@ -40,6 +40,8 @@ __all__ = [
     "validate",
     "Validation",
     "render",
+    "solve_thermal",
+    "thermal_keys",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -238,4 +240,4 @@ def validate(
 
 
 from ._fit import FitResult, fit  # noqa: E402  (needs Measurements)
-from ._render import render  # noqa: E402
+from ._render import render, solve_thermal, thermal_keys  # noqa: E402

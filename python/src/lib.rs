@@ -11,6 +11,7 @@ mod model;
 mod radiometry;
 mod rendering;
 mod scene_patch;
+mod thermal;
 mod validation;
 
 use pyo3::prelude::*;
@@ -30,6 +31,8 @@ fn _irpol(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fitting::fit_materials, m)?)?;
     m.add_function(wrap_pyfunction!(rendering::render_scene, m)?)?;
     m.add_function(wrap_pyfunction!(scene_patch::check_scene_keys, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::thermal_keys, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::solve_thermal, m)?)?;
     m.add_function(wrap_pyfunction!(validation::validate_material, m)?)?;
     Ok(())
 }

@@ -1,9 +1,10 @@
 //! `irpol render` in memory: a scene file (optionally with values replaced, and at an instant of
-//! its thermal run) rendered to numpy images; with `out`, also every file the command writes.
+//! its thermal run, solved here or read from a saved run) rendered to numpy images; with `out`,
+//! also every file the command writes.
 
 use crate::errors::{bad_argument, raised};
 use crate::scene_patch::{patched, scene_text, toml_value, Missing};
-use irpol::app::render::scene_to_render;
+use irpol::app::saved_thermal::scene_to_render_from;
 use irpol::app::AppError;
 use irpol::output::{write_outputs, Channel};
 use irpol::progress::Silent;
@@ -26,10 +27,11 @@ fn render_images(
     scene: &std::path::Path,
     text: &str,
     time_s: Option<f64>,
+    thermal_solution: Option<&std::path::Path>,
     out: Option<&std::path::Path>,
 ) -> Result<Images, AppError> {
     let start = Instant::now();
-    let loaded = scene_to_render(scene, text, time_s, &Silent)?;
+    let loaded = scene_to_render_from(scene, text, time_s, thermal_solution, &Silent)?;
     let rendered = render(&loaded, &Silent)?;
     let image = &rendered.image;
     let mut channels: Vec<(&'static str, Vec<f32>)> = Channel::ALL
@@ -57,7 +59,7 @@ fn render_images(
 
 /// `error` raised as [`raised`] does, except that the refusals naming the command line's
 /// `--time` flags name the keyword `time_s` of `irpol.render` instead.
-fn in_python_terms(error: AppError) -> PyErr {
+pub(crate) fn in_python_terms(error: AppError) -> PyErr {
     match error {
         AppError::ThermalNeedsInstant(path) => bad_argument(format!(
             "{}: has a [thermal] section: say when to render it with time_s=SECONDS \
@@ -74,9 +76,9 @@ fn in_python_terms(error: AppError) -> PyErr {
 }
 
 /// Dotted scene keys and the values to give them.
-type Patch<'py> = Vec<(String, Bound<'py, PyAny>)>;
+pub(crate) type Patch<'py> = Vec<(String, Bound<'py, PyAny>)>;
 
-fn apply(
+pub(crate) fn apply(
     scene: &std::path::Path,
     text: String,
     patch: Option<Patch<'_>>,
@@ -94,10 +96,12 @@ fn apply(
 
 /// Renders `scene` with `patch` (dotted scene keys, which must exist, → values) and then
 /// `overrides` (the same, a missing last key added) applied to its text; `time_s` is the instant
-/// (s from thermal.start_utc) of a scene with [thermal]. Returns channel name → float32 image
+/// (s from thermal.start_utc) of a scene with [thermal], its temperatures from the run saved in
+/// `thermal_solution` (by `solve_thermal`) when given. Returns channel name → float32 image
 /// (rows from the top), plus "summary" (JSON text) when `out` is given.
 #[pyfunction]
-#[pyo3(signature = (scene, patch = None, overrides = None, time_s = None, out = None))]
+#[pyo3(signature = (scene, patch = None, overrides = None, time_s = None, out = None,
+                    thermal_solution = None))]
 pub fn render_scene<'py>(
     py: Python<'py>,
     scene: PathBuf,
@@ -105,11 +109,13 @@ pub fn render_scene<'py>(
     overrides: Option<Patch<'py>>,
     time_s: Option<f64>,
     out: Option<PathBuf>,
+    thermal_solution: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let text = apply(&scene, scene_text(&scene)?, patch, Missing::Refuse)?;
     let text = apply(&scene, text, overrides, Missing::Create)?;
+    let solution = thermal_solution.as_deref();
     let images = py
-        .detach(|| render_images(&scene, &text, time_s, out.as_deref()))
+        .detach(|| render_images(&scene, &text, time_s, solution, out.as_deref()))
         .map_err(in_python_terms)?;
     let d = PyDict::new(py);
     for (name, data) in images.channels {

@@ -146,6 +146,9 @@ pub enum AppError {
     InstantNeedsThermal(PathBuf),
     #[error("t = {} s is not an instant of the thermal run", crate::text::number(*.0))]
     NotAnInstant(f64),
+    /// A saved thermal run that cannot be written, read or used for the scene.
+    #[error(transparent)]
+    SavedSolution(Box<crate::thermal_scene::SavedSolutionError>),
     /// The scene at an instant of its thermal run could not be built.
     #[error("{}: {message}", crate::text::path(path))]
     SceneAt { path: PathBuf, message: String },

@@ -212,7 +212,7 @@ fn series_manifest(scene: &Scene, renders: &[TimedRender]) -> serde_json::Value 
 }
 
 /// The thermal scene with the temperatures of `solution` at `time_s` (an instant of the run).
-fn solution_instant(
+pub(super) fn solution_instant(
     scene: &Scene,
     solution: &ThermalSolution,
     time_s: f64,

@@ -142,7 +142,7 @@ pub struct ClearDay {
 }
 
 /// The weather at one instant.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct WeatherSample {
     /// Air temperature (K).
     pub air_k: f64,

@@ -6,12 +6,15 @@
 //! - [`solve`]: the per-vertex runs and the recorded surface temperatures.
 //! - [`parts`]: min/mean/max per part over time.
 //! - [`instant`]: the scene rebuilt at a recorded instant, for rendering.
+//! - [`saved`]: a run's content key, and the run saved to a file and read back (sweeps).
 
 pub mod exposure;
 pub mod instant;
 pub mod parts;
+pub mod saved;
 pub mod solve;
 
 pub use instant::{scene_at, InstantError};
 pub use parts::{part_series, PartSeries};
+pub use saved::{SavedSolutionError, ThermalKey};
 pub use solve::{solve_scene, vertex_surfaces, SolveStats, ThermalRunError, ThermalSolution};

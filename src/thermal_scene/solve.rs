@@ -28,8 +28,9 @@ use crate::transport::accel::Accelerator;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
-/// Surface temperatures of every shading vertex at the recorded instants.
-#[derive(Clone, Debug)]
+/// Surface temperatures of every shading vertex at the recorded instants (saved whole by
+/// [`super::saved`]).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ThermalSolution {
     /// Recorded instants (s from `start_utc`), ascending: 0, every output step, the end, and any
     /// extra instants asked for.
@@ -43,7 +44,7 @@ pub struct ThermalSolution {
 }
 
 /// How much work the run took and how well it closed its energy budget.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct SolveStats {
     /// Shading vertices whose temperatures the model computes.
     pub thermal_vertices: usize,
@@ -134,7 +135,7 @@ const DAY_S: f64 = 86_400.0;
 
 /// The sample times of the run: every `time_step_s`, every `output_step_s`, the end and `extra`
 /// (through the first day too when it is spun up), and which of them are recorded.
-fn sample_times(setup: &ThermalSetup, extra: &[f64]) -> (Vec<f64>, Vec<bool>) {
+pub(crate) fn sample_times(setup: &ThermalSetup, extra: &[f64]) -> (Vec<f64>, Vec<bool>) {
     let end = setup.duration_s;
     let sampled_end = sampled_end(setup);
     let mut times: Vec<(f64, bool)> = Vec::new();

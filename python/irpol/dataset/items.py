@@ -1,5 +1,7 @@
 """One item of a sweep, as a Dask task runs it: its outputs written into a temporary folder,
-hashed, then renamed to ``out/items/<i>/`` in one step. Workers never write the manifest."""
+hashed, then renamed to ``out/items/<i>/`` in one step; and the thermal run that the renders at
+instants of one thermal configuration share, saved once to ``out/thermal/<key>.bin``. Workers
+never write the manifest."""
 
 from __future__ import annotations
 
@@ -9,7 +11,7 @@ import shutil
 import time
 import uuid
 from pathlib import Path
-from typing import Any, Dict
+from typing import Any, Dict, List, Optional
 
 import irpol
 
@@ -34,13 +36,36 @@ def item_folder(out: Path, index: int) -> Path:
     return out / "items" / str(index)
 
 
-def _render(job: Dict[str, Any], params: Dict[str, Any], folder: Path) -> None:
-    patch = {k: v for k, v in params.items() if k != TIME_KEY}
-    irpol.render(job["scene"], patch=patch, time_s=params.get(TIME_KEY), out=folder,
-                 **job["render"])
+def thermal_path(out: Path, key: str) -> Path:
+    return out / "thermal" / f"{key}.bin"
 
 
-def _fit(job: Dict[str, Any], params: Dict[str, Any], folder: Path) -> None:
+def scene_patch(params: Dict[str, Any]) -> Dict[str, Any]:
+    """The scene keys an item changes (its grid values but the instant)."""
+    return {k: v for k, v in params.items() if k != TIME_KEY}
+
+
+def solve_thermal(job: Dict[str, Any], key: str, patch: Dict[str, Any],
+                  times: List[float]) -> str:
+    """Solves and saves the thermal run `key` (the scene with `patch`, recording `times`) and
+    returns `key`; the renders that need it wait for this task."""
+    path = thermal_path(Path(job["out"]), key)
+    solved = irpol.solve_thermal(job["scene"], times, path, patch=patch)
+    if solved != key:  # the scene or a file it reads changed since the sweep was planned
+        raise ValueError(f"{path}: the scene's thermal inputs changed during the sweep (key "
+                         f"{solved[:12]}, planned {key[:12]}): run the sweep again")
+    return key
+
+
+def _render(job: Dict[str, Any], params: Dict[str, Any], folder: Path,
+            thermal: Optional[str]) -> None:
+    solution = None if thermal is None else thermal_path(Path(job["out"]), thermal)
+    irpol.render(job["scene"], patch=scene_patch(params), time_s=params.get(TIME_KEY), out=folder,
+                 thermal_solution=solution, **job["render"])
+
+
+def _fit(job: Dict[str, Any], params: Dict[str, Any], folder: Path,
+         _thermal: Optional[str]) -> None:
     base = Path(job["spec_dir"])
     [result] = irpol.fit([base / f for f in params["files"]], **job["options"])
     folder.mkdir(parents=True)
@@ -56,18 +81,21 @@ def _publish(staging: Path, final: Path) -> None:
     os.rename(staging, final)
 
 
-def run_item(job: Dict[str, Any], index: int, params: Dict[str, Any]) -> Dict[str, Any]:
-    """Runs item `index` and returns its manifest row; raises on failure (Dask retries it)."""
+def run_item(job: Dict[str, Any], index: int, params: Dict[str, Any],
+             thermal: Optional[str] = None) -> Dict[str, Any]:
+    """Runs item `index` and returns its manifest row; raises on failure (Dask retries it).
+    `thermal` is the key of the saved thermal run a render takes its temperatures from (the
+    result of its :func:`solve_thermal` task), None to solve the run itself (or none needed)."""
     start = time.perf_counter()
     out = Path(job["out"])
     final = item_folder(out, index)
     staging = final.with_name(f".{index}.tmp-{uuid.uuid4().hex}")
     staging.parent.mkdir(parents=True, exist_ok=True)
     try:
-        (_render if job["kind"] == "render" else _fit)(job, params, staging)
+        (_render if job["kind"] == "render" else _fit)(job, params, staging, thermal)
         outputs = hashes(staging)
         _publish(staging, final)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return {"item": index, "params": params, "status": "ok", "error": None, "outputs": outputs,
-            "seconds": round(time.perf_counter() - start, 6)}
+            "thermal": thermal, "seconds": round(time.perf_counter() - start, 6)}

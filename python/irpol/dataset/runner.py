@@ -1,4 +1,6 @@
-"""Runs a sweep's unfinished items on Dask distributed and records each in the manifest."""
+"""Runs a sweep's unfinished items on Dask distributed and records each in the manifest. Renders
+at instants of a thermal scene share its runs: one task per distinct run solves and saves it, and
+the renders that need it depend on that task instead of each solving the run again."""
 
 from __future__ import annotations
 
@@ -8,11 +10,13 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator, Optional
+from typing import Dict, Iterator, List, Optional, Tuple
 
-from .items import run_item
+import irpol
+
+from .items import run_item, scene_patch, solve_thermal
 from .manifest import Manifest
-from .spec import Spec, SpecError, load_spec
+from .spec import TIME_KEY, Item, Spec, SpecError, load_spec
 
 # A failed item is run once more before it is recorded as failed.
 RETRIES = 1
@@ -53,10 +57,56 @@ def _job(spec: Spec) -> dict:
             "spec_dir": str(spec.path.parent.resolve())}
 
 
-def _failed_row(index: int, params: dict, error: BaseException) -> dict:
+def _failed_row(index: int, params: dict, error: BaseException, thermal: Optional[str]) -> dict:
     message = str(error).strip() or type(error).__name__
     return {"item": index, "params": params, "status": "failed",
-            "error": f"{type(error).__name__}: {message}", "outputs": {}, "seconds": None}
+            "error": f"{type(error).__name__}: {message}", "outputs": {}, "thermal": thermal,
+            "seconds": None}
+
+
+@dataclass
+class ThermalPlan:
+    """Which saved thermal run each render at an instant takes its temperatures from (by item
+    index), and per run the scene keys to solve it with and the instants it records."""
+
+    key_of: Dict[int, str]
+    runs: Dict[str, Tuple[dict, List[float]]]
+
+
+def _run_keys(spec: Spec, items: List[Item], patch: dict) -> List[Optional[str]]:
+    """The run key of each item (all with scene keys `patch`); None for an item refused here (an
+    instant outside the run, a scene that does not load), which then solves for itself and fails
+    with its own error as it would without the plan."""
+    def keys(group: List[Item]) -> List[str]:
+        return irpol.thermal_keys(spec.scene, [it.params[TIME_KEY] for it in group], patch=patch)
+
+    try:
+        return keys(items)
+    except (ValueError, OSError, TypeError):
+        if len(items) == 1:
+            return [None]
+        return [_run_keys(spec, [item], patch)[0] for item in items]
+
+
+def _thermal_plan(spec: Spec, todo: List[Item]) -> ThermalPlan:
+    """Items with the same scene keys share a scene; its run keys (irpol.thermal_keys) group
+    their instants, and equal keys across scenes (other viewpoints) share a run too."""
+    plan = ThermalPlan(key_of={}, runs={})
+    if spec.kind != "render" or TIME_KEY not in spec.grid:
+        return plan
+    scenes: Dict[str, List[Item]] = {}
+    for item in todo:
+        scenes.setdefault(repr(sorted(scene_patch(item.params).items())), []).append(item)
+    for items in scenes.values():
+        patch = scene_patch(items[0].params)
+        for item, key in zip(items, _run_keys(spec, items, patch)):
+            if key is None:
+                continue
+            plan.key_of[item.index] = key
+            _, times = plan.runs.setdefault(key, (patch, []))
+            if item.params[TIME_KEY] not in times:
+                times.append(item.params[TIME_KEY])
+    return plan
 
 
 def _progress(total: int, enabled: bool):
@@ -89,8 +139,15 @@ def run(spec_path, scheduler: Optional[str] = None, workers: Optional[int] = Non
     ok = failed = 0
     if todo:
         job, run_id = _job(spec), uuid.uuid4().hex[:12]
+        plan = _thermal_plan(spec, todo)
         with dask_client(scheduler, workers) as client:
-            futures = {client.submit(run_item, job, it.index, it.params, retries=RETRIES,
+            # A render's argument is its run's future: Dask starts it once the run is saved.
+            solves = {key: client.submit(solve_thermal, job, key, patch, sorted(times),
+                                         retries=RETRIES, pure=False,
+                                         key=f"irpol-thermal-{key[:16]}-{run_id}")
+                      for key, (patch, times) in plan.runs.items()}
+            futures = {client.submit(run_item, job, it.index, it.params,
+                                     solves.get(plan.key_of.get(it.index)), retries=RETRIES,
                                      pure=False, key=f"irpol-item-{it.index}-{run_id}"): it
                        for it in todo}
             bar = _progress(len(todo), progress)
@@ -99,8 +156,9 @@ def run(spec_path, scheduler: Optional[str] = None, workers: Optional[int] = Non
                 try:
                     row = future.result()
                     ok += 1
-                except Exception as error:  # the item's own failure, after its retry
-                    row = _failed_row(item.index, item.params, error)
+                except Exception as error:  # the item's (or its run's) failure, after a retry
+                    row = _failed_row(item.index, item.params, error,
+                                      plan.key_of.get(item.index))
                     failed += 1
                 # Released once recorded: a result held by a worker that dies later would
                 # otherwise be computed again, replacing the files the row describes.
