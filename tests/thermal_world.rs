@@ -300,8 +300,9 @@ fn a_closed_box_reaches_its_steady_state_and_closes_its_energy() {
         let closure = solution.stats.worst_energy_closure;
         let residual = solution.enclosure_residual_k[0];
         println!(
-            "box C = {capacity} J/K: {last:.4} K, by hand {expected:.4} K; closure {closure:.2e}, \
-             fixed-point residual {residual:.1e} K"
+            "box C = {capacity} J/K: {last:.4} K, by hand {expected:.4} K ({:.1e} K off); closure {closure:.2e}, \
+             fixed-point residual {residual:.1e} K",
+            (last - expected).abs()
         );
         assert!(expected > BOX_AIR_K + 10.0);
         assert!((last - expected).abs() < 0.05, "{last} vs {expected} K");
