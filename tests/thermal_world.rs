@@ -461,3 +461,23 @@ temperature_k = 300.0
     );
     assert!(!out.exists());
 }
+
+/// The solved ground's fixed back face is a typed temperature too: below 200 K it is warned
+/// about as °C, by its key.
+#[test]
+fn a_celsius_back_under_the_ground_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let ground = thermal_ground().replace(
+        "back = { temperature_k = 288.0 }",
+        "back = { temperature_k = 15.0 }",
+    );
+    let path = write_scene(dir.path(), &scene_text(&ground, "", &slab_and_plate()));
+    let warnings = load_scene(&path).unwrap().warnings;
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w
+                .contains("environment.ground.thermal.back.temperature_k = 15 K looks like °C")),
+        "{warnings:?}"
+    );
+}

@@ -110,8 +110,8 @@ pub enum ThermalRunError {
         at: String,
         error: ThermalError,
     },
-    /// An enclosure's air temperature and its members' back faces did not agree within
-    /// [`enclosure::NODE_ACCEPT_K`] after the fixed-point iterations of a step.
+    /// An enclosure's air temperature and its members' back faces did not agree (within 1e-3 K)
+    /// after the fixed-point iterations of a step.
     #[error(
         "thermal.enclosures.{}{at}: the air temperature did not settle (members and balance {} K \
          apart after {iterations} iterations); try a smaller time_step_s",

@@ -14,9 +14,8 @@
 //! the step means of the (linear) air temperature and solar gain, then gives T₁. T₁ = g is a scalar
 //! fixed point, found by secant iteration to [`NODE_TOLERANCE_K`] from a guess extrapolating the
 //! last two steps' rates (the slope carried over from the previous step; on the car's day 1.1
-//! member solves per step). The node takes the balance's T₁,
-//! so its energy closes exactly whatever residual is left; the members saw g, within the
-//! tolerance of it.
+//! member solves per step). The node takes the balance's T₁, so its energy closes exactly
+//! whatever residual is left; the members saw g, within the tolerance of it.
 
 use super::{
     Budget, Drive, Exposure, GroundHistory, Groups, History, Run, ThermalRunError, VertexFailure,
@@ -35,8 +34,9 @@ use rayon::prelude::*;
 pub const NODE_TOLERANCE_K: f64 = 1e-4;
 /// Iterations of one step's fixed point before it is judged.
 const NODE_ITERATIONS: usize = 30;
-/// After [`NODE_ITERATIONS`], a residual up to this is accepted (the adaptive sub-steps of the
-/// members can make the map jump by ~1e-5 K; the energy still closes) and a larger one is an error.
+/// After [`NODE_ITERATIONS`], a residual up to this is accepted (the members' adaptive sub-steps
+/// make the map slightly discontinuous in g; the energy closes anyway) and a larger one is an
+/// error.
 pub const NODE_ACCEPT_K: f64 = 1e-3;
 
 /// One distinct history of a member part, standing for `area_m2` of the enclosure's walls.
