@@ -29,6 +29,7 @@ fn autumn() -> Environment {
         ground: GroundConfig {
             temperature_k: 288.0,
             emissivity: 0.95,
+            thermal: None,
         },
     };
     Environment::new(&config, &Band::lwir()).unwrap()

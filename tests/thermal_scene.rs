@@ -634,4 +634,19 @@ fn the_ground_in_the_cars_shadow_is_cooler_in_the_afternoon() {
         t[in_shadow], t[in_sun]
     );
     assert!(t[in_shadow] < t[in_sun] - 5.0);
+    // The cabin's coupled solve: its fixed point settles to its tolerance and node and walls
+    // close their energy.
+    let noon = record(&solution, 43200.0);
+    let (cabin, air) = (
+        solution.enclosure_air_k[0][noon],
+        solution.weather[noon].air_k,
+    );
+    println!(
+        "car_day cabin at noon UTC: {cabin:.2} K, air {air:.2} K; fixed-point residual {:.1e} K, \
+         energy closure {:.1e}",
+        solution.enclosure_residual_k[0], solution.stats.worst_energy_closure
+    );
+    assert!(cabin > air + 10.0);
+    assert!(solution.enclosure_residual_k[0] <= 1e-4);
+    assert!(solution.stats.worst_energy_closure < 1e-6);
 }

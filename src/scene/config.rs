@@ -68,8 +68,8 @@ pub use crate::emitter::SunConfig;
 pub use crate::material::InlineMaterialConfig;
 use crate::tables::{optional_table, table, table_list, table_map, table_or_flag};
 pub use crate::thermal::config::{
-    BackConfig, BackKeyword, ConvectiveBack, FixedBack, GeneratedWeather, InternalHeatConfig,
-    LayerMaterialConfig, PartThermalConfig, ThermalConfig, WeatherConfig,
+    BackConfig, BackKeyword, ConvectiveBack, EnclosureConfig, FixedBack, GeneratedWeather,
+    InternalHeatConfig, LayerMaterialConfig, PartThermalConfig, ThermalConfig, WeatherConfig,
 };
 use serde::{Deserialize, Deserializer};
 use std::collections::BTreeMap;
@@ -306,8 +306,13 @@ pub enum SkyConfig {
 #[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct GroundConfig {
+    /// The ground's temperature; with `thermal`, its starting state.
     pub temperature_k: f64,
     pub emissivity: f64,
+    /// With `[thermal]`: the ground below the horizon is a surface of its own, solved with the
+    /// run (horizontal, unshadowed, the same weather), its stack and surface as a part's.
+    #[serde(default, deserialize_with = "optional_table")]
+    pub thermal: Option<PartThermalConfig>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -273,6 +273,7 @@ mod tests {
             ground: GroundConfig {
                 temperature_k: ground_t,
                 emissivity: ground_e,
+                thermal: None,
             },
         }
     }

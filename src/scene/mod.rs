@@ -172,8 +172,14 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
     ));
     let (thermal, thermal_rebuild) = match thermal_run {
         Some((mut run, instants, _)) => {
-            run.surfaces =
-                thermal::resolve_surfaces(path, &config, &surfaces, &object_names, &materials)?;
+            run.surfaces = thermal::resolve_surfaces(
+                path,
+                &config,
+                &surfaces,
+                &object_names,
+                &materials,
+                &run.enclosures,
+            )?;
             (Some(std::sync::Arc::new(run)), Some(instants))
         }
         None => (None, None),

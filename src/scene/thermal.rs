@@ -7,7 +7,9 @@ use super::config::{EnvironmentConfig, ObjectConfig, PartThermalConfig, SceneCon
 use super::{SceneError, SceneMaterial, Surface};
 use crate::emitter::moving_sun_irradiance;
 use crate::optics::Band;
-use crate::thermal::setup::{resolve_part, resolve_run, SurfaceThermal, ThermalSetupError};
+use crate::thermal::setup::{
+    resolve_part, resolve_run, Enclosure, GroundSurface, SurfaceThermal, ThermalSetupError,
+};
 pub use crate::thermal::setup::{Schedule, ThermalSetup};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -31,8 +33,15 @@ pub(super) fn resolve_thermal(
     dir: &Path,
     band: &Band,
 ) -> Result<Option<(ThermalSetup, InstantSettings, f64)>, SceneError> {
+    let fail = |error| SceneError::Thermal {
+        file: path.to_owned(),
+        error,
+    };
     let Some(thermal) = &config.thermal else {
-        return Ok(None);
+        return match config.environment.ground.thermal {
+            Some(_) => Err(fail(ThermalSetupError::GroundWithoutRun)),
+            None => Ok(None),
+        };
     };
     let sun_irradiance_w_m2 =
         moving_sun_irradiance(config.sun.as_ref(), band).map_err(|error| SceneError::Sun {
@@ -48,18 +57,44 @@ pub(super) fn resolve_thermal(
         netd_reference_given: config.sensor.netd_reference_k.is_some(),
         sun_irradiance_w_m2,
     };
-    let fail = |error| SceneError::Thermal {
-        file: path.to_owned(),
-        error,
-    };
     let ground_k = config.environment.ground.temperature_k;
-    let run = resolve_run(thermal, dir, ground_k).map_err(fail)?;
+    let mut run = resolve_run(thermal, dir, ground_k).map_err(fail)?;
+    run.ground = resolve_ground(config, &run.enclosures).map_err(fail)?;
     let start_air_k = run
         .weather
         .at(0.0)
         .map_err(|e| fail(ThermalSetupError::Weather(e)))?
         .air_k;
     Ok(Some((run, instants, start_air_k)))
+}
+
+/// `environment.ground.thermal`: its keys checked as a part's (its emissivity defaults to the
+/// ground's), no enclosure; its starting state the ground's typed temperature.
+fn resolve_ground(
+    config: &SceneConfig,
+    enclosures: &[Enclosure],
+) -> Result<Option<GroundSurface>, ThermalSetupError> {
+    let ground = &config.environment.ground;
+    let Some(part) = &ground.thermal else {
+        return Ok(None);
+    };
+    if part.enclosure.is_some() {
+        return Err(ThermalSetupError::GroundEnclosure { key: "enclosure" });
+    }
+    if part.solar_transmittance.is_some() {
+        let key = "solar_transmittance";
+        return Err(ThermalSetupError::GroundEnclosure { key });
+    }
+    let no_layers = BTreeMap::new();
+    let layers = config.thermal.as_ref().map_or(&no_layers, |t| &t.layers);
+    let emissivity = part.emissivity.unwrap_or(ground.emissivity);
+    let surface = resolve_part(part, layers, enclosures, emissivity)
+        .map_err(ThermalSetupError::GroundSurface)?;
+    Ok(Some(GroundSurface {
+        surface,
+        initial_k: ground.temperature_k,
+        occluded_k: config.thermal.as_ref().and_then(|t| t.ground_temperature_k),
+    }))
 }
 
 /// The thermal stack of an object's part `part`: its own, else the object's.
@@ -72,13 +107,15 @@ pub fn part_thermal<'a>(object: &'a ObjectConfig, part: &str) -> Option<&'a Part
 }
 
 /// Each surface's thermal model. `materials[i]` is material i (its
-/// [`SceneMaterial::thermal_emissivity`] is the default emissivity).
+/// [`SceneMaterial::thermal_emissivity`] is the default emissivity); every enclosure of
+/// `enclosures` must have a member.
 pub(super) fn resolve_surfaces(
     path: &Path,
     config: &SceneConfig,
     surfaces: &[Surface],
     object_names: &[String],
     materials: &[SceneMaterial],
+    enclosures: &[Enclosure],
 ) -> Result<Vec<Option<SurfaceThermal>>, SceneError> {
     let no_layers = BTreeMap::new();
     let layers = config.thermal.as_ref().map_or(&no_layers, |t| &t.layers);
@@ -106,7 +143,7 @@ pub(super) fn resolve_surfaces(
                 }
             },
         };
-        let model = resolve_part(part, layers, emissivity).map_err(|error| {
+        let model = resolve_part(part, layers, enclosures, emissivity).map_err(|error| {
             let error = ThermalSetupError::Part { part: label, error };
             SceneError::Thermal {
                 file: path.to_owned(),
@@ -115,11 +152,17 @@ pub(super) fn resolve_surfaces(
         })?;
         resolved.push(Some(model));
     }
+    let fail = |error| SceneError::Thermal {
+        file: path.to_owned(),
+        error,
+    };
     if resolved.iter().all(Option::is_none) {
-        return Err(SceneError::Thermal {
-            file: path.to_owned(),
-            error: ThermalSetupError::NoStack,
-        });
+        return Err(fail(ThermalSetupError::NoStack));
+    }
+    let member = |e: usize| resolved.iter().flatten().any(|m| m.enclosure == Some(e));
+    if let Some(e) = (0..enclosures.len()).find(|&e| !member(e)) {
+        let name = enclosures[e].name.clone();
+        return Err(fail(ThermalSetupError::EmptyEnclosure { name }));
     }
     Ok(resolved)
 }

@@ -118,6 +118,12 @@ fn typed_temperatures(config: &SceneConfig) -> Vec<(String, f64)> {
             env.ground.temperature_k,
         ),
     ];
+    typed.extend(back_temperature(&env.ground.thermal).map(|t| {
+        (
+            "environment.ground.thermal.back.temperature_k".to_owned(),
+            t,
+        )
+    }));
     if let SkyConfig::Table {
         brightness_temperature_k: Some(table),
         ..

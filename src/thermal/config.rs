@@ -46,6 +46,19 @@ pub struct ThermalConfig {
     /// Layer materials by name.
     #[serde(default, deserialize_with = "table_map")]
     pub layers: BTreeMap<String, LayerMaterialConfig>,
+    /// Enclosed air nodes by name (a car's cabin), coupled to their member parts' back faces.
+    #[serde(default, deserialize_with = "table_map")]
+    pub enclosures: BTreeMap<String, EnclosureConfig>,
+}
+
+/// `[thermal.enclosures.NAME]`: one enclosed air node (docs/design.md §1.8).
+#[derive(Debug, Deserialize, Clone)]
+#[serde(deny_unknown_fields)]
+pub struct EnclosureConfig {
+    /// Heat capacity of the enclosed air and what is lumped with it (J/K).
+    pub heat_capacity_j_k: f64,
+    /// Conductance of the air exchange with the outside air, ventilation and leakage (W/K).
+    pub air_exchange_w_k: f64,
 }
 
 fn default_output_step() -> f64 {
@@ -111,6 +124,10 @@ pub struct PartThermalConfig {
     /// (hours from `start_utc`, non-decreasing; constant outside).
     #[serde(default)]
     pub internal_heat_w_m2: InternalHeatConfig,
+    /// The enclosure (`[thermal.enclosures.NAME]`) the back face sees instead of the outside air.
+    pub enclosure: Option<String>,
+    /// Fraction of the solar irradiance on the front that passes into the enclosure (glazing).
+    pub solar_transmittance: Option<f64>,
 }
 
 /// `[[name, thickness_m], …]`, refusing other shapes with a message that says what an entry is

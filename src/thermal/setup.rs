@@ -4,8 +4,8 @@
 //! a stack, and their materials' emissivities, are the scene's to say.
 
 use super::config::{
-    BackConfig, InternalHeatConfig, LayerMaterialConfig, PartThermalConfig, ThermalConfig,
-    WeatherConfig,
+    BackConfig, EnclosureConfig, InternalHeatConfig, LayerMaterialConfig, PartThermalConfig,
+    ThermalConfig, WeatherConfig,
 };
 use super::{
     Back, Layer, LayerMaterial, LayerStack, Site, StationFormat, StationWeather, ThermalError,
@@ -32,6 +32,31 @@ pub struct ThermalSetup {
     /// Per scene surface (indexed like `Scene::surfaces`): its thermal model, or `None` for a part
     /// held at its typed temperature.
     pub surfaces: Vec<Option<SurfaceThermal>>,
+    /// The environment's ground as a surface of its own (`environment.ground.thermal`), or `None`
+    /// for the typed ground temperature.
+    pub ground: Option<GroundSurface>,
+    /// `[thermal.enclosures]` in name order; [`SurfaceThermal::enclosure`] indexes it.
+    pub enclosures: Vec<Enclosure>,
+}
+
+/// The environment's ground solved with the run: horizontal, unshadowed, the whole sky in view.
+pub struct GroundSurface {
+    pub surface: SurfaceThermal,
+    /// The starting state (`environment.ground.temperature_k`).
+    pub initial_k: f64,
+    /// `thermal.ground_temperature_k` when given: what blocked directions radiate (below the
+    /// horizon is the solved ground); `None`: the solved ground there too.
+    pub occluded_k: Option<f64>,
+}
+
+/// One enclosed air node (`[thermal.enclosures.NAME]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Enclosure {
+    pub name: String,
+    /// Heat capacity C (J/K).
+    pub heat_capacity_j_k: f64,
+    /// Air-exchange conductance G to the outside air (W/K).
+    pub air_exchange_w_k: f64,
 }
 
 impl std::fmt::Debug for ThermalSetup {
@@ -54,6 +79,11 @@ pub struct SurfaceThermal {
     /// Front convective coefficient; `None` = [`super::convection::mcadams_coefficient`].
     pub convection_w_m2k: Option<f64>,
     pub internal_heat: Schedule,
+    /// Index into [`ThermalSetup::enclosures`] of the node the back face sees (its back is then
+    /// `Back::Convective` with the node's temperature in place of the outside air).
+    pub enclosure: Option<usize>,
+    /// Fraction of the solar irradiance on the front that enters the enclosure (0 unless glazing).
+    pub solar_transmittance: f64,
 }
 
 /// A quantity piecewise linear in time (s), constant beyond its first and last points.
@@ -153,6 +183,36 @@ pub enum ThermalSetupError {
         part: String,
         error: PartThermalError,
     },
+    /// `environment.ground.thermal`, its keys checked as a part's.
+    #[error("environment.ground.thermal.{0}")]
+    GroundSurface(PartThermalError),
+    #[error(
+        "environment.ground.thermal.{key}: the environment's ground has no enclosure behind it; \
+         remove {key}"
+    )]
+    GroundEnclosure { key: &'static str },
+    #[error(
+        "environment.ground.thermal needs a [thermal] section (the weather, site and layers that \
+         drive it)"
+    )]
+    GroundWithoutRun,
+    #[error(
+        "thermal.enclosures.{}.{key} = {} must be within {range}",
+        crate::text::shown(name), number(*value)
+    )]
+    Enclosure {
+        name: String,
+        key: &'static str,
+        value: f64,
+        range: &'static str,
+    },
+    #[error(
+        "thermal.enclosures.{}: no part's thermal table has enclosure = \"{}\"; add it to the \
+         member parts or remove the enclosure",
+        crate::text::shown(name),
+        crate::text::shown(name)
+    )]
+    EmptyEnclosure { name: String },
 }
 
 /// A part's `thermal` key that cannot be used; messages start with the key at fault.
@@ -183,6 +243,30 @@ pub enum PartThermalError {
     BackTemperature { temperature_k: f64 },
     #[error("internal_heat_w_m2 is an empty schedule: give [[time_h, w_m2], …]")]
     EmptySchedule,
+    #[error(
+        "enclosure: '{}' is not defined in [thermal.enclosures] (defined: {})",
+        crate::text::shown(name),
+        if defined.is_empty() { "none".to_owned() } else { crate::text::shown_at_most(&defined.join(", "), 200) }
+    )]
+    UnknownEnclosure { name: String, defined: Vec<String> },
+    #[error(
+        "enclosure needs back = {{ convection_w_m2k = … }}: the coefficient between the back face \
+         and the enclosed air"
+    )]
+    EnclosureBack,
+    #[error(
+        "solar_transmittance needs enclosure = \"NAME\": the sunlight through the part enters an \
+         enclosure"
+    )]
+    TransmittanceWithoutEnclosure,
+    #[error(
+        "solar_absorptance + solar_transmittance = {} + {} is more than 1",
+        number(*absorptance), number(*transmittance)
+    )]
+    AbsorbedAndTransmitted {
+        absorptance: f64,
+        transmittance: f64,
+    },
     #[error(
         "internal_heat_w_m2 has a point [{} h, {} W/m²] outside ±{} h, ±{} W/m²",
         number(*time_h), number(*w_m2), number(MAX_SCHEDULE_H), number(MAX_INTERNAL_HEAT_W_M2)
@@ -241,7 +325,49 @@ pub fn resolve_run(
         spinup_days: config.spinup_days,
         ground_temperature_k: ground,
         surfaces: Vec::new(),
+        ground: None,
+        enclosures: resolve_enclosures(&config.enclosures)?,
     })
+}
+
+/// `[thermal.enclosures]` checked, in name order (members are checked with the parts).
+fn resolve_enclosures(
+    configs: &BTreeMap<String, EnclosureConfig>,
+) -> Result<Vec<Enclosure>, ThermalSetupError> {
+    configs
+        .iter()
+        .map(|(name, c)| {
+            let check = |key, value: f64, ok: bool, range| {
+                if ok {
+                    Ok(value)
+                } else {
+                    Err(ThermalSetupError::Enclosure {
+                        name: name.clone(),
+                        key,
+                        value,
+                        range,
+                    })
+                }
+            };
+            let capacity = c.heat_capacity_j_k;
+            let exchange = c.air_exchange_w_k;
+            Ok(Enclosure {
+                name: name.clone(),
+                heat_capacity_j_k: check(
+                    "heat_capacity_j_k",
+                    capacity,
+                    capacity > 0.0 && capacity <= MAX_ENCLOSURE_CAPACITY_J_K,
+                    "(0, 1e12] J/K",
+                )?,
+                air_exchange_w_k: check(
+                    "air_exchange_w_k",
+                    exchange,
+                    (0.0..=MAX_AIR_EXCHANGE_W_K).contains(&exchange),
+                    "[0, 1e9] W/K",
+                )?,
+            })
+        })
+        .collect()
 }
 
 /// Where and when the run is: the scene's keys, each defaulting to the station file's (its site,
@@ -396,11 +522,17 @@ pub const MAX_CONVECTION_W_M2K: f64 = 1e5;
 pub const MAX_INTERNAL_HEAT_W_M2: f64 = 1e6;
 /// Largest |time| of a schedule point (h): beyond any run ([`MAX_STEPS`] minutes is ~4 years).
 pub const MAX_SCHEDULE_H: f64 = 1e6;
+/// Largest enclosure heat capacity (J/K): a hall of 1e5 m³ of air with its contents is ~1e9.
+pub const MAX_ENCLOSURE_CAPACITY_J_K: f64 = 1e12;
+/// Largest air-exchange conductance (W/K): a wide-open hall.
+pub const MAX_AIR_EXCHANGE_W_K: f64 = 1e9;
 
-/// One part's keys, checked, with its thermal `emissivity` (given, or its material's).
+/// One part's keys, checked, with its thermal `emissivity` (given, or its material's);
+/// `enclosures` are the names of `[thermal.enclosures]` in order.
 pub fn resolve_part(
     part: &PartThermalConfig,
     layers: &BTreeMap<String, LayerMaterialConfig>,
+    enclosures: &[Enclosure],
     emissivity: f64,
 ) -> Result<SurfaceThermal, PartThermalError> {
     let stack = resolve_stack(&part.stack, layers)?;
@@ -416,14 +548,60 @@ pub fn resolve_part(
     if let Some(h) = part.convection_w_m2k {
         convection("convection_w_m2k", h)?;
     }
+    let back = resolve_back(&part.back)?;
+    let (enclosure, solar_transmittance) = resolve_enclosure_keys(part, &back, enclosures)?;
     Ok(SurfaceThermal {
         stack,
-        back: resolve_back(&part.back)?,
+        back,
         solar_absorptance: part.solar_absorptance,
         emissivity,
         convection_w_m2k: part.convection_w_m2k,
         internal_heat: resolve_schedule(&part.internal_heat_w_m2)?,
+        enclosure,
+        solar_transmittance,
     })
+}
+
+/// A part's `enclosure` (its index) and `solar_transmittance` (0 when not given): the enclosure
+/// defined, the back convective (its coefficient couples the face to the node), and the light
+/// transmitted entering an enclosure and no more than what is not absorbed.
+fn resolve_enclosure_keys(
+    part: &PartThermalConfig,
+    back: &Back,
+    enclosures: &[Enclosure],
+) -> Result<(Option<usize>, f64), PartThermalError> {
+    let enclosure =
+        match &part.enclosure {
+            None => None,
+            Some(name) => Some(enclosures.iter().position(|e| &e.name == name).ok_or_else(
+                || PartThermalError::UnknownEnclosure {
+                    name: name.clone(),
+                    defined: enclosures.iter().map(|e| e.name.clone()).collect(),
+                },
+            )?),
+        };
+    if enclosure.is_some() && !matches!(back, Back::Convective { .. }) {
+        return Err(PartThermalError::EnclosureBack);
+    }
+    let Some(transmittance) = part.solar_transmittance else {
+        return Ok((enclosure, 0.0));
+    };
+    if !(transmittance.is_finite() && (0.0..=1.0).contains(&transmittance)) {
+        return Err(PartThermalError::Fraction {
+            key: "solar_transmittance",
+            value: transmittance,
+        });
+    }
+    if enclosure.is_none() {
+        return Err(PartThermalError::TransmittanceWithoutEnclosure);
+    }
+    if part.solar_absorptance + transmittance > 1.0 {
+        return Err(PartThermalError::AbsorbedAndTransmitted {
+            absorptance: part.solar_absorptance,
+            transmittance,
+        });
+    }
+    Ok((enclosure, transmittance))
 }
 
 /// `[[layer name, thickness_m], …]` front to back, each name one of `layers`.

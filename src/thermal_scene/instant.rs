@@ -20,7 +20,7 @@ pub enum InstantError {
 }
 
 /// `scene` at recorded instant `index` of `solution`. The sky is rebuilt at the instant's air
-/// temperature, and so are the atmosphere's path temperature and the NETD reference unless the
+/// temperature, the ground at its solved temperature when it is a thermal surface, and so are the atmosphere's path temperature and the NETD reference unless the
 /// scene fixes them; the sun is the weather's direction with the scene's band irradiance (none
 /// below the horizon).
 pub fn scene_at(
@@ -39,6 +39,10 @@ pub fn scene_at(
     at.air_temperature_k = w.air_k;
     let mut environment = instants.environment.clone();
     environment.air_temperature_k = w.air_k;
+    // A solved ground radiates at its temperature of the instant (the typed one was its start).
+    if let Some(ground_k) = &solution.ground_k {
+        environment.ground.temperature_k = ground_k[index];
+    }
     at.environment =
         Environment::new(&environment, &scene.sensor.band).map_err(InstantError::Environment)?;
     let band = &scene.sensor.band;

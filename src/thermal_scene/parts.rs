@@ -1,5 +1,6 @@
 //! Per-part summaries of a thermal solution: min, mean and max surface temperature over each
-//! part's vertices at every recorded instant (`temperatures.csv` and the plot).
+//! part's vertices at every recorded instant (`temperatures.csv` and the plot), with the solved
+//! environment ground and enclosures' air as series of their own.
 
 use super::{vertex_surfaces, ThermalSolution};
 use crate::scene::Scene;
@@ -12,8 +13,26 @@ pub struct PartSeries {
     pub surface_k: Vec<[f64; 3]>,
 }
 
-/// Every part's series, in scene order.
+/// Every part's series, in scene order, then the environment's ground (`environment/ground`)
+/// when it is solved and each enclosure's air (`enclosure/NAME`), min = mean = max.
 pub fn part_series(scene: &Scene, solution: &ThermalSolution) -> Vec<PartSeries> {
+    let mut series = surface_series(scene, solution);
+    let single = |name: String, values: &[f64]| PartSeries {
+        name,
+        surface_k: values.iter().map(|&t| [t, t, t]).collect(),
+    };
+    if let Some(ground_k) = &solution.ground_k {
+        series.push(single("environment/ground".to_owned(), ground_k));
+    }
+    let enclosures = scene.thermal.as_deref().map_or(&[][..], |s| &s.enclosures);
+    for (enclosure, air_k) in enclosures.iter().zip(&solution.enclosure_air_k) {
+        series.push(single(format!("enclosure/{}", enclosure.name), air_k));
+    }
+    series
+}
+
+/// Every part's series, in scene order.
+fn surface_series(scene: &Scene, solution: &ThermalSolution) -> Vec<PartSeries> {
     let vertex_surface = vertex_surfaces(scene);
     scene
         .surfaces

@@ -29,7 +29,7 @@ use crate::progress::Progress;
 use crate::scene::thermal::{InstantSettings, ThermalSetup};
 use crate::scene::Scene;
 use crate::text::{number, path as shown_path};
-use crate::thermal::setup::SurfaceThermal;
+use crate::thermal::setup::{GroundSurface, SurfaceThermal};
 use sha2::{Digest, Sha256};
 use std::fmt::{Debug, Write as _};
 use std::path::{Path, PathBuf};
@@ -238,6 +238,8 @@ fn hash_setup(h: &mut Hashing, setup: &ThermalSetup) {
         spinup_days,
         ground_temperature_k,
         surfaces,
+        ground,
+        enclosures,
     } = setup;
     h.field("site", site);
     h.field("weather", weather);
@@ -251,23 +253,43 @@ fn hash_setup(h: &mut Hashing, setup: &ThermalSetup) {
         h.field("surface", &i);
         match surface {
             None => h.field("typed", &()),
-            Some(SurfaceThermal {
-                stack,
-                back,
-                solar_absorptance,
-                emissivity,
-                convection_w_m2k,
-                internal_heat,
-            }) => {
-                h.field("stack", stack);
-                h.field("back", back);
-                h.field("solar_absorptance", solar_absorptance);
-                h.field("emissivity", emissivity);
-                h.field("convection_w_m2k", convection_w_m2k);
-                h.field("internal_heat", internal_heat);
-            }
+            Some(surface) => hash_surface(h, surface),
         }
     }
+    if let Some(GroundSurface {
+        surface,
+        initial_k,
+        occluded_k,
+    }) = ground
+    {
+        h.field("ground", &"thermal");
+        hash_surface(h, surface);
+        h.field("ground_initial_k", initial_k);
+        h.field("ground_occluded_k", occluded_k);
+    }
+    h.field("enclosures", enclosures);
+}
+
+/// One surface's thermal model, every field.
+fn hash_surface(h: &mut Hashing, surface: &SurfaceThermal) {
+    let SurfaceThermal {
+        stack,
+        back,
+        solar_absorptance,
+        emissivity,
+        convection_w_m2k,
+        internal_heat,
+        enclosure,
+        solar_transmittance,
+    } = surface;
+    h.field("stack", stack);
+    h.field("back", back);
+    h.field("solar_absorptance", solar_absorptance);
+    h.field("emissivity", emissivity);
+    h.field("convection_w_m2k", convection_w_m2k);
+    h.field("internal_heat", internal_heat);
+    h.field("enclosure", enclosure);
+    h.field("solar_transmittance", solar_transmittance);
 }
 
 /// The file's bytes: header, then the CBOR body.

@@ -21,12 +21,18 @@ use crate::text::{about, number};
 use crate::thermal::convection::mcadams_coefficient;
 use crate::thermal::setup::{SurfaceThermal, ThermalSetup};
 use crate::thermal::{
-    Forcing, FrontForcing, Resolution, Solver, SolverControl, ThermalError, ThermalState,
-    WeatherSample, STEFAN_BOLTZMANN,
+    Forcing, FrontForcing, Resolution, Solver, SolverControl, StepReport, ThermalError,
+    ThermalState, WeatherSample, STEFAN_BOLTZMANN,
 };
 use crate::transport::accel::Accelerator;
 use rayon::prelude::*;
 use std::collections::HashMap;
+
+mod enclosure;
+mod ground;
+
+use enclosure::NodeRun;
+use ground::GroundHistory;
 
 /// Surface temperatures of every shading vertex at the recorded instants (saved whole by
 /// [`super::saved`]).
@@ -41,6 +47,16 @@ pub struct ThermalSolution {
     /// The weather at each recorded instant.
     pub weather: Vec<WeatherSample>,
     pub stats: SolveStats,
+    /// The environment's ground temperature at each recorded instant (K) when it is solved
+    /// (`environment.ground.thermal`); `None` for the typed ground.
+    pub ground_k: Option<Vec<f64>>,
+    /// `enclosure_air_k[e][i]`: enclosure e's air temperature (in `[thermal.enclosures]` order)
+    /// at `times_s[i]` (K).
+    pub enclosure_air_k: Vec<Vec<f64>>,
+    /// Per enclosure: the largest difference between the node temperature the members saw at
+    /// the end of a step and the one the node's energy balance then gave (K, the fixed point's
+    /// residual; the energy closes whatever it is).
+    pub enclosure_residual_k: Vec<f64>,
 }
 
 /// How much work the run took and how well it closed its energy budget.
@@ -95,6 +111,19 @@ pub enum ThermalRunError {
         at: String,
         error: ThermalError,
     },
+    /// An enclosure's air temperature and its members' back faces did not agree (within 1e-3 K)
+    /// after the fixed-point iterations of a step.
+    #[error(
+        "thermal.enclosures.{}{at}: the air temperature did not settle (members and balance {} K \
+         apart after {iterations} iterations); try a smaller time_step_s",
+        crate::text::shown(name), number(*residual_k)
+    )]
+    Enclosure {
+        name: String,
+        at: String,
+        residual_k: f64,
+        iterations: usize,
+    },
 }
 
 /// Most (thermal vertex, shadow instant) pairs: one byte of sun visibility each, one shadow ray
@@ -121,13 +150,18 @@ impl VertexFailure {
         }
     }
 
-    /// " at t = 3600 s" (" of the spin-up day"), or nothing.
+    /// ", step from t = 3600 s" (", spin-up step …"), or nothing.
     fn at(&self) -> String {
-        match (self.time_s, self.spinup) {
-            (None, _) => String::new(),
-            (Some(t), false) => format!(", step from t = {} s", number(t)),
-            (Some(t), true) => format!(", spin-up step from t = {} s", number(t)),
-        }
+        step_label(self.time_s, self.spinup)
+    }
+}
+
+/// ", step from t = 3600 s" (", spin-up step …") for a step starting at `time_s`, or nothing.
+fn step_label(time_s: Option<f64>, spinup: bool) -> String {
+    match (time_s, spinup) {
+        (None, _) => String::new(),
+        (Some(t), false) => format!(", step from t = {} s", number(t)),
+        (Some(t), true) => format!(", spin-up step from t = {} s", number(t)),
     }
 }
 
@@ -226,6 +260,15 @@ impl ThermalVertices {
         &self.lit[i * self.shadows..(i + 1) * self.shadows]
     }
 
+    /// What thermal vertex `i` sees.
+    fn exposure(&self, i: usize, mesh: &ShadedMesh) -> Exposure<'_> {
+        Exposure {
+            normal: mesh.normals[self.index[i]],
+            sky_view: self.sky_view[i],
+            lit: self.lit(i),
+        }
+    }
+
     /// Each thermal vertex's history class, and one representative vertex per class.
     fn group(&self, mesh: &ShadedMesh) -> (Vec<usize>, Vec<usize>) {
         let mut class_of: HashMap<HistoryKey, usize> = HashMap::new();
@@ -289,37 +332,40 @@ pub fn solve_scene(
         samples: &samples,
         run_samples: times.partition_point(|&t| t <= setup.duration_s + 1e-6),
     };
+    // The environment's ground depends on nothing else: solved first, it forces every part.
+    let ground = run.solve_ground()?;
     progress.begin("thermal solve", representatives.len() as u64);
-    let histories = representatives
-        .par_iter()
-        .map(|&i| {
-            let v = vertices.index[i];
-            let surface = vertices.surface[i] as usize;
-            let model = setup.surfaces[surface].as_ref().expect("thermal vertex");
-            let exposure = Exposure {
-                normal: scene.mesh.normals[v],
-                sky_view: vertices.sky_view[i],
-                lit: vertices.lit(i),
-            };
-            let result = run
-                .vertex(model, &exposure, scene.mesh.temperatures[v])
-                .map_err(|failure| {
-                    let object = scene.surfaces[surface].object;
-                    ThermalRunError::Solver {
-                        part: format!(
-                            "objects[{object}] '{}' part '{}'",
-                            scene.object_names[object], scene.surfaces[surface].part
-                        ),
-                        at: failure.at(),
-                        error: failure.error,
-                    }
-                });
-            progress.advance(1);
-            result
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let mut histories = run.independent(
+        scene,
+        &vertices,
+        &representatives,
+        ground.as_ref(),
+        progress,
+    )?;
+    let groups = Groups {
+        vertices: &vertices,
+        class: &class,
+        representatives: &representatives,
+    };
+    let nodes = run.enclosures(scene, &groups, ground.as_ref(), &mut histories, progress)?;
     progress.end();
-    Ok(run.solution(&scene.mesh, &vertices, &class, &histories))
+    let histories: Vec<History> = (histories.into_iter())
+        .map(|h| h.expect("every class is solved, on its own or with its enclosure"))
+        .collect();
+    Ok(run.solution(&scene.mesh, &groups, &histories, ground, nodes))
+}
+
+/// A part's vertex solve that failed, named by its part.
+fn independent_error(scene: &Scene, surface: usize, failure: VertexFailure) -> ThermalRunError {
+    let object = scene.surfaces[surface].object;
+    ThermalRunError::Solver {
+        part: format!(
+            "objects[{object}] '{}' part '{}'",
+            scene.object_names[object], scene.surfaces[surface].part
+        ),
+        at: failure.at(),
+        error: failure.error,
+    }
 }
 
 /// The run's tables within their limits, before any is allocated: sun visibility per thermal
@@ -437,40 +483,138 @@ struct History {
     closure: f64,
 }
 
+impl History {
+    fn new() -> History {
+        History {
+            surface_k: Vec::new(),
+            substeps: 0,
+            closure: 0.0,
+        }
+    }
+}
+
+/// What drives one vertex through one pass (a spin-up day or the run): its model, what it sees,
+/// and the solved environment ground's temperature at every sample of the pass (`None`: the
+/// typed ground).
+struct Drive<'a> {
+    model: &'a SurfaceThermal,
+    exposure: &'a Exposure<'a>,
+    ground: Option<&'a [f64]>,
+    spinup: bool,
+}
+
+/// Energy bookkeeping of a march: stored heat, net heat in and the heat through the boundaries.
+#[derive(Clone, Copy, Debug, Default)]
+struct Budget {
+    stored: f64,
+    net_in: f64,
+    gross: f64,
+}
+
+impl Budget {
+    fn add(&mut self, report: &StepReport) {
+        self.stored += report.stored_j_m2;
+        self.net_in += report.net_in_j_m2();
+        self.gross +=
+            report.front_in_j_m2.abs() + report.back_in_j_m2.abs() + report.internal_j_m2.abs();
+    }
+
+    /// |stored − net in| relative to the heat through the boundaries.
+    fn closure(&self) -> f64 {
+        (self.stored - self.net_in).abs() / self.gross.max(f64::MIN_POSITIVE)
+    }
+}
+
+/// Which vertices share a history and which vertex stands for each.
+struct Groups<'a> {
+    vertices: &'a ThermalVertices,
+    /// Each thermal vertex's history class.
+    class: &'a [usize],
+    /// One thermal vertex per class.
+    representatives: &'a [usize],
+}
+
 impl Run<'_> {
-    /// The recorded temperatures of every shading vertex, each thermal vertex's from its class.
+    /// The recorded temperatures of every shading vertex, each thermal vertex's from its class,
+    /// with the environment ground's and the enclosures' when solved.
     fn solution(
         &self,
         mesh: &ShadedMesh,
-        vertices: &ThermalVertices,
-        class: &[usize],
+        groups: &Groups,
         histories: &[History],
+        ground: Option<GroundHistory>,
+        nodes: Vec<NodeRun>,
     ) -> ThermalSolution {
         let recorded: Vec<usize> = (0..self.run_samples)
             .filter(|&j| self.recorded[j])
             .collect();
         let mut surface_k = vec![mesh.temperatures.clone(); recorded.len()];
-        for (i, &v) in vertices.index.iter().enumerate() {
-            let history = &histories[class[i]];
+        for (i, &v) in groups.vertices.index.iter().enumerate() {
+            let history = &histories[groups.class[i]];
             for (r, row) in surface_k.iter_mut().enumerate() {
                 row[v] = history.surface_k[r];
             }
+        }
+        let mut stats = SolveStats {
+            thermal_vertices: groups.vertices.index.len(),
+            distinct_solves: histories.len(),
+            substeps: histories.iter().map(|h| h.substeps).sum(),
+            worst_energy_closure: histories.iter().map(|h| h.closure).fold(0.0, f64::max),
+        };
+        if let Some(g) = &ground {
+            stats.distinct_solves += 1;
+            stats.substeps += g.substeps;
+            stats.worst_energy_closure = stats.worst_energy_closure.max(g.closure);
+        }
+        for node in &nodes {
+            stats.worst_energy_closure = stats.worst_energy_closure.max(node.closure);
         }
         ThermalSolution {
             times_s: recorded.iter().map(|&j| self.times[j]).collect(),
             surface_k,
             weather: recorded.iter().map(|&j| self.samples[j]).collect(),
-            stats: SolveStats {
-                thermal_vertices: vertices.index.len(),
-                distinct_solves: histories.len(),
-                substeps: histories.iter().map(|h| h.substeps).sum(),
-                worst_energy_closure: histories.iter().map(|h| h.closure).fold(0.0, f64::max),
-            },
+            stats,
+            ground_k: ground.map(|g| recorded.iter().map(|&j| g.run[j]).collect()),
+            enclosure_air_k: nodes.iter().map(|n| n.air_k.clone()).collect(),
+            enclosure_residual_k: nodes.iter().map(|n| n.residual_k).collect(),
         }
     }
 
-    /// The forcing of §1.8 at sample `j` (see the module docs).
-    fn forcing(&self, model: &SurfaceThermal, exposure: &Exposure, j: usize) -> Forcing {
+    /// The solves of the vertices outside any enclosure, each on its own, in parallel (`None`
+    /// for an enclosure's members, solved with their node).
+    fn independent(
+        &self,
+        scene: &Scene,
+        vertices: &ThermalVertices,
+        representatives: &[usize],
+        ground: Option<&GroundHistory>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<Option<History>>, ThermalRunError> {
+        representatives
+            .par_iter()
+            .map(|&i| {
+                let v = vertices.index[i];
+                let surface = vertices.surface[i] as usize;
+                let model = self.setup.surfaces[surface]
+                    .as_ref()
+                    .expect("thermal vertex");
+                if model.enclosure.is_some() {
+                    return Ok(None);
+                }
+                let exposure = vertices.exposure(i, &scene.mesh);
+                let result = self
+                    .vertex(model, &exposure, scene.mesh.temperatures[v], ground)
+                    .map(Some)
+                    .map_err(|failure| independent_error(scene, surface, failure));
+                progress.advance(1);
+                result
+            })
+            .collect()
+    }
+
+    /// Solar irradiance on a vertex's front at sample `j` (W m⁻²) before absorption: α_s of it
+    /// is absorbed, τ of it passes into an enclosure.
+    fn incident_w_m2(&self, exposure: &Exposure, j: usize) -> f64 {
         let (t, w) = (self.times[j], &self.samples[j]);
         let s = w.sun_direction;
         let cos_sun = exposure.normal.dot(&s).max(0.0);
@@ -479,14 +623,49 @@ impl Run<'_> {
         } else {
             0.0
         };
+        direct + w.diffuse_horizontal_w_m2 * exposure.sky_view
+    }
+
+    /// Absorbed long-wave ε [E_lw F_sky + σT_g⁴ (1 − F_sky)] with the typed T_g, or with the
+    /// solved ground at `ground_k`: below the horizon ((1 − n_z)/2 of the cosine-weighted
+    /// hemisphere) at it, the blocked rest of the sky at `thermal.ground_temperature_k` when
+    /// given, else at it too.
+    fn longwave_in(
+        &self,
+        model: &SurfaceThermal,
+        exposure: &Exposure,
+        w: &WeatherSample,
+        ground_k: Option<f64>,
+    ) -> f64 {
         let f_sky = exposure.sky_view;
-        let ground = STEFAN_BOLTZMANN * self.setup.ground_temperature_k.powi(4);
+        let Some(ground_k) = ground_k else {
+            let ground = STEFAN_BOLTZMANN * self.setup.ground_temperature_k.powi(4);
+            return model.emissivity * (w.longwave_down_w_m2 * f_sky + ground * (1.0 - f_sky));
+        };
+        let below = 0.5 * (1.0 - exposure.normal.z);
+        let blocked = (1.0 - f_sky - below).max(0.0);
+        let occluded_k = self
+            .setup
+            .ground
+            .as_ref()
+            .and_then(|g| g.occluded_k)
+            .unwrap_or(ground_k);
+        let sigma = STEFAN_BOLTZMANN;
+        model.emissivity
+            * (w.longwave_down_w_m2 * f_sky
+                + sigma * ground_k.powi(4) * below
+                + sigma * occluded_k.powi(4) * blocked)
+    }
+
+    /// The forcing of §1.8 at sample `j` (see the module docs).
+    fn forcing(&self, drive: &Drive, j: usize) -> Forcing {
+        let (t, w) = (self.times[j], &self.samples[j]);
+        let model = drive.model;
+        let ground_k = drive.ground.map(|g| g[j]);
         Forcing {
             front: FrontForcing {
-                absorbed_w_m2: model.solar_absorptance
-                    * (direct + w.diffuse_horizontal_w_m2 * f_sky),
-                longwave_in_w_m2: model.emissivity
-                    * (w.longwave_down_w_m2 * f_sky + ground * (1.0 - f_sky)),
+                absorbed_w_m2: model.solar_absorptance * self.incident_w_m2(drive.exposure, j),
+                longwave_in_w_m2: self.longwave_in(model, drive.exposure, w, ground_k),
                 emissivity: model.emissivity,
                 h_w_m2k: model
                     .convection_w_m2k
@@ -498,86 +677,95 @@ impl Run<'_> {
         }
     }
 
+    /// A vertex's solver and its uniform starting state.
+    fn start(
+        &self,
+        model: &SurfaceThermal,
+        initial_k: f64,
+    ) -> Result<(Solver, ThermalState), VertexFailure> {
+        let grid = model
+            .stack
+            .discretise(&Resolution::default())
+            .map_err(VertexFailure::before_run)?;
+        let state = ThermalState::uniform(&grid, initial_k).map_err(VertexFailure::before_run)?;
+        let solver =
+            Solver::new(grid, SolverControl::default()).map_err(VertexFailure::before_run)?;
+        Ok((solver, state))
+    }
+
+    /// Samples 0..first_day are the day a spin-up repeats.
+    fn first_day(&self) -> usize {
+        self.times.partition_point(|&t| t <= DAY_S + 1e-6)
+    }
+
     /// Spin-up (the first day repeated) and the run, recording the surface temperature.
     fn vertex(
         &self,
         model: &SurfaceThermal,
         exposure: &Exposure,
         initial_k: f64,
+        ground: Option<&GroundHistory>,
     ) -> Result<History, VertexFailure> {
-        let grid = model
-            .stack
-            .discretise(&Resolution::default())
-            .map_err(VertexFailure::before_run)?;
-        let mut state =
-            ThermalState::uniform(&grid, initial_k).map_err(VertexFailure::before_run)?;
-        let mut solver =
-            Solver::new(grid, SolverControl::default()).map_err(VertexFailure::before_run)?;
-        let mut history = History {
-            surface_k: Vec::new(),
-            substeps: 0,
-            closure: 0.0,
-        };
-        let first_day = self.times.partition_point(|&t| t <= DAY_S + 1e-6);
-        for _ in 0..self.setup.spinup_days {
-            self.march(&mut solver, &mut state, model, exposure, 0..first_day, None)?;
+        let (mut solver, mut state) = self.start(model, initial_k)?;
+        for pass in 0..self.setup.spinup_days as usize {
+            let drive = Drive {
+                model,
+                exposure,
+                ground: ground.map(|g| g.spinup[pass].as_slice()),
+                spinup: true,
+            };
+            let days = 0..self.first_day();
+            self.march(&mut solver, &mut state, &drive, days, |_, _, _| {})?;
         }
+        let mut history = History::new();
         if self.recorded[0] {
             history.surface_k.push(state.surface_k());
         }
-        let all = 0..self.run_samples;
-        self.march(
-            &mut solver,
-            &mut state,
+        let drive = Drive {
             model,
             exposure,
-            all,
-            Some(&mut history),
-        )?;
+            ground: ground.map(|g| g.run.as_slice()),
+            spinup: false,
+        };
+        let all = 0..self.run_samples;
+        let budget = self.march(&mut solver, &mut state, &drive, all, |j, state, report| {
+            history.substeps += report.substeps as u64;
+            if self.recorded[j] {
+                history.surface_k.push(state.surface_k());
+            }
+        })?;
+        history.closure = budget.closure();
         Ok(history)
     }
 
-    /// Steps through samples `range` (from its first to its last time).
+    /// Steps through samples `range` (from its first to its last time), calling `each` after
+    /// every step with the sample reached, the state and the step's report.
     fn march(
         &self,
         solver: &mut Solver,
         state: &mut ThermalState,
-        model: &SurfaceThermal,
-        exposure: &Exposure,
+        drive: &Drive,
         range: std::ops::Range<usize>,
-        mut history: Option<&mut History>,
-    ) -> Result<(), VertexFailure> {
-        let mut stored = 0.0;
-        let mut net_in = 0.0;
-        let mut gross = 0.0;
-        let mut start = self.forcing(model, exposure, range.start);
+        mut each: impl FnMut(usize, &ThermalState, &StepReport),
+    ) -> Result<Budget, VertexFailure> {
+        let mut budget = Budget::default();
+        let mut start = self.forcing(drive, range.start);
         for j in range.start + 1..range.end {
-            let end = self.forcing(model, exposure, j);
+            let end = self.forcing(drive, j);
             let (t0, t1) = (self.times[j - 1], self.times[j]);
             let report =
                 solver
                     .step(state, t1 - t0, &start, &end)
                     .map_err(|error| VertexFailure {
                         time_s: Some(t0),
-                        spinup: history.is_none(),
+                        spinup: drive.spinup,
                         error,
                     })?;
-            stored += report.stored_j_m2;
-            net_in += report.net_in_j_m2();
-            gross +=
-                report.front_in_j_m2.abs() + report.back_in_j_m2.abs() + report.internal_j_m2.abs();
-            if let Some(h) = history.as_deref_mut() {
-                h.substeps += report.substeps as u64;
-                if self.recorded[j] {
-                    h.surface_k.push(state.surface_k());
-                }
-            }
+            budget.add(&report);
+            each(j, state, &report);
             start = end;
         }
-        if let Some(h) = history {
-            h.closure = (stored - net_in).abs() / gross.max(f64::MIN_POSITIVE);
-        }
-        Ok(())
+        Ok(budget)
     }
 }
 
