@@ -31,6 +31,7 @@ mod warnings;
 
 use crate::emitter::Sun;
 use crate::material::MaterialResolver;
+use crate::optics::Band;
 use camera::Camera;
 use config::{ObjectConfig, SceneConfig, Shading, WeatherConfig};
 use environment::Environment;
@@ -137,15 +138,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
     }
     let transport = render_settings::transport_settings(path, &config.render)?;
     let thermal_run = thermal::resolve_thermal(path, &config, dir, band)?;
-    let sun = match (&config.sun, &thermal_run) {
-        (Some(sun), None) => sun.resolve(band).map_err(|error| SceneError::Sun {
-            file: path.to_owned(),
-            error,
-        })?,
-        _ => None,
-    };
-    // The open-world model has no sun (a warning says so); the summary must not claim one.
-    let sun = sun.filter(|_| transport != Transport::OpenWorld);
+    let sun = fixed_sun(path, &config, band, thermal_run.is_some(), transport)?;
     let start_air_k = thermal_run.as_ref().map(|(_, _, air_k)| *air_k);
 
     let library = dir.join(config.material_library.as_deref().unwrap_or("fits"));
@@ -205,6 +198,25 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         thermal_instant: None,
         warnings,
     })
+}
+
+/// The `[sun]` of a scene without `[thermal]` (a thermal run moves its own sun).
+fn fixed_sun(
+    path: &Path,
+    config: &SceneConfig,
+    band: &Band,
+    thermal: bool,
+    transport: Transport,
+) -> Result<Option<Sun>, SceneError> {
+    let sun = match (&config.sun, thermal) {
+        (Some(sun), false) => sun.resolve(band).map_err(|error| SceneError::Sun {
+            file: path.to_owned(),
+            error,
+        })?,
+        _ => None,
+    };
+    // The open-world model has no sun (a warning says so); the summary must not claim one.
+    Ok(sun.filter(|_| transport != Transport::OpenWorld))
 }
 
 /// The weather file and its coldest air, for the warnings (a clear day's air is its own keys,
