@@ -54,11 +54,20 @@ pub struct Reconstruction {
 impl Reconstruction {
     /// Compares `estimate` (S0, S1, S2 per pixel) with `truth`, in one parallel pass.
     pub fn of(truth: &[[f64; 4]], estimate: &[[f64; 3]]) -> Reconstruction {
+        // Fixed blocks summed in image order: the same sums, to the last bit, on any number of
+        // threads (a work-stealing reduction would make summary.json differ between runs).
+        const BLOCK: usize = 4096;
         let sums = truth
-            .par_iter()
-            .zip(estimate)
-            .fold(ErrorSums::default, |sums, (t, e)| sums.add(t, e))
-            .reduce(ErrorSums::default, ErrorSums::merge);
+            .par_chunks(BLOCK)
+            .zip(estimate.par_chunks(BLOCK))
+            .map(|(t, e)| {
+                t.iter()
+                    .zip(e)
+                    .fold(ErrorSums::default(), |sums, (t, e)| sums.add(t, e))
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .fold(ErrorSums::default(), ErrorSums::merge);
         let n = truth.len().max(1) as f64;
         let psnr_of = |peak: f64, squared: f64| psnr_db(peak, squared / n);
         Reconstruction {
@@ -134,6 +143,47 @@ impl CameraMetrics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// summary.json must not change with the thread count: sweeps compare outputs by hash.
+    #[test]
+    fn metrics_are_bit_identical_on_any_number_of_threads() {
+        let pixels = 100_003;
+        let value = |i: usize, k: usize| ((i * 7919 + k * 104_729) % 10_007) as f64 * 1e-3 + 0.1;
+        let truth: Vec<[f64; 4]> = (0..pixels)
+            .map(|i| {
+                [
+                    10.0 + value(i, 0),
+                    value(i, 1) - 5.0,
+                    value(i, 2) - 5.0,
+                    0.0,
+                ]
+            })
+            .collect();
+        let estimate: Vec<[f64; 3]> = truth
+            .iter()
+            .enumerate()
+            .map(|(i, t)| [t[0] + value(i, 3) * 1e-3, t[1] * 0.99, t[2] + 1e-3])
+            .collect();
+        let on_threads = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let r = pool.install(|| Reconstruction::of(&truth, &estimate));
+            [
+                r.psnr_s0_db,
+                r.psnr_s1_db,
+                r.psnr_s2_db,
+                r.psnr_dolp_db,
+                r.aop_rmse_deg,
+            ]
+            .map(|v| v.unwrap().to_bits())
+        };
+        let one = on_threads(1);
+        for threads in [2, 3, 7] {
+            assert_eq!(on_threads(threads), one, "{threads} threads");
+        }
+    }
 
     #[test]
     fn psnr_follows_its_definition() {
