@@ -1,9 +1,12 @@
 //! Speed of the physics core: one full 4×4 Mueller evaluation, the first-column fast path, and an
-//! emissivity table 0°–89° in 1° steps at the default (1e-5) accuracy.
+//! emissivity table 0°–89° in 1° steps at the default (1e-5) accuracy; random geometries in
+//! degree columns one at a time and in blocks.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use irpol::optics::RefractiveIndex;
-use irpol::pbrdf::{Direction, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution};
+use irpol::pbrdf::{
+    Direction, GeometryColumns, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution,
+};
 
 fn paper_paint(shadowing: Shadowing) -> Pbrdf {
     Pbrdf::new(
@@ -80,6 +83,52 @@ fn mueller_loop(c: &mut Criterion) {
     group.finish();
 }
 
+/// 10⁴ random geometries in degrees (θ, φ uniform), as the Python `mueller` evaluates them: one
+/// at a time through `Pbrdf::mueller` of the checked directions, and as columns
+/// (`Pbrdf::mueller_columns`, the same numbers computed in blocks). Output into a reused buffer,
+/// so the page faults of a fresh array are not timed.
+fn mueller_random_columns(c: &mut Criterion) {
+    const COUNT: usize = 10_000;
+    let mut state = 1u64;
+    let mut uniform = |high: f64| {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        high * ((state >> 11) as f64 / (1u64 << 53) as f64)
+    };
+    let mut angles: [Vec<f64>; 4] = Default::default();
+    for _ in 0..COUNT {
+        for (column, high) in angles.iter_mut().zip([85.0, 360.0, 85.0, 360.0]) {
+            column.push(uniform(high));
+        }
+    }
+    let columns = GeometryColumns {
+        theta_i: &angles[0],
+        phi_i: &angles[1],
+        theta_r: &angles[2],
+        phi_r: &angles[3],
+    };
+    let mut out = vec![0.0; 16 * COUNT];
+    let mut group = c.benchmark_group("random_10000_cauchy");
+    group.throughput(Throughput::Elements(COUNT as u64));
+    for shadowing in [Shadowing::None, Shadowing::Smith] {
+        let model = paper_paint(shadowing);
+        group.bench_function(format!("one_at_a_time_{}", shadowing.name()), |b| {
+            b.iter(|| {
+                for (row, m_out) in out.chunks_exact_mut(16).enumerate() {
+                    let (incident, scattered) = columns.directions(row).unwrap();
+                    let m = model.mueller(&incident, &scattered).transpose();
+                    m_out.copy_from_slice(m.as_slice());
+                }
+            })
+        });
+        group.bench_function(format!("columns_{}", shadowing.name()), |b| {
+            b.iter(|| model.mueller_columns(&columns, 0, &mut out).unwrap())
+        });
+    }
+    group.finish();
+}
+
 fn emissivity(c: &mut Criterion) {
     let thetas: Vec<f64> = (0..90).map(|t| (t as f64).to_radians()).collect();
     let quadrature = HemisphereQuadrature::default();
@@ -109,5 +158,11 @@ fn emissivity(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, mueller, mueller_loop, emissivity);
+criterion_group!(
+    benches,
+    mueller,
+    mueller_loop,
+    mueller_random_columns,
+    emissivity
+);
 criterion_main!(benches);

@@ -17,13 +17,27 @@ use super::multiply_add;
 /// below), and exact at multiples of 90°.
 #[inline]
 pub fn sin_cos_degrees(x_deg: f64) -> (f64, f64) {
+    sin_cos_degrees_within_a_turn(within_a_turn(x_deg))
+}
+
+/// `x_deg` reduced to at most one turn in magnitude (unchanged when it already is), as
+/// [`sin_cos_degrees`] reduces it: a batch reduces a block of angles with this branch first, so
+/// that its loop over [`sin_cos_degrees_within_a_turn`] has no call and vectorizes.
+#[inline(always)]
+pub(crate) fn within_a_turn(x_deg: f64) -> f64 {
     // fmod is exact; it only keeps the quarter count below small multiples (x − 90k is exact
     // whenever 90k is an integer no larger than 2|x|, as both are multiples of ulp(x)).
-    let x = if x_deg.abs() > 360.0 {
+    if x_deg.abs() > 360.0 {
         x_deg % 360.0
     } else {
         x_deg
-    };
+    }
+}
+
+/// [`sin_cos_degrees`] of an angle with |x| ≤ 360° (of [`within_a_turn`]): branch free, the same
+/// operations and so the same results.
+#[inline(always)]
+pub(crate) fn sin_cos_degrees_within_a_turn(x: f64) -> (f64, f64) {
     let quarter_turns = (x / 90.0).round_ties_even();
     let reduced = x - 90.0 * quarter_turns; // exact, within ±45°
     let (s, c) = sin_cos_within_an_eighth_turn(reduced.to_radians());

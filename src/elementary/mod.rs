@@ -7,6 +7,7 @@ mod degrees;
 mod exponential;
 
 pub use degrees::sin_cos_degrees;
+pub(crate) use degrees::{sin_cos_degrees_within_a_turn, within_a_turn};
 pub(crate) use exponential::inline_exp;
 
 /// a·b + c, fused where the target has the instruction (x86-64 with FMA, as `.cargo/config.toml`

@@ -42,7 +42,10 @@ impl Direction {
     }
 
     #[inline(always)]
-    fn from_sines_and_cosines((sin_t, cos_t): (f64, f64), (sin_p, cos_p): (f64, f64)) -> Direction {
+    pub(crate) fn from_sines_and_cosines(
+        (sin_t, cos_t): (f64, f64),
+        (sin_p, cos_p): (f64, f64),
+    ) -> Direction {
         Direction {
             vector: Vector3::new(sin_t * cos_p, sin_t * sin_p, cos_t),
             azimuthal_axis: Vector3::new(-sin_p, cos_p, 0.0),

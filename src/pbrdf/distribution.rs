@@ -417,19 +417,27 @@ impl CauchySmithTable {
         }
     }
 
-    /// Λ(θ) for a direction with cos θ = `cos_theta` ∈ (0, 1].
-    pub(crate) fn lambda(&self, cos_theta: f64) -> f64 {
+    /// Smith's G1(θ) = 1/(1 + Λ(θ)) for a direction with cos θ = `cos_theta` ∈ (0, 1]. With
+    /// Λ = x^(q−1) [K/s − φ(s)/2] multiplied through by s,
+    ///     G1 = s / (s + x^(q−1) (K − s φ(s)/2)),
+    /// which needs two divisions where Λ and then 1/(1 + Λ) needed four: this runs once per
+    /// direction of every random-geometry evaluation, where the divisions and square root were
+    /// most of its cost. At s = 0 (grazing) it is 0, Λ's pole.
+    #[inline]
+    pub(crate) fn masking(&self, cos_theta: f64) -> f64 {
         let sin2 = (1.0 - cos_theta * cos_theta).max(0.0);
         if sin2 == 0.0 {
-            return 0.0;
+            return 1.0;
         }
-        let denominator = self.a * sin2 + cos_theta * cos_theta;
+        let a_sin2 = self.a * sin2;
+        let denominator = a_sin2 + cos_theta * cos_theta;
         let s = cos_theta / denominator.sqrt();
-        let x = self.a * sin2 / denominator;
+        let x = a_sin2 / denominator;
         // x^(q−1) as e^((q−1) ln x), as in the slope density: glibc's correctly rounded pow was
         // the largest single cost of a bulk evaluation (~14 %); the relative error, ~(q−1)|ln x|
-        // 1e-16, matters only where Λ ≈ x^(q−1) K/s is itself negligible against 1.
-        inline_exp((self.q - 1.0) * x.ln()) * (self.k / s - 0.5 * self.phi.at(s))
+        // 1e-16, matters only where x^(q−1) is itself negligible against s.
+        let tail = inline_exp((self.q - 1.0) * x.ln()) * (self.k - 0.5 * s * self.phi.at(s));
+        s / (s + tail)
     }
 
     /// φ(s) = I_x(q−1, ½)/x^(q−1) at x = 1 − s²: also the tail of the Cauchy law's slope
@@ -665,13 +673,14 @@ mod tests {
                     // θ from 0.01° to 90°, denser toward grazing where Λ grows.
                     let c = (i as f64 / 4000.0).powi(2);
                     let exact = 1.0 / (1.0 + prepared.smith_lambda(c));
-                    let tabulated = 1.0 / (1.0 + table.lambda(c));
+                    let tabulated = table.masking(c);
                     assert!(
                         (exact - tabulated).abs() <= bound * exact,
                         "q={q} σ={sigma} cosθ={c}: {exact} vs {tabulated}"
                     );
                 }
-                assert_eq!(table.lambda(1.0), 0.0);
+                assert_eq!(table.masking(1.0), 1.0);
+                assert_eq!(table.masking(0.0), 0.0);
             }
         }
         assert!(SlopeDistribution::Gaussian { sigma: 0.1 }

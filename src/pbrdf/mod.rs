@@ -4,6 +4,7 @@
 //! renderer use.
 
 mod band;
+mod batch;
 mod distribution;
 mod error;
 mod geometry;
@@ -18,6 +19,7 @@ mod visible_slopes;
 
 pub use crate::optics::Direction;
 pub use band::{BandPbrdf, MaterialOptics};
+pub use batch::GeometryColumns;
 pub use distribution::{
     parse_distribution, slope_distribution, DistributionError, DistributionKind, SlopeDistribution,
 };

@@ -330,7 +330,7 @@ impl Pbrdf {
             .lambda_table
             .get_or_init(|| self.prepared.smith_lambda_table());
         match table {
-            Some(table) => 1.0 / (1.0 + table.lambda(cos_theta)),
+            Some(table) => table.masking(cos_theta),
             None => self.masking_without_table(cos_theta),
         }
     }

@@ -1,0 +1,312 @@
+//! The Mueller BRDF over columns of geometries in degrees (the Python `mueller`, benches): bit
+//! for bit [`Pbrdf::mueller`] of each row's directions as `irpol eval` reads them, computed in
+//! blocks so that the work splits into short loops of independent iterations.
+//!
+//! Why blocks: one geometry's evaluation is a long chain (four sines and cosines, two Smith
+//! masking factors, the facet density, the Fresnel terms, the frame rotations) interrupted by
+//! calls (the logarithms, the Smith Λ), and evaluated geometry after geometry it runs close to its
+//! latency. Over a block, the sines and cosines of all directions are one branch-free loop that
+//! the compiler vectorizes, the masking factors one loop of independent calls, and only then the
+//! per-pair part runs. Every value is computed by the same operations as in the one-at-a-time
+//! path, so the results are unchanged to the bit (tested below).
+
+use super::{ModelError, Pbrdf, Shadowing};
+use crate::elementary::{sin_cos_degrees_within_a_turn, within_a_turn};
+use crate::optics::{Direction, Mueller};
+use crate::pbrdf::ScatteringGeometry;
+
+/// Geometries per block: large enough for the loops to amortize, small enough that a block's
+/// sines, cosines and masking factors (12 × 64 values, 6 kB) stay in the L1 cache.
+const BLOCK: usize = 64;
+
+/// Four equally long columns of geometries in degrees, read as `irpol eval` reads a row:
+/// θ_i ∈ [0°, 90°), θ_r ∈ (−90°, 90°) with a negative θ_r the direction across the normal
+/// ([`super::fold_signed_zenith`]), finite azimuths.
+#[derive(Clone, Copy, Debug)]
+pub struct GeometryColumns<'a> {
+    pub theta_i: &'a [f64],
+    pub phi_i: &'a [f64],
+    pub theta_r: &'a [f64],
+    pub phi_r: &'a [f64],
+}
+
+impl GeometryColumns<'_> {
+    /// The geometry count, `None` unless all four columns have it.
+    pub fn count(&self) -> Option<usize> {
+        let count = self.theta_i.len();
+        ([self.phi_i.len(), self.theta_r.len(), self.phi_r.len()] == [count; 3]).then_some(count)
+    }
+
+    /// The directions of geometry `row`, checked as `irpol eval` checks a row.
+    pub fn directions(&self, row: usize) -> Result<(Direction, Direction), ModelError> {
+        Ok((
+            Direction::from_degrees_checked("theta_i_deg", self.theta_i[row], self.phi_i[row])?,
+            Direction::from_signed_degrees_checked(
+                "theta_r_deg",
+                self.theta_r[row],
+                self.phi_r[row],
+            )?,
+        ))
+    }
+
+    /// Whether geometry `row` passes [`GeometryColumns::directions`]' checks (the same
+    /// conditions, without building the directions), and its four angles with θ_r folded to its
+    /// unsigned form.
+    #[inline(always)]
+    fn folded(&self, row: usize) -> (bool, [f64; 4]) {
+        let (ti, pi, tr, pr) = (
+            self.theta_i[row],
+            self.phi_i[row],
+            self.theta_r[row],
+            self.phi_r[row],
+        );
+        let (tr, pr) = if tr < 0.0 && pr.is_finite() {
+            super::fold_signed_zenith(tr, pr)
+        } else {
+            (tr, pr)
+        };
+        // NaN fails every comparison, so each condition also refuses it.
+        let valid = (0.0..90.0).contains(&ti)
+            && pi.is_finite()
+            && (0.0..90.0).contains(&tr)
+            && pr.is_finite();
+        (valid, [ti, pi, tr, pr])
+    }
+}
+
+/// The sines and cosines of one block's directions and their masking factors, column by column.
+struct Block {
+    /// θ_i, φ_i, θ_r, φ_r (degrees, reduced to one turn), then overwritten by their sines.
+    sines: [[f64; BLOCK]; 4],
+    cosines: [[f64; BLOCK]; 4],
+    masking: [[f64; BLOCK]; 2],
+}
+
+/// The value computed for the previous key, reused while the key repeats: in a broadcast table
+/// the outer angles repeat over the inner ones, so a Smith masking factor (an interpolated
+/// incomplete beta function for the Cauchy distribution, the costliest per-direction value) is
+/// computed once per run of equal cosines. The same function of the same input: the result is
+/// the same to the bit.
+struct Repeated {
+    last: Option<(u64, f64)>,
+}
+
+impl Repeated {
+    #[inline(always)]
+    fn get(&mut self, key: f64, compute: impl FnOnce(f64) -> f64) -> f64 {
+        match self.last {
+            Some((k, v)) if k == key.to_bits() => v,
+            _ => {
+                let v = compute(key);
+                self.last = Some((key.to_bits(), v));
+                v
+            }
+        }
+    }
+}
+
+impl Pbrdf {
+    /// The Mueller BRDF (sr⁻¹, psps frames, row-major m00…m33) of geometries `first..` of
+    /// `columns` into `out`, 16 values per geometry, as many as `out` holds: bit for bit
+    /// [`Pbrdf::mueller`] of [`GeometryColumns::directions`]. The error is that of the first
+    /// invalid geometry in the range; `out` is then partly written.
+    pub fn mueller_columns(
+        &self,
+        columns: &GeometryColumns<'_>,
+        first: usize,
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let mut block = Block {
+            sines: [[0.0; BLOCK]; 4],
+            cosines: [[0.0; BLOCK]; 4],
+            masking: [[1.0; BLOCK]; 2],
+        };
+        let mut masking = [Repeated { last: None }, Repeated { last: None }];
+        for (b, values) in out.chunks_mut(16 * BLOCK).enumerate() {
+            let start = first + b * BLOCK;
+            let count = values.len() / 16;
+            self.fill_block(columns, start, count, &mut block, &mut masking)?;
+            self.write_block(&block, values);
+        }
+        Ok(())
+    }
+
+    /// Checks geometries `start..start + count` and computes their sines, cosines and masking
+    /// factors into `block` (the first `count` entries of each column).
+    fn fill_block(
+        &self,
+        columns: &GeometryColumns<'_>,
+        start: usize,
+        count: usize,
+        block: &mut Block,
+        masking: &mut [Repeated; 2],
+    ) -> Result<(), ModelError> {
+        let (mut valid, mut beyond_a_turn) = (true, false);
+        for j in 0..count {
+            let (ok, angles) = columns.folded(start + j);
+            valid &= ok;
+            for (column, angle) in block.sines.iter_mut().zip(angles) {
+                beyond_a_turn |= angle.abs() > 360.0;
+                column[j] = angle;
+            }
+        }
+        if !valid {
+            for row in start..start + count {
+                columns.directions(row)?;
+            }
+        }
+        // Only where needed: in a loop the compiler evaluates fmod for every angle and selects
+        // (6 % of a random-geometry evaluation, perf), though it changes only angles beyond a
+        // turn, which are rare.
+        if beyond_a_turn {
+            for column in block.sines.iter_mut() {
+                for angle in &mut column[..count] {
+                    *angle = within_a_turn(*angle);
+                }
+            }
+        }
+        // Over the whole block, whatever `count`: a fixed trip count, and a stale tail is
+        // harmless (never written out).
+        for (sines, cosines) in block.sines.iter_mut().zip(block.cosines.iter_mut()) {
+            for (s, c) in sines.iter_mut().zip(cosines.iter_mut()) {
+                (*s, *c) = sin_cos_degrees_within_a_turn(*s);
+            }
+        }
+        if self.shadowing() == Shadowing::Smith {
+            for (side, cosines) in [(0, 0), (1, 2)] {
+                for j in 0..count {
+                    block.masking[side][j] =
+                        masking[side].get(block.cosines[cosines][j], |c| self.masking(c));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The Mueller matrices of a filled block's first `values.len() / 16` geometries.
+    fn write_block(&self, block: &Block, values: &mut [f64]) {
+        let [sin_ti, sin_pi, sin_tr, sin_pr] = &block.sines;
+        let [cos_ti, cos_pi, cos_tr, cos_pr] = &block.cosines;
+        for (j, m_out) in values.chunks_exact_mut(16).enumerate() {
+            let incident =
+                Direction::from_sines_and_cosines((sin_ti[j], cos_ti[j]), (sin_pi[j], cos_pi[j]));
+            let scattered =
+                Direction::from_sines_and_cosines((sin_tr[j], cos_tr[j]), (sin_pr[j], cos_pr[j]));
+            let m = match ScatteringGeometry::new(&incident, &scattered) {
+                Some(g) => self.mueller_for_geometry(&g, block.masking[0][j], block.masking[1][j]),
+                None => Mueller::zeros(),
+            };
+            for (slot, value) in m_out.iter_mut().zip(m.transpose().iter()) {
+                *slot = *value;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optics::RefractiveIndex;
+    use crate::pbrdf::SlopeDistribution;
+
+    fn model(shadowing: Shadowing) -> Pbrdf {
+        Pbrdf::new(
+            SlopeDistribution::Cauchy { sigma: 0.1, q: 1.8 },
+            shadowing,
+            RefractiveIndex::new(1.2, 0.2),
+            0.01,
+        )
+        .unwrap()
+    }
+
+    /// Random geometries (several blocks and a partial one, signed θ_r, azimuths beyond a turn,
+    /// runs of repeated angles) give exactly the matrices of the one-at-a-time path.
+    #[test]
+    fn columns_equal_mueller_to_the_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = |low: f64, high: f64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            low + (high - low) * ((state >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        let count = 3 * BLOCK + 17;
+        let mut theta_i: Vec<f64> = (0..count).map(|_| uniform(0.0, 89.9)).collect();
+        let phi_i: Vec<f64> = (0..count).map(|_| uniform(-800.0, 800.0)).collect();
+        let theta_r: Vec<f64> = (0..count).map(|_| uniform(-89.9, 89.9)).collect();
+        let phi_r: Vec<f64> = (0..count).map(|_| uniform(-800.0, 800.0)).collect();
+        theta_i[10..30].fill(45.0);
+        theta_i[40] = 0.0;
+        let columns = GeometryColumns {
+            theta_i: &theta_i,
+            phi_i: &phi_i,
+            theta_r: &theta_r,
+            phi_r: &phi_r,
+        };
+        for shadowing in [
+            Shadowing::None,
+            Shadowing::TorranceSparrow,
+            Shadowing::Smith,
+        ] {
+            let model = model(shadowing);
+            let mut out = vec![f64::NAN; 16 * (count - 5)];
+            model.mueller_columns(&columns, 5, &mut out).unwrap();
+            for (j, got) in out.chunks_exact(16).enumerate() {
+                let (incident, scattered) = columns.directions(5 + j).unwrap();
+                let want = model.mueller(&incident, &scattered).transpose();
+                assert!(
+                    got.iter()
+                        .zip(want.iter())
+                        .all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "{shadowing:?} row {j}: {got:?} vs {want}"
+                );
+            }
+        }
+    }
+
+    /// The block's own checks refuse exactly what the direction constructors refuse, and the
+    /// error is the first invalid row's.
+    #[test]
+    fn invalid_rows_give_the_first_rows_error() {
+        let specials = [
+            0.0,
+            -0.0,
+            10.0,
+            -10.0,
+            89.999,
+            90.0,
+            -90.0,
+            -89.999,
+            400.0,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        let model = model(Shadowing::Smith);
+        for &ti in &specials {
+            for &pi in &specials {
+                for &tr in &specials {
+                    for &pr in &specials {
+                        let rows = [5.0, ti, 5.0];
+                        let (theta_i, phi_i) = (rows, [0.0, pi, 0.0]);
+                        let (theta_r, phi_r) = ([5.0, tr, 5.0], [180.0, pr, 180.0]);
+                        let columns = GeometryColumns {
+                            theta_i: &theta_i,
+                            phi_i: &phi_i,
+                            theta_r: &theta_r,
+                            phi_r: &phi_r,
+                        };
+                        let mut out = [0.0; 48];
+                        // Compared as messages: a NaN value makes equal errors unequal.
+                        let got = model
+                            .mueller_columns(&columns, 0, &mut out)
+                            .map_err(|e| e.to_string());
+                        let want = columns.directions(1).map(|_| ()).map_err(|e| e.to_string());
+                        assert_eq!(got, want, "{ti} {pi} {tr} {pr}");
+                        assert_eq!(columns.folded(1).0, want.is_ok(), "{ti} {pi} {tr} {pr}");
+                    }
+                }
+            }
+        }
+    }
+}
