@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{irpol, write_scene};
+use common::{irpol, record, vertices_of, write_scene};
 use irpol::progress::Silent;
 use irpol::scene::{load_scene, Scene};
 use irpol::thermal_scene::{scene_at, solve_scene, vertex_surfaces, ThermalSolution};
@@ -107,21 +107,6 @@ fn solved(dir: &std::path::Path, extra: &str, times: &[f64]) -> (Scene, ThermalS
     let scene = load_scene(&path).unwrap();
     let solution = solve_scene(&scene, times, &Silent).unwrap();
     (scene, solution)
-}
-
-/// Vertices of object `name`.
-fn vertices_of(scene: &Scene, name: &str) -> Vec<usize> {
-    let object = scene.object_names.iter().position(|n| n == name).unwrap();
-    vertex_surfaces(scene)
-        .iter()
-        .enumerate()
-        .filter(|(_, &s)| scene.surfaces[s as usize].object == object)
-        .map(|(v, _)| v)
-        .collect()
-}
-
-fn record(solution: &ThermalSolution, time_s: f64) -> usize {
-    solution.times_s.iter().position(|&t| t == time_s).unwrap()
 }
 
 /// Acceptance 4: the ground in the ball's afternoon shadow is cooler than the ground in sun, and

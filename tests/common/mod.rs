@@ -271,3 +271,19 @@ solar_absorptance = 0.6
         .to_owned(),
     )
 }
+
+/// Vertices of object `name` of a scene.
+pub fn vertices_of(scene: &irpol::scene::Scene, name: &str) -> Vec<usize> {
+    let object = scene.object_names.iter().position(|n| n == name).unwrap();
+    irpol::thermal_scene::vertex_surfaces(scene)
+        .iter()
+        .enumerate()
+        .filter(|(_, &s)| scene.surfaces[s as usize].object == object)
+        .map(|(v, _)| v)
+        .collect()
+}
+
+/// The index of the recorded instant `time_s` of a thermal run.
+pub fn record(solution: &irpol::thermal_scene::ThermalSolution, time_s: f64) -> usize {
+    solution.times_s.iter().position(|&t| t == time_s).unwrap()
+}
