@@ -6,7 +6,7 @@
 //! marker is missing. Fields beyond 24 (visibility, precipitation, …) are not read.
 
 use super::station::{
-    check_station, field_value, label, read_records, Field, HourRecord, LineRefusal, Missing,
+    field_value, header_station, label, read_records, Field, HourRecord, LineRefusal, Missing,
     Station, StationFormat, StationWeather, FIELDS,
 };
 use super::FieldProblem;
@@ -115,27 +115,8 @@ fn location(line: &str) -> Result<Station, FieldProblem> {
             crate::text::shown_at_most(line, 80)
         )));
     }
-    let number = |index: usize, what: &str| -> Result<f64, FieldProblem> {
-        fields[index]
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| {
-                FieldProblem(format!(
-                    "LOCATION field {} ({what}): '{}' is not a number",
-                    index + 1,
-                    shown(fields[index])
-                ))
-            })
-    };
-    let station = Station {
-        latitude_deg: number(6, "latitude")?,
-        longitude_deg: number(7, "longitude")?,
-        time_zone_h: number(8, "time zone")?,
-        elevation_m: number(9, "elevation")?,
-    };
-    check_station(&station).map_err(|e| FieldProblem(format!("LOCATION: {e}")))?;
-    Ok(station)
+    // LOCATION,city,state,country,source,WMO,latitude,longitude,time zone,elevation.
+    header_station(&fields, [8, 6, 7, 9], "LOCATION")
 }
 
 /// One data row.

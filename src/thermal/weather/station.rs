@@ -398,6 +398,46 @@ pub(super) fn label(
     Ok((local, utc.and_utc()))
 }
 
+/// A header line's site from its fields at `columns` (0-based: time zone, latitude, longitude,
+/// elevation), each a finite number, then checked; `line` names the header line in messages.
+pub(super) fn header_station<S: AsRef<str>>(
+    fields: &[S],
+    columns: [usize; 4],
+    line: &str,
+) -> Result<Station, FieldProblem> {
+    let number = |index: usize, what: &str| -> Result<f64, FieldProblem> {
+        let field = fields[index].as_ref();
+        field
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                FieldProblem(format!(
+                    "{line} field {} ({what}): '{}' is not a number",
+                    index + 1,
+                    crate::text::shown(field)
+                ))
+            })
+    };
+    // Read left to right, so a line with several bad fields names its first one.
+    let mut order = [0, 1, 2, 3];
+    order.sort_by_key(|&i| columns[i]);
+    let names = ["time zone", "latitude", "longitude", "elevation"];
+    let mut value = [0.0; 4];
+    for i in order {
+        value[i] = number(columns[i], names[i])?;
+    }
+    let [time_zone_h, latitude_deg, longitude_deg, elevation_m] = value;
+    let station = Station {
+        latitude_deg,
+        longitude_deg,
+        time_zone_h,
+        elevation_m,
+    };
+    check_station(&station).map_err(|e| FieldProblem(format!("{line}: {e}")))?;
+    Ok(station)
+}
+
 /// Checks the header's site: latitude within ±90°, longitude within ±180°, time zone within
 /// −12…+14 h, elevation within −1000…9000 m.
 pub(super) fn check_station(station: &Station) -> Result<(), FieldProblem> {
@@ -480,6 +520,41 @@ pub(super) fn check_sequence(records: &[HourRecord], last_line: u64) -> Result<(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_header_site_is_read_from_its_columns_and_its_first_bad_field_named() {
+        let tmy3 = ["724940", "SF", "CA", "-8", "37.6", "-122.4", "2"];
+        let station = header_station(&tmy3, [3, 4, 5, 6], "site line").unwrap();
+        assert_eq!(
+            [
+                station.time_zone_h,
+                station.latitude_deg,
+                station.longitude_deg,
+                station.elevation_m
+            ],
+            [-8.0, 37.6, -122.4, 2.0]
+        );
+        let bad = ["724940", "SF", "CA", "x", "y", "-122.4", "2"];
+        let error = header_station(&bad, [3, 4, 5, 6], "site line").unwrap_err();
+        assert_eq!(
+            error.0,
+            "site line field 4 (time zone): 'x' is not a number"
+        );
+        // EPW: latitude (field 7) comes before the time zone (field 9).
+        let epw = [
+            "LOCATION", "M", "-", "DEU", "s", "1", "lat", "11.5", "tz", "520",
+        ];
+        let error = header_station(&epw, [8, 6, 7, 9], "LOCATION").unwrap_err();
+        assert_eq!(
+            error.0,
+            "LOCATION field 7 (latitude): 'lat' is not a number"
+        );
+        let far = [
+            "LOCATION", "M", "-", "DEU", "s", "1", "95", "11.5", "1", "520",
+        ];
+        let error = header_station(&far, [8, 6, 7, 9], "LOCATION").unwrap_err();
+        assert!(error.0.starts_with("LOCATION: "), "{}", error.0);
+    }
 
     #[test]
     fn clark_allen_clear_and_overcast() {

@@ -6,7 +6,7 @@
 //! no infrared column: the sky's long-wave is always Clark & Allen's. −9900 (NSRDB) is missing.
 
 use super::station::{
-    check_station, field_value, label, read_records, Field, HourRecord, LineRefusal, Missing,
+    field_value, header_station, label, read_records, Field, HourRecord, LineRefusal, Missing,
     Station, StationFormat, StationWeather, FIELDS,
 };
 use super::FieldProblem;
@@ -126,27 +126,7 @@ fn site(fields: &[String]) -> Result<Station, FieldProblem> {
             fields.len()
         )));
     }
-    let number = |index: usize, what: &str| -> Result<f64, FieldProblem> {
-        fields[index]
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| {
-                FieldProblem(format!(
-                    "site line field {} ({what}): '{}' is not a number",
-                    index + 1,
-                    shown(&fields[index])
-                ))
-            })
-    };
-    let station = Station {
-        time_zone_h: number(3, "time zone")?,
-        latitude_deg: number(4, "latitude")?,
-        longitude_deg: number(5, "longitude")?,
-        elevation_m: number(6, "elevation")?,
-    };
-    check_station(&station).map_err(|e| FieldProblem(format!("site line: {e}")))?;
-    Ok(station)
+    header_station(fields, [3, 4, 5, 6], "site line")
 }
 
 /// One data row.
