@@ -151,3 +151,28 @@ fn the_day_cars_paint_and_asphalt_polarize_as_measured_in_the_field() {
     assert!((0.02..0.07).contains(&paint), "painted panels {paint}");
     assert!(asphalt > 0.01, "asphalt {asphalt}");
 }
+
+#[test]
+fn the_shipped_terrain_scene_is_the_car_in_a_five_million_triangle_field() {
+    // scenes/car_terrain.toml is the scale benchmark (docs/verification.md, "Large scenes"):
+    // the car's 15 942 faces plus a 1600 × 1600-cell terrain tile, its relief the asked rms.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = load_scene(&root.join("scenes/car_terrain.toml")).unwrap();
+    assert_eq!(scene.mesh.triangles.len(), 15_942 + 2 * 1600 * 1600);
+    assert_eq!((scene.camera.width, scene.camera.height), (1920, 1080));
+    let field = scene
+        .object_names
+        .iter()
+        .position(|n| n == "field")
+        .unwrap();
+    let heights: Vec<f64> = scene
+        .mesh
+        .triangles
+        .iter()
+        .zip(&scene.mesh.triangle_surface)
+        .filter(|(_, &s)| scene.surfaces[s as usize].object == field)
+        .map(|(t, _)| scene.mesh.positions[t[0] as usize].z + 0.6)
+        .collect();
+    let rms = (heights.iter().map(|h| h * h).sum::<f64>() / heights.len() as f64).sqrt();
+    assert!((rms - 0.15).abs() < 0.002, "terrain rms {rms}");
+}

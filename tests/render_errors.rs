@@ -472,3 +472,36 @@ fn camera_settings_are_checked_by_key() {
         expect(&text, pieces);
     }
 }
+
+#[test]
+fn terrain_keys_are_checked_by_name() {
+    let terrain = |keys: &str| {
+        scene_with_mesh("unused.obj", "").replace(
+            "mesh = \"unused.obj\"",
+            &format!("shape = {{ kind = \"terrain\", size = [10.0, 10.0], divisions = [20, 20], {keys} }}"),
+        )
+    };
+    let cases = [
+        (
+            "rms_height_m = 0.1, correlation_length_m = 0.5",
+            "shape.correlation_length_m = 0.5 must be at least two cells (1 m)",
+        ),
+        (
+            "rms_height_m = -0.1, correlation_length_m = 2.0",
+            "shape.rms_height_m = -0.1 must be finite and ≥ 0",
+        ),
+        (
+            "rms_height_m = 0.1, correlation_length_m = 2.0, hurst = 1.5",
+            "shape.hurst = 1.5 must be within (0, 1]",
+        ),
+        (
+            "rms_height_m = 0.1, correlation_length_m = 2.0, roughness = 3",
+            "unknown field `roughness`",
+        ),
+        ("rms_height_m = 0.1", "missing field `correlation_length_m`"),
+    ];
+    for (keys, message) in cases {
+        let text = refuse(&terrain(keys), &[]);
+        expect(&text, &["scene.toml", message]);
+    }
+}

@@ -211,3 +211,35 @@ fn gouraud_and_per_pixel_shading_agree_on_a_fine_sphere() {
     assert!(count > 5000);
     assert!(worst < 5e-3, "S0 differs by {worst}");
 }
+
+#[test]
+fn a_flat_terrain_renders_as_the_plane_and_a_rough_one_as_a_rough_surface() {
+    // rms height 0: the terrain is the plane, vertex for vertex, with the plane's normal, so
+    // its render is bit for bit the plane's. With relief its image differs, and only where
+    // the ground is (the sky pixels stay the sky's).
+    let scene = |shape: &str| {
+        format!(
+            "{}{}{}[[objects]]\nname = \"ground\"\nshape = {{ {shape} }}\nmaterial = \"m\"\n\
+             temperature_k = 295.0\ntranslate = [0.0, 0.0, -1.0]\n",
+            camera_toml(48),
+            AUTUMN_ENVIRONMENT,
+            material_toml(0.3, 2.0, 1.5, 0.1, 0.05),
+        )
+    };
+    let grid = "size = [12.0, 12.0], divisions = [24, 24]";
+    let (_, plane) = render_text(&scene(&format!("kind = \"plane\", {grid}")));
+    let terrain = |rms: f64| {
+        render_text(&scene(&format!(
+            "kind = \"terrain\", {grid}, rms_height_m = {rms}, correlation_length_m = 2.0, seed = 4"
+        )))
+        .1
+    };
+    let flat = terrain(0.0);
+    assert_eq!(flat.stokes, plane.stokes);
+    assert!(plane.surface.iter().filter(|&&s| s != BACKGROUND).count() > 200);
+    let rough = terrain(0.3);
+    let changed = (0..plane.stokes.len())
+        .filter(|&p| rough.stokes[p] != plane.stokes[p])
+        .count();
+    assert!(changed > 200, "{changed} pixels changed");
+}

@@ -9,10 +9,10 @@
 //! S2 = I45 − I135, so their noise is correlated exactly as in a real instrument. Seeded
 //! (ChaCha8, one stream per image row), so a render is reproducible whatever the thread count.
 
+use crate::elementary::standard_normal;
 use crate::scene::{Atmosphere, Sensor};
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use std::f64::consts::PI;
 
 /// Atmospheric transmission and path emission for one pixel at `range` metres: the Stokes
 /// vector `s` seen through the path, and its standard error `error` scaled by τ (the path
@@ -74,13 +74,6 @@ impl Noise {
             .map(|_| [0; 4].map(|_| standard_normal(&mut rng)))
             .collect()
     }
-}
-
-/// Box–Muller transform of two uniforms in (0, 1].
-pub(crate) fn standard_normal(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = 1.0 - rng.random::<f64>();
-    let u2: f64 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
 }
 
 #[cfg(test)]

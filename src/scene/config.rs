@@ -510,4 +510,18 @@ pub enum ShapeConfig {
         #[serde(deserialize_with = "exactly")]
         divisions: [u32; 2],
     },
+    /// A random heightfield tile over the `size` plane (docs/scenes.md, `scene::terrain`): its
+    /// rms height, correlation length, optional Hurst exponent (von Kármán, else Gaussian) and
+    /// seed.
+    Terrain {
+        #[serde(deserialize_with = "exactly")]
+        size: [f64; 2],
+        #[serde(deserialize_with = "exactly")]
+        divisions: [u32; 2],
+        rms_height_m: f64,
+        correlation_length_m: f64,
+        hurst: Option<f64>,
+        #[serde(default)]
+        seed: u64,
+    },
 }

@@ -25,6 +25,7 @@ pub mod ply;
 pub mod procedural;
 mod render_settings;
 pub mod sensor;
+pub mod terrain;
 pub mod thermal;
 mod viewing;
 mod warnings;

@@ -3,6 +3,7 @@
 
 use super::config::{ObjectConfig, ShapeConfig};
 use super::mesh::{self, MeshError, ObjectShading, RawMesh, ShadedMesh, Transform};
+use super::terrain::TerrainSpectrum;
 use super::{obj, ply, procedural, thermal, SceneError, Surface, CELSIUS_SUSPECT_K};
 use crate::material::MaterialResolver;
 use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
@@ -292,16 +293,76 @@ fn procedural_shape(
             Ok(procedural::icosphere(radius, subdivisions))
         }
         ShapeConfig::Plane { size, divisions } => {
-            if !size.iter().all(|s| s.is_finite() && *s > 0.0) {
-                return Err(invalid("shape.size must be finite and > 0".into()));
-            }
-            if !divisions.iter().all(|d| (1..=4096).contains(d)) {
-                return Err(invalid("shape.divisions must be within 1…4096".into()));
-            }
+            check_grid(size, divisions, invalid)?;
             let divisions = plane_cell_m.map_or(divisions, |cell| {
                 procedural::divisions_for_cell(size, divisions, cell)
             });
             Ok(procedural::plane(size, divisions))
         }
+        ShapeConfig::Terrain {
+            size,
+            divisions,
+            rms_height_m,
+            correlation_length_m,
+            hurst,
+            seed,
+        } => {
+            let spectrum = TerrainSpectrum {
+                rms_height_m,
+                correlation_length_m,
+                hurst,
+                seed,
+            };
+            check_terrain(size, divisions, &spectrum, invalid)?;
+            Ok(procedural::terrain(size, divisions, &spectrum))
+        }
     }
+}
+
+/// A plane's or terrain's size and divisions.
+fn check_grid(size: [f64; 2], divisions: [u32; 2], invalid: Invalid) -> Result<(), SceneError> {
+    if !size.iter().all(|s| s.is_finite() && *s > 0.0) {
+        return Err(invalid("shape.size must be finite and > 0".into()));
+    }
+    if !divisions.iter().all(|d| (1..=4096).contains(d)) {
+        return Err(invalid("shape.divisions must be within 1…4096".into()));
+    }
+    Ok(())
+}
+
+/// A terrain's grid and spectrum: the grid must resolve the correlation length (two cells at
+/// least), else the tile is white noise at the grid's own scale whatever ℓ says.
+fn check_terrain(
+    size: [f64; 2],
+    divisions: [u32; 2],
+    spectrum: &TerrainSpectrum,
+    invalid: Invalid,
+) -> Result<(), SceneError> {
+    check_grid(size, divisions, invalid)?;
+    let rms = spectrum.rms_height_m;
+    if !(rms.is_finite() && rms >= 0.0) {
+        return Err(invalid(format!(
+            "shape.rms_height_m = {} must be finite and ≥ 0",
+            number(rms)
+        )));
+    }
+    let cell = (size[0] / divisions[0] as f64).max(size[1] / divisions[1] as f64);
+    let length = spectrum.correlation_length_m;
+    if !(length.is_finite() && length >= 2.0 * cell) {
+        return Err(invalid(format!(
+            "shape.correlation_length_m = {} must be at least two cells ({} m): use more \
+             divisions or a longer correlation length",
+            number(length),
+            number(2.0 * cell)
+        )));
+    }
+    if let Some(h) = spectrum.hurst {
+        if !(h > 0.0 && h <= 1.0) {
+            return Err(invalid(format!(
+                "shape.hurst = {} must be within (0, 1]",
+                number(h)
+            )));
+        }
+    }
+    Ok(())
 }

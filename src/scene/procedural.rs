@@ -1,7 +1,8 @@
-//! Procedural test objects with exact normals: an icosphere and a subdivided plane. Each is one
-//! part named `surface`.
+//! Procedural objects with exact normals: an icosphere, a subdivided plane and a terrain tile.
+//! Each is one part named `surface`.
 
 use super::mesh::{FaceOrigin, RawFace, RawMesh};
+use super::terrain::{self, TerrainSpectrum};
 use nalgebra::Vector3;
 use std::collections::HashMap;
 
@@ -102,18 +103,59 @@ pub fn divisions_for_cell(size: [f64; 2], divisions: [u32; 2], cell_m: f64) -> [
 pub fn plane(size: [f64; 2], divisions: [u32; 2]) -> RawMesh {
     let [nx, ny] = divisions.map(|d| d.max(1));
     let mut mesh = RawMesh::default();
+    push_grid_vertices(&mut mesh, size, [nx, ny], |_, _| 0.0);
+    mesh.normals.push(Vector3::z());
+    push_grid_faces(&mut mesh, [nx, ny], |_| 0);
+    mesh
+}
+
+/// A terrain tile (see [`super::terrain`]): the `size` plane of [`plane`] displaced by a random
+/// heightfield of the given spectrum, with the heightfield's exact normals at every vertex. The
+/// tile is periodic, so its last row and column repeat the first.
+pub fn terrain(size: [f64; 2], divisions: [u32; 2], spectrum: &TerrainSpectrum) -> RawMesh {
+    let [nx, ny] = divisions.map(|d| d.max(1));
+    let (gx, gy) = (nx as usize, ny as usize);
+    let field = terrain::synthesize(size, [gx, gy], spectrum);
+    let grid = |i: u32, j: u32| (j as usize % gy) * gx + i as usize % gx;
+    let mut mesh = RawMesh::default();
+    push_grid_vertices(&mut mesh, size, [nx, ny], |i, j| field.height[grid(i, j)]);
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let g = grid(i, j);
+            mesh.normals
+                .push(Vector3::new(-field.slope_x[g], -field.slope_y[g], 1.0).normalize());
+        }
+    }
+    push_grid_faces(&mut mesh, [nx, ny], |vertex| vertex);
+    mesh
+}
+
+/// The (nx + 1) × (ny + 1) corners of a `size` grid centred at the origin, row-major, at
+/// height `height(i, j)`.
+fn push_grid_vertices(
+    mesh: &mut RawMesh,
+    size: [f64; 2],
+    [nx, ny]: [u32; 2],
+    height: impl Fn(u32, u32) -> f64,
+) {
+    mesh.positions.reserve(((nx + 1) * (ny + 1)) as usize);
     for j in 0..=ny {
         for i in 0..=nx {
             mesh.positions.push(Vector3::new(
                 size[0] * (i as f64 / nx as f64 - 0.5),
                 size[1] * (j as f64 / ny as f64 - 0.5),
-                0.0,
+                height(i, j),
             ));
         }
     }
-    mesh.normals.push(Vector3::z());
+}
+
+/// Two counter-clockwise (seen from +z) triangles per grid cell, one part; `normal(v)` is the
+/// normal index of vertex v.
+fn push_grid_faces(mesh: &mut RawMesh, [nx, ny]: [u32; 2], normal: impl Fn(u32) -> u32) {
     let part = mesh.part_index(SHAPE_PART);
     let index = |i: u32, j: u32| j * (nx + 1) + i;
+    mesh.faces.reserve(2 * (nx * ny) as usize);
     for j in 0..ny {
         for i in 0..nx {
             let (a, b, c, d) = (
@@ -125,14 +167,13 @@ pub fn plane(size: [f64; 2], divisions: [u32; 2]) -> RawMesh {
             for vertices in [[a, b, c], [a, c, d]] {
                 mesh.faces.push(RawFace {
                     vertices,
-                    normals: Some([0, 0, 0]),
+                    normals: Some(vertices.map(&normal)),
                     part,
                     origin: FaceOrigin::Index(mesh.faces.len() + 1),
                 });
             }
         }
     }
-    mesh
 }
 
 #[cfg(test)]
@@ -181,5 +222,37 @@ mod tests {
             area += 0.5 * cross.norm();
         }
         assert!((area - 8.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_terrain_tile_is_periodic_and_its_normals_face_up() {
+        let spectrum = TerrainSpectrum {
+            rms_height_m: 0.5,
+            correlation_length_m: 2.0,
+            hurst: Some(0.5),
+            seed: 9,
+        };
+        let mesh = terrain([20.0, 10.0], [40, 20], &spectrum);
+        assert_eq!(
+            (mesh.positions.len(), mesh.faces.len()),
+            (41 * 21, 2 * 40 * 20)
+        );
+        let at = |i: usize, j: usize| j * 41 + i;
+        for j in 0..=20 {
+            assert_eq!(mesh.positions[at(0, j)].z, mesh.positions[at(40, j)].z);
+            assert_eq!(mesh.normals[at(0, j)], mesh.normals[at(40, j)]);
+        }
+        for i in 0..=40 {
+            assert_eq!(mesh.positions[at(i, 0)].z, mesh.positions[at(i, 20)].z);
+        }
+        assert!(mesh
+            .normals
+            .iter()
+            .all(|n| n.z > 0.0 && (n.norm() - 1.0).abs() < 1e-12));
+        // Every face winds up (+z), so its geometric normal agrees with the shading normals.
+        for face in &mesh.faces {
+            let [a, b, c] = face.vertices.map(|i| mesh.positions[i as usize]);
+            assert!((b - a).cross(&(c - a)).z > 0.0);
+        }
     }
 }

@@ -8,7 +8,7 @@ use crate::scene::{Detector, Sensor};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::render::sensor::standard_normal;
+use crate::elementary::standard_normal;
 
 /// Salt that keeps the fixed pattern's random streams apart from the temporal noise's.
 const PATTERN_SALT: u64 = 0x6669_7865_6470_6174;

@@ -21,7 +21,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
-use crate::render::sensor::standard_normal;
+use crate::elementary::standard_normal;
 
 /// Nominal polarizer orientations α_k (0°, 45°, 90°, 135°).
 pub const ORIENTATIONS: [f64; 4] = [0.0, FRAC_PI_4, FRAC_PI_2, 3.0 * FRAC_PI_4];
