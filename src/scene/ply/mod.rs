@@ -11,7 +11,7 @@
 //!
 //! Binary payloads are then read directly from the bytes ([`binary`]): the parser keeps every
 //! item as a map of named properties, a few hundred bytes and several allocations each, which
-//! made a million-triangle file take seconds and a gigabyte. ASCII payloads stay with the parser:
+//! made a million-triangle file take a second and 0.9 GB. ASCII payloads stay with the parser:
 //! they are small (a mesh of millions of triangles is not written as text) and its tokenizer
 //! handles the text forms a direct reader would have to repeat.
 
