@@ -151,6 +151,37 @@ fn nan_in_mesh() {
     expect(&text, &["bad.ply"]);
 }
 
+/// A binary PLY must hold exactly what its header declares: trailing bytes and a payload that
+/// ends inside a face are refused, naming the file and the face. (uchar values keep the bytes
+/// ASCII, so the file can be written as text.)
+#[test]
+fn binary_ply_payloads_must_match_their_header() {
+    let header = "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty uchar x\n\
+                  property uchar y\nproperty uchar z\nelement face 2\n\
+                  property list uchar uchar vertex_indices\nend_header\n";
+    let payload = "\0\0\0\x01\0\0\0\0\x01\x03\0\x01\x02\x03\0\x02\x01";
+    let good = format!("{header}{payload}");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tri.ply"), &good).unwrap();
+    let path = write_scene(dir.path(), &scene_with_mesh("tri.ply", ""));
+    render_scene(&path, &dir.path().join("out"), &Silent).unwrap();
+    let trailing = format!("{good}junk");
+    let text = refuse(&scene_with_mesh("tri.ply", ""), &[("tri.ply", &trailing)]);
+    expect(
+        &text,
+        &["tri.ply", "4 bytes follow the items the header declares"],
+    );
+    let cut = &good[..good.len() - 1];
+    let text = refuse(&scene_with_mesh("tri.ply", ""), &[("tri.ply", cut)]);
+    expect(
+        &text,
+        &[
+            "tri.ply",
+            "face 2: the file ends inside property 'vertex_indices' (payload byte 13)",
+        ],
+    );
+}
+
 /// A PLY header that declares an element or a property twice is refused by line: the reader
 /// keys them by name, so the second would silently replace the first.
 #[test]

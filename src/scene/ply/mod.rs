@@ -1,36 +1,69 @@
-//! PLY meshes (ASCII or binary, via `ply-rs-bw`): `vertex` elements with x, y, z, optional
-//! nx, ny, nz and an optional per-vertex `temperature` (K; docs/design.md §2.3), and `face` elements with
-//! a `vertex_indices` (or `vertex_index`) list. A PLY has no groups: all faces form one part,
+//! PLY meshes (ASCII or binary): `vertex` elements with x, y, z, optional nx, ny, nz and an
+//! optional per-vertex `temperature` (K; docs/design.md §2.3), and `face` elements with a
+//! `vertex_indices` (or `vertex_index`) list. A PLY has no groups: all faces form one part,
 //! named `surface`.
 //!
-//! The header is read and checked before the payload: the parser reserves and fills one element
-//! per declared item, so a few hundred bytes declaring 4 294 967 295 faces would otherwise exhaust
-//! memory. Each element's count must fit in the bytes that follow the header (every item takes at
-//! least its fixed-size properties in binary, a digit and a separator per property in ASCII) and
-//! stay within [`MAX_PLY_ITEMS`].
+//! The header is read by `ply-rs-bw` (its grammar knows every type name and alias, comments and
+//! `obj_info`) and checked before the payload: each element's count must fit in the bytes that
+//! follow the header (every item takes at least its fixed-size properties in binary, a digit and
+//! a separator per property in ASCII) and stay within [`MAX_PLY_ITEMS`], so a few hundred bytes
+//! declaring 4 294 967 295 faces are refused before anything is reserved.
+//!
+//! Binary payloads are then read directly from the bytes ([`binary`]): the parser keeps every
+//! item as a map of named properties, a few hundred bytes and several allocations each, which
+//! made a million-triangle file take a second and 0.9 GB. ASCII payloads stay with the parser:
+//! they are small (a mesh of millions of triangles is not written as text) and its tokenizer
+//! handles the text forms a direct reader would have to repeat.
+
+mod binary;
 
 use super::mesh::{FaceOrigin, MeshError, RawFace, RawMesh};
 use crate::text::{shown, shown_at_most};
 use nalgebra::Vector3;
 use ply_rs_bw::parser::{Parser, Reader};
 use ply_rs_bw::ply::{
-    DefaultElement, ElementDef, Encoding, Header, Payload, Property, PropertyType, ScalarType,
+    DefaultElement, ElementDef, Encoding, Header, Property, PropertyType, ScalarType,
 };
 
 /// The single part of a PLY mesh.
 pub const PLY_PART: &str = "surface";
 
 /// Most items (vertices, faces, or items of any other element) a PLY element may declare. The
-/// parser keeps every item as a map of named properties, a few hundred bytes each, so this keeps
-/// a mesh's memory to a few GB; 10 million triangles is far beyond what a scene of this renderer
-/// needs.
+/// parser behind ASCII files keeps every item as a map of named properties, a few hundred bytes
+/// each, so this keeps a mesh's memory to a few GB; 10 million triangles is far beyond what a
+/// scene of this renderer needs.
 pub const MAX_PLY_ITEMS: usize = 10_000_000;
 
 /// Characters of the parser's own message kept in ours (it quotes whole input lines).
 const PARSER_MESSAGE_CHARS: usize = 160;
 
+/// The vertex properties irpol reads, in the order their values are checked.
+const VERTEX_KEYS: [&str; 7] = ["x", "y", "z", "nx", "ny", "nz", "temperature"];
+
+/// Reads a PLY file: binary payloads directly, ASCII ones through the parser.
 pub fn parse_ply(bytes: &[u8]) -> Result<RawMesh, MeshError> {
-    let payload = read_checked(bytes)?;
+    let (header, reader) = read_header_checked(bytes)?;
+    let payload = reader.get_ref();
+    match header.encoding {
+        Encoding::Ascii => mesh_through_parser(&header, reader),
+        Encoding::BinaryLittleEndian => binary::read_mesh(&header, payload, binary::Order::Little),
+        Encoding::BinaryBigEndian => binary::read_mesh(&header, payload, binary::Order::Big),
+    }
+}
+
+/// [`parse_ply`] with the payload read item by item through the parser whatever the encoding,
+/// as every file was before the direct binary reader: kept so that the benchmark
+/// (`benches/mesh.rs`) and the tests compare the two readers on the same files.
+#[doc(hidden)]
+pub fn parse_ply_through_parser(bytes: &[u8]) -> Result<RawMesh, MeshError> {
+    let (header, reader) = read_header_checked(bytes)?;
+    mesh_through_parser(&header, reader)
+}
+
+fn mesh_through_parser(header: &Header, mut reader: Reader<&[u8]>) -> Result<RawMesh, MeshError> {
+    let payload = Parser::<DefaultElement>::new()
+        .read_payload(&mut reader, header)
+        .map_err(|e| unreadable(&e))?;
     let vertices = payload
         .get("vertex")
         .ok_or("the PLY file has no 'vertex' element")?;
@@ -58,17 +91,7 @@ fn read_vertices(vertices: &[DefaultElement], mesh: &mut RawMesh) -> Result<bool
         .first()
         .is_some_and(|v| v.contains_key("temperature"));
     if let Some(first) = vertices.first() {
-        mesh.notes.extend(
-            first
-                .keys()
-                .filter(|k| looks_like_temperature(k) && !has_temperature)
-                .map(|k| {
-                    format!(
-                        "vertex property '{k}' looks like a temperature but is ignored: irpol \
-                         reads per-vertex temperatures (K) only from a property named 'temperature'"
-                    )
-                }),
-        );
+        mesh.notes = temperature_notes(first.keys().map(String::as_str), has_temperature);
     }
     let mut temperatures = Vec::new();
     for (i, vertex) in vertices.iter().enumerate() {
@@ -76,12 +99,8 @@ fn read_vertices(vertices: &[DefaultElement], mesh: &mut RawMesh) -> Result<bool
             let value = vertex
                 .get(key)
                 .and_then(scalar_value)
-                .ok_or_else(|| format!("vertex {}: no numeric property '{key}'", i + 1))?;
-            if value.is_finite() {
-                Ok(value)
-            } else {
-                Err(format!("vertex {}: property '{key}' is not finite", i + 1).into())
-            }
+                .ok_or_else(|| no_numeric_property(i, key))?;
+            finite(value, i, key)
         };
         mesh.positions
             .push(Vector3::new(scalar("x")?, scalar("y")?, scalar("z")?));
@@ -100,6 +119,37 @@ fn read_vertices(vertices: &[DefaultElement], mesh: &mut RawMesh) -> Result<bool
     Ok(has_normals)
 }
 
+/// The notes for vertex properties named like a temperature (`names` in header order) when
+/// the vertices have no `temperature` itself.
+fn temperature_notes<'a>(
+    names: impl Iterator<Item = &'a str>,
+    has_temperature: bool,
+) -> Vec<String> {
+    names
+        .filter(|k| looks_like_temperature(k) && !has_temperature)
+        .map(|k| {
+            format!(
+                "vertex property '{k}' looks like a temperature but is ignored: irpol \
+                 reads per-vertex temperatures (K) only from a property named 'temperature'"
+            )
+        })
+        .collect()
+}
+
+/// Vertex `i` (from 0) lacks scalar property `key`.
+fn no_numeric_property(i: usize, key: &str) -> MeshError {
+    format!("vertex {}: no numeric property '{key}'", i + 1).into()
+}
+
+/// `value` of property `key` of vertex `i` (from 0), refused unless finite.
+fn finite(value: f64, i: usize, key: &str) -> Result<f64, MeshError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(format!("vertex {}: property '{key}' is not finite", i + 1).into())
+    }
+}
+
 /// The `face` element's polygons, split into triangle fans of part `part`.
 fn read_faces(
     faces: &[DefaultElement],
@@ -107,6 +157,7 @@ fn read_faces(
     has_normals: bool,
     mesh: &mut RawMesh,
 ) -> Result<(), MeshError> {
+    let vertex_count = mesh.positions.len();
     for (f, face) in faces.iter().enumerate() {
         let origin = FaceOrigin::Index(f + 1);
         let indices = face
@@ -114,16 +165,40 @@ fn read_faces(
             .or_else(|| face.get("vertex_index"))
             .and_then(list_value)
             .ok_or_else(|| format!("{origin}: no integer list 'vertex_indices'"))?;
+        let polygon = Polygon {
+            origin,
+            part,
+            has_normals,
+            vertex_count,
+        };
+        polygon.push(&indices, mesh)?;
+    }
+    Ok(())
+}
+
+/// One face of a PLY and what its triangles need.
+struct Polygon {
+    origin: FaceOrigin,
+    part: u32,
+    has_normals: bool,
+    /// Vertices the file declares: indices must be below.
+    vertex_count: usize,
+}
+
+impl Polygon {
+    /// Checks the face's vertex `indices` and appends it as a triangle fan.
+    fn push(&self, indices: &[i64], mesh: &mut RawMesh) -> Result<(), MeshError> {
+        let origin = self.origin;
         if indices.len() < 3 {
             return Err(format!("{origin}: a face needs at least 3 vertices").into());
         }
         if let Some(bad) = indices
             .iter()
-            .find(|&&v| v < 0 || v as usize >= mesh.positions.len())
+            .find(|&&v| v < 0 || v as u64 >= self.vertex_count as u64)
         {
             return Err(format!(
                 "{origin}: vertex index {bad} is out of range ({} vertices)",
-                mesh.positions.len()
+                self.vertex_count
             )
             .into());
         }
@@ -131,24 +206,18 @@ fn read_faces(
             let vertices = [indices[0], indices[i], indices[i + 1]].map(|v| v as u32);
             mesh.faces.push(RawFace {
                 vertices,
-                normals: has_normals.then_some(vertices),
-                part,
+                normals: self.has_normals.then_some(vertices),
+                part: self.part,
                 origin,
             });
         }
+        Ok(())
     }
-    Ok(())
 }
 
-/// Reads the header, checks it against the bytes that follow ([`check_header`]), then reads the
-/// payload.
-fn read_checked(bytes: &[u8]) -> Result<Payload<DefaultElement>, MeshError> {
-    let unreadable = |e: &dyn std::fmt::Display| {
-        MeshError::from(format!(
-            "not a readable PLY file: {}",
-            shown_at_most(&e.to_string(), PARSER_MESSAGE_CHARS)
-        ))
-    };
+/// Reads and checks the header ([`check_unique_declarations`], [`check_header`]); returns it
+/// with the reader at the payload (the parser numbers payload lines from the header's).
+fn read_header_checked(bytes: &[u8]) -> Result<(Header, Reader<&[u8]>), MeshError> {
     check_unique_declarations(bytes)?;
     let parser = Parser::<DefaultElement>::new();
     let mut reader = Reader::new(bytes);
@@ -157,9 +226,14 @@ fn read_checked(bytes: &[u8]) -> Result<Payload<DefaultElement>, MeshError> {
         .map_err(|e| unreadable(&e))?;
     // The reader advances through the slice, so what it still holds is the payload.
     check_header(&header, reader.get_ref().len())?;
-    parser
-        .read_payload(&mut reader, &header)
-        .map_err(|e| unreadable(&e))
+    Ok((header, reader))
+}
+
+fn unreadable(e: &dyn std::fmt::Display) -> MeshError {
+    MeshError::from(format!(
+        "not a readable PLY file: {}",
+        shown_at_most(&e.to_string(), PARSER_MESSAGE_CHARS)
+    ))
 }
 
 /// Refuses an element declared twice, or a property declared twice in one element. The parser
