@@ -288,7 +288,7 @@ impl Pbrdf {
 mod tests {
     use super::*;
     use crate::optics::RefractiveIndex;
-    use crate::pbrdf::SlopeDistribution;
+    use crate::pbrdf::{FacetSide, SlopeDistribution, Subsurface};
 
     fn model(shadowing: Shadowing) -> Pbrdf {
         Pbrdf::new(
@@ -298,6 +298,45 @@ mod tests {
             0.01,
         )
         .unwrap()
+    }
+
+    /// Models that take every path of a block: each shadowing kind; a narrow Cauchy lobe with
+    /// q = 100 and a narrow Gaussian, whose facet densities fall below e^−708 at moderate tilts
+    /// (the geometries recomputed one at a time); the Gaussian Smith factor (its closed form,
+    /// not the table); internal facets (ε = 1/N², the other branch of the Fresnel square root);
+    /// a subsurface term (the one-at-a-time loop).
+    fn models_of_every_path() -> Vec<Pbrdf> {
+        let mut models: Vec<Pbrdf> = [
+            Shadowing::None,
+            Shadowing::TorranceSparrow,
+            Shadowing::Smith,
+        ]
+        .into_iter()
+        .map(model)
+        .collect();
+        let index = RefractiveIndex::new(1.5, 0.05);
+        for distribution in [
+            SlopeDistribution::Cauchy {
+                sigma: 0.01,
+                q: 100.0,
+            },
+            SlopeDistribution::Gaussian { sigma: 0.05 },
+            SlopeDistribution::Gaussian { sigma: 0.4 },
+        ] {
+            models.push(Pbrdf::new(distribution, Shadowing::Smith, index, 0.0).unwrap());
+        }
+        let internal = model(Shadowing::Smith).with_volume(FacetSide::Internal, None);
+        models.push(internal.unwrap());
+        let subsurface = Subsurface {
+            rho_s: 0.3,
+            d: 0.2,
+            n_sub: None,
+            d_c: None,
+        };
+        let with_subsurface =
+            model(Shadowing::Smith).with_volume(FacetSide::External, Some(subsurface));
+        models.push(with_subsurface.unwrap());
+        models
     }
 
     /// Random geometries (several blocks and a partial one, signed θ_r, azimuths beyond a turn,
@@ -324,14 +363,10 @@ mod tests {
             theta_r: &theta_r,
             phi_r: &phi_r,
         };
-        for shadowing in [
-            Shadowing::None,
-            Shadowing::TorranceSparrow,
-            Shadowing::Smith,
-        ] {
-            let model = model(shadowing);
+        for model in models_of_every_path() {
             let mut out = vec![f64::NAN; 16 * (count - 5)];
             model.mueller_columns(&columns, 5, &mut out).unwrap();
+            let mut underflows = 0;
             for (j, got) in out.chunks_exact(16).enumerate() {
                 let (incident, scattered) = columns.directions(5 + j).unwrap();
                 let want = model.mueller(&incident, &scattered).transpose();
@@ -339,8 +374,13 @@ mod tests {
                     got.iter()
                         .zip(want.iter())
                         .all(|(a, b)| a.to_bits() == b.to_bits()),
-                    "{shadowing:?} row {j}: {got:?} vs {want}"
+                    "{model:?} row {j}: {got:?} vs {want}"
                 );
+                underflows += usize::from(got[0] < 1e-300);
+            }
+            // The narrow lobes do reach the one-at-a-time fallback.
+            if model.distribution().sigma() <= 0.05 {
+                assert!(underflows > 10, "{model:?}: {underflows}");
             }
         }
     }
