@@ -7,7 +7,7 @@ when otherwise idle (a process busy on one core about halves irpol's side, not t
   least 20× with smith (measured 64–84×);
 - random geometries (θ_i, φ_i, θ_r, φ_r uniform), where every geometry needs its own four sines
   and cosines and two Smith masking factors that a table shares: the acceptance asks for 20× with
-  `none` (measured 38–100×) and 40× with smith (measured 48–83× idle, 35–62× with another
+  `none` (measured 38–113×) and 40× with smith (measured 48–83× idle, 35–62× with another
   process on one core). Reported, not asserted, as a shared machine's noise is larger than those
   margins; the port's smith is slower (scipy's betainc), irpol's barely (a vectorized table).
 
