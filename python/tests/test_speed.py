@@ -1,13 +1,15 @@
 """irpol.mueller against the numpy port of the model (scripts/pbrdf_numpy.py) on 1e6 geometries,
 in the same run, for paper_paint (Cauchy, smith) and the same material with shadowing `none`.
 
-Measured, best of 5 (irpol, 2 threads) against best of 2 (the port):
+Measured, best of 5 (irpol, 2 threads) against best of 2 (the port), on the 2-core test machine
+when otherwise idle (a process busy on one core about halves irpol's side, not the port's):
 - a broadcast table (θ_i × θ_r × φ_r, 100 each, the way BRDF tables are evaluated): asserted at
-  least 20× with smith (measured 30–40× on 2 cores);
+  least 20× with smith (measured 64–84×);
 - random geometries (θ_i, φ_i, θ_r, φ_r uniform), where every geometry needs its own four sines
   and cosines and two Smith masking factors that a table shares: the acceptance asks for 20× with
-  `none` and 40× with smith. Reported, not asserted, as a shared machine's noise is larger than
-  those margins; the port's smith is slower (scipy's betainc), irpol's barely (a table).
+  `none` (measured 38–113×) and 40× with smith (measured 48–83× idle, 35–62× with another
+  process on one core). Reported, not asserted, as a shared machine's noise is larger than those
+  margins; the port's smith is slower (scipy's betainc), irpol's barely (a vectorized table).
 
 Timing ratios are fragile: the one assertion keeps a margin; the numbers are in the run's
 "irpol numbers" section."""

@@ -85,15 +85,22 @@ const TWO_TO_J_OVER_64: [u64; 64] = [
 /// overflow, and NaN go to the system `exp`.
 #[inline(always)]
 pub(crate) fn inline_exp(y: f64) -> f64 {
+    if !(y > -708.0 && y < 709.0) {
+        return y.exp();
+    }
+    exp_within_range(y)
+}
+
+/// [`inline_exp`] of a y in (−708, 709) without the range check: branch free, so that a loop
+/// over it vectorizes. Other arguments give a finite but meaningless value, or ∞.
+#[inline(always)]
+pub(crate) fn exp_within_range(y: f64) -> f64 {
     // Adding 1.5·2^52 rounds to an integer, which then sits in the low bits of the sum.
     const ROUNDING_SHIFT: f64 = 6755399441055744.0;
     const SIXTY_FOUR_OVER_LN2: f64 = 92.33248261689366;
     // ln 2/64 = HI + LO, HI with 32 significant bits so that k·HI is exact for |k| < 2^21.
     const LN2_OVER_64_HI: f64 = 0.01083042469326756;
     const LN2_OVER_64_LO: f64 = 2.9815858269852933e-12;
-    if !(y > -708.0 && y < 709.0) {
-        return y.exp();
-    }
     let shifted = multiply_add(y, SIXTY_FOUR_OVER_LN2, ROUNDING_SHIFT);
     let k = shifted.to_bits(); // k mod 2^51 in two's complement, in the low bits
     let k_float = shifted - ROUNDING_SHIFT;

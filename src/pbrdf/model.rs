@@ -8,7 +8,7 @@ use super::subsurface::{FacetSide, PreparedSubsurface, Subsurface};
 use super::terms::Parameter;
 use super::visible_slopes::VisibleSlopes;
 use super::{ModelError, Shadowing, SlopeDistribution};
-use crate::elementary::inline_exp;
+use crate::elementary::{exp_within_range, inline_exp};
 use crate::optics::frame::{
     double_angle, facet_axis_in_incident_frame, facet_axis_in_scattered_frame, Direction,
 };
@@ -33,7 +33,8 @@ pub struct Pbrdf {
     permittivity: Complex64,
     /// Smith–Cauchy Λ, built on the first [`Pbrdf::masking`]; `None` inside for the other
     /// distributions.
-    lambda_table: OnceLock<Option<CauchySmithTable>>,
+    /// (Boxed: with its per-interval polynomials it is large, and most models have none.)
+    lambda_table: OnceLock<Option<Box<CauchySmithTable>>>,
     /// The importance sampler of visible slopes, built on the first sampled direction; `None`
     /// inside where no visible-normal density exists (Cauchy q ≤ 3/2).
     /// (Boxed: it is large, and most models are never sampled.)
@@ -319,20 +320,25 @@ impl Pbrdf {
     /// The factor of the shadowing G that depends on one direction only, for a direction with
     /// cos θ = `cos_theta`: Smith's G1(θ) = 1/(1+Λ(θ)); 1 for `none` and `torrance-sparrow`
     /// (docs/design.md §1.3). The Cauchy Λ comes from a table built on the model's first call (~0.1 ms,
-    /// then ~20 ns per direction; within 2e-15 of the incomplete-beta form for q ≤ 4, see
-    /// `CauchySmithTable`), so every evaluation of one model — `irpol eval`, renders,
+    /// then ~10 ns per direction, a few in a block's vectorized loop; within 1e-14 of the
+    /// incomplete-beta form for q ≤ 4, 2e-13 up to q = 100, see `CauchySmithTable`), so every evaluation of one model — `irpol eval`, renders,
     /// quadratures, the Python `mueller` — uses the same numbers.
     pub fn masking(&self, cos_theta: f64) -> f64 {
         if self.shadowing != Shadowing::Smith {
             return 1.0;
         }
-        let table = self
-            .lambda_table
-            .get_or_init(|| self.prepared.smith_lambda_table());
-        match table {
+        match self.cauchy_smith_table() {
             Some(table) => table.masking(cos_theta),
             None => self.masking_without_table(cos_theta),
         }
+    }
+
+    /// The table behind [`Pbrdf::masking`] of a Cauchy model (built on the first call), `None`
+    /// for the Gaussian.
+    pub(super) fn cauchy_smith_table(&self) -> Option<&CauchySmithTable> {
+        self.lambda_table
+            .get_or_init(|| self.prepared.smith_lambda_table().map(Box::new))
+            .as_deref()
     }
 
     /// The [`Pbrdf::masking`] factors of ω_i and ω_r.
@@ -353,7 +359,16 @@ impl Pbrdf {
     /// holds the [`Pbrdf::masking`] factors of ω_i and ω_r.
     #[inline(always)]
     fn facet_reflection(&self, geometry: &FacetGeometry, masking: [f64; 2]) -> FacetReflection {
-        let shape = self.facet_shape(geometry, masking);
+        self.facet_reflection_with_shape(geometry, self.facet_shape(geometry, masking))
+    }
+
+    /// [`Pbrdf::facet_reflection`] for the facet shape of `geometry`.
+    #[inline(always)]
+    fn facet_reflection_with_shape(
+        &self,
+        geometry: &FacetGeometry,
+        shape: FacetShape,
+    ) -> FacetReflection {
         let (rs2, rp2, cross, fresnel_inverse) =
             FresnelFractions::from_cos2(geometry.cos2_beta, self.permittivity)
                 .reflectances_and_cross_unnormalized();
@@ -369,23 +384,35 @@ impl Pbrdf {
     /// the shadowing (shared by a material's models over wavelength, docs/design.md §1.9).
     #[inline(always)]
     pub(super) fn facet_shape(&self, geometry: &FacetGeometry, masking: [f64; 2]) -> FacetShape {
+        let (exponent, factor) = self.facet_shape_exponent(geometry, masking, self.shadowing);
+        FacetShape {
+            density: inline_exp(exponent),
+            factor,
+        }
+    }
+
+    /// [`Pbrdf::facet_shape`] as (E, factor) with density e^E, before the exponential, for the
+    /// model's `shadowing` (a parameter so that a vectorized loop can take it as a constant:
+    /// LLVM does not vectorize a loop around the match on it).
+    #[inline(always)]
+    fn facet_shape_exponent(
+        &self,
+        geometry: &FacetGeometry,
+        masking: [f64; 2],
+        shadowing: Shadowing,
+    ) -> (f64, f64) {
         let FacetGeometry {
             cos_i,
             cos_r,
             tan2_theta,
             cos2_beta,
         } = *geometry;
-        let g = self
-            .shadowing
-            .factor_with_masking(cos_i, cos_r, cos2_beta, masking);
+        let g = shadowing.factor_with_masking(cos_i, cos_r, cos2_beta, masking);
         // P(θ)/(4 cosθ cosθ_i cosθ_r) = D(θ)/(4 cosθ_i cosθ_r) with D = P/cosθ = c e^E.
         let (density_exponent, density_factor) = self
             .prepared
             .normal_distribution_exponent_and_factor(tan2_theta);
-        FacetShape {
-            density: inline_exp(density_exponent),
-            factor: density_factor * g / (4.0 * cos_i * cos_r),
-        }
+        (density_exponent, density_factor * g / (4.0 * cos_i * cos_r))
     }
 
     /// ε = N², the Fresnel coefficients' parameter.
@@ -434,18 +461,52 @@ impl Pbrdf {
 
     #[inline]
     fn mueller_at(&self, geometry: &ScatteringGeometry, masking: [f64; 2]) -> Mueller {
-        let facet = self.facet_reflection(&geometry.facet, masking);
+        let facets_and_depolarizer =
+            self.facets_and_depolarizer(geometry, self.facet_shape(&geometry.facet, masking));
+        match self.subsurface_mueller(geometry) {
+            Some(subsurface) => facets_and_depolarizer + subsurface,
+            None => facets_and_depolarizer,
+        }
+    }
+
+    /// [`Pbrdf::mueller_for_geometry`] of a model without a subsurface term and with shadowing
+    /// `shadowing` (its own), without calls or branches that a vectorized loop could not take
+    /// (the block evaluation, src/pbrdf/batch.rs):
+    /// the density's exponential without its range check. The flag says whether the matrix is
+    /// the exact one, i.e. whether the exponent was in the exponential's fast range; where not (a
+    /// density below e^−708), the caller recomputes that geometry one at a time.
+    #[inline(always)]
+    pub(super) fn facets_and_depolarizer_in_range(
+        &self,
+        geometry: &ScatteringGeometry,
+        masking: [f64; 2],
+        shadowing: Shadowing,
+    ) -> (Mueller, bool) {
+        debug_assert_eq!(shadowing, self.shadowing);
+        let (exponent, factor) = self.facet_shape_exponent(&geometry.facet, masking, shadowing);
+        let shape = FacetShape {
+            density: exp_within_range(exponent),
+            factor,
+        };
+        let in_range = exponent > -708.0 && exponent < 709.0;
+        (self.facets_and_depolarizer(geometry, shape), in_range)
+    }
+
+    /// The facet and depolarizer terms of [`Pbrdf::mueller_at`] for a facet shape.
+    #[inline(always)]
+    fn facets_and_depolarizer(&self, geometry: &ScatteringGeometry, shape: FacetShape) -> Mueller {
+        let facet = self.facet_reflection_with_shape(&geometry.facet, shape);
         // F_fres = [[A, B, 0, 0], [B, A, 0, 0], [0, 0, C, S], [0, 0, −S, C]] with the facet scale
         // folded in: A, B = (|r_s|² ± |r_p|²)/2, C + iS = r_s* r_p.
         let (a, b) = facet.scaled_a_and_b();
         let c = facet.cross.re * facet.scale;
         let s = facet.cross.im * facet.scale;
-        let facets_and_depolarizer =
-            geometry.assemble_mueller([a, b, c, s], self.rho_d * FRAC_1_PI);
-        match self.subsurface_mueller(geometry) {
-            Some(subsurface) => facets_and_depolarizer + subsurface,
-            None => facets_and_depolarizer,
-        }
+        geometry.assemble_mueller([a, b, c, s], self.rho_d * FRAC_1_PI)
+    }
+
+    /// Whether the model has the subsurface term of docs/design.md §1.10.
+    pub(super) fn has_subsurface(&self) -> bool {
+        self.subsurface.is_some()
     }
 
     /// First column F_j0 (sr⁻¹): the Stokes BRDF for unpolarized illumination, the only part that
