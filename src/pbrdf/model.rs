@@ -384,7 +384,8 @@ impl Pbrdf {
     /// the shadowing (shared by a material's models over wavelength, docs/design.md §1.9).
     #[inline(always)]
     pub(super) fn facet_shape(&self, geometry: &FacetGeometry, masking: [f64; 2]) -> FacetShape {
-        let (exponent, factor) = self.facet_shape_exponent(geometry, masking, self.shadowing);
+        let (exponent, factor) =
+            self.facet_shape_exponent::<false>(geometry, masking, self.shadowing);
         FacetShape {
             density: inline_exp(exponent),
             factor,
@@ -393,9 +394,10 @@ impl Pbrdf {
 
     /// [`Pbrdf::facet_shape`] as (E, factor) with density e^E, before the exponential, for the
     /// model's `shadowing` (a parameter so that a vectorized loop can take it as a constant:
-    /// LLVM does not vectorize a loop around the match on it).
+    /// LLVM does not vectorize a loop around the match on it). `INLINE_LN`: the density's
+    /// logarithm for a vectorized loop (see `PreparedDistribution::slope_pdf_exponent_and_factor`).
     #[inline(always)]
-    fn facet_shape_exponent(
+    fn facet_shape_exponent<const INLINE_LN: bool>(
         &self,
         geometry: &FacetGeometry,
         masking: [f64; 2],
@@ -411,7 +413,7 @@ impl Pbrdf {
         // P(θ)/(4 cosθ cosθ_i cosθ_r) = D(θ)/(4 cosθ_i cosθ_r) with D = P/cosθ = c e^E.
         let (density_exponent, density_factor) = self
             .prepared
-            .normal_distribution_exponent_and_factor(tan2_theta);
+            .normal_distribution_exponent_and_factor::<INLINE_LN>(tan2_theta);
         (density_exponent, density_factor * g / (4.0 * cos_i * cos_r))
     }
 
@@ -483,7 +485,8 @@ impl Pbrdf {
         shadowing: Shadowing,
     ) -> (Mueller, bool) {
         debug_assert_eq!(shadowing, self.shadowing);
-        let (exponent, factor) = self.facet_shape_exponent(&geometry.facet, masking, shadowing);
+        let (exponent, factor) =
+            self.facet_shape_exponent::<true>(&geometry.facet, masking, shadowing);
         let shape = FacetShape {
             density: exp_within_range(exponent),
             factor,
