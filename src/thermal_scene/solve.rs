@@ -22,7 +22,7 @@ use crate::thermal::convection::mcadams_coefficient;
 use crate::thermal::setup::{SurfaceThermal, ThermalSetup};
 use crate::thermal::{
     Forcing, FrontForcing, Resolution, Solver, SolverControl, StepReport, ThermalError,
-    ThermalState, WeatherSample, STEFAN_BOLTZMANN,
+    ThermalState, WeatherSample,
 };
 use crate::transport::accel::Accelerator;
 use rayon::prelude::*;
@@ -30,9 +30,11 @@ use std::collections::HashMap;
 
 mod enclosure;
 mod ground;
+mod radiation;
 
 use enclosure::NodeRun;
 use ground::GroundHistory;
+use radiation::{SampleRadiation, ShadowInterval};
 
 /// Surface temperatures of every shading vertex at the recorded instants (saved whole by
 /// [`super::saved`]).
@@ -355,6 +357,13 @@ pub fn solve_scene(
     Ok(run.solution(&scene.mesh, &groups, &histories, ground, nodes))
 }
 
+/// The front convective coefficient: the part's, or McAdams' from the wind.
+fn front_convection_w_m2k(model: &SurfaceThermal, w: &WeatherSample) -> f64 {
+    model
+        .convection_w_m2k
+        .unwrap_or(mcadams_coefficient(w.wind_m_s))
+}
+
 /// A part's vertex solve that failed, named by its part.
 fn independent_error(scene: &Scene, surface: usize, failure: VertexFailure) -> ThermalRunError {
     let object = scene.surfaces[surface].object;
@@ -458,11 +467,7 @@ struct Exposure<'a> {
 impl Exposure<'_> {
     /// V_sun at `time_s`, linear between shadow instants.
     fn sun_visible(&self, time_s: f64, step_s: f64) -> f64 {
-        let x = time_s / step_s;
-        let i = (x.floor() as usize).min(self.lit.len() - 1);
-        let j = (i + 1).min(self.lit.len() - 1);
-        let s = (x - i as f64).clamp(0.0, 1.0);
-        f64::from(self.lit[i]) * (1.0 - s) + f64::from(self.lit[j]) * s
+        ShadowInterval::at(time_s, step_s, self.lit.len()).visible(self.lit)
     }
 }
 
@@ -612,64 +617,38 @@ impl Run<'_> {
             .collect()
     }
 
+    /// The sun, the sky and the ground at sample `j`, with the solved ground at `ground_k`.
+    fn radiation(&self, j: usize, ground_k: Option<f64>) -> SampleRadiation {
+        let occluded_k = (self.setup.ground.as_ref()).and_then(|g| g.occluded_k);
+        let typed = self.setup.ground_temperature_k;
+        SampleRadiation::new(&self.samples[j], typed, ground_k, occluded_k)
+    }
+
     /// Solar irradiance on a vertex's front at sample `j` (W m⁻²) before absorption: α_s of it
     /// is absorbed, τ of it passes into an enclosure.
     fn incident_w_m2(&self, exposure: &Exposure, j: usize) -> f64 {
-        let (t, w) = (self.times[j], &self.samples[j]);
-        let s = w.sun_direction;
-        let cos_sun = exposure.normal.dot(&s).max(0.0);
-        let direct = if s.z > 0.0 {
-            w.direct_normal_w_m2 * cos_sun * exposure.sun_visible(t, self.setup.shadow_step_s)
-        } else {
-            0.0
-        };
-        direct + w.diffuse_horizontal_w_m2 * exposure.sky_view
-    }
-
-    /// Absorbed long-wave ε [E_lw F_sky + σT_g⁴ (1 − F_sky)] with the typed T_g, or with the
-    /// solved ground at `ground_k`: below the horizon ((1 − n_z)/2 of the cosine-weighted
-    /// hemisphere) at it, the blocked rest of the sky at `thermal.ground_temperature_k` when
-    /// given, else at it too.
-    fn longwave_in(
-        &self,
-        model: &SurfaceThermal,
-        exposure: &Exposure,
-        w: &WeatherSample,
-        ground_k: Option<f64>,
-    ) -> f64 {
-        let f_sky = exposure.sky_view;
-        let Some(ground_k) = ground_k else {
-            let ground = STEFAN_BOLTZMANN * self.setup.ground_temperature_k.powi(4);
-            return model.emissivity * (w.longwave_down_w_m2 * f_sky + ground * (1.0 - f_sky));
-        };
-        let below = 0.5 * (1.0 - exposure.normal.z);
-        let blocked = (1.0 - f_sky - below).max(0.0);
-        let occluded_k = self
-            .setup
-            .ground
-            .as_ref()
-            .and_then(|g| g.occluded_k)
-            .unwrap_or(ground_k);
-        let sigma = STEFAN_BOLTZMANN;
-        model.emissivity
-            * (w.longwave_down_w_m2 * f_sky
-                + sigma * ground_k.powi(4) * below
-                + sigma * occluded_k.powi(4) * blocked)
+        let visible = exposure.sun_visible(self.times[j], self.setup.shadow_step_s);
+        (self.radiation(j, None)).incident_w_m2(&exposure.normal, exposure.sky_view, visible)
     }
 
     /// The forcing of §1.8 at sample `j` (see the module docs).
     fn forcing(&self, drive: &Drive, j: usize) -> Forcing {
         let (t, w) = (self.times[j], &self.samples[j]);
         let model = drive.model;
-        let ground_k = drive.ground.map(|g| g[j]);
+        let exposure = drive.exposure;
+        let radiation = self.radiation(j, drive.ground.map(|g| g[j]));
+        let visible = exposure.sun_visible(t, self.setup.shadow_step_s);
+        let incident = radiation.incident_w_m2(&exposure.normal, exposure.sky_view, visible);
         Forcing {
             front: FrontForcing {
-                absorbed_w_m2: model.solar_absorptance * self.incident_w_m2(drive.exposure, j),
-                longwave_in_w_m2: self.longwave_in(model, drive.exposure, w, ground_k),
+                absorbed_w_m2: model.solar_absorptance * incident,
+                longwave_in_w_m2: radiation.longwave_in_w_m2(
+                    model.emissivity,
+                    exposure.normal.z,
+                    exposure.sky_view,
+                ),
                 emissivity: model.emissivity,
-                h_w_m2k: model
-                    .convection_w_m2k
-                    .unwrap_or(mcadams_coefficient(w.wind_m_s)),
+                h_w_m2k: front_convection_w_m2k(model, w),
                 air_k: w.air_k,
             },
             back: model.back,
