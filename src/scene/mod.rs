@@ -17,6 +17,7 @@ pub mod car;
 pub mod config;
 pub mod environment;
 mod error;
+pub mod heightfield;
 pub mod mesh;
 mod names;
 pub mod obj;
@@ -36,6 +37,7 @@ use crate::optics::Band;
 use camera::Camera;
 use config::{ObjectConfig, SceneConfig, Shading, WeatherConfig};
 use environment::Environment;
+use heightfield::Heightfield;
 use mesh::ShadedMesh;
 use object::{build_object, ObjectSink};
 use std::path::{Path, PathBuf};
@@ -76,6 +78,9 @@ pub struct Scene {
     pub object_names: Vec<String>,
     pub surfaces: Vec<Surface>,
     pub mesh: ShadedMesh,
+    /// The terrain objects that stay heightfields in world space (upright: no rotation about x
+    /// or y), in object order, for the thermal model's horizon maps; empty without terrains.
+    pub heightfields: Vec<Heightfield>,
     /// `[thermal]`: temperatures from the model of §1.8 (solved by `thermal_scene`).
     pub thermal: Option<std::sync::Arc<thermal::ThermalSetup>>,
     /// With `[thermal]`: how the scene is rebuilt at an instant of the run.
@@ -153,7 +158,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         thermal_start_air_k: start_air_k,
         thermal_plane_cell_m: config.thermal.as_ref().map(|t| t.plane_cell_m),
     };
-    let (object_names, mesh) = build_objects(&config.objects, &mut sink)?;
+    let (object_names, mesh, heightfields) = build_objects(&config.objects, &mut sink)?;
     let materials = materials
         .finish()
         .map_err(|error| SceneError::material(path, None, error))?;
@@ -194,6 +199,7 @@ fn build_scene(path: &Path, config: SceneConfig) -> Result<Scene, SceneError> {
         object_names,
         surfaces,
         mesh,
+        heightfields,
         thermal,
         thermal_rebuild,
         thermal_instant: None,
@@ -235,13 +241,15 @@ fn weather_file_air<'a>(
     }
 }
 
-/// Every object, named (given, else its mesh file's stem, else `objectN`), in one mesh.
+/// Every object, named (given, else its mesh file's stem, else `objectN`), in one mesh, and the
+/// heightfields of the upright terrains among them.
 fn build_objects(
     objects: &[ObjectConfig],
     sink: &mut ObjectSink,
-) -> Result<(Vec<String>, ShadedMesh), SceneError> {
+) -> Result<(Vec<String>, ShadedMesh, Vec<Heightfield>), SceneError> {
     let mut object_names = Vec::new();
     let mut mesh = ShadedMesh::default();
+    let mut heightfields = Vec::new();
     for (index, object) in objects.iter().enumerate() {
         let name = object.name.clone().unwrap_or_else(|| {
             object
@@ -253,11 +261,12 @@ fn build_objects(
                 })
         });
         let label = format!("objects[{index}] '{name}'");
-        let object_mesh = build_object(object, &label, object_names.len(), sink)?;
+        let (object_mesh, heightfield) = build_object(object, &label, object_names.len(), sink)?;
         object_names.push(name);
         mesh.append(object_mesh);
+        heightfields.extend(heightfield);
     }
-    Ok((object_names, mesh))
+    Ok((object_names, mesh, heightfields))
 }
 
 #[cfg(test)]
@@ -359,6 +368,49 @@ mod tests {
             "/nonexistent/missing.obj: cannot read the mesh (in objects[0] 'missing')"
         );
         assert!(std::error::Error::source(&error).is_some());
+    }
+
+    /// A terrain object after the sphere, turned by `rotate_deg`.
+    fn terrain_object(rotate_deg: &str) -> String {
+        format!(
+            "[[objects]]\nname = \"ground\"\nmaterial = \"m\"\ntemperature_k = 290.0\n\
+             shape = {{ kind = \"terrain\", size = [8.0, 6.0], divisions = [16, 10], \
+             rms_height_m = 0.2, correlation_length_m = 2.0, seed = 3 }}\n\
+             scale = 2.0\ntranslate = [1.0, 2.0, -0.5]\nrotate_deg = {rotate_deg}\n"
+        )
+    }
+
+    #[test]
+    fn an_upright_terrain_is_kept_as_a_heightfield_and_a_tilted_one_is_not() {
+        let plain = load_scene_text(Path::new("s.toml"), &scene_text("")).unwrap();
+        assert!(plain.heightfields.is_empty());
+        let text = scene_text(&terrain_object("[0.0, 0.0, 40.0]"));
+        let scene = load_scene_text(Path::new("s.toml"), &text).unwrap();
+        let [field] = scene.heightfields.as_slice() else {
+            panic!("{} heightfields", scene.heightfields.len());
+        };
+        assert_eq!(scene.surfaces[field.surface as usize].object, 1);
+        assert_eq!(field.divisions, [16, 10]);
+        assert_eq!(field.cell_m, [1.0, 1.2]);
+        // Every vertex of the terrain's surface is a grid point at its own height, and every
+        // grid point is one of them.
+        let mut seen = [false; 17 * 11];
+        for (t, triangle) in scene.mesh.triangles.iter().enumerate() {
+            let on_terrain = scene.mesh.triangle_surface[t] == field.surface;
+            for &v in triangle {
+                let p = scene.mesh.positions[v as usize];
+                let g = field.grid_point(&p);
+                assert_eq!(g.is_some(), on_terrain, "vertex {v} at {p:?}");
+                if let Some(g) = g {
+                    assert_eq!(field.heights_m[g], p.z);
+                    seen[g] = true;
+                }
+            }
+        }
+        assert!(seen.iter().all(|&s| s));
+        let tilted = scene_text(&terrain_object("[0.0, 3.0, 40.0]"));
+        let scene = load_scene_text(Path::new("s.toml"), &tilted).unwrap();
+        assert!(scene.heightfields.is_empty());
     }
 
     #[test]

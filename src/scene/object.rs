@@ -2,6 +2,7 @@
 //! against the scene, their materials and temperatures, and its world-space shading mesh.
 
 use super::config::{ObjectConfig, ShapeConfig};
+use super::heightfield::Heightfield;
 use super::mesh::{self, MeshError, ObjectShading, RawMesh, ShadedMesh, Transform};
 use super::terrain::TerrainSpectrum;
 use super::{obj, ply, procedural, thermal, SceneError, Surface, CELSIUS_SUSPECT_K};
@@ -31,14 +32,14 @@ struct LoadedMesh {
 }
 
 /// Loads an object's mesh, checks its parts against the scene, resolves part materials and
-/// temperatures, and returns its world-space shading mesh. `label` names it in messages
-/// ("objects\[0\] 'car'").
+/// temperatures, and returns its world-space shading mesh, with its heightfield when it is an
+/// upright terrain. `label` names it in messages ("objects\[0\] 'car'").
 pub(super) fn build_object(
     object: &ObjectConfig,
     label: &str,
     object_index: usize,
     sink: &mut ObjectSink,
-) -> Result<ShadedMesh, SceneError> {
+) -> Result<(ShadedMesh, Option<Heightfield>), SceneError> {
     let scene = sink.materials.scene;
     let fail = |message: String| SceneError::new(scene, format!("{label}: {message}"));
     // Only a plane whose surface temperatures come from the model needs the finer grid.
@@ -69,7 +70,33 @@ pub(super) fn build_object(
     let name = &loaded.name;
     sink.warnings
         .extend(skipped.map(|w| format!("{name} (in {label}): {w}")));
-    Ok(mesh)
+    let heightfield = terrain_heightfield(object, &loaded.raw, &setup);
+    Ok((mesh, heightfield))
+}
+
+/// The heightfield of a terrain object that stays one in world space (see `heightfield`).
+fn terrain_heightfield(
+    object: &ObjectConfig,
+    raw: &RawMesh,
+    setup: &ObjectShading,
+) -> Option<Heightfield> {
+    let Some(ShapeConfig::Terrain {
+        size, divisions, ..
+    }) = object.shape
+    else {
+        return None;
+    };
+    // A terrain has the one part, `procedural::SHAPE_PART`.
+    let part = raw.parts.iter().position(|p| p == procedural::SHAPE_PART)?;
+    let surface = setup.part_surface[part];
+    Heightfield::of_terrain(
+        raw,
+        size,
+        divisions,
+        object.rotate_deg,
+        &setup.transform,
+        surface,
+    )
 }
 
 /// The mesh reader's notes, and per-vertex temperatures that look like °C.

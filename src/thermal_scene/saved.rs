@@ -198,6 +198,8 @@ fn inputs_digest(scene: &Scene, setup: &ThermalSetup) -> Sha256 {
         path: _,
         warnings: _,
         thermal_instant: _,
+        // The terrains' grids: their heights are vertices of `mesh`, hashed below.
+        heightfields: _,
         // `setup`, hashed by `hash_setup`.
         thermal: _,
         air_temperature_k,
