@@ -5,11 +5,14 @@
 //! - [`layers`]: layer materials and stacks, validated, discretised into finite volumes.
 //! - [`solver`]: implicit stepping with adaptive sub-steps, the non-linear surface balance and
 //!   energy bookkeeping.
+//! - [`batch`]: fixed-step BDF2 marching many vertices of one stack together, sharing one
+//!   factorization per sub-step.
 //! - [`config`], [`setup`]: a scene's `[thermal]` keys and their checked form (the run and each
 //!   part's stack); [`convection`]: the front convective coefficient.
 //! - [`weather`]: the weather the surface balance needs, from a CSV or a built-in clear day,
 //!   interpolated in time.
 
+pub mod batch;
 pub mod config;
 pub mod convection;
 pub mod layers;
@@ -17,6 +20,9 @@ pub mod setup;
 pub mod solver;
 pub mod weather;
 
+pub use batch::{
+    BatchForcing, BatchReport, BatchSolver, BatchState, Lanes, BATCH_MAX_SUBSTEP_S, LANES,
+};
 pub use layers::{
     Grid, Layer, LayerLimit, LayerMaterial, LayerStack, Resolution, ThermalError, LAYER_LIMITS,
     MAX_GRID_NODES,

@@ -65,7 +65,7 @@ impl FrontForcing {
             + self.h_w_m2k * (self.air_k - surface_k)
     }
 
-    fn lerp(&self, end: &Self, s: f64) -> Self {
+    pub(super) fn lerp(&self, end: &Self, s: f64) -> Self {
         let l = |a: f64, b: f64| a + (b - a) * s;
         Self {
             absorbed_w_m2: l(self.absorbed_w_m2, end.absorbed_w_m2),
@@ -76,7 +76,7 @@ impl FrontForcing {
         }
     }
 
-    fn validate(&self) -> Result<(), ThermalError> {
+    pub(super) fn validate(&self) -> Result<(), ThermalError> {
         let bad = |what: &str, v: f64, rule: &str| {
             Err(ThermalError::InvalidInput(format!(
                 "front forcing {what} must be {rule}, got {}",
@@ -120,7 +120,7 @@ pub enum Back {
 }
 
 impl Back {
-    fn lerp(&self, end: &Self, s: f64) -> Self {
+    pub(super) fn lerp(&self, end: &Self, s: f64) -> Self {
         let l = |a: f64, b: f64| a + (b - a) * s;
         match (self, end) {
             (Back::Fixed(a), Back::Fixed(b)) => Back::Fixed(l(*a, *b)),
@@ -155,7 +155,7 @@ impl Back {
         }
     }
 
-    fn validate(&self) -> Result<(), ThermalError> {
+    pub(super) fn validate(&self) -> Result<(), ThermalError> {
         let temp_ok = |t: f64| t.is_finite() && t > 0.0;
         match *self {
             Back::Adiabatic => Ok(()),
@@ -195,7 +195,7 @@ pub struct Forcing {
 }
 
 impl Forcing {
-    fn lerp(&self, end: &Self, s: f64) -> Self {
+    pub(super) fn lerp(&self, end: &Self, s: f64) -> Self {
         Self {
             front: self.front.lerp(&end.front, s),
             back: self.back.lerp(&end.back, s),
@@ -203,7 +203,7 @@ impl Forcing {
         }
     }
 
-    fn validate(&self) -> Result<(), ThermalError> {
+    pub(super) fn validate(&self) -> Result<(), ThermalError> {
         self.front.validate()?;
         self.back.validate()?;
         if !self.internal_w_m2.is_finite() {
@@ -345,10 +345,10 @@ impl StepReport {
 
 /// Energies (J m⁻²) that crossed the boundaries in one implicit Euler step.
 #[derive(Debug, Clone, Copy, Default)]
-struct Crossed {
-    front: f64,
-    back: f64,
-    internal: f64,
+pub(super) struct Crossed {
+    pub(super) front: f64,
+    pub(super) back: f64,
+    pub(super) internal: f64,
 }
 
 /// Tridiagonal rows a_i T_{i−1} + b_i T_i + c_i T_{i+1} = d_i and the elimination's working rows.
@@ -423,12 +423,7 @@ impl Solver {
         start: &Forcing,
         end: &Forcing,
     ) -> Result<StepReport, ThermalError> {
-        if !(dt_s.is_finite() && dt_s > 0.0) {
-            return Err(ThermalError::InvalidInput(format!(
-                "time step must be positive and finite, got {} s",
-                number(dt_s)
-            )));
-        }
+        check_step_s(dt_s)?;
         if state.temperatures_k.len() != self.grid.len() {
             return Err(ThermalError::InvalidInput(format!(
                 "state has {} nodes, the grid {}",
@@ -558,6 +553,17 @@ impl Solver {
     }
 }
 
+/// A time step must be positive and finite.
+pub(super) fn check_step_s(dt_s: f64) -> Result<(), ThermalError> {
+    if dt_s.is_finite() && dt_s > 0.0 {
+        return Ok(());
+    }
+    Err(ThermalError::InvalidInput(format!(
+        "time step must be positive and finite, got {} s",
+        number(dt_s)
+    )))
+}
+
 /// One backward Euler step of length `h` from `old` under forcing `f` (taken at the step's end);
 /// writes the new temperatures to `out` and returns the energies that crossed the boundaries.
 fn implicit_euler(
@@ -576,25 +582,38 @@ fn implicit_euler(
     let k4 = h * f.front.emissivity * STEFAN_BOLTZMANN;
     let t_s = solve_surface(rows.bp[0], k4, rows.dp[0], old[0], newton_tol)?;
     substitute_from_front(rows, t_s, out);
+    let back_stored = grid.capacities_j_m2k()[n - 1] * (out[n - 1] - old[n - 1]);
+    let g = grid.conductances_w_m2k()[n - 2];
+    Ok(crossed(h, f, t_s, [out[n - 2], out[n - 1]], g, back_stored))
+}
+
+/// Energies that crossed the boundaries in one implicit step of length `h` ending at surface
+/// temperature `t_s` and back nodes `back_k` = [T_{n−2}, T_{n−1}] linked by conductance `g`.
+/// `back_stored` is what the step's left-hand side books as the back node's heat change (C ΔT
+/// for backward Euler, the BDF2 combination in the batch solver): with a fixed back, what the
+/// reservoir supplies to hold the node is that balance closed by hand.
+pub(super) fn crossed(
+    h: f64,
+    f: &Forcing,
+    t_s: f64,
+    back_k: [f64; 2],
+    g: f64,
+    back_stored: f64,
+) -> Crossed {
     let front = h * f.front.net_flux_w_m2(t_s);
     let internal = h * f.internal_w_m2;
     let back = match f.back {
         Back::Adiabatic => 0.0,
         Back::Convective { h_w_m2k, air_k } => {
-            h * h_w_m2k * (air_k.unwrap_or(f.front.air_k) - out[n - 1])
+            h * h_w_m2k * (air_k.unwrap_or(f.front.air_k) - back_k[1])
         }
-        // What the reservoir must supply to hold the back node: its balance closed by hand.
-        Back::Fixed(_) => {
-            let cap = grid.capacities_j_m2k()[n - 1];
-            let g = grid.conductances_w_m2k()[n - 2];
-            cap * (out[n - 1] - old[n - 1]) - h * g * (out[n - 2] - out[n - 1]) - internal
-        }
+        Back::Fixed(_) => back_stored - h * g * (back_k[0] - back_k[1]) - internal,
     };
-    Ok(Crossed {
+    Crossed {
         front,
         back,
         internal,
-    })
+    }
 }
 
 /// Rows of (C/h + conduction) multiplied by h, with the linear boundary terms.
@@ -610,22 +629,50 @@ fn assemble(grid: &Grid, old: &[f64], h: f64, f: &Forcing, rows: &mut Rows) {
         rows.b[i] = cap[i] + g_left + g_right;
         rows.d[i] = cap[i] * old[i];
     }
-    let fr = &f.front;
-    rows.b[0] += h * fr.h_w_m2k;
-    rows.d[0] += h * (fr.absorbed_w_m2 + fr.longwave_in_w_m2 + fr.h_w_m2k * fr.air_k);
+    let (b_add, d) = front_row(h, &f.front, rows.d[0]);
+    rows.b[0] += b_add;
+    rows.d[0] = d;
     let last = n - 1;
-    rows.d[last] += h * f.internal_w_m2;
-    match f.back {
-        Back::Adiabatic => {}
-        Back::Convective { h_w_m2k, air_k } => {
-            rows.b[last] += h * h_w_m2k;
-            rows.d[last] += h * h_w_m2k * air_k.unwrap_or(fr.air_k);
+    match back_row(h, f, rows.d[last]) {
+        BackRow::Linear { b_add, d } => {
+            rows.b[last] += b_add;
+            rows.d[last] = d;
         }
-        Back::Fixed(t) => {
+        BackRow::Fixed(t) => {
             rows.a[last] = 0.0;
             rows.b[last] = 1.0;
             rows.d[last] = t;
         }
+    }
+}
+
+/// The front row's linear boundary terms for a step of length `h` (the row multiplied by h):
+/// what convection adds to the diagonal, and the right-hand side given its history part
+/// `d_history` (C T_old for backward Euler). The radiation ε σ T⁴ stays out of the rows.
+pub(super) fn front_row(h: f64, fr: &FrontForcing, d_history: f64) -> (f64, f64) {
+    let d = d_history + h * (fr.absorbed_w_m2 + fr.longwave_in_w_m2 + fr.h_w_m2k * fr.air_k);
+    (h * fr.h_w_m2k, d)
+}
+
+/// The back row of a step of length `h`: the internal flux and the back boundary.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum BackRow {
+    /// Add `b_add` to the diagonal; the right-hand side becomes `d`.
+    Linear { b_add: f64, d: f64 },
+    /// The row becomes T_back = this temperature.
+    Fixed(f64),
+}
+
+/// The back row's boundary terms given the right-hand side's history part `d_history`.
+pub(super) fn back_row(h: f64, f: &Forcing, d_history: f64) -> BackRow {
+    let d = d_history + h * f.internal_w_m2;
+    match f.back {
+        Back::Adiabatic => BackRow::Linear { b_add: 0.0, d },
+        Back::Convective { h_w_m2k, air_k } => BackRow::Linear {
+            b_add: h * h_w_m2k,
+            d: d + h * h_w_m2k * air_k.unwrap_or(f.front.air_k),
+        },
+        Back::Fixed(t) => BackRow::Fixed(t),
     }
 }
 
@@ -658,10 +705,8 @@ fn solve_surface(b: f64, k4: f64, d: f64, start: f64, tol: f64) -> Result<f64, T
     }
     let mut t = start.max(1.0);
     for _ in 0..NEWTON_ITERATIONS {
-        let t3 = t * t * t;
-        let step = (b * t + k4 * t3 * t - d) / (b + 4.0 * k4 * t3);
-        // From the left, Newton may overshoot below zero only if it started there; keep T > 0.
-        t = (t - step).max(0.5 * t);
+        let step;
+        (t, step) = surface_newton_step(b, k4, d, t);
         if step.abs() <= tol {
             return Ok(t);
         }
@@ -672,9 +717,18 @@ fn solve_surface(b: f64, k4: f64, d: f64, start: f64, tol: f64) -> Result<f64, T
     })
 }
 
+/// One Newton iteration on B T + K T⁴ = D from `t`: the new iterate and the update taken.
+#[inline(always)]
+pub(super) fn surface_newton_step(b: f64, k4: f64, d: f64, t: f64) -> (f64, f64) {
+    let t3 = t * t * t;
+    let step = (b * t + k4 * t3 * t - d) / (b + 4.0 * k4 * t3);
+    // From the left, Newton may overshoot below zero only if it started there; keep T > 0.
+    ((t - step).max(0.5 * t), step)
+}
+
 /// Newton iterations of the surface balance before it is given up: it converges quadratically
 /// from any positive start (a few iterations); halving from far above takes at most ~60.
-const NEWTON_ITERATIONS: usize = 100;
+pub(super) const NEWTON_ITERATIONS: usize = 100;
 
 /// Sub-steps (accepted and rejected) one [`Solver::step`] may take beyond the dt/max_substep it
 /// needs at least, before it ends in [`ThermalError::NotConverged`]. The shipped car's day takes
