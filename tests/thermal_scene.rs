@@ -325,10 +325,26 @@ fn thermal_command_writes_the_table_meshes_and_plot() {
     }
     assert!(out.join("temperatures.png").is_file());
     assert!(out.join("surface_0006_21600s.ply").is_file());
-    // The PLY is a mesh irpol reads back, with the temperature property.
+    // The PLY is a mesh irpol reads back, with the temperature property: the shading mesh and
+    // the solution's temperatures at that instant (as f32), read by irpol's reader and by
+    // ply-rs-bw's parser alike (the file is written by hand, so a second reader checks it).
     let ply = std::fs::read(out.join("surface_0003_10800s.ply")).unwrap();
     let header = String::from_utf8_lossy(&ply[..300]);
     assert!(header.contains("property float temperature"), "{header}");
+    let loaded = load_scene(&scene).unwrap();
+    let solution = solve_scene(&loaded, &[], &Silent).unwrap();
+    let direct = irpol::scene::ply::parse_ply(&ply).unwrap();
+    let parsed = irpol::scene::ply::parse_ply_through_parser(&ply).unwrap();
+    for raw in [&direct, &parsed] {
+        assert_eq!(raw.positions.len(), loaded.mesh.positions.len());
+        let faces: Vec<[u32; 3]> = raw.faces.iter().map(|f| f.vertices).collect();
+        assert_eq!(faces, loaded.mesh.triangles);
+        let temperatures = raw.vertex_temperatures.as_ref().unwrap();
+        for (v, (&t, p)) in temperatures.iter().zip(&raw.positions).enumerate() {
+            assert_eq!(t, solution.surface_k[3][v] as f32 as f64);
+            assert_eq!(p.x, loaded.mesh.positions[v].x as f32 as f64);
+        }
+    }
 }
 
 #[test]

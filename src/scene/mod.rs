@@ -370,49 +370,6 @@ mod tests {
         assert!(std::error::Error::source(&error).is_some());
     }
 
-    /// A terrain object after the sphere, turned by `rotate_deg`.
-    fn terrain_object(rotate_deg: &str) -> String {
-        format!(
-            "[[objects]]\nname = \"ground\"\nmaterial = \"m\"\ntemperature_k = 290.0\n\
-             shape = {{ kind = \"terrain\", size = [8.0, 6.0], divisions = [16, 10], \
-             rms_height_m = 0.2, correlation_length_m = 2.0, seed = 3 }}\n\
-             scale = 2.0\ntranslate = [1.0, 2.0, -0.5]\nrotate_deg = {rotate_deg}\n"
-        )
-    }
-
-    #[test]
-    fn an_upright_terrain_is_kept_as_a_heightfield_and_a_tilted_one_is_not() {
-        let plain = load_scene_text(Path::new("s.toml"), &scene_text("")).unwrap();
-        assert!(plain.heightfields.is_empty());
-        let text = scene_text(&terrain_object("[0.0, 0.0, 40.0]"));
-        let scene = load_scene_text(Path::new("s.toml"), &text).unwrap();
-        let [field] = scene.heightfields.as_slice() else {
-            panic!("{} heightfields", scene.heightfields.len());
-        };
-        assert_eq!(scene.surfaces[field.surface as usize].object, 1);
-        assert_eq!(field.divisions, [16, 10]);
-        assert_eq!(field.cell_m, [1.0, 1.2]);
-        // Every vertex of the terrain's surface is a grid point at its own height, and every
-        // grid point is one of them.
-        let mut seen = [false; 17 * 11];
-        for (t, triangle) in scene.mesh.triangles.iter().enumerate() {
-            let on_terrain = scene.mesh.triangle_surface[t] == field.surface;
-            for &v in triangle {
-                let p = scene.mesh.positions[v as usize];
-                let g = field.grid_point(&p);
-                assert_eq!(g.is_some(), on_terrain, "vertex {v} at {p:?}");
-                if let Some(g) = g {
-                    assert_eq!(field.heights_m[g], p.z);
-                    seen[g] = true;
-                }
-            }
-        }
-        assert!(seen.iter().all(|&s| s));
-        let tilted = scene_text(&terrain_object("[0.0, 3.0, 40.0]"));
-        let scene = load_scene_text(Path::new("s.toml"), &tilted).unwrap();
-        assert!(scene.heightfields.is_empty());
-    }
-
     #[test]
     fn a_sun_in_the_open_world_is_a_warning_and_no_sun() {
         let sun = "[sun]\nelevation_deg = 40.0\nazimuth_deg = 180.0\n";

@@ -1,6 +1,8 @@
 //! What each thermal vertex sees (docs/design.md §1.8 with §1.7): the cosine-weighted fraction of its
 //! hemisphere that is open sky, F_sky, and whether the sun is visible from it at each shadow
-//! instant, V_sun, both from the scene's ray tracer.
+//! instant, V_sun. What blocks a direction is either a triangle (the scene's ray tracer) or an
+//! upright terrain tile, through its horizon map (`transport::horizon`): a terrain's millions of
+//! vertices would otherwise need billions of rays.
 //!
 //! **Sky view factor as a control variate.** Unoccluded, F_sky = (1 + n_z)/2 exactly (the part of
 //! the hemisphere about n above the horizon, cosine weighted). Only the blocked part is estimated:
@@ -12,6 +14,7 @@
 use crate::optics::frame::any_perpendicular;
 use crate::pbrdf::cosine_hemisphere_rule;
 use crate::transport::accel::Accelerator;
+use crate::transport::horizon::HorizonMap;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
@@ -23,11 +26,14 @@ use rayon::prelude::*;
 const SKY_RULE_RADIAL: usize = 12;
 const SKY_RULE_AZIMUTHAL: usize = 24;
 
-/// A vertex's position and unit normal.
+/// A vertex's position and unit normal, and the terrain grid point it is, if any.
 #[derive(Clone, Copy, Debug)]
 pub struct VertexFrame {
     pub position: Vector3<f64>,
     pub normal: Vector3<f64>,
+    /// (heightfield, grid point) when the vertex is a point of an upright terrain tile
+    /// (`Scene::heightfields`), whose own horizon map then answers for it.
+    pub grid: Option<(usize, usize)>,
 }
 
 impl VertexFrame {
@@ -37,44 +43,97 @@ impl VertexFrame {
     }
 }
 
+/// Everything that can block a vertex's view: the triangles of the scene that are not upright
+/// terrain (in a ray-tracing hierarchy), and each terrain's horizon map.
+pub struct Occluders<'a> {
+    accel: Accelerator<'a>,
+    /// A sphere holding every triangle of `accel`: a ray that misses it needs no traversal
+    /// (most rays of a terrain far from the objects on it).
+    bounds: Option<(Vector3<f64>, f64)>,
+    horizons: Vec<HorizonMap<'a>>,
+}
+
+impl<'a> Occluders<'a> {
+    /// The occluders from `accel`'s triangles and the terrains' `horizons`.
+    pub fn new(accel: Accelerator<'a>, horizons: Vec<HorizonMap<'a>>) -> Occluders<'a> {
+        let bounds = accel.bounding_sphere();
+        Occluders {
+            accel,
+            bounds,
+            horizons,
+        }
+    }
+
+    /// Whether the ray from vertex `v` along unit `direction` (above the horizontal) is blocked.
+    pub fn blocked(&self, v: &VertexFrame, direction: &Vector3<f64>) -> bool {
+        let below_terrain = self
+            .horizons
+            .iter()
+            .enumerate()
+            .any(|(h, map)| match v.grid {
+                Some((on, g)) if on == h => map.blocks(g, direction),
+                _ => map.blocks_from(&v.position, direction),
+            });
+        below_terrain || self.hits_triangles(&v.origin(self.accel.offset), direction)
+    }
+
+    fn hits_triangles(&self, origin: &Vector3<f64>, direction: &Vector3<f64>) -> bool {
+        let Some((centre, radius)) = self.bounds else {
+            return false;
+        };
+        // Ray–sphere: the closest approach of the ray's line to the centre, ahead of the origin.
+        let to_centre = centre - origin;
+        let along = to_centre.dot(direction);
+        let outside = to_centre.norm_squared() > radius * radius;
+        let misses =
+            (outside && along < 0.0) || to_centre.norm_squared() - along * along > radius * radius;
+        !misses && self.accel.occluded(origin, direction)
+    }
+
+    /// F_sky of vertex `v` (see the module docs).
+    pub fn sky_view(&self, v: &VertexFrame, rule: &[(Vector3<f64>, f64)]) -> f64 {
+        let n = v.normal;
+        let t = any_perpendicular(&n);
+        let b = n.cross(&t);
+        let blocked: f64 = rule
+            .iter()
+            .map(|(d, w)| (t * d.x + b * d.y + n * d.z, w))
+            .filter(|(d, _)| d.z > 0.0 && self.blocked(v, d))
+            .map(|(_, w)| w)
+            .sum();
+        (0.5 * (1.0 + n.z) - blocked / std::f64::consts::PI).max(0.0)
+    }
+
+    /// V_sun of vertex `v` toward unit `sun`: 1 where the sun is above the horizon, in front of
+    /// the surface and unblocked, else 0 (the direct term is zero there anyway).
+    pub fn sun_visible(&self, v: &VertexFrame, sun: &Vector3<f64>) -> u8 {
+        u8::from(sun.z > 0.0 && v.normal.dot(sun) > 0.0 && !self.blocked(v, sun))
+    }
+}
+
+/// The sky-view rule (Σ w = π over the projected disk), in the frame z = normal.
+pub fn sky_rule() -> Vec<(Vector3<f64>, f64)> {
+    cosine_hemisphere_rule(SKY_RULE_RADIAL, SKY_RULE_AZIMUTHAL)
+}
+
 /// F_sky of every vertex (see the module docs).
-pub fn sky_view_factors(accel: &Accelerator, vertices: &[VertexFrame]) -> Vec<f64> {
-    let rule = cosine_hemisphere_rule(SKY_RULE_RADIAL, SKY_RULE_AZIMUTHAL);
-    vertices
-        .par_iter()
-        .map(|v| {
-            let n = v.normal;
-            let t = any_perpendicular(&n);
-            let b = n.cross(&t);
-            let origin = v.origin(accel.offset);
-            let blocked: f64 = rule
-                .iter()
-                .map(|(d, w)| (t * d.x + b * d.y + n * d.z, w))
-                .filter(|(d, _)| d.z > 0.0 && accel.occluded(&origin, d))
-                .map(|(_, w)| w)
-                .sum();
-            (0.5 * (1.0 + n.z) - blocked / std::f64::consts::PI).max(0.0)
-        })
+pub fn sky_view_factors(occluders: &Occluders, vertices: &[VertexFrame]) -> Vec<f64> {
+    let rule = sky_rule();
+    (vertices.par_iter())
+        .map(|v| occluders.sky_view(v, &rule))
         .collect()
 }
 
 /// V_sun of every vertex at every instant, `sun[k]` the unit direction toward the sun at instant
-/// k: row-major `[vertex][instant]`, 1 where the sun is above the horizon, in front of the surface
-/// and unblocked, else 0 (the direct term is zero there anyway).
+/// k: row-major `[vertex][instant]` (see [`Occluders::sun_visible`]).
 pub fn sun_visibility(
-    accel: &Accelerator,
+    occluders: &Occluders,
     vertices: &[VertexFrame],
     sun: &[Vector3<f64>],
 ) -> Vec<u8> {
     vertices
         .par_iter()
-        .flat_map_iter(|v| {
-            let origin = v.origin(accel.offset);
-            sun.iter().map(move |s| {
-                let lit = s.z > 0.0 && v.normal.dot(s) > 0.0 && !accel.occluded(&origin, s);
-                u8::from(lit)
-            })
-        })
+        .flat_map_iter(|v| sun.iter().map(move |s| occluders.sun_visible(v, s)))
         .collect()
 }
 
@@ -98,13 +157,17 @@ mod tests {
     #[test]
     fn open_vertices_get_the_exact_view_factor() {
         let mesh = roof();
-        let accel = Accelerator::new(&mesh, 3.0).unwrap();
+        let occluders = Occluders::new(Accelerator::new(&mesh, 3.0).unwrap(), Vec::new());
         let tilted = Vector3::new(1.0, 0.0, 1.0).normalize();
         let far = |normal| VertexFrame {
             position: Vector3::new(50.0, 0.0, 0.0),
             normal,
+            grid: None,
         };
-        let f = sky_view_factors(&accel, &[far(Vector3::z()), far(tilted), far(Vector3::x())]);
+        let f = sky_view_factors(
+            &occluders,
+            &[far(Vector3::z()), far(tilted), far(Vector3::x())],
+        );
         assert_eq!(f[0], 1.0);
         assert_eq!(f[1], 0.5 * (1.0 + tilted.z));
         assert_eq!(f[2], 0.5);
@@ -116,12 +179,13 @@ mod tests {
         // view factor of a square to a parallel point, F = (2/π)[2 a/√(1+a²) atan(a/√(1+a²))]
         // with a = 1 (half-width over height) → 0.5541 (Howell's catalogue, C-12 on a quarter).
         let mesh = roof();
-        let accel = Accelerator::new(&mesh, 3.0).unwrap();
+        let occluders = Occluders::new(Accelerator::new(&mesh, 3.0).unwrap(), Vec::new());
         let v = VertexFrame {
             position: Vector3::zeros(),
             normal: Vector3::z(),
+            grid: None,
         };
-        let f = sky_view_factors(&accel, &[v])[0];
+        let f = sky_view_factors(&occluders, &[v])[0];
         let a: f64 = 1.0;
         let s = (1.0 + a * a).sqrt();
         let blocked = 2.0 / std::f64::consts::PI * 2.0 * a / s * (a / s).atan();
@@ -134,21 +198,23 @@ mod tests {
     #[test]
     fn the_sun_is_seen_unless_blocked_behind_or_below() {
         let mesh = roof();
-        let accel = Accelerator::new(&mesh, 3.0).unwrap();
+        let occluders = Occluders::new(Accelerator::new(&mesh, 3.0).unwrap(), Vec::new());
         let under = VertexFrame {
             position: Vector3::zeros(),
             normal: Vector3::z(),
+            grid: None,
         };
         let beside = VertexFrame {
             position: Vector3::new(5.0, 0.0, 0.0),
             normal: Vector3::z(),
+            grid: None,
         };
         let sun = [
             Vector3::z(),
             Vector3::new(1.0, 0.0, 0.2).normalize(),
             Vector3::new(1.0, 0.0, -0.1).normalize(),
         ];
-        let v = sun_visibility(&accel, &[under, beside], &sun);
+        let v = sun_visibility(&occluders, &[under, beside], &sun);
         assert_eq!(v, vec![0, 1, 0, 1, 1, 0]);
     }
 }

@@ -13,7 +13,7 @@
 //! F_sky, shadow history and initial temperature have bit-identical forcing, so one solve serves
 //! both (most of a ground plane, the flat panels of a box). This is exact, not an approximation.
 
-use super::exposure::{sky_view_factors, sun_visibility, VertexFrame};
+use super::exposure::{sky_view_factors, sun_visibility, Occluders, VertexFrame};
 use crate::progress::Progress;
 use crate::scene::mesh::{bounding_diagonal, ShadedMesh};
 use crate::scene::Scene;
@@ -25,14 +25,19 @@ use crate::thermal::{
     ThermalState, WeatherSample,
 };
 use crate::transport::accel::Accelerator;
+use crate::transport::horizon::HorizonMap;
+use nalgebra::Vector3;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 mod enclosure;
+mod field;
 mod ground;
 mod radiation;
 
 use enclosure::NodeRun;
+use field::{FieldStats, FieldVertices};
 use ground::GroundHistory;
 use radiation::{SampleRadiation, ShadowInterval};
 
@@ -72,6 +77,16 @@ pub struct SolveStats {
     pub substeps: u64,
     /// Worst |stored heat − ∫ net flux| over the run, relative to the ∫|flux| of that vertex.
     pub worst_energy_closure: f64,
+}
+
+impl SolveStats {
+    /// Counts a terrain field's vertices (each its own solve), sub-steps and closure.
+    fn add_field(&mut self, field: &FieldStats) {
+        self.thermal_vertices += field.vertices;
+        self.distinct_solves += field.vertices;
+        self.substeps += field.substeps;
+        self.worst_energy_closure = self.worst_energy_closure.max(field.closure);
+    }
 }
 
 /// Why a thermal run failed.
@@ -219,43 +234,59 @@ struct ThermalVertices {
 }
 
 impl ThermalVertices {
-    /// The vertices of parts with a stack, with their sky view and sun visibility traced.
+    /// The vertices of parts with a stack, with their sky view and sun visibility traced, and
+    /// apart from them the vertices of upright terrain tiles, solved as fields (see `field`).
     fn trace(
         scene: &Scene,
         setup: &ThermalSetup,
+        occluders: &Occluders,
         progress: &dyn Progress,
-    ) -> Result<ThermalVertices, ThermalRunError> {
+    ) -> Result<(ThermalVertices, Vec<FieldVertices>), ThermalRunError> {
         let mesh = &scene.mesh;
         let all_surfaces = vertex_surfaces(scene);
-        let index: Vec<usize> = (0..mesh.positions.len())
-            .filter(|&v| setup.surfaces[all_surfaces[v] as usize].is_some())
-            .collect();
-        let frames: Vec<VertexFrame> = index
-            .iter()
-            .map(|&v| VertexFrame {
+        let mut fields = field_sets(scene, setup);
+        let mut index = Vec::new();
+        let mut frames = Vec::new();
+        for (v, &surface) in all_surfaces.iter().enumerate() {
+            if setup.surfaces[surface as usize].is_none() {
+                continue;
+            }
+            let grid = grid_point_of(scene, surface, &mesh.positions[v]);
+            let field = grid.and_then(|(h, g)| {
+                let field = fields.iter_mut().find(|f| f.heightfield == h)?;
+                Some((field, g))
+            });
+            if let Some((field, g)) = field {
+                field.vertex.push(v);
+                field.grid.push(g);
+                continue;
+            }
+            index.push(v);
+            frames.push(VertexFrame {
                 position: mesh.positions[v],
                 normal: mesh.normals[v],
-            })
-            .collect();
+                grid,
+            });
+        }
         progress.begin("sky view and shadows", 2);
-        let accel = Accelerator::new(mesh, bounding_diagonal(&mesh.positions))
-            .map_err(ThermalRunError::Accel)?;
-        let sky_view = sky_view_factors(&accel, &frames);
+        let sky_view = sky_view_factors(occluders, &frames);
         progress.advance(1);
         let sun = shadow_instants(setup)
             .iter()
             .map(|&t| weather_at(setup, t).map(|w| w.sun_direction))
             .collect::<Result<Vec<_>, _>>()?;
-        let lit = sun_visibility(&accel, &frames, &sun);
+        let lit = sun_visibility(occluders, &frames, &sun);
         progress.advance(1);
         progress.end();
-        Ok(ThermalVertices {
+        let vertices = ThermalVertices {
             surface: index.iter().map(|&v| all_surfaces[v]).collect(),
             index,
             sky_view,
             lit,
             shadows: sun.len(),
-        })
+        };
+        fields.retain(|f| !f.vertex.is_empty());
+        Ok((vertices, fields))
     }
 
     fn lit(&self, i: usize) -> &[u8] {
@@ -325,7 +356,14 @@ pub fn solve_scene(
         .iter()
         .map(|&t| weather_at(setup, t))
         .collect::<Result<Vec<_>, _>>()?;
-    let vertices = ThermalVertices::trace(scene, setup, progress)?;
+    let occluding = occluding_mesh(scene);
+    let accel = Accelerator::new(&occluding, bounding_diagonal(&scene.mesh.positions))
+        .map_err(ThermalRunError::Accel)?;
+    let horizons = (scene.heightfields.par_iter())
+        .map(HorizonMap::new)
+        .collect();
+    let occluders = Occluders::new(accel, horizons);
+    let (vertices, fields) = ThermalVertices::trace(scene, setup, &occluders, progress)?;
     let (class, representatives) = vertices.group(&scene.mesh);
     let run = Run {
         setup,
@@ -354,7 +392,21 @@ pub fn solve_scene(
     let histories: Vec<History> = (histories.into_iter())
         .map(|h| h.expect("every class is solved, on its own or with its enclosure"))
         .collect();
-    Ok(run.solution(&scene.mesh, &groups, &histories, ground, nodes))
+    let mut solution = run.solution(&scene.mesh, &groups, &histories, ground.as_ref(), nodes);
+    for field in &fields {
+        progress.begin("terrain thermal solve", field.vertex.len() as u64);
+        let stats = run.solve_field(
+            scene,
+            field,
+            &occluders,
+            ground.as_ref(),
+            progress,
+            &mut solution.surface_k,
+        )?;
+        progress.end();
+        solution.stats.add_field(&stats);
+    }
+    Ok(solution)
 }
 
 /// The front convective coefficient: the part's, or McAdams' from the wind.
@@ -378,13 +430,15 @@ fn independent_error(scene: &Scene, surface: usize, failure: VertexFailure) -> T
 }
 
 /// The run's tables within their limits, before any is allocated: sun visibility per thermal
-/// vertex and shadow instant, surface temperatures per vertex and recorded instant (the instants
+/// vertex (outside terrain fields) and shadow instant, surface temperatures per vertex and recorded instant (the instants
 /// themselves are limited by the `[thermal]` keys, [`crate::thermal::setup`]).
 fn check_sizes(scene: &Scene, setup: &ThermalSetup) -> Result<(), ThermalRunError> {
     let surfaces = vertex_surfaces(scene);
+    // A terrain field's vertices keep no visibility table (see `field`).
+    let fields: Vec<u32> = field_sets(scene, setup).iter().map(|f| f.surface).collect();
     let thermal = surfaces
         .iter()
-        .filter(|&&s| setup.surfaces[s as usize].is_some())
+        .filter(|&&s| setup.surfaces[s as usize].is_some() && !fields.contains(&s))
         .count();
     let shadows = shadow_instants_count(setup);
     let recorded = (setup.duration_s / setup.output_step_s).floor() as usize + 2;
@@ -416,6 +470,60 @@ fn check_sizes(scene: &Scene, setup: &ThermalSetup) -> Result<(), ThermalRunErro
         }
     }
     Ok(())
+}
+
+/// An empty field for every upright terrain tile whose part has a stack outside any enclosure
+/// (an enclosure's members are marched with their air node, one at a time).
+fn field_sets(scene: &Scene, setup: &ThermalSetup) -> Vec<FieldVertices> {
+    (scene.heightfields.iter().enumerate())
+        .filter(|(_, hf)| {
+            let model = setup.surfaces[hf.surface as usize].as_ref();
+            model.is_some_and(|m| m.enclosure.is_none())
+        })
+        .map(|(heightfield, hf)| FieldVertices {
+            heightfield,
+            surface: hf.surface,
+            vertex: Vec::new(),
+            grid: Vec::new(),
+        })
+        .collect()
+}
+
+/// (heightfield, grid point) of a vertex of `surface` at `position`, when it is a point of an
+/// upright terrain tile.
+fn grid_point_of(scene: &Scene, surface: u32, position: &Vector3<f64>) -> Option<(usize, usize)> {
+    let h = (scene.heightfields.iter()).position(|hf| hf.surface == surface)?;
+    Some((h, scene.heightfields[h].grid_point(position)?))
+}
+
+/// The triangles that rays must test: all but the upright terrain tiles' (their horizon maps
+/// answer for them).
+fn occluding_mesh(scene: &Scene) -> Cow<'_, ShadedMesh> {
+    if scene.heightfields.is_empty() {
+        return Cow::Borrowed(&scene.mesh);
+    }
+    let terrain = |s: u32| scene.heightfields.iter().any(|hf| hf.surface == s);
+    let mesh = &scene.mesh;
+    let mut kept = ShadedMesh::default();
+    let mut new_index = vec![u32::MAX; mesh.positions.len()];
+    for (triangle, &s) in mesh.triangles.iter().zip(&mesh.triangle_surface) {
+        if terrain(s) {
+            continue;
+        }
+        let corners = triangle.map(|v| {
+            let slot = &mut new_index[v as usize];
+            if *slot == u32::MAX {
+                *slot = kept.positions.len() as u32;
+                kept.positions.push(mesh.positions[v as usize]);
+                kept.normals.push(mesh.normals[v as usize]);
+                kept.temperatures.push(mesh.temperatures[v as usize]);
+            }
+            *slot
+        });
+        kept.triangles.push(corners);
+        kept.triangle_surface.push(s);
+    }
+    Cow::Owned(kept)
 }
 
 /// The surface (object part) of every shading vertex (a shading vertex belongs to one part).
@@ -547,7 +655,7 @@ impl Run<'_> {
         mesh: &ShadedMesh,
         groups: &Groups,
         histories: &[History],
-        ground: Option<GroundHistory>,
+        ground: Option<&GroundHistory>,
         nodes: Vec<NodeRun>,
     ) -> ThermalSolution {
         let recorded: Vec<usize> = (0..self.run_samples)
@@ -566,7 +674,7 @@ impl Run<'_> {
             substeps: histories.iter().map(|h| h.substeps).sum(),
             worst_energy_closure: histories.iter().map(|h| h.closure).fold(0.0, f64::max),
         };
-        if let Some(g) = &ground {
+        if let Some(g) = ground {
             stats.distinct_solves += 1;
             stats.substeps += g.substeps;
             stats.worst_energy_closure = stats.worst_energy_closure.max(g.closure);

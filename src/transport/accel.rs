@@ -94,6 +94,22 @@ impl<'a> Accelerator<'a> {
         hit
     }
 
+    /// A sphere (centre, radius) holding every triangle, with a margin of ten ray offsets, or
+    /// `None` for an empty mesh: a ray that misses it hits nothing.
+    pub fn bounding_sphere(&self) -> Option<(Vector3<f64>, f64)> {
+        let used = || (self.mesh.triangles.iter()).flat_map(|t| t.map(|v| v as usize));
+        let first = self.mesh.positions[used().next()?];
+        let (lo, hi) = used().fold((first, first), |(lo, hi), v| {
+            let p = &self.mesh.positions[v];
+            (lo.inf(p), hi.sup(p))
+        });
+        let centre = 0.5 * (lo + hi);
+        let radius = used()
+            .map(|v| (self.mesh.positions[v] - centre).norm())
+            .fold(0.0, f64::max);
+        Some((centre, radius * (1.0 + 1e-9) + 10.0 * self.offset))
+    }
+
     /// (b1, b2) of `point` on triangle `t` (in its plane), clamped into the triangle.
     fn barycentric(&self, t: usize, point: &Vector3<f64>) -> (f64, f64) {
         let [i0, i1, i2] = self.mesh.triangles[t].map(|v| v as usize);

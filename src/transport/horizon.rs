@@ -137,7 +137,13 @@ impl<'a> HorizonMap<'a> {
     /// (the horizon is never below it) and the zenith never; the thermal model counts directions
     /// below the horizontal as the environment's ground and asks only about those above.
     pub fn blocks(&self, g: usize, direction: &Vector3<f64>) -> bool {
-        let horizontal = direction.x.hypot(direction.y);
+        let horizontal = horizontal_length(direction);
+        // Above the point's highest horizon in any azimuth nothing blocks: most directions of a
+        // sky-view rule over gently rolling ground, settled without the azimuth search.
+        let highest = self.horizon[g].iter().fold(0f32, |m, &h| m.max(h));
+        if direction.z >= f64::from(highest) * horizontal {
+            return false;
+        }
         direction.z < self.horizon_tan(g, direction) * horizontal
     }
 
@@ -147,8 +153,26 @@ impl<'a> HorizonMap<'a> {
     /// ends once even the field's highest point could not raise the horizon, so a point above the
     /// whole field returns at once.
     pub fn horizon_tan_from(&self, p: &Vector3<f64>, direction: &Vector3<f64>) -> f64 {
+        self.march_from(p, direction, None)
+    }
+
+    /// [`Self::blocks`] from any point: whether the terrain rises above `direction` seen from
+    /// `p`. The march stops at the first sample above the direction, or once even the field's
+    /// highest point could not reach it (a short walk for all but the lowest directions).
+    pub fn blocks_from(&self, p: &Vector3<f64>, direction: &Vector3<f64>) -> bool {
+        let horizontal = horizontal_length(direction);
+        if horizontal == 0.0 {
+            return false;
+        }
+        let elevation_tan = direction.z / horizontal;
+        self.march_from(p, direction, Some(elevation_tan)) > elevation_tan
+    }
+
+    /// The largest horizon tan from `p` in the azimuth of `direction`, marching until it exceeds
+    /// `enough` (when given) or no farther point could raise it (see [`Self::horizon_tan_from`]).
+    fn march_from(&self, p: &Vector3<f64>, direction: &Vector3<f64>, enough: Option<f64>) -> f64 {
         let field = self.field;
-        let horizontal = direction.x.hypot(direction.y);
+        let horizontal = horizontal_length(direction);
         let rise = field.max_height_m - p.z;
         if rise <= 0.0 || horizontal == 0.0 {
             return 0.0;
@@ -167,11 +191,14 @@ impl<'a> HorizonMap<'a> {
             return 0.0;
         };
         let step = field.cell_m[0].min(field.cell_m[1]);
+        // Below `enough` nothing but exceeding it matters, so the walk ends where even the
+        // highest point could not rise above it.
+        let floor = enough.map_or(0.0, |e| e.max(0.0));
         let mut best = 0.0f64;
         let mut k = (t_in / step).ceil().max(1.0);
         while k * step <= t_out {
             let t = k * step;
-            if rise / t <= best {
+            if rise / t <= best.max(floor) || enough.is_some_and(|e| best > e) {
                 break;
             }
             if let Some(z) = field.surface_height(u0 + t * du, v0 + t * dv) {
@@ -180,12 +207,6 @@ impl<'a> HorizonMap<'a> {
             k += 1.0;
         }
         best
-    }
-
-    /// [`Self::blocks`] from any point, by [`Self::horizon_tan_from`].
-    pub fn blocks_from(&self, p: &Vector3<f64>, direction: &Vector3<f64>) -> bool {
-        let horizontal = direction.x.hypot(direction.y);
-        direction.z < self.horizon_tan_from(p, direction) * horizontal
     }
 
     /// The stored horizon tan of grid point `g` along lattice step `step` (one of the 16).
@@ -279,6 +300,13 @@ fn line_horizons(z: &[f64], line: &[usize], step_m: f64, ahead: &mut Vec<u32>, o
     if let Some(&last) = line.last() {
         out[last] = 0.0;
     }
+}
+
+/// The length of a direction's horizontal part. Directions here are unit vectors, so the plain
+/// square root cannot overflow (glibc's `hypot`, which guards against that, took 3 % of a
+/// terrain's thermal run).
+fn horizontal_length(d: &Vector3<f64>) -> f64 {
+    (d.x * d.x + d.y * d.y).sqrt()
 }
 
 #[cfg(test)]
