@@ -66,28 +66,48 @@ impl<'a> Occluders<'a> {
 
     /// Whether the ray from vertex `v` along unit `direction` (above the horizontal) is blocked.
     pub fn blocked(&self, v: &VertexFrame, direction: &Vector3<f64>) -> bool {
+        self.blocked_from(&self.viewpoint(v), direction)
+    }
+
+    /// What every direction from `v` shares: where rays leave, its own terrain's highest
+    /// horizon, and the cone of the triangles' bounding sphere.
+    fn viewpoint(&self, v: &VertexFrame) -> Viewpoint {
+        let origin = v.origin(self.accel.offset);
+        let own = v.grid.map(|(h, g)| (h, g, self.horizons[h].highest_tan(g)));
+        let triangles = self.bounds.map_or(Triangles::None, |(centre, radius)| {
+            let to_centre = centre - origin;
+            let distance = to_centre.norm();
+            if distance <= radius {
+                Triangles::Around
+            } else {
+                // A ray meets the sphere iff its angle to the centre is within asin(r/D).
+                let cos = (1.0 - (radius / distance).powi(2)).sqrt();
+                Triangles::Within(to_centre / distance, cos)
+            }
+        });
+        Viewpoint {
+            frame: *v,
+            origin,
+            own,
+            triangles,
+        }
+    }
+
+    fn blocked_from(&self, vp: &Viewpoint, direction: &Vector3<f64>) -> bool {
         let below_terrain = self
             .horizons
             .iter()
             .enumerate()
-            .any(|(h, map)| match v.grid {
-                Some((on, g)) if on == h => map.blocks(g, direction),
-                _ => map.blocks_from(&v.position, direction),
+            .any(|(h, map)| match vp.own {
+                Some((on, g, highest)) if on == h => map.blocks_under(g, direction, highest),
+                _ => map.blocks_from(&vp.frame.position, direction),
             });
-        below_terrain || self.hits_triangles(&v.origin(self.accel.offset), direction)
-    }
-
-    fn hits_triangles(&self, origin: &Vector3<f64>, direction: &Vector3<f64>) -> bool {
-        let Some((centre, radius)) = self.bounds else {
-            return false;
+        let toward_triangles = match vp.triangles {
+            Triangles::None => false,
+            Triangles::Around => true,
+            Triangles::Within(axis, cos) => direction.dot(&axis) >= cos,
         };
-        // Ray–sphere: the closest approach of the ray's line to the centre, ahead of the origin.
-        let to_centre = centre - origin;
-        let along = to_centre.dot(direction);
-        let outside = to_centre.norm_squared() > radius * radius;
-        let misses =
-            (outside && along < 0.0) || to_centre.norm_squared() - along * along > radius * radius;
-        !misses && self.accel.occluded(origin, direction)
+        below_terrain || (toward_triangles && self.accel.occluded(&vp.origin, direction))
     }
 
     /// F_sky of vertex `v` (see the module docs).
@@ -95,20 +115,45 @@ impl<'a> Occluders<'a> {
         let n = v.normal;
         let t = any_perpendicular(&n);
         let b = n.cross(&t);
+        let vp = self.viewpoint(v);
         let blocked: f64 = rule
             .iter()
             .map(|(d, w)| (t * d.x + b * d.y + n * d.z, w))
-            .filter(|(d, _)| d.z > 0.0 && self.blocked(v, d))
+            .filter(|(d, _)| d.z > 0.0 && self.blocked_from(&vp, d))
             .map(|(_, w)| w)
             .sum();
         (0.5 * (1.0 + n.z) - blocked / std::f64::consts::PI).max(0.0)
     }
 
-    /// V_sun of vertex `v` toward unit `sun`: 1 where the sun is above the horizon, in front of
-    /// the surface and unblocked, else 0 (the direct term is zero there anyway).
-    pub fn sun_visible(&self, v: &VertexFrame, sun: &Vector3<f64>) -> u8 {
-        u8::from(sun.z > 0.0 && v.normal.dot(sun) > 0.0 && !self.blocked(v, sun))
+    /// V_sun of vertex `v` toward each unit direction of `sun`: 1 where the sun is above the
+    /// horizon, in front of the surface and unblocked, else 0 (the direct term is zero there
+    /// anyway).
+    pub fn sun_visible(&self, v: &VertexFrame, sun: &[Vector3<f64>]) -> Vec<u8> {
+        let vp = self.viewpoint(v);
+        let lit =
+            |s: &Vector3<f64>| s.z > 0.0 && v.normal.dot(s) > 0.0 && !self.blocked_from(&vp, s);
+        sun.iter().map(|s| u8::from(lit(s))).collect()
     }
+}
+
+/// What every direction from one vertex shares (see [`Occluders::viewpoint`]).
+struct Viewpoint {
+    frame: VertexFrame,
+    origin: Vector3<f64>,
+    /// (heightfield, grid point, its highest horizon tan) of a terrain vertex.
+    own: Option<(usize, usize, f64)>,
+    triangles: Triangles,
+}
+
+/// Where the triangles' bounding sphere lies as seen from a vertex.
+#[derive(Clone, Copy)]
+enum Triangles {
+    /// There are none.
+    None,
+    /// The vertex is inside it: every direction is traced.
+    Around,
+    /// Only directions within this cone (unit axis, cos of its half-angle) can meet one.
+    Within(Vector3<f64>, f64),
 }
 
 /// The sky-view rule (Σ w = π over the projected disk), in the frame z = normal.
@@ -133,7 +178,7 @@ pub fn sun_visibility(
 ) -> Vec<u8> {
     vertices
         .par_iter()
-        .flat_map_iter(|v| sun.iter().map(move |s| occluders.sun_visible(v, s)))
+        .flat_map_iter(|v| occluders.sun_visible(v, sun))
         .collect()
 }
 

@@ -137,11 +137,21 @@ impl<'a> HorizonMap<'a> {
     /// (the horizon is never below it) and the zenith never; the thermal model counts directions
     /// below the horizontal as the environment's ground and asks only about those above.
     pub fn blocks(&self, g: usize, direction: &Vector3<f64>) -> bool {
+        self.blocks_under(g, direction, self.highest_tan(g))
+    }
+
+    /// The highest horizon tan of grid point `g` in any azimuth (≥ 0).
+    pub fn highest_tan(&self, g: usize) -> f64 {
+        f64::from(self.horizon[g].iter().fold(0f32, |m, &h| m.max(h)))
+    }
+
+    /// [`Self::blocks`] with the point's [`Self::highest_tan`] already known (a caller asking
+    /// about many directions from one point).
+    pub fn blocks_under(&self, g: usize, direction: &Vector3<f64>, highest_tan: f64) -> bool {
         let horizontal = horizontal_length(direction);
         // Above the point's highest horizon in any azimuth nothing blocks: most directions of a
         // sky-view rule over gently rolling ground, settled without the azimuth search.
-        let highest = self.horizon[g].iter().fold(0f32, |m, &h| m.max(h));
-        if direction.z >= f64::from(highest) * horizontal {
+        if direction.z >= highest_tan * horizontal {
             return false;
         }
         direction.z < self.horizon_tan(g, direction) * horizontal

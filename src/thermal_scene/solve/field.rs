@@ -319,7 +319,7 @@ impl BlockView {
         BlockView {
             normal: frames.map(|f| f.normal),
             sky_view: frames.map(|f| occluders.sky_view(&f, rule)),
-            lit: frames.map(|f| sun.iter().map(|s| occluders.sun_visible(&f, s)).collect()),
+            lit: frames.map(|f| occluders.sun_visible(&f, sun)),
         }
     }
 }
