@@ -117,17 +117,7 @@ impl Run<'_> {
         let model = self.setup.surfaces[surface]
             .as_ref()
             .expect("a field is a thermal surface");
-        let fail = |error: ThermalError, time_s: Option<f64>, spinup: bool| {
-            independent_error(
-                scene,
-                surface,
-                VertexFailure {
-                    time_s,
-                    spinup,
-                    error,
-                },
-            )
-        };
+        let fail = |error, time_s, spinup| field_error(scene, surface, error, time_s, spinup);
         let grid = (model.stack)
             .discretise(&Resolution::batch())
             .map_err(|e| fail(e, None, false))?;
@@ -186,17 +176,7 @@ impl Run<'_> {
         let initial: Lanes = std::array::from_fn(|l| {
             scene.mesh.temperatures[field.vertex[block[l.min(block.len() - 1)]]]
         });
-        let fail = |error: ThermalError, time_s: Option<f64>, spinup: bool| {
-            independent_error(
-                scene,
-                surface,
-                VertexFailure {
-                    time_s,
-                    spinup,
-                    error,
-                },
-            )
-        };
+        let fail = |error, time_s, spinup| field_error(scene, surface, error, time_s, spinup);
         let mut state =
             BatchState::uniform(solver.grid(), initial).map_err(|e| fail(e, None, false))?;
         let mut closure: f64 = 0.0;
@@ -294,6 +274,22 @@ impl Run<'_> {
         let spinup = u64::from(self.setup.spinup_days) * per_pass(0..self.first_day());
         (spinup + per_pass(0..self.run_samples)) * vertices as u64
     }
+}
+
+/// A field's failed solve, named by its part and the step (`time_s`, `None` before the run).
+fn field_error(
+    scene: &Scene,
+    surface: usize,
+    error: ThermalError,
+    time_s: Option<f64>,
+    spinup: bool,
+) -> ThermalRunError {
+    let failure = VertexFailure {
+        time_s,
+        spinup,
+        error,
+    };
+    independent_error(scene, surface, failure)
 }
 
 /// The frames of a block's vertices, the last repeated to fill the lanes.
