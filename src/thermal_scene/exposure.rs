@@ -64,11 +64,6 @@ impl<'a> Occluders<'a> {
         }
     }
 
-    /// Whether the ray from vertex `v` along unit `direction` (above the horizontal) is blocked.
-    pub fn blocked(&self, v: &VertexFrame, direction: &Vector3<f64>) -> bool {
-        self.blocked_from(&self.viewpoint(v), direction)
-    }
-
     /// What every direction from `v` shares: where rays leave, its own terrain's highest
     /// horizon, and the cone of the triangles' bounding sphere.
     fn viewpoint(&self, v: &VertexFrame) -> Viewpoint {
@@ -93,6 +88,8 @@ impl<'a> Occluders<'a> {
         }
     }
 
+    /// Whether the ray from the viewpoint along unit `direction` (above the horizontal) is
+    /// blocked.
     fn blocked_from(&self, vp: &Viewpoint, direction: &Vector3<f64>) -> bool {
         let below_terrain = self
             .horizons

@@ -58,11 +58,12 @@ struct FieldDrive<'a> {
     ground: Option<&'a [f64]>,
 }
 
-/// The recorded surface temperatures of a block ([recorded instant][lane]) and its worst
-/// energy closure.
+/// The recorded surface temperatures of a block ([recorded instant][lane]), its worst energy
+/// closure and the sub-steps each of its lanes took.
 struct BlockResult {
     surface_k: Vec<Lanes>,
     closure: f64,
+    substeps: u64,
 }
 
 /// A block's energy bookkeeping per lane (the batched solver's stored heat plus its deferred
@@ -72,10 +73,13 @@ struct BatchBudget {
     stored: Lanes,
     net_in: Lanes,
     gross: Lanes,
+    /// Sub-steps taken (the same for every lane).
+    substeps: u64,
 }
 
 impl BatchBudget {
     fn add(&mut self, report: &BatchReport) {
+        self.substeps += report.substeps as u64;
         for (l, net_in) in report.net_in_j_m2().into_iter().enumerate() {
             self.stored[l] += report.stored_j_m2[l] + report.deferred_j_m2[l];
             self.net_in[l] += net_in;
@@ -149,6 +153,7 @@ impl Run<'_> {
                 .collect::<Result<Vec<_>, _>>()?;
             for (block, result) in batch.iter().zip(results) {
                 stats.closure = stats.closure.max(result.closure);
+                stats.substeps += result.substeps * block.len() as u64;
                 for (row, lanes) in surface_k.iter_mut().zip(&result.surface_k) {
                     for (l, &i) in block.iter().enumerate() {
                         row[field.vertex[i]] = lanes[l];
@@ -156,7 +161,6 @@ impl Run<'_> {
                 }
             }
         }
-        stats.substeps = self.field_substeps(field.vertex.len());
         Ok(stats)
     }
 
@@ -173,13 +177,12 @@ impl Run<'_> {
         field: &FieldVertices,
     ) -> Result<BlockResult, ThermalRunError> {
         let surface = field.surface as usize;
-        let initial: Lanes = std::array::from_fn(|l| {
-            scene.mesh.temperatures[field.vertex[block[l.min(block.len() - 1)]]]
-        });
+        let initial: Lanes =
+            std::array::from_fn(|l| scene.mesh.temperatures[field.vertex[lane(block, l)]]);
         let fail = |error, time_s, spinup| field_error(scene, surface, error, time_s, spinup);
         let mut state =
             BatchState::uniform(solver.grid(), initial).map_err(|e| fail(e, None, false))?;
-        let mut closure: f64 = 0.0;
+        let (mut closure, mut substeps): (f64, u64) = (0.0, 0);
         for pass in 0..self.setup.spinup_days as usize {
             let drive = FieldDrive {
                 model,
@@ -189,7 +192,8 @@ impl Run<'_> {
             let budget = self
                 .march_field(solver, &mut state, &drive, 0..self.first_day(), |_, _| {})
                 .map_err(|(e, t)| fail(e, Some(t), true))?;
-            closure = closure.max(budget);
+            closure = closure.max(budget.closure());
+            substeps += budget.substeps;
         }
         let mut surface_k = Vec::new();
         if self.recorded[0] {
@@ -209,12 +213,13 @@ impl Run<'_> {
             .map_err(|(e, t)| fail(e, Some(t), false))?;
         Ok(BlockResult {
             surface_k,
-            closure: closure.max(budget),
+            closure: closure.max(budget.closure()),
+            substeps: substeps + budget.substeps,
         })
     }
 
-    /// Steps a block through samples `range`, calling `each` after every step; returns the
-    /// worst lane's energy closure, or the error and the start of the failed step.
+    /// Steps a block through samples `range`, calling `each` after every step; returns its
+    /// energy bookkeeping, or the error and the start of the failed step.
     fn march_field(
         &self,
         solver: &mut BatchSolver,
@@ -222,7 +227,7 @@ impl Run<'_> {
         drive: &FieldDrive,
         range: std::ops::Range<usize>,
         mut each: impl FnMut(usize, &BatchState),
-    ) -> Result<f64, (ThermalError, f64)> {
+    ) -> Result<BatchBudget, (ThermalError, f64)> {
         let mut budget = BatchBudget::default();
         let mut start = self.field_forcing(drive, range.start);
         for j in range.start + 1..range.end {
@@ -235,7 +240,7 @@ impl Run<'_> {
             each(j, state);
             start = end;
         }
-        Ok(budget.closure())
+        Ok(budget)
     }
 
     /// The forcing of every lane of a block at sample `j` (the §1.8 balance of
@@ -263,17 +268,6 @@ impl Run<'_> {
             internal_w_m2: model.internal_heat.at(t),
         }
     }
-
-    /// Sub-steps of the fixed-step march over the whole run and spin-up, all vertices.
-    fn field_substeps(&self, vertices: usize) -> u64 {
-        let per_pass = |range: std::ops::Range<usize>| -> u64 {
-            (range.start + 1..range.end)
-                .map(|j| ((self.times[j] - self.times[j - 1]) / BATCH_MAX_SUBSTEP_S).ceil() as u64)
-                .sum()
-        };
-        let spinup = u64::from(self.setup.spinup_days) * per_pass(0..self.first_day());
-        (spinup + per_pass(0..self.run_samples)) * vertices as u64
-    }
 }
 
 /// A field's failed solve, named by its part and the step (`time_s`, `None` before the run).
@@ -292,10 +286,16 @@ fn field_error(
     independent_error(scene, surface, failure)
 }
 
+/// The field vertex of lane `l` of a block: the block's own, the last repeated to fill the lanes
+/// of a short block.
+fn lane(block: &[usize], l: usize) -> usize {
+    block[l.min(block.len() - 1)]
+}
+
 /// The frames of a block's vertices, the last repeated to fill the lanes.
 fn block_frames(scene: &Scene, field: &FieldVertices, block: &[usize]) -> [VertexFrame; LANES] {
     std::array::from_fn(|l| {
-        let i = block[l.min(block.len() - 1)];
+        let i = lane(block, l);
         let v = field.vertex[i];
         VertexFrame {
             position: scene.mesh.positions[v],
