@@ -1,13 +1,13 @@
-//! Gaussian deviates from a seeded ChaCha8 stream, shared by the detector noise and the procedural
-//! terrain. `rand_distr` would add a crate for one function; Box–Muller is exact.
+//! Gaussian deviates from a seeded ChaCha8 stream, shared by the detector noise, the polarizer
+//! array's orientation errors and the procedural terrain. `rand_distr`'s ziggurat (Marsaglia and
+//! Tsang) is exact like Box–Muller and avoids its logarithm and cosine per deviate: those were
+//! 13 % of a noisy 1080p open-world render of the car (four deviates per pixel).
 
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-use std::f64::consts::PI;
+use rand_distr::StandardNormal;
 
-/// Box–Muller transform of two uniforms in (0, 1].
+/// A standard normal deviate drawn from `rng`.
 pub(crate) fn standard_normal(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = 1.0 - rng.random::<f64>();
-    let u2: f64 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
+    rng.sample(StandardNormal)
 }
