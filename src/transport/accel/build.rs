@@ -124,10 +124,11 @@ pub fn build(mesh: &ShadedMesh) -> (Vec<Node>, Vec<Prim>) {
 
 /// Appends the subtree over `prims` (which start at `start` in leaf order) to `out`.
 fn subtree(prims: &mut [Prim], start: usize, depth: u32, out: &mut Vec<Node>) {
-    let bounds = prims.iter().fold(Bounds::EMPTY, |b, p| b.union(&p.bounds));
-    let centroids = prims
-        .iter()
-        .fold(Bounds::EMPTY, |b, p| b.union(&Bounds::point(&p.centroid)));
+    let (mut bounds, mut centroids) = (Bounds::EMPTY, Bounds::EMPTY);
+    for p in prims.iter() {
+        bounds = bounds.union(&p.bounds);
+        centroids = centroids.union(&Bounds::point(&p.centroid));
+    }
     let split = if prims.len() == 1 {
         None
     } else if centroids.extent(centroids.widest_axis()) > 0.0 && depth < MEDIAN_DEPTH {
@@ -179,9 +180,9 @@ fn collect_subtree(prims: &mut [Prim], start: usize, depth: u32) -> Vec<Node> {
 /// a small object over a large ground separates from it) come first and returns their count, or
 /// `None` when a leaf is cheaper (and allowed).
 fn sah_split(prims: &mut [Prim], centroids: &Bounds, bounds: &Bounds) -> Option<usize> {
+    let scale: [f32; 3] = std::array::from_fn(|a| BINS as f32 / centroids.extent(a));
     let bin = |p: &Prim, axis: usize| {
-        let scale = BINS as f32 / centroids.extent(axis);
-        (((p.centroid[axis] - centroids.lo[axis]) * scale) as usize).min(BINS - 1)
+        (((p.centroid[axis] - centroids.lo[axis]) * scale[axis]) as usize).min(BINS - 1)
     };
     let mut counts = [[0usize; BINS]; 3];
     let mut boxes = [[Bounds::EMPTY; BINS]; 3];
