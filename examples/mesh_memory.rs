@@ -73,8 +73,7 @@ fn main() -> ExitCode {
         peak_rss()
     );
     let building = Instant::now();
-    let accelerator = Accelerator::new(&shaded, bounding_diagonal(&shaded.positions))
-        .expect("the grid makes a hierarchy");
+    let accelerator = Accelerator::new(&shaded, bounding_diagonal(&shaded.positions));
     println!(
         "hierarchy: {:.2} s, peak {}, now {}",
         building.elapsed().as_secs_f64(),

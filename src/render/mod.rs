@@ -113,8 +113,7 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
     let tracer = match scene.transport {
         Transport::OpenWorld => None,
         Transport::Path(settings) => {
-            accel = Accelerator::new(mesh, bounding_diagonal(&mesh.positions))
-                .map_err(|e| RenderError::Scene(SceneError::new(&scene.path, e.to_string())))?;
+            accel = Accelerator::new(mesh, bounding_diagonal(&mesh.positions));
             Some(PathTracer::new(scene, &open_world, &accel, settings))
         }
     };

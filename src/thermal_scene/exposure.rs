@@ -199,7 +199,7 @@ mod tests {
     #[test]
     fn open_vertices_get_the_exact_view_factor() {
         let mesh = roof();
-        let occluders = Occluders::new(Accelerator::new(&mesh, 3.0).unwrap(), Vec::new());
+        let occluders = Occluders::new(Accelerator::new(&mesh, 3.0), Vec::new());
         let tilted = Vector3::new(1.0, 0.0, 1.0).normalize();
         let far = |normal| VertexFrame {
             position: Vector3::new(50.0, 0.0, 0.0),
@@ -221,7 +221,7 @@ mod tests {
         // view factor of a square to a parallel point, F = (2/π)[2 a/√(1+a²) atan(a/√(1+a²))]
         // with a = 1 (half-width over height) → 0.5541 (Howell's catalogue, C-12 on a quarter).
         let mesh = roof();
-        let occluders = Occluders::new(Accelerator::new(&mesh, 3.0).unwrap(), Vec::new());
+        let occluders = Occluders::new(Accelerator::new(&mesh, 3.0), Vec::new());
         let v = VertexFrame {
             position: Vector3::zeros(),
             normal: Vector3::z(),
@@ -240,7 +240,7 @@ mod tests {
     #[test]
     fn the_sun_is_seen_unless_blocked_behind_or_below() {
         let mesh = roof();
-        let occluders = Occluders::new(Accelerator::new(&mesh, 3.0).unwrap(), Vec::new());
+        let occluders = Occluders::new(Accelerator::new(&mesh, 3.0), Vec::new());
         let under = VertexFrame {
             position: Vector3::zeros(),
             normal: Vector3::z(),

@@ -94,9 +94,6 @@ impl SolveStats {
 pub enum ThermalRunError {
     #[error("{0} has no [thermal] section")]
     NotThermal(String),
-    /// The scene's triangles do not make a ray-tracing hierarchy.
-    #[error("{0}")]
-    Accel(crate::transport::accel::AccelError),
     /// The weather has no value at a time the run needs.
     #[error("{0}")]
     Weather(crate::thermal::WeatherError),
@@ -357,8 +354,7 @@ pub fn solve_scene(
         .map(|&t| weather_at(setup, t))
         .collect::<Result<Vec<_>, _>>()?;
     let occluding = occluding_mesh(scene);
-    let accel = Accelerator::new(&occluding, bounding_diagonal(&scene.mesh.positions))
-        .map_err(ThermalRunError::Accel)?;
+    let accel = Accelerator::new(&occluding, bounding_diagonal(&scene.mesh.positions));
     let horizons = (scene.heightfields.par_iter())
         .map(HorizonMap::new)
         .collect();

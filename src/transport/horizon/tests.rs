@@ -267,7 +267,7 @@ fn sky_view(
 fn horizons_agree_with_rays_on_a_rough_terrain() {
     for (size, scale, rotate) in [([32.0, 32.0], 1.0, 0.0), ([32.0, 24.0], 1.5, 30.0)] {
         let (mesh, field) = shaded_tile(size, scale, rotate);
-        let accel = Accelerator::new(&mesh, 60.0).unwrap();
+        let accel = Accelerator::new(&mesh, 60.0);
         let map = HorizonMap::new(&field);
         let grid: Vec<usize> = mesh
             .positions
