@@ -364,8 +364,14 @@ def choose_variant(mi, requested):
     if requested:
         mi.set_variant(requested)
         return requested
+    # Dr.Jit falls back on any libLLVM it finds; one older than 16 aborts the process while
+    # compiling (LLVM ERROR: Cannot select ... fmaximum), which no exception catches.
+    llvm_ok = "DRJIT_LIBLLVM_PATH" in os.environ
     for v in ["scalar_mono_polarized", "llvm_ad_mono_polarized", "scalar_rgb_polarized",
               "scalar_spectral_polarized"]:
+        if v.startswith("llvm") and not llvm_ok:
+            print(f"  (variant {v} skipped: no libLLVM 16-19 found; see mitsuba_requirements.txt)")
+            continue
         if v in mi.variants():
             try:
                 mi.set_variant(v)
