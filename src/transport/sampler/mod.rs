@@ -96,9 +96,7 @@ impl<'a, R: Rng> PixelSampler<'a, R> {
             return [self.rng.random(), self.rng.random()];
         }
         match &mut self.points {
-            Points::Sobol(randomization) => {
-                [2 * depth, 2 * depth + 1].map(|d| randomization.coordinate(self.path, d, self.rng))
-            }
+            Points::Sobol(randomization) => randomization.pair(self.path, 2 * depth, self.rng),
             Points::Jittered(patterns) => {
                 while patterns.len() <= depth {
                     let mut pattern = multi_jittered(self.paths, self.rng);

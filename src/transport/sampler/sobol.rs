@@ -47,13 +47,16 @@ const fn sobol_matrix(degree: usize, inner: u32, initial: [u32; 3]) -> [u32; 32]
     columns
 }
 
-/// Point `index` of the unscrambled sequence in dimension `dimension`, as 32 fixed-point bits.
-fn sobol_bits(index: u32, dimension: usize) -> u32 {
-    let (mut bits, mut rest, mut column) = (0u32, index, 0);
+/// Point `index` of the unscrambled sequence in dimensions `first` and `first + 1`, as 32
+/// fixed-point bits each. Branch-free: a column enters where its bit of the index is set, by a
+/// mask (a branch on the index's bits mispredicts about every other column: with it, the
+/// Mitsuba comparison's render took 5 % more CPU).
+fn sobol_bits(index: u32, first: usize) -> [u32; 2] {
+    let (mut bits, mut rest, mut column) = ([0u32; 2], index, 0);
     while rest != 0 {
-        if rest & 1 == 1 {
-            bits ^= SOBOL_MATRICES[dimension][column];
-        }
+        let mask = 0u32.wrapping_sub(rest & 1);
+        bits[0] ^= SOBOL_MATRICES[first][column] & mask;
+        bits[1] ^= SOBOL_MATRICES[first + 1][column] & mask;
         rest >>= 1;
         column += 1;
     }
@@ -88,14 +91,18 @@ impl Randomization {
         }
     }
 
-    /// Coordinate `dimension` of point `index`, randomized: the scrambled, shifted 32 bits of
-    /// the sequence plus uniform bits from `rng` below them (52 bits in all, so that the largest
-    /// value, (2^52 − 1)/2^52, is exactly representable below 1).
-    pub fn coordinate(&self, index: usize, dimension: usize, rng: &mut impl Rng) -> f64 {
-        let bits = sobol_bits(index as u32, dimension);
-        let randomized = nested_scramble(bits, self.seeds[dimension]) ^ self.shifts[dimension];
-        let below = u64::from(rng.random::<u32>() >> 12);
-        ((u64::from(randomized) << 20) | below) as f64 / (1u64 << 52) as f64
+    /// Coordinates `first` and `first + 1` of point `index`, randomized: the scrambled, shifted
+    /// 32 bits of the sequence plus 20 uniform bits from `rng` below them (52 bits in all, so
+    /// that the largest value, (2^52 − 1)/2^52, is exactly representable below 1).
+    pub fn pair(&self, index: usize, first: usize, rng: &mut impl Rng) -> [f64; 2] {
+        let bits = sobol_bits(index as u32, first);
+        let below: u64 = rng.random();
+        [0, 1].map(|k| {
+            let d = first + k;
+            let randomized = nested_scramble(bits[k], self.seeds[d]) ^ self.shifts[d];
+            let low = (below >> (32 * k)) & 0xf_ffff;
+            ((u64::from(randomized) << 20) | low) as f64 / (1u64 << 52) as f64
+        })
     }
 }
 
@@ -121,7 +128,8 @@ mod tests {
         for (g, expected) in scipy.iter().enumerate() {
             let index = (g ^ (g >> 1)) as u32;
             for (dimension, value) in expected.iter().enumerate() {
-                let ours = sobol_bits(index, dimension) as f64 / 4_294_967_296.0;
+                let bits = sobol_bits(index, dimension - dimension % 2)[dimension % 2];
+                let ours = bits as f64 / 4_294_967_296.0;
                 assert_eq!(ours, *value, "point {g}, dimension {dimension}");
             }
         }
