@@ -1,19 +1,18 @@
-//! Ray queries and the hierarchy build (`transport::accel`, docs/verification.md, Benchmarks).
+//! Ray queries (`transport::accel`, docs/verification.md, Benchmarks; the hierarchy's build is
+//! `benches/mesh.rs`'s `bvh_build`).
 //!
 //! The scene is the Mitsuba comparison's: an icosphere of 20 480 triangles (radius 1, centre at
 //! z = 1.02) over a 12 × 12 m plane of two triangles. `closest_hit` and `occluded` are timed for
 //! secondary rays as the path tracer casts them: leaving the sphere's surface outward and the
 //! plane upward (cosine-distributed about the normal, origins offset by the accelerator's
-//! offset), 4096 fixed rays per iteration, throughput in rays. `build` times `Accelerator::new`
-//! on a shaded procedural plane of about 1 million triangles.
+//! offset), 4096 fixed rays per iteration, throughput in rays.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use irpol::scene::mesh::{shade_mesh, ObjectShading, ShadedMesh, Transform};
+use irpol::scene::mesh::ShadedMesh;
 use irpol::scene::procedural::{icosphere, plane};
 use irpol::transport::accel::Accelerator;
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
-use std::time::Duration;
 
 const RAYS: usize = 4096;
 const CENTRE: Vector3<f64> = Vector3::new(0.0, 0.0, 1.02);
@@ -105,25 +104,5 @@ fn queries(c: &mut Criterion) {
     group.finish();
 }
 
-fn build(c: &mut Criterion) {
-    let mut group = c.benchmark_group("accel_build");
-    group
-        .sample_size(10)
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(10));
-    // 2 · 708² ≈ 1.0 M triangles.
-    let raw = plane([100.0, 100.0], [708, 708]);
-    let setup = ObjectShading {
-        transform: Transform::new(1.0, [0.0; 3], [0.0; 3]),
-        crease_angle_deg: 30.0,
-        part_temperature: &[Some(300.0)],
-        part_surface: &[0],
-    };
-    let (shaded, _) = shade_mesh(&raw, &setup).unwrap();
-    group.throughput(Throughput::Elements(shaded.triangles.len() as u64));
-    group.bench_function("plane_1M", |b| b.iter(|| Accelerator::new(&shaded, 141.0)));
-    group.finish();
-}
-
-criterion_group!(benches, queries, build);
+criterion_group!(benches, queries);
 criterion_main!(benches);
