@@ -114,7 +114,7 @@ pub fn build(mesh: &ShadedMesh) -> (Vec<Node>, Vec<Prim>) {
         .into_par_iter()
         .map(|t| Prim::new(mesh, t))
         .collect();
-    let mut nodes = Vec::with_capacity(2 * prims.len() / MAX_LEAF.max(2));
+    let mut nodes = Vec::with_capacity(2 * prims.len() / MAX_LEAF);
     if !prims.is_empty() {
         subtree(&mut prims, 0, 0, &mut nodes);
     }
@@ -171,7 +171,7 @@ fn subtree(prims: &mut [Prim], start: usize, depth: u32, out: &mut Vec<Node>) {
 }
 
 fn collect_subtree(prims: &mut [Prim], start: usize, depth: u32) -> Vec<Node> {
-    let mut out = Vec::with_capacity(2 * prims.len() / MAX_LEAF.max(2));
+    let mut out = Vec::with_capacity(2 * prims.len() / MAX_LEAF);
     subtree(prims, start, depth, &mut out);
     out
 }
