@@ -4,14 +4,14 @@
 //! s = unit(n × k) and p = k × s; the Stokes vector (S0, S1, S2, S3) is referred to (s, p) with
 //! S1 > 0 s-polarized, S2 at +45° from s toward p, S3 > 0 left-circular. A frame is therefore fixed
 //! by its s axis and k alone: re-expressing a Stokes vector in another frame about the same k is a
-//! rotation by the angle η from the old s toward the old p (`rotate_stokes(S, η)`, Mueller L(η)).
+//! rotation by the angle η from the old s toward the old p ([`FrameTurn`], Mueller L(η)).
 //!
 //! Local directions ([`Direction`]) carry their own axes so that θ = 0 takes the limit θ → 0⁺
 //! along the given azimuth (SCATMECH's choice). World-space frames of the renderer use
 //! [`OutgoingFrame`] (the psps frame of a direction leaving a surface) and
 //! [`rotation_between_frames`].
 
-use super::polarization::{rotate_stokes, Stokes};
+use super::polarization::{FrameTurn, Stokes};
 use crate::elementary::sin_cos_degrees;
 use nalgebra::Vector3;
 
@@ -198,23 +198,37 @@ pub fn any_perpendicular(n: &Vector3<f64>) -> Vector3<f64> {
     n.cross(&helper).normalize()
 }
 
-/// The angle η with which a Stokes vector referred to s axis `from_s` is re-expressed in the frame
+/// The turn η with which a Stokes vector referred to s axis `from_s` is re-expressed in the frame
 /// with s axis `to_s`, both perpendicular to the propagation direction `k`:
-/// S_to = `rotate_stokes`(S_from, η), η = atan2(to_s · p_from, to_s · from_s), p_from = k × from_s.
+/// S_to = L(η) S_from, η = atan2(to_s · p_from, to_s · from_s), p_from = k × from_s.
 #[inline]
 pub fn rotation_between_frames(
     from_s: &Vector3<f64>,
     to_s: &Vector3<f64>,
     k: &Vector3<f64>,
-) -> f64 {
+) -> FrameTurn {
     let p_from = k.cross(from_s);
-    to_s.dot(&p_from).atan2(to_s.dot(from_s))
+    FrameTurn::from_cos_sin(to_s.dot(from_s), to_s.dot(&p_from))
 }
 
-/// A Stokes vector leaving along `toward_camera` with psps s axis `s_axis`, in the pixel frame of
-/// docs/design.md §1.6: x = image right made perpendicular to the ray, y = x_pix-completing image up
-/// (y = ω × x, propagation toward the camera). With ψ = atan2(s·y_pix, s·x_pix) the rotation is
-/// `rotate_stokes`(S, −ψ).
+/// The turn from the psps frame (s axis `s_axis`) of light leaving along `toward_camera` into the
+/// pixel frame of docs/design.md §1.6: x = image right made perpendicular to the ray, y = ω × x
+/// (y completing image up, propagation toward the camera). With ψ = atan2(s·y_pix, s·x_pix),
+/// the turn is by −ψ.
+#[inline]
+pub fn camera_frame_turn(
+    s_axis: &Vector3<f64>,
+    toward_camera: &Vector3<f64>,
+    image_right: &Vector3<f64>,
+) -> FrameTurn {
+    let w_r = toward_camera;
+    let x_pix = (image_right - w_r * image_right.dot(w_r)).normalize();
+    let y_pix = w_r.cross(&x_pix);
+    FrameTurn::from_cos_sin(s_axis.dot(&x_pix), -s_axis.dot(&y_pix))
+}
+
+/// A Stokes vector leaving along `toward_camera` with psps s axis `s_axis`, in the pixel frame
+/// ([`camera_frame_turn`]).
 #[inline]
 pub fn stokes_to_camera_frame(
     local: &Stokes,
@@ -222,11 +236,7 @@ pub fn stokes_to_camera_frame(
     toward_camera: &Vector3<f64>,
     image_right: &Vector3<f64>,
 ) -> Stokes {
-    let w_r = toward_camera;
-    let x_pix = (image_right - w_r * image_right.dot(w_r)).normalize();
-    let y_pix = w_r.cross(&x_pix);
-    let psi = s_axis.dot(&y_pix).atan2(s_axis.dot(&x_pix));
-    rotate_stokes(local, -psi)
+    camera_frame_turn(s_axis, toward_camera, image_right).apply(local)
 }
 
 #[cfg(test)]
@@ -270,14 +280,14 @@ mod tests {
         let b = k.cross(&a);
         let to = (a * 0.3f64.cos() + b * 0.3f64.sin()).normalize();
         // `to` is 0.3 rad from `a` toward its p axis k × a = b.
-        assert!((rotation_between_frames(&a, &to, &k) - 0.3).abs() < 1e-15);
+        assert!((rotation_between_frames(&a, &to, &k).angle() - 0.3).abs() < 1e-15);
         let stokes = Stokes::new(1.0, 0.4, -0.2, 0.1);
-        let direct = rotate_stokes(&stokes, rotation_between_frames(&a, &to, &k));
+        let direct = rotation_between_frames(&a, &to, &k).apply(&stokes);
         let right = Vector3::new(1.0, 0.2, 0.0);
         let via_camera = stokes_to_camera_frame(&stokes, &a, &k, &right);
         let x_pix = (right - k * right.dot(&k)).normalize();
         let camera_eta = rotation_between_frames(&a, &x_pix, &k);
-        assert!((via_camera - rotate_stokes(&stokes, camera_eta)).norm() < 1e-14);
+        assert!((via_camera - camera_eta.apply(&stokes)).norm() < 1e-14);
         assert!((direct[3] - stokes[3]).abs() == 0.0);
     }
 

@@ -13,13 +13,15 @@ mod realizability;
 pub use band_nodes::{SpectralMix, TableMissesBand, WavelengthNodes};
 pub use brightness::TemperatureLookup;
 pub use dispersion::{LorentzDispersion, LorentzError, LorentzOscillator};
-pub use frame::{rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame};
+pub use frame::{
+    camera_frame_turn, rotation_between_frames, stokes_to_camera_frame, Direction, OutgoingFrame,
+};
 pub use fresnel::{fresnel_amplitudes, FresnelFractions, RefractiveIndex};
 pub use planck::{
     ln_spectral_radiance, spectral_radiance, valid_temperature, Band, OpticsError,
     MAX_TEMPERATURE_K, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM,
 };
 pub use polarization::{
-    fresnel_mueller, jones_to_mueller, rotate_stokes, stokes_rotator, Mueller, Stokes,
+    fresnel_mueller, jones_to_mueller, rotate_stokes, FrameTurn, Mueller, Stokes,
 };
 pub use realizability::{coherency_eigenvalues, coherency_matrix, Coherency};

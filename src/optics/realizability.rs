@@ -64,7 +64,7 @@ pub fn coherency_eigenvalues(m: &Mueller) -> [f64; 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optics::{fresnel_mueller, jones_to_mueller, stokes_rotator};
+    use crate::optics::{fresnel_mueller, jones_to_mueller, FrameTurn};
 
     fn c(re: f64, im: f64) -> Complex64 {
         Complex64::new(re, im)
@@ -106,8 +106,9 @@ mod tests {
         ) * 0.5;
         assert_eigenvalues(&p_polarizer, [0.0, 0.0, 0.0, 0.5]);
         // A quarter-wave retarder turned by 0.4 rad, and a metal's reflection, scaled.
-        let retarder =
-            stokes_rotator(-0.4) * fresnel_mueller(c(1.0, 0.0), c(0.0, 1.0)) * stokes_rotator(0.4);
+        let retarder = FrameTurn::from_angle(-0.4).mueller()
+            * fresnel_mueller(c(1.0, 0.0), c(0.0, 1.0))
+            * FrameTurn::from_angle(0.4).mueller();
         assert_eigenvalues(&retarder, [0.0, 0.0, 0.0, 1.0]);
         let metal = fresnel_mueller(c(-0.8, 0.3), c(0.6, -0.2)) * 3.0;
         assert_eigenvalues(&metal, [0.0, 0.0, 0.0, metal[(0, 0)]]);

@@ -27,6 +27,7 @@ pub use error::ModelError;
 pub use geometry::{fold_signed_zenith, signed_zenith_note};
 pub use hemisphere::{cosine_hemisphere_rule, HemisphereQuadrature};
 pub use model::{Pbrdf, ScatteringGeometry};
+pub use sample::ScatteredView;
 pub use shadowing::Shadowing;
 pub use subsurface::{FacetSide, Subsurface, SubsurfaceKeysWithoutRhoS, Transmission};
 pub use terms::{Body, ModelTerms, OutsideDomain, Parameter, ParameterInfo, Term};

@@ -8,7 +8,7 @@
 //! (pdf cosθ_i/π) covers the diffuse term; the two are mixed with a fixed weight, so the mixture
 //! pdf is exact everywhere.
 
-use super::visible_slopes::VisibleSlopes;
+use super::visible_slopes::VisibleView;
 use super::Pbrdf;
 use nalgebra::Vector3;
 use std::f64::consts::{FRAC_1_PI, PI};
@@ -26,7 +26,25 @@ impl Pbrdf {
         (0.9 - 0.8 * diffuse).clamp(0.1, 0.9)
     }
 
-    /// Draws ω_i (local frame, macro normal ẑ) for light scattered along unit `scattered` from
+    /// `scattered` (local, unit, above the surface) prepared for [`Pbrdf::sample_incident`]: what
+    /// every sample drawn for it shares, computed once (a pixel's paths all share their first
+    /// vertex's).
+    pub fn scattered_view(&self, scattered: &Vector3<f64>) -> ScatteredView {
+        let sin_theta = scattered.x.hypot(scattered.y);
+        let azimuth = if sin_theta > 0.0 {
+            [scattered.x / sin_theta, scattered.y / sin_theta]
+        } else {
+            [1.0, 0.0]
+        };
+        ScatteredView {
+            direction: *scattered,
+            masking: self.masking(scattered.z),
+            azimuth,
+            visible: (self.visible_slopes()).map(|v| v.view(scattered.z / sin_theta)),
+        }
+    }
+
+    /// Draws ω_i (local frame, macro normal ẑ) for light scattered along `view`'s direction from
     /// the mixture of the facet-lobe and cosine densities, with uniforms `u` ∈ [0, 1)². `u[0]` both
     /// chooses the lobe (below the lobe's weight w) and, rescaled to [0, 1), gives the first
     /// coordinate within it (the visible slope along ω_r's azimuth, or the radius); `u[1]` gives
@@ -37,22 +55,23 @@ impl Pbrdf {
     /// horizon (such samples carry zero BRDF; they count as drawn).
     pub fn sample_incident(
         &self,
-        scattered: &Vector3<f64>,
+        view: &ScatteredView,
         u: [f64; 2],
     ) -> Option<(Vector3<f64>, f64)> {
         let weight = self.specular_sampling_weight();
+        let scattered = &view.direction;
         let phi = 2.0 * PI * u[1];
-        // Smith's G1(ω_r) of the visible-normal density, when the sampler has computed it.
-        let mut masking = None;
         let incident = if u[0] < weight {
             let lobe_point = [u[0] / weight, u[1]];
-            let h = match self.visible_slopes() {
-                Some(visible) => {
-                    let (h, g1) = visible_normal(visible, scattered, lobe_point);
-                    masking = Some(g1);
-                    h
+            let h = match (self.visible_slopes(), &view.visible) {
+                (Some(sampler), Some(visible)) => {
+                    // The slope drawn at azimuth 0, rotated back by ω_r's azimuth φ.
+                    let [x, y] = sampler.sample(visible, lobe_point);
+                    let [cos_phi, sin_phi] = view.azimuth;
+                    let (mx, my) = (cos_phi * x - sin_phi * y, sin_phi * x + cos_phi * y);
+                    Vector3::new(-mx, -my, 1.0).normalize()
                 }
-                None => {
+                _ => {
                     let tan2 = self.distribution().slope_quantile(lobe_point[0]).powi(2);
                     let cos_h = 1.0 / (1.0 + tan2).sqrt();
                     let sin_h = tan2.sqrt() * cos_h;
@@ -70,29 +89,22 @@ impl Pbrdf {
             let r = r2.sqrt();
             Vector3::new(r * phi.cos(), r * phi.sin(), (1.0 - r2).sqrt())
         };
-        if incident.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.mixture_pdf(scattered, &incident, masking);
+        let pdf = self.mixture_pdf(view, &incident);
         (pdf > 0.0 && pdf.is_finite()).then_some((incident, pdf))
     }
 
     /// The mixture density (sr⁻¹) with which [`Pbrdf::sample_incident`] draws unit `incident`
     /// for unit `scattered`.
     pub fn incident_pdf(&self, scattered: &Vector3<f64>, incident: &Vector3<f64>) -> f64 {
-        self.mixture_pdf(scattered, incident, None)
+        self.mixture_pdf(&self.scattered_view(scattered), incident)
     }
 
-    /// [`Pbrdf::incident_pdf`], given the visible-normal G1(ω_r) when it is already known.
-    fn mixture_pdf(
-        &self,
-        scattered: &Vector3<f64>,
-        incident: &Vector3<f64>,
-        masking: Option<f64>,
-    ) -> f64 {
+    /// [`Pbrdf::incident_pdf`] for a prepared view.
+    fn mixture_pdf(&self, view: &ScatteredView, incident: &Vector3<f64>) -> f64 {
         if incident.z <= 0.0 {
             return 0.0;
         }
+        let scattered = &view.direction;
         let weight = self.specular_sampling_weight();
         let cosine = incident.z * FRAC_1_PI;
         let half = incident + scattered;
@@ -101,13 +113,8 @@ impl Pbrdf {
             let tan2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
             // P(θ_h) = p(tanθ_h)/cos³θ_h and D = P/cosθ_h.
             let facet_density = self.prepared_distribution().slope_pdf(tan2) / h.z.powi(3);
-            match self.visible_slopes() {
-                Some(visible) => {
-                    let g1 = masking.unwrap_or_else(|| {
-                        visible.masking(scattered.z / scattered.x.hypot(scattered.y))
-                    });
-                    g1 * facet_density / (4.0 * h.z * scattered.z)
-                }
+            match &view.visible {
+                Some(visible) => visible.masking() * facet_density / (4.0 * h.z * scattered.z),
                 None => facet_density / (4.0 * incident.dot(&h)),
             }
         } else {
@@ -117,22 +124,17 @@ impl Pbrdf {
     }
 }
 
-/// A facet normal (local frame) that unit `scattered` sees, drawn with `u` from the visible
-/// slopes: turned to azimuth 0, then the slope rotated back by ω_r's azimuth φ; and G1(ω_r).
-fn visible_normal(
-    visible: &VisibleSlopes,
-    scattered: &Vector3<f64>,
-    u: [f64; 2],
-) -> (Vector3<f64>, f64) {
-    let sin_theta = scattered.x.hypot(scattered.y);
-    let (cos_phi, sin_phi) = if sin_theta > 0.0 {
-        (scattered.x / sin_theta, scattered.y / sin_theta)
-    } else {
-        (1.0, 0.0)
-    };
-    let ([x, y], masking) = visible.sample(scattered.z / sin_theta, u);
-    let (mx, my) = (cos_phi * x - sin_phi * y, sin_phi * x + cos_phi * y);
-    (Vector3::new(-mx, -my, 1.0).normalize(), masking)
+/// A scattered direction prepared for sampling ([`Pbrdf::scattered_view`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ScatteredView {
+    /// ω_r, local and unit.
+    pub direction: Vector3<f64>,
+    /// The model's G1(ω_r) ([`Pbrdf::masking`]), which shading needs with every sample.
+    pub masking: f64,
+    /// (cos φ_r, sin φ_r): the visible slopes are drawn at azimuth 0 and turned by it.
+    azimuth: [f64; 2],
+    /// The visible-normal sampler's view of ω_r; `None` where there is no such sampler.
+    visible: Option<VisibleView>,
 }
 
 #[cfg(test)]
@@ -189,6 +191,7 @@ mod tests {
             )
             .unwrap();
             let w_r = Vector3::new(theta_r.sin(), 0.0, theta_r.cos());
+            let view = pbrdf.scattered_view(&w_r);
             let mut rng = ChaCha8Rng::seed_from_u64(3);
             // Fraction of samples inside a cap around the specular direction, against the
             // integral of the pdf over the cap by a fine quadrature.
@@ -198,7 +201,7 @@ mod tests {
             let mut inside = 0usize;
             for _ in 0..n {
                 let u = [rng.random(), rng.random()];
-                if let Some((w, _)) = pbrdf.sample_incident(&w_r, u) {
+                if let Some((w, _)) = pbrdf.sample_incident(&view, u) {
                     inside += (w.dot(&axis) > cap) as usize;
                 }
             }
@@ -252,9 +255,10 @@ mod tests {
             let mut rng = ChaCha8Rng::seed_from_u64(5);
             for theta_r in [0.1f64, 0.9, 1.45] {
                 let w_r = Vector3::new(theta_r.sin() * 0.6, theta_r.sin() * 0.8, theta_r.cos());
+                let view = pbrdf.scattered_view(&w_r);
                 for _ in 0..200 {
                     let u = [rng.random(), rng.random()];
-                    let Some((w_i, pdf)) = pbrdf.sample_incident(&w_r, u) else {
+                    let Some((w_i, pdf)) = pbrdf.sample_incident(&view, u) else {
                         continue;
                     };
                     let m00 = pbrdf.mueller(
@@ -292,12 +296,13 @@ mod tests {
             let pbrdf = Pbrdf::new(distribution, Shadowing::Smith, index, 0.0).unwrap();
             for theta in [0.3f64, 1.0, 1.3, 1.5] {
                 let w_r = Vector3::new(theta.sin(), 0.0, theta.cos());
+                let view = pbrdf.scattered_view(&w_r);
                 let m = 1000;
                 let mut sum = 0.0;
                 for i in 0..m {
                     for j in 0..m {
                         let u = [(i as f64 + 0.5) / m as f64, (j as f64 + 0.5) / m as f64];
-                        if let Some((w_i, pdf)) = pbrdf.sample_incident(&w_r, u) {
+                        if let Some((w_i, pdf)) = pbrdf.sample_incident(&view, u) {
                             let m00 = pbrdf.mueller(
                                 &Direction::from_unit_vector(w_i),
                                 &Direction::from_unit_vector(w_r),

@@ -36,10 +36,10 @@ use super::tables::THETA_MAX;
 use crate::emitter::{DiscQuadrature, Sun, SUN_TEMPERATURE_K};
 use crate::optics::band_nodes::{BrightnessGrid, FractionsByRadiance};
 use crate::optics::{
-    rotate_stokes, rotation_between_frames, stokes_to_camera_frame, Direction, Mueller,
-    OutgoingFrame, SpectralMix, Stokes,
+    camera_frame_turn, rotation_between_frames, Direction, FrameTurn, Mueller, OutgoingFrame,
+    SpectralMix, Stokes,
 };
-use crate::pbrdf::{BandPbrdf, MaterialOptics, Pbrdf};
+use crate::pbrdf::{BandPbrdf, MaterialOptics, Pbrdf, ScatteredView};
 use crate::scene::mesh::SurfaceHit;
 use crate::scene::{PathSettings, Scene};
 use nalgebra::Vector3;
@@ -74,6 +74,31 @@ impl Vertex {
             hit,
             normal: if back { -hit.normal } else { hit.normal },
             geometric_normal: if geometric_front { unit } else { -unit },
+        }
+    }
+}
+
+/// A vertex prepared for shading light that leaves it along ω: the outgoing frame, the material
+/// and its sampling pBRDF's view of ω (shared by every sample drawn there; `None` when ω is
+/// below the shading normal, where nothing is reflected).
+struct ShadingPoint<'v> {
+    vertex: &'v Vertex,
+    frame: OutgoingFrame,
+    material: usize,
+    view: Option<ScatteredView>,
+}
+
+impl PathTracer<'_> {
+    fn shading_point<'v>(&self, vertex: &'v Vertex, omega: &Vector3<f64>) -> ShadingPoint<'v> {
+        let frame = OutgoingFrame::new(&vertex.normal, omega);
+        let material = self.scene.triangle_material(vertex.hit.triangle);
+        let w_o = frame.to_local(omega);
+        let pbrdf = self.scene.materials[material].optics.sampling_pbrdf();
+        ShadingPoint {
+            vertex,
+            frame,
+            material,
+            view: (w_o.z > 0.0).then(|| pbrdf.scattered_view(&w_o)),
         }
     }
 }
@@ -239,14 +264,15 @@ impl PathTracer<'_> {
         image_right: &Vector3<f64>,
         rng: &mut ChaCha8Rng,
     ) -> Estimate {
-        let frame = OutgoingFrame::new(&vertex.normal, omega);
-        let to_pixel = |s: &Stokes| stokes_to_camera_frame(s, &frame.s_axis, omega, image_right);
-        let material = self.scene.triangle_material(vertex.hit.triangle);
+        let point = self.shading_point(vertex, omega);
+        let frame = &point.frame;
+        let to_pixel_frame = camera_frame_turn(&frame.s_axis, omega, image_right);
+        let to_pixel = |s: &Stokes| to_pixel_frame.apply(s);
         let exact = self
             .open_world
-            .leaving(material, &frame, vertex.hit.temperature);
+            .leaving(point.material, frame, vertex.hit.temperature);
         let n = self.settings.samples.max(1);
-        let sun = self.sun_integral(vertex, &frame, material);
+        let sun = self.sun_integral(&point);
         // Sums of the samples' differences from the first one: the variance is then exactly zero
         // when every sample is the same (an unoccluded, fully lit or fully shadowed point).
         let (mut first, mut sum, mut sum2) = (None, Stokes::zeros(), Stokes::zeros());
@@ -264,7 +290,7 @@ impl PathTracer<'_> {
         let mut sampler = PixelSampler::new(n as usize, rng);
         for s in 0..sampler.paths() {
             sampler.start_path(s);
-            let mut x = self.correction(vertex, &frame, material, 0, &mut sampler);
+            let mut x = self.correction(&point, 0, &mut sampler);
             if let Some(integral) = sun {
                 x += integral * visibility[s % shadow_rays];
             }
@@ -297,39 +323,32 @@ impl PathTracer<'_> {
         depth: u32,
         sampler: &mut Sampler,
     ) -> (Stokes, Vector3<f64>) {
-        let frame = OutgoingFrame::new(&vertex.normal, omega);
-        let material = self.scene.triangle_material(vertex.hit.triangle);
+        let point = self.shading_point(vertex, omega);
         let mut s = self
             .open_world
-            .leaving(material, &frame, vertex.hit.temperature);
-        if let Some(integral) = self.sun_integral(vertex, &frame, material) {
+            .leaving(point.material, &point.frame, vertex.hit.temperature);
+        if let Some(integral) = self.sun_integral(&point) {
             let disc_point = [sampler.uniform(), sampler.uniform()];
             s += integral * self.sun_visibility(vertex, disc_point);
         }
         if depth <= self.settings.bounces {
-            s += self.correction(vertex, &frame, material, depth, sampler);
+            s += self.correction(&point, depth, sampler);
         }
-        (s, frame.s_axis)
+        (s, point.frame.s_axis)
     }
 
-    /// One sample of ∫ F (S_in − L_env e₀) cosθ_i dΩ_i at `vertex` (depth `depth`), in the psps
-    /// frame of `frame`, the pBRDF sampled at the path's point for this depth
+    /// One sample of ∫ F (S_in − L_env e₀) cosθ_i dΩ_i at `point` (depth `depth`), in the psps
+    /// frame of its outgoing frame, the pBRDF sampled at the path's point for this depth
     /// ([`PixelSampler::bounce_point`], stratified over the pixel's paths).
-    fn correction(
-        &self,
-        vertex: &Vertex,
-        frame: &OutgoingFrame,
-        material: usize,
-        depth: u32,
-        sampler: &mut Sampler,
-    ) -> Stokes {
+    fn correction(&self, point: &ShadingPoint, depth: u32, sampler: &mut Sampler) -> Stokes {
+        let (vertex, frame, material) = (point.vertex, &point.frame, point.material);
         let optics = &self.scene.materials[material].optics;
         let pbrdf = optics.sampling_pbrdf();
-        let w_o = frame.to_local(&frame.omega);
-        if w_o.z <= 0.0 {
+        let Some(view) = &point.view else {
             return Stokes::zeros();
-        }
-        let Some((w_i, pdf)) = pbrdf.sample_incident(&w_o, sampler.bounce_point(depth)) else {
+        };
+        let w_o = view.direction;
+        let Some((w_i, pdf)) = pbrdf.sample_incident(view, sampler.bounce_point(depth)) else {
             return Stokes::zeros();
         };
         let direction = frame.to_world(&w_i);
@@ -348,10 +367,10 @@ impl PathTracer<'_> {
         let incident = Direction::from_unit_vector(w_i);
         let s_incident = -frame.to_world(&incident.azimuthal_axis);
         let eta = rotation_between_frames(&s_from, &s_incident, &toward_x);
-        let mut s_in = rotate_stokes(&leaving, eta);
+        let mut s_in = eta.apply(&leaving);
         let environment = self.scene.environment.radiance(&direction);
         let scattered = Direction::from_unit_vector(w_o);
-        let masking = [pbrdf.masking(w_i.z), pbrdf.masking(w_o.z)];
+        let masking = [pbrdf.masking(w_i.z), view.masking];
         let local = match (optics, &self.band_sources[material]) {
             (MaterialOptics::Band(band), Some(sources)) => {
                 let emitted = self.emitted_toward(&next, &toward_x, eta);
@@ -376,7 +395,12 @@ impl PathTracer<'_> {
     /// What the hit `vertex` emits toward the receiver along `toward_x` (its open-world emission,
     /// rotated by `eta` into the receiver's incident frame) and its spectrum: the hit's
     /// emissivity at each wavelength node (a band material; `None`: grey) and temperature.
-    fn emitted_toward(&self, vertex: &Vertex, toward_x: &Vector3<f64>, eta: f64) -> EmittedLight {
+    fn emitted_toward(
+        &self,
+        vertex: &Vertex,
+        toward_x: &Vector3<f64>,
+        eta: FrameTurn,
+    ) -> EmittedLight {
         let frame = OutgoingFrame::new(&vertex.normal, toward_x);
         let material = self.scene.triangle_material(vertex.hit.triangle);
         let temperature = vertex.hit.temperature;
@@ -386,7 +410,7 @@ impl PathTracer<'_> {
             radiance: self.open_world.radiance.radiance(temperature),
             emissivity: tables.emissivity_at(cos_theta, temperature),
             per_node: tables.node_emissivities(cos_theta),
-            polarization: rotate_stokes(&Stokes::new(0.0, 1.0, 0.0, 0.0), eta),
+            polarization: eta.apply(&Stokes::new(0.0, 1.0, 0.0, 0.0)),
         }
     }
 
@@ -399,32 +423,22 @@ impl PathTracer<'_> {
     ) -> Stokes {
         let s_local = frame.to_world(&scattered.azimuthal_axis);
         let omega = frame.to_world(&scattered.vector);
-        rotate_stokes(
-            local,
-            rotation_between_frames(&s_local, &frame.s_axis, &omega),
-        )
+        rotation_between_frames(&s_local, &frame.s_axis, &omega).apply(local)
     }
 
-    /// ∫_disc F_j0(ω→ω_o) cosθ dΩ L_sun = E_sun Σ w_k F_j0(ω_k→ω_o) cosθ_k, in `frame`; `None`
+    /// ∫_disc F_j0(ω→ω_o) cosθ dΩ L_sun = E_sun Σ w_k F_j0(ω_k→ω_o) cosθ_k, in the point's frame; `None`
     /// without a sun or where no node is above the local horizon.
-    fn sun_integral(
-        &self,
-        vertex: &Vertex,
-        frame: &OutgoingFrame,
-        material: usize,
-    ) -> Option<Stokes> {
+    fn sun_integral(&self, point: &ShadingPoint) -> Option<Stokes> {
+        let (frame, material) = (&point.frame, point.material);
         let (sun, rules) = self.sun.as_ref()?;
-        if sun.direction.dot(&vertex.geometric_normal) <= 0.0 {
+        if sun.direction.dot(&point.vertex.geometric_normal) <= 0.0 {
             return None;
         }
-        let w_o = frame.to_local(&frame.omega);
-        if w_o.z <= 0.0 {
-            return None;
-        }
+        let view = point.view.as_ref()?;
         let optics = &self.scene.materials[material].optics;
         let pbrdf: &Pbrdf = optics.sampling_pbrdf();
-        let scattered = Direction::from_unit_vector(w_o);
-        let masking_o = pbrdf.masking(w_o.z);
+        let scattered = Direction::from_unit_vector(view.direction);
+        let masking_o = view.masking;
         let mut sum = Stokes::zeros();
         let mut any = false;
         for (node, weight) in &rules[material].nodes {

@@ -6,7 +6,7 @@
 use crate::fit::MeasurementData;
 use crate::material::Material;
 use crate::measure::MeasurementSet;
-use crate::optics::{rotation_between_frames, stokes_rotator, Mueller, Stokes};
+use crate::optics::{rotation_between_frames, FrameTurn, Mueller, Stokes};
 use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
 
 use super::super::ReportError;
@@ -358,7 +358,7 @@ const NEGLIGIBLE_MIXING: f64 = 3.5e-8;
 /// along k = ẑ and each frame is the limit θ_r → 0⁺ along its azimuth φ (docs/design.md §1.3), with
 /// s = lim unit(ẑ × k) = ê_φ = (−sin φ, cos φ, 0) ([`Direction::azimuthal_axis`]); η is the angle
 /// from the row's s toward its p = k × s at which the in-plane s lies (optics::frame).
-fn normal_detector_turn(phi_i_deg: f64, phi_r_deg: f64) -> f64 {
+fn normal_detector_turn(phi_i_deg: f64, phi_r_deg: f64) -> FrameTurn {
     let own = Direction::from_angles(0.0, phi_r_deg.to_radians());
     let in_plane_phi = phi_i_deg + in_plane_relative_azimuth(0.0);
     let in_plane = Direction::from_angles(0.0, in_plane_phi.to_radians());
@@ -367,7 +367,7 @@ fn normal_detector_turn(phi_i_deg: f64, phi_r_deg: f64) -> f64 {
 
 /// A row measured with the detector at the normal, re-expressed in the psps frame of the
 /// in-plane profile (the frame the in-plane model curves are drawn in at θ_r = 0), so that it
-/// can be drawn there whatever its φ_r: M' = L(η) M with L = `stokes_rotator` and η from
+/// can be drawn there whatever its φ_r: M' = L(η) M with L = [`FrameTurn::mueller`] and η from
 /// [`normal_detector_turn`]. Only the outgoing (row) side turns; the incident side is the scan's.
 ///
 /// L(η) mixes rows 1 and 2 of each column (m1c' = cos2η m1c + sin2η m2c, m2c' = −sin2η m1c +
@@ -385,7 +385,7 @@ fn in_plane_frame_at_normal(
     phi_i_deg: f64,
     phi_r_deg: f64,
 ) -> ([Option<Reading>; 16], Mueller) {
-    let turn = stokes_rotator(normal_detector_turn(phi_i_deg, phi_r_deg));
+    let turn = normal_detector_turn(phi_i_deg, phi_r_deg).mueller();
     let mut turned = [None; 16];
     for (element, slot) in turned.iter_mut().enumerate() {
         let (row, column) = (element / 4, element % 4);
@@ -1027,10 +1027,10 @@ mod tests {
     fn the_frame_turn_at_the_normal_follows_the_azimuth() {
         // At k = ẑ, s = ê_φ and p = ẑ × ê_φ = (−cos φ, −sin φ, 0) = ê_(φ+90°): the s axes of
         // azimuths φ_r and φ_i + 180° differ by η = φ_i + 180° − φ_r, counted from s toward p.
-        let quarter = normal_detector_turn(0.0, 90.0);
+        let quarter = normal_detector_turn(0.0, 90.0).angle();
         assert!((quarter - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
-        let turn = normal_detector_turn(20.0, 250.0);
+        let turn = normal_detector_turn(20.0, 250.0).angle();
         assert!((turn - (-50f64).to_radians()).abs() < 1e-14);
-        assert!(normal_detector_turn(10.0, 190.0).abs() < 1e-15);
+        assert!(normal_detector_turn(10.0, 190.0).angle().abs() < 1e-15);
     }
 }
