@@ -207,7 +207,8 @@ struct FitArgs {
     /// Shadowing of the fitted model: none, torrance-sparrow or smith.
     #[arg(long, default_value = "smith")]
     shadowing: String,
-    /// Free parameters, e.g. sigma,q,n,k,rho (default: all that are not fixed).
+    /// Free parameters, e.g. sigma,q,n,k,rho (default: all of the terms' parameters that are not
+    /// fixed, except k behind internal facets, held at 0).
     #[arg(long)]
     free: Option<String>,
     /// Fixed parameter values, e.g. k=0.1,rho=0.

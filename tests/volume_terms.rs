@@ -358,8 +358,8 @@ fn ptfe_fits_conserve_energy_and_the_volume_model_predicts_better() {
     );
     let (volume, volume_m00, volume_normalized) = fit("internal+subsurface", "volume");
     let spec = volume.grey_model().unwrap();
-    assert!((1.15..1.45).contains(&spec.n), "{spec:?}");
-    // Measured on the unseen incidences: m00 3.8 % against 14.3 %, m_ij/m00 0.0194 against
+    assert!((1.25..1.45).contains(&spec.n), "{spec:?}");
+    // Measured on the unseen incidences: m00 4.5 % against 14.3 %, m_ij/m00 0.0199 against
     // 0.0204 (docs/measurements.md).
     assert!(
         volume_m00 < 0.5 * today_m00,

@@ -24,8 +24,8 @@ pub struct FitOptions {
     pub term_candidates: Vec<ModelTerms>,
     /// K of K-fold cross-validation (`--cv K`), reported beside AIC and deciding the terms.
     pub cv_folds: Option<usize>,
-    /// Adjustable parameters; `None` = every parameter that is not in `fixed`. q is ignored for
-    /// the Gaussian.
+    /// Adjustable parameters; `None` = every parameter the terms fit by default
+    /// ([`ModelTerms::fitted_by_default`]) that is not in `fixed`. q is ignored for the Gaussian.
     pub free: Option<Vec<Parameter>>,
     /// Values of parameters held fixed. A parameter neither free nor here takes
     /// [`Parameter::default_value`].
@@ -80,7 +80,7 @@ impl FitOptions {
         match &self.free {
             None => Ok(Parameter::ALL
                 .into_iter()
-                .filter(|p| self.terms.has(*p) && !self.fixed.contains_key(p))
+                .filter(|p| self.terms.fitted_by_default(*p) && !self.fixed.contains_key(p))
                 .collect()),
             Some(free) => {
                 if let Some(p) = free.iter().find(|p| self.fixed.contains_key(p)) {

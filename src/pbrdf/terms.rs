@@ -104,6 +104,17 @@ impl ModelTerms {
         term == Term::Facet || term == self.body.term()
     }
 
+    /// Whether a fit frees `parameter` unless told otherwise (`--free`, `--fix`): every parameter
+    /// of the terms except k behind internal facets, held at 0 (docs/design.md §1.10). Light
+    /// reflected inside a grain must have crossed the grain to get there, so the grain is
+    /// transparent at that wavelength; its absorption along the way is the body's ρ_s, not an
+    /// interface property. Left free, k stands in for what the facet model lacks (PTFE at
+    /// 1.064 µm, which does not absorb, fits k ≈ 0.07 and an index of 1.23 instead of 1.39).
+    pub fn fitted_by_default(&self, parameter: Parameter) -> bool {
+        self.has(parameter)
+            && !(parameter == Parameter::K && self.facet_side == FacetSide::Internal)
+    }
+
     /// Parses `external+subsurface` and the like (`internal+depolarizer` too).
     pub fn parse(text: &str) -> Option<ModelTerms> {
         ModelTerms::ALL
