@@ -61,35 +61,42 @@ impl Pbrdf {
         let weight = self.specular_sampling_weight();
         let scattered = &view.direction;
         let phi = 2.0 * PI * u[1];
-        let incident = if u[0] < weight {
-            let lobe_point = [u[0] / weight, u[1]];
-            let h = match (self.visible_slopes(), &view.visible) {
-                (Some(sampler), Some(visible)) => {
-                    // The slope drawn at azimuth 0, rotated back by ω_r's azimuth φ.
-                    let [x, y] = sampler.sample(visible, lobe_point);
-                    let [cos_phi, sin_phi] = view.azimuth;
-                    let (mx, my) = (cos_phi * x - sin_phi * y, sin_phi * x + cos_phi * y);
-                    Vector3::new(-mx, -my, 1.0).normalize()
-                }
-                _ => {
-                    let tan2 = self.distribution().slope_quantile(lobe_point[0]).powi(2);
-                    let cos_h = 1.0 / (1.0 + tan2).sqrt();
-                    let sin_h = tan2.sqrt() * cos_h;
-                    Vector3::new(sin_h * phi.cos(), sin_h * phi.sin(), cos_h)
-                }
-            };
-            let cos_beta = scattered.dot(&h);
-            if cos_beta <= 0.0 {
-                return None;
-            }
-            h * (2.0 * cos_beta) - scattered
-        } else {
+        let cosine_pdf = |incident: &Vector3<f64>| (1.0 - weight) * incident.z * FRAC_1_PI;
+        if u[0] >= weight {
             // Malley: a uniform point on the disc lifted to the hemisphere.
             let r2 = ((u[0] - weight) / (1.0 - weight)).clamp(0.0, 1.0);
             let r = r2.sqrt();
-            Vector3::new(r * phi.cos(), r * phi.sin(), (1.0 - r2).sqrt())
+            let incident = Vector3::new(r * phi.cos(), r * phi.sin(), (1.0 - r2).sqrt());
+            let pdf = self.mixture_pdf(view, &incident);
+            return (pdf > 0.0 && pdf.is_finite()).then_some((incident, pdf));
+        }
+        let lobe_point = [u[0] / weight, u[1]];
+        let (h, tan2) = match (self.visible_slopes(), &view.visible) {
+            (Some(sampler), Some(visible)) => {
+                // The slope drawn at azimuth 0, rotated back by ω_r's azimuth φ.
+                let [x, y] = sampler.sample(visible, lobe_point);
+                let [cos_phi, sin_phi] = view.azimuth;
+                let (mx, my) = (cos_phi * x - sin_phi * y, sin_phi * x + cos_phi * y);
+                (Vector3::new(-mx, -my, 1.0).normalize(), x * x + y * y)
+            }
+            _ => {
+                let tan2 = self.distribution().slope_quantile(lobe_point[0]).powi(2);
+                let cos_h = 1.0 / (1.0 + tan2).sqrt();
+                let sin_h = tan2.sqrt() * cos_h;
+                let h = Vector3::new(sin_h * phi.cos(), sin_h * phi.sin(), cos_h);
+                (h, tan2)
+            }
         };
-        let pdf = self.mixture_pdf(view, &incident);
+        let cos_beta = scattered.dot(&h);
+        if cos_beta <= 0.0 {
+            return None;
+        }
+        let incident = h * (2.0 * cos_beta) - scattered;
+        if incident.z <= 0.0 {
+            return None;
+        }
+        // The facet just drawn gives the lobe's density without re-deriving it from ω_i + ω_r.
+        let pdf = weight * self.lobe_pdf(view, tan2, h.z, cos_beta) + cosine_pdf(&incident);
         (pdf > 0.0 && pdf.is_finite()).then_some((incident, pdf))
     }
 
@@ -104,23 +111,31 @@ impl Pbrdf {
         if incident.z <= 0.0 {
             return 0.0;
         }
-        let scattered = &view.direction;
         let weight = self.specular_sampling_weight();
-        let cosine = incident.z * FRAC_1_PI;
-        let half = incident + scattered;
+        let half = incident + view.direction;
         let lobe = if half.z > 0.0 {
             let h = half.normalize();
             let tan2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
-            // P(θ_h) = p(tanθ_h)/cos³θ_h and D = P/cosθ_h.
-            let facet_density = self.prepared_distribution().slope_pdf(tan2) / h.z.powi(3);
-            match &view.visible {
-                Some(visible) => visible.masking() * facet_density / (4.0 * h.z * scattered.z),
-                None => facet_density / (4.0 * incident.dot(&h)),
-            }
+            self.lobe_pdf(view, tan2, h.z, incident.dot(&h))
         } else {
             0.0
         };
-        weight * lobe + (1.0 - weight) * cosine
+        weight * lobe + (1.0 - weight) * incident.z * FRAC_1_PI
+    }
+
+    /// The facet lobe's density (sr⁻¹) of the ω_i mirrored by the facet h with tan²θ_h = `tan2`,
+    /// cosθ_h = `cos_h` and ω_i·h = `cos_beta`. Facet density P(θ_h) = p(tanθ_h)/cos³θ_h and
+    /// D = P/cosθ_h; with visible normals G1(ω_r) D/(4 cosθ_r) = G1 p (1 + tan²θ_h)²/(4 cosθ_r),
+    /// without them P/(4 cos β).
+    fn lobe_pdf(&self, view: &ScatteredView, tan2: f64, cos_h: f64, cos_beta: f64) -> f64 {
+        let slope_density = self.prepared_distribution().slope_pdf(tan2);
+        match &view.visible {
+            Some(visible) => {
+                let secant2 = 1.0 + tan2;
+                visible.masking() * slope_density * secant2 * secant2 / (4.0 * view.direction.z)
+            }
+            None => slope_density / (cos_h * cos_h * cos_h * 4.0 * cos_beta),
+        }
     }
 }
 
