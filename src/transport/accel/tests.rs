@@ -1,3 +1,4 @@
+use super::collapse::LANES;
 use super::*;
 use crate::scene::procedural::{icosphere, plane};
 use rand::{Rng, SeedableRng};
@@ -192,8 +193,9 @@ fn queries_agree_with_brute_force_on_a_triangle_soup() {
     let mesh = triangle_soup(&mut rng, 3000);
     let accel = Accelerator::new(&mesh, 10.0);
     let leaves: Vec<usize> = (accel.nodes.iter())
-        .map(Node::count)
+        .flat_map(|n| n.count)
         .filter(|&c| c > 0)
+        .map(|c| c as usize)
         .collect();
     assert_eq!(leaves.iter().sum::<usize>(), mesh.triangles.len());
     assert!(leaves.iter().all(|&c| c <= 4));
@@ -219,39 +221,154 @@ fn queries_agree_with_brute_force_on_a_triangle_soup() {
     assert!(hits > 5000 && misses > 1000, "{hits} hits, {misses} misses");
 }
 
-/// Every node's box holds the f64 vertices of every triangle below it (bounds rounded outward),
-/// and the leaves cover each triangle once.
-#[test]
-fn boxes_hold_their_triangles() {
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
-    let mesh = triangle_soup(&mut rng, 2000);
-    let accel = Accelerator::new(&mesh, 10.0);
-    let mut seen = vec![0; mesh.triangles.len()];
-    fn check(accel: &Accelerator, at: usize, seen: &mut [u32]) -> (usize, usize) {
-        let node = &accel.nodes[at];
-        let (first, end) = if node.count() > 0 {
-            (node.link as usize, node.link as usize + node.count())
+/// What a walk of the wide tree saw: how many times each node and each triangle was reached,
+/// and the most nodes on a path.
+struct Seen {
+    nodes: Vec<u32>,
+    triangles: Vec<u32>,
+    depth: usize,
+}
+
+/// Walks the wide tree from node `at` (at `level`, the root at 1): checks that every used
+/// lane's box holds the f64 vertices of every triangle below it (bounds rounded outward),
+/// counts what it reaches in `seen`, and returns the leaf-order slots below (first, end), which
+/// must be contiguous.
+fn check_subtree(accel: &Accelerator, at: usize, level: usize, seen: &mut Seen) -> (usize, usize) {
+    seen.nodes[at] += 1;
+    seen.depth = seen.depth.max(level);
+    let node = &accel.nodes[at];
+    let used = (0..LANES).filter(|&l| node.used(l));
+    let mut ranges = Vec::new();
+    for lane in used {
+        let (child, count) = (node.child[lane] as usize, node.count[lane] as usize);
+        let (first, end) = if count > 0 {
+            for slot in child..child + count {
+                seen.triangles[accel.order[slot] as usize] += 1;
+            }
+            (child, child + count)
         } else {
-            let (first, _) = check(accel, at + 1, seen);
-            let (_, end) = check(accel, at + node.link as usize, seen);
-            (first, end)
+            check_subtree(accel, child, level + 1, seen)
         };
         for slot in first..end {
             let t = accel.order[slot] as usize;
             for v in accel.mesh.triangles[t] {
                 let p = accel.mesh.positions[v as usize];
                 for a in 0..3 {
-                    assert!(f64::from(node.lo[a]) < p[a] && p[a] < f64::from(node.hi[a]));
+                    let (lo, hi) = (node.bounds[0][a][lane], node.bounds[1][a][lane]);
+                    assert!(
+                        f64::from(lo) < p[a] && p[a] < f64::from(hi),
+                        "node {at} lane {lane}"
+                    );
                 }
             }
-            if node.count() > 0 {
-                seen[t] += 1;
+        }
+        ranges.push((first, end));
+    }
+    // In slot order by construction; sorted here so that the check does not depend on it.
+    ranges.sort_unstable();
+    for pair in ranges.windows(2) {
+        assert_eq!(
+            pair[0].1, pair[1].0,
+            "node {at}: slots {ranges:?} not contiguous"
+        );
+    }
+    let (first, last) = (ranges.first(), ranges.last());
+    (first.expect("a node with no lane").0, last.unwrap().1)
+}
+
+/// The collapsed tree is a tree over every triangle: every lane's box holds the f64 vertices of
+/// every triangle below it, each node is reached once from the root, each triangle lies in
+/// exactly one leaf, leaves hold at most four, and a node has four lanes unless all its lanes
+/// are leaves (nothing left to open).
+#[test]
+fn the_wide_tree_holds_every_triangle_once_inside_its_boxes() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+    for mesh in [triangle_soup(&mut rng, 2000), sphere_over_plane()] {
+        let accel = Accelerator::new(&mesh, 10.0);
+        let mut seen = Seen {
+            nodes: vec![0; accel.nodes.len()],
+            triangles: vec![0; mesh.triangles.len()],
+            depth: 0,
+        };
+        let range = check_subtree(&accel, 0, 1, &mut seen);
+        assert_eq!(range, (0, mesh.triangles.len()));
+        assert!(seen.nodes.iter().all(|&n| n == 1));
+        assert!(seen.triangles.iter().all(|&n| n == 1));
+        // The traversal's stack is sized from the depth.
+        assert_eq!(seen.depth, accel.depth);
+        assert!(3 * accel.depth <= SHORT_STACK);
+        assert!(accel.nodes.iter().all(|n| n.count.iter().all(|&c| c <= 4)));
+        // A lane left unused means no interior lane was left to open.
+        for node in &accel.nodes {
+            let used = (0..LANES).filter(|&l| node.used(l));
+            if used.clone().count() < LANES {
+                assert!(used.clone().all(|l| node.count[l] > 0), "{node:?}");
             }
         }
-        (first, end)
     }
-    assert_eq!(check(&accel, 0, &mut seen), (0, mesh.triangles.len()));
-    assert!(seen.iter().all(|&s| s == 1));
+    // A single triangle: a binary tree of one leaf, a root with one lane.
+    let mesh = square();
+    let one = mesh_of(mesh.positions.clone(), vec![[0, 1, 2]]);
+    let accel = Accelerator::new(&one, 1.0);
+    assert_eq!(accel.nodes.len(), 1);
+    assert_eq!(accel.nodes[0].count, [1, 0, 0, 0]);
+    let (nodes, triangles) = (vec![0], vec![0]);
+    let mut seen = Seen {
+        nodes,
+        triangles,
+        depth: 0,
+    };
+    assert_eq!(check_subtree(&accel, 0, 1, &mut seen), (0, 1));
+    assert_eq!((seen.nodes[0], seen.triangles[0], accel.depth), (1, 1, 1));
+}
+
+/// 5 000 random triangles (sizes from 1 mm to 3 m, crossing one another) and 20 000 rays from
+/// inside and around them: `closest_hit` finds the brute-force loop's triangle at the same
+/// distance, and `occluded` agrees, on every ray (random triangles make ties improbable).
+#[test]
+fn queries_agree_with_brute_force_on_a_large_random_mesh() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
+    let mut positions = Vec::new();
+    for _ in 0..5000 {
+        let centre = Vector3::from_fn(|_, _| rng.random_range(-5.0..5.0));
+        let size = 10f64.powf(rng.random_range(-3.0..0.5));
+        for _ in 0..3 {
+            positions.push(centre + Vector3::from_fn(|_, _| rng.random_range(-size..size)));
+        }
+    }
+    let triangles = (0..5000u32)
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    let mesh = mesh_of(positions, triangles);
+    let accel = Accelerator::new(&mesh, 10.0);
+    let (mut hits, mut misses) = (0, 0);
+    for i in 0..20_000 {
+        let origin = Vector3::from_fn(|_, _| rng.random_range(-7.0..7.0));
+        let ray = Ray::new(&origin, &random_direction(&mut rng, i));
+        let mut expected = None;
+        for t in 0..mesh.triangles.len() {
+            let t_max = expected.map_or(f64::INFINITY, |(_, distance)| distance);
+            if let Some((distance, _, _)) = Triangle::new(&mesh, t).intersect(&ray, t_max) {
+                expected = Some((t, distance));
+            }
+        }
+        let ours = accel.closest(&ray);
+        match (expected, ours) {
+            (Some((t, distance)), Some((slot, ours, _, _))) => {
+                hits += 1;
+                assert_eq!(accel.order[slot] as usize, t, "ray {i}");
+                assert!(
+                    (ours - distance).abs() <= 1e-12,
+                    "ray {i}: {ours} {distance}"
+                );
+            }
+            (None, None) => misses += 1,
+            _ => panic!("ray {i}: {ours:?}, expected {expected:?}"),
+        }
+        let occluded = accel.occluded(&ray.origin, &ray.direction);
+        assert_eq!(occluded, expected.is_some(), "ray {i}");
+    }
+    assert!(hits > 5000 && misses > 1000, "{hits} hits, {misses} misses");
 }
 
 /// Degenerate meshes build without panicking and answer: no triangles; many triangles on one
@@ -268,7 +385,7 @@ fn degenerate_meshes_build_and_answer() {
 
     let point = mesh_of(vec![Vector3::new(1.0, 2.0, 3.0)], vec![[0, 0, 0]; 1000]);
     let accel = Accelerator::new(&point, 1.0);
-    assert!(accel.nodes.iter().all(|n| n.count() <= 4));
+    assert!(accel.nodes.iter().all(|n| n.count.iter().all(|&c| c <= 4)));
     let towards = Vector3::new(1.0, 2.0, 3.0).normalize();
     assert!(accel.closest_hit(&Vector3::zeros(), &towards).is_none());
 
@@ -276,7 +393,7 @@ fn degenerate_meshes_build_and_answer() {
     let square = square();
     let copies = mesh_of(square.positions.clone(), vec![[0, 1, 2]; 1000]);
     let accel = Accelerator::new(&copies, 1.0);
-    assert!(accel.nodes.iter().all(|n| n.count() <= 4));
+    assert!(accel.nodes.iter().all(|n| n.count.iter().all(|&c| c <= 4)));
     let down = -Vector3::z();
     let hit = accel
         .closest_hit(&Vector3::new(0.5, -0.5, 1.0), &down)
