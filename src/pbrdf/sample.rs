@@ -61,7 +61,6 @@ impl Pbrdf {
         let weight = self.specular_sampling_weight();
         let scattered = &view.direction;
         let phi = 2.0 * PI * u[1];
-        let cosine_pdf = |incident: &Vector3<f64>| (1.0 - weight) * incident.z * FRAC_1_PI;
         if u[0] >= weight {
             // Malley: a uniform point on the disc lifted to the hemisphere.
             let r2 = ((u[0] - weight) / (1.0 - weight)).clamp(0.0, 1.0);
@@ -96,7 +95,7 @@ impl Pbrdf {
             return None;
         }
         // The facet just drawn gives the lobe's density without re-deriving it from ω_i + ω_r.
-        let pdf = weight * self.lobe_pdf(view, tan2, h.z, cos_beta) + cosine_pdf(&incident);
+        let pdf = mixture(weight, self.lobe_pdf(view, tan2, h.z, cos_beta), &incident);
         (pdf > 0.0 && pdf.is_finite()).then_some((incident, pdf))
     }
 
@@ -120,7 +119,7 @@ impl Pbrdf {
         } else {
             0.0
         };
-        weight * lobe + (1.0 - weight) * incident.z * FRAC_1_PI
+        mixture(weight, lobe, incident)
     }
 
     /// The facet lobe's density (sr⁻¹) of the ω_i mirrored by the facet h with tan²θ_h = `tan2`,
@@ -137,6 +136,12 @@ impl Pbrdf {
             None => slope_density / (cos_h * cos_h * cos_h * 4.0 * cos_beta),
         }
     }
+}
+
+/// The mixture density of the facet lobe (density `lobe`, chosen with probability `weight`) and
+/// the cosine lobe cosθ_i/π at unit `incident`.
+fn mixture(weight: f64, lobe: f64, incident: &Vector3<f64>) -> f64 {
+    weight * lobe + (1.0 - weight) * incident.z * FRAC_1_PI
 }
 
 /// A scattered direction prepared for sampling ([`Pbrdf::scattered_view`]).

@@ -79,13 +79,22 @@ impl Vertex {
 }
 
 /// A vertex prepared for shading light that leaves it along ω: the outgoing frame, the material
-/// and its sampling pBRDF's view of ω (shared by every sample drawn there; `None` when ω is
-/// below the shading normal, where nothing is reflected).
+/// and, when ω is above the shading normal (below it nothing is reflected), what every sample
+/// drawn there shares ([`Outgoing`]).
 struct ShadingPoint<'v> {
     vertex: &'v Vertex,
     frame: OutgoingFrame,
     material: usize,
-    view: Option<ScatteredView>,
+    outgoing: Option<Outgoing>,
+}
+
+/// ω in the local frame, computed once per vertex: the sampling pBRDF's view of it, its local
+/// psps axes, and the turn from those axes into the outgoing frame's s axis (the frame a
+/// vertex's estimates are returned in).
+struct Outgoing {
+    view: ScatteredView,
+    scattered: Direction,
+    to_frame: FrameTurn,
 }
 
 impl PathTracer<'_> {
@@ -94,11 +103,21 @@ impl PathTracer<'_> {
         let material = self.scene.triangle_material(vertex.hit.triangle);
         let w_o = frame.to_local(omega);
         let pbrdf = self.scene.materials[material].optics.sampling_pbrdf();
+        let outgoing = (w_o.z > 0.0).then(|| {
+            let scattered = Direction::from_unit_vector(w_o);
+            let s_local = frame.to_world(&scattered.azimuthal_axis);
+            let k = frame.to_world(&scattered.vector);
+            Outgoing {
+                view: pbrdf.scattered_view(&w_o),
+                to_frame: rotation_between_frames(&s_local, &frame.s_axis, &k),
+                scattered,
+            }
+        });
         ShadingPoint {
             vertex,
             frame,
             material,
-            view: (w_o.z > 0.0).then(|| pbrdf.scattered_view(&w_o)),
+            outgoing,
         }
     }
 }
@@ -344,10 +363,14 @@ impl PathTracer<'_> {
         let (vertex, frame, material) = (point.vertex, &point.frame, point.material);
         let optics = &self.scene.materials[material].optics;
         let pbrdf = optics.sampling_pbrdf();
-        let Some(view) = &point.view else {
+        let Some(Outgoing {
+            view,
+            scattered,
+            to_frame,
+        }) = &point.outgoing
+        else {
             return Stokes::zeros();
         };
-        let w_o = view.direction;
         let Some((w_i, pdf)) = pbrdf.sample_incident(view, sampler.bounce_point(depth)) else {
             return Stokes::zeros();
         };
@@ -369,14 +392,13 @@ impl PathTracer<'_> {
         let eta = rotation_between_frames(&s_from, &s_incident, &toward_x);
         let mut s_in = eta.apply(&leaving);
         let environment = self.scene.environment.radiance(&direction);
-        let scattered = Direction::from_unit_vector(w_o);
         let masking = [pbrdf.masking(w_i.z), view.masking];
         let local = match (optics, &self.band_sources[material]) {
             (MaterialOptics::Band(band), Some(sources)) => {
                 let emitted = self.emitted_toward(&next, &toward_x, eta);
                 let geometry = BandScattering {
                     incident: &incident,
-                    scattered: &scattered,
+                    scattered,
                     masking,
                 };
                 band_scattering(band, sources, &geometry, &s_in, &emitted, environment)
@@ -385,11 +407,11 @@ impl PathTracer<'_> {
             _ => {
                 s_in[0] -= environment;
                 let mueller =
-                    pbrdf.mueller_with_masking(&incident, &scattered, masking[0], masking[1]);
+                    pbrdf.mueller_with_masking(&incident, scattered, masking[0], masking[1]);
                 mueller * s_in * (w_i.z / pdf)
             }
         };
-        self.to_outgoing_frame(&local, &scattered, frame)
+        to_frame.apply(&local)
     }
 
     /// What the hit `vertex` emits toward the receiver along `toward_x` (its open-world emission,
@@ -414,18 +436,6 @@ impl PathTracer<'_> {
         }
     }
 
-    /// A Stokes vector in the psps frame of local `scattered` re-expressed with `frame.s_axis`.
-    fn to_outgoing_frame(
-        &self,
-        local: &Stokes,
-        scattered: &Direction,
-        frame: &OutgoingFrame,
-    ) -> Stokes {
-        let s_local = frame.to_world(&scattered.azimuthal_axis);
-        let omega = frame.to_world(&scattered.vector);
-        rotation_between_frames(&s_local, &frame.s_axis, &omega).apply(local)
-    }
-
     /// ∫_disc F_j0(ω→ω_o) cosθ dΩ L_sun = E_sun Σ w_k F_j0(ω_k→ω_o) cosθ_k, in the point's frame; `None`
     /// without a sun or where no node is above the local horizon.
     fn sun_integral(&self, point: &ShadingPoint) -> Option<Stokes> {
@@ -434,11 +444,11 @@ impl PathTracer<'_> {
         if sun.direction.dot(&point.vertex.geometric_normal) <= 0.0 {
             return None;
         }
-        let view = point.view.as_ref()?;
+        let outgoing = point.outgoing.as_ref()?;
         let optics = &self.scene.materials[material].optics;
         let pbrdf: &Pbrdf = optics.sampling_pbrdf();
-        let scattered = Direction::from_unit_vector(view.direction);
-        let masking_o = view.masking;
+        let scattered = &outgoing.scattered;
+        let masking_o = outgoing.view.masking;
         let mut sum = Stokes::zeros();
         let mut any = false;
         for (node, weight) in &rules[material].nodes {
@@ -453,17 +463,17 @@ impl PathTracer<'_> {
                 (MaterialOptics::Band(band), Some(sources)) => {
                     let [mixed] = band.mueller_mixtures(
                         &incident,
-                        &scattered,
+                        scattered,
                         masking,
                         [SpectralMix::fixed(&sources.sun)],
                     );
                     mixed
                 }
-                _ => pbrdf.mueller_with_masking(&incident, &scattered, masking[0], masking[1]),
+                _ => pbrdf.mueller_with_masking(&incident, scattered, masking[0], masking[1]),
             };
             sum += mueller.column(0) * (weight * w_i.z);
         }
-        any.then(|| self.to_outgoing_frame(&(sum * sun.irradiance), &scattered, frame))
+        any.then(|| outgoing.to_frame.apply(&(sum * sun.irradiance)))
     }
 
     /// 1 if a shadow ray from `vertex` to the disc point `[area fraction, angle fraction]`
