@@ -53,6 +53,7 @@ fn fixture_material(dir: &Path) -> Material {
         n: nodes.iter().map(|n| n.1).collect(),
         k: nodes.iter().map(|n| n.2).collect(),
         rho_d: vec![0.0; nodes.len()],
+        volume: Default::default(),
         dispersion: None,
     };
     let material = Material {

@@ -6,7 +6,7 @@ use super::parameters::{DistributionKind, Parameter, ParameterBounds, ParameterV
 use super::robust::RobustLoss;
 use super::stages::Optimizer;
 use super::FitError;
-use crate::pbrdf::{ModelTerms, Shadowing};
+use crate::pbrdf::{ModelTerms, Shadowing, SpectralRole};
 use std::collections::BTreeMap;
 
 /// Options of [`super::fit_measurement`].
@@ -42,6 +42,9 @@ pub struct FitOptions {
     pub settings: OptimizerSettings,
     /// How n, k depend on wavelength when a material was measured at several (docs/design.md §1.9).
     pub dispersion: super::Dispersion,
+    /// Parameters a spectral fit frees at each wavelength that it would otherwise share
+    /// ([`SpectralRole::SharedByDefault`]: the subsurface term's d, n_sub, d_c).
+    pub per_wavelength: Vec<Parameter>,
 }
 
 impl Default for FitOptions {
@@ -61,6 +64,7 @@ impl Default for FitOptions {
             bounds: ParameterBounds::default(),
             settings: OptimizerSettings::default(),
             dispersion: super::Dispersion::Table,
+            per_wavelength: Vec::new(),
         }
     }
 }
@@ -90,6 +94,17 @@ impl FitOptions {
                 }
                 Ok(free.clone())
             }
+        }
+    }
+
+    /// Whether a spectral fit gives `parameter` one value for every wavelength
+    /// (docs/design.md §1.10: geometry always; the subsurface's d, n_sub, d_c unless
+    /// [`FitOptions::per_wavelength`] names them).
+    pub fn shared_across_wavelengths(&self, parameter: Parameter) -> bool {
+        match parameter.info().spectral {
+            SpectralRole::Shared => true,
+            SpectralRole::SharedByDefault => !self.per_wavelength.contains(&parameter),
+            SpectralRole::PerWavelength => false,
         }
     }
 

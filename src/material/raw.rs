@@ -4,6 +4,7 @@
 //! flattened field, and a typo such as `rho = 0.5` must not silently give ρ_d = 0), then checked
 //! into the typed model.
 
+use super::spectral::{PerWavelength, SpectralVolume};
 use super::{MaterialModel, ModelSpec, SpectralModel};
 use crate::measure::SAME_WAVELENGTH_UM;
 use crate::optics::{LorentzDispersion, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
@@ -14,8 +15,8 @@ use crate::pbrdf::{
 use crate::text::number;
 use serde::Deserialize;
 
-/// `[model]` as written: `V` is `f64` where only a grey model is allowed, [`OneOrMany`] where a
-/// spectral table is too.
+/// `[model]` as written: `V` is `f64` where only a grey model is allowed, [`PerWavelength`] where
+/// a spectral table is too.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawModel<V> {
@@ -28,20 +29,12 @@ pub(super) struct RawModel<V> {
     rho_d: Option<V>,
     #[serde(default)]
     facet: FacetSide,
-    rho_s: Option<f64>,
-    d: Option<f64>,
-    n_sub: Option<f64>,
-    d_c: Option<f64>,
+    rho_s: Option<V>,
+    d: Option<V>,
+    n_sub: Option<V>,
+    d_c: Option<V>,
     wavelength_um: V,
     dispersion: Option<LorentzDispersion>,
-}
-
-/// A number or a list of numbers (a grey or a spectral key of `[model]`).
-#[derive(Deserialize)]
-#[serde(untagged)]
-pub(super) enum OneOrMany {
-    One(f64),
-    Many(Vec<f64>),
 }
 
 /// Why a `[model]` table is refused (the message follows the file's path and line).
@@ -63,11 +56,18 @@ pub enum ModelTableError {
     MixedShapes,
     #[error("a spectral table needs at least two wavelengths (write numbers for a grey material)")]
     ShortTable,
-    #[error("{name} has {len} values for {count} wavelengths (wavelength_um)")]
+    #[error(
+        "{name} has {len} values for {count} wavelengths (wavelength_um): {} µm has none; give \
+         one number (shared by every wavelength) or one per wavelength",
+        number(*.missing_um)
+    )]
     Length {
         name: &'static str,
         len: usize,
         count: usize,
+        /// The first table wavelength without a value (the last one given when there are too
+        /// many).
+        missing_um: f64,
     },
     #[error(
         "wavelength_um must be strictly ascending ({} µm then {} µm)",
@@ -87,11 +87,6 @@ pub enum ModelTableError {
     Dispersion(#[source] crate::optics::LorentzError),
     #[error("{0}")]
     PolarizationWithoutSubsurface(#[from] SubsurfaceKeysWithoutRhoS),
-    #[error(
-        "facet = \"internal\", rho_s and d are grey-model terms: a spectral table cannot use \
-         them yet (fit each wavelength as a grey material)"
-    )]
-    SpectralVolume,
 }
 
 /// Refuses a wavelength irpol does not model.
@@ -129,76 +124,78 @@ impl TryFrom<RawModel<f64>> for ModelSpec {
     }
 }
 
-impl TryFrom<RawModel<OneOrMany>> for MaterialModel {
+impl TryFrom<RawModel<PerWavelength>> for MaterialModel {
     type Error = ModelTableError;
 
-    fn try_from(raw: RawModel<OneOrMany>) -> Result<MaterialModel, ModelTableError> {
-        use OneOrMany::{Many, One};
-        let RawModel {
+    fn try_from(raw: RawModel<PerWavelength>) -> Result<MaterialModel, ModelTableError> {
+        if let Some(grey) = raw.grey() {
+            return Ok(MaterialModel::Grey(ModelSpec::try_from(grey)?));
+        }
+        use PerWavelength::{Each, Shared};
+        let distribution = raw.distribution.with(raw.sigma, raw.q)?;
+        let (Each(wavelength_um), Each(n), Each(k)) = (raw.wavelength_um, raw.n, raw.k) else {
+            return Err(ModelTableError::MixedShapes);
+        };
+        // One check of the subsurface keys for grey and spectral files alike.
+        let present = |key: &Option<PerWavelength>| key.as_ref().map(|_| 0.0);
+        Subsurface::from_keys(
+            present(&raw.rho_s),
+            present(&raw.d),
+            present(&raw.n_sub),
+            present(&raw.d_c),
+        )?;
+        let rho_d = match raw.rho_d.unwrap_or(Shared(0.0)) {
+            Shared(r) => vec![r; wavelength_um.len()],
+            Each(r) => r,
+        };
+        let model = SpectralModel {
             distribution,
-            sigma,
-            q,
-            shadowing,
+            shadowing: raw.shadowing,
+            wavelength_um,
             n,
             k,
             rho_d,
-            facet,
-            rho_s,
-            d,
-            n_sub,
-            d_c,
-            wavelength_um,
-            dispersion,
-        } = raw;
-        let rho_d = rho_d.unwrap_or(One(0.0));
-        let volume = facet != FacetSide::External
-            || rho_s.is_some()
-            || d.is_some()
-            || n_sub.is_some()
-            || d_c.is_some();
-        match (wavelength_um, n, k, rho_d) {
-            (One(wavelength_um), One(n), One(k), One(rho_d)) => {
-                let grey = RawModel {
-                    distribution,
-                    sigma,
-                    q,
-                    shadowing,
-                    n,
-                    k,
-                    rho_d: Some(rho_d),
-                    facet,
-                    rho_s,
-                    d,
-                    n_sub,
-                    d_c,
-                    wavelength_um,
-                    dispersion,
-                };
-                Ok(MaterialModel::Grey(ModelSpec::try_from(grey)?))
-            }
-            (Many(_), Many(_), Many(_), _) if volume => Err(ModelTableError::SpectralVolume),
-            (Many(wavelength_um), Many(n), Many(k), rho_d) => {
-                let rho_d = match rho_d {
-                    One(r) => vec![r; wavelength_um.len()],
-                    Many(r) => r,
-                };
-                let model = SpectralModel {
-                    distribution: distribution.with(sigma, q)?,
-                    shadowing,
-                    wavelength_um,
-                    n,
-                    k,
-                    rho_d,
-                    dispersion,
-                };
-                check_table(&model)?;
-                Ok(MaterialModel::Spectral(model))
-            }
-            _ => {
-                distribution.with(sigma, q)?;
-                Err(ModelTableError::MixedShapes)
-            }
-        }
+            volume: SpectralVolume {
+                facet: raw.facet,
+                rho_s: raw.rho_s,
+                d: raw.d,
+                n_sub: raw.n_sub,
+                d_c: raw.d_c,
+            },
+            dispersion: raw.dispersion,
+        };
+        check_table(&model)?;
+        Ok(MaterialModel::Spectral(model))
+    }
+}
+
+impl RawModel<PerWavelength> {
+    /// The model as a grey one, when every key is a single number (wavelength_um, n and k).
+    fn grey(&self) -> Option<RawModel<f64>> {
+        let one = |v: &PerWavelength| match v {
+            PerWavelength::Shared(x) => Some(*x),
+            PerWavelength::Each(_) => None,
+        };
+        let optional = |v: &Option<PerWavelength>| match v {
+            None => Some(None),
+            Some(v) => one(v).map(Some),
+        };
+        Some(RawModel {
+            distribution: self.distribution,
+            sigma: self.sigma,
+            q: self.q,
+            shadowing: self.shadowing,
+            n: one(&self.n)?,
+            k: one(&self.k)?,
+            rho_d: optional(&self.rho_d)?,
+            facet: self.facet,
+            rho_s: optional(&self.rho_s)?,
+            d: optional(&self.d)?,
+            n_sub: optional(&self.n_sub)?,
+            d_c: optional(&self.d_c)?,
+            wavelength_um: one(&self.wavelength_um)?,
+            dispersion: self.dispersion.clone(),
+        })
     }
 }
 
@@ -209,13 +206,27 @@ fn check_table(model: &SpectralModel) -> Result<(), ModelTableError> {
     if count < 2 {
         return Err(ModelTableError::ShortTable);
     }
+    let volume = model
+        .volume
+        .keys()
+        .into_iter()
+        .filter_map(|(name, value)| Some((name, value?.table_len()?)));
     for (name, len) in [
         ("n", model.n.len()),
         ("k", model.k.len()),
         ("rho_d", model.rho_d.len()),
-    ] {
+    ]
+    .into_iter()
+    .chain(volume)
+    {
         if len != count {
-            return Err(ModelTableError::Length { name, len, count });
+            let missing_um = model.wavelength_um[len.min(count - 1)];
+            return Err(ModelTableError::Length {
+                name,
+                len,
+                count,
+                missing_um,
+            });
         }
     }
     for &w in &model.wavelength_um {

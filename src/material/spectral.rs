@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 /// A material's model over wavelength.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged, try_from = "super::raw::RawModel<super::raw::OneOrMany>")]
+#[serde(untagged, try_from = "super::raw::RawModel<PerWavelength>")]
 pub enum MaterialModel {
     /// One N = n + ik and ρ_d, used at every wavelength (`wavelength_um` is where it was measured).
     Grey(ModelSpec),
@@ -31,10 +31,78 @@ pub struct SpectralModel {
     pub k: Vec<f64>,
     /// One per wavelength.
     pub rho_d: Vec<f64>,
+    /// The facet side and the subsurface term (docs/design.md §1.10), as a grey model has them.
+    #[serde(flatten)]
+    pub volume: SpectralVolume,
     /// The dispersion law n, k were fitted with, when a law was (`fit --dispersion lorentz:N`);
     /// `n`, `k` hold it evaluated at the table wavelengths, so readers need not know the law.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dispersion: Option<LorentzDispersion>,
+}
+
+/// The volume terms of a spectral model (docs/design.md §1.10): which side of the facets reflects,
+/// and the subsurface term's parameters, each shared by every wavelength (one number: the fit
+/// shared it) or one per table wavelength. Absent keys mean what they mean in a grey model: no
+/// subsurface term without ρ_s, d = 0, n_sub = n, d_c = d.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SpectralVolume {
+    #[serde(default, skip_serializing_if = "FacetSide::is_external")]
+    pub facet: FacetSide,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_s: Option<PerWavelength>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d: Option<PerWavelength>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub n_sub: Option<PerWavelength>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d_c: Option<PerWavelength>,
+}
+
+/// A model parameter over a spectral table: one number for every wavelength, or one per
+/// wavelength (linear in λ between nodes, as n and k).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum PerWavelength {
+    Shared(f64),
+    Each(Vec<f64>),
+}
+
+impl PerWavelength {
+    /// The value at a wavelength, `interpolate` taking a table to its value there.
+    fn at(&self, interpolate: &impl Fn(&[f64]) -> f64) -> f64 {
+        match self {
+            PerWavelength::Shared(value) => *value,
+            PerWavelength::Each(values) => interpolate(values),
+        }
+    }
+
+    /// One number when every wavelength has the same value, else the table.
+    pub fn from_values(values: Vec<f64>) -> PerWavelength {
+        match values.first() {
+            Some(&first) if values.iter().all(|&v| v == first) => PerWavelength::Shared(first),
+            _ => PerWavelength::Each(values),
+        }
+    }
+
+    /// The number of values a table holds (`None` for a shared number).
+    pub fn table_len(&self) -> Option<usize> {
+        match self {
+            PerWavelength::Shared(_) => None,
+            PerWavelength::Each(values) => Some(values.len()),
+        }
+    }
+}
+
+impl SpectralVolume {
+    /// The subsurface keys by name, as a material file writes them.
+    pub fn keys(&self) -> [(&'static str, Option<&PerWavelength>); 4] {
+        [
+            ("rho_s", self.rho_s.as_ref()),
+            ("d", self.d.as_ref()),
+            ("n_sub", self.n_sub.as_ref()),
+            ("d_c", self.d_c.as_ref()),
+        ]
+    }
 }
 
 /// A wavelength outside a spectral material's table.
@@ -129,19 +197,49 @@ impl SpectralModel {
                 values[a] + f * (values[b] - values[a])
             }
         };
+        let volume = |key: &Option<PerWavelength>| key.as_ref().map(|v| v.at(&interpolate));
+        let rho_s = volume(&self.volume.rho_s);
         Ok(ModelSpec {
             distribution: self.distribution,
             shadowing: self.shadowing,
             n: interpolate(&self.n),
             k: interpolate(&self.k),
             rho_d: interpolate(&self.rho_d),
-            facet: FacetSide::External,
-            rho_s: None,
-            d: None,
-            n_sub: None,
-            d_c: None,
+            facet: self.volume.facet,
+            rho_s,
+            // As a grey file reads (material::raw): d is 0 where the subsurface term has none.
+            d: rho_s.map(|_| volume(&self.volume.d).unwrap_or(0.0)),
+            n_sub: volume(&self.volume.n_sub),
+            d_c: volume(&self.volume.d_c),
             wavelength_um,
         })
+    }
+
+    /// The spectral model whose nodes are `nodes`, grey models at ascending wavelengths with one
+    /// slope distribution, shadowing and facet side (a spectral fit's wavelengths): the inverse of
+    /// [`SpectralModel::nodes`]. A subsurface parameter equal at every node is written once.
+    pub fn from_nodes(nodes: &[ModelSpec], dispersion: Option<LorentzDispersion>) -> SpectralModel {
+        let column = |value: fn(&ModelSpec) -> f64| nodes.iter().map(value).collect::<Vec<_>>();
+        let volume = |value: fn(&ModelSpec) -> Option<f64>| {
+            let values: Option<Vec<f64>> = nodes.iter().map(value).collect();
+            values.map(PerWavelength::from_values)
+        };
+        SpectralModel {
+            distribution: nodes[0].distribution,
+            shadowing: nodes[0].shadowing,
+            wavelength_um: column(|m| m.wavelength_um),
+            n: column(|m| m.n),
+            k: column(|m| m.k),
+            rho_d: column(|m| m.rho_d),
+            volume: SpectralVolume {
+                facet: nodes[0].facet,
+                rho_s: volume(|m| m.rho_s),
+                d: volume(|m| m.d),
+                n_sub: volume(|m| m.n_sub),
+                d_c: volume(|m| m.d_c),
+            },
+            dispersion,
+        }
     }
 
     /// The first and last table wavelengths, µm.
@@ -239,6 +337,7 @@ mod tests {
             n: vec![0.5, 1.4, 2.1],
             k: vec![0.5, 2.1, 0.1],
             rho_d: vec![0.0, 0.01, 0.02],
+            volume: SpectralVolume::default(),
             dispersion: None,
         }
     }

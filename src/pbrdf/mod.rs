@@ -30,4 +30,6 @@ pub use model::{Pbrdf, ScatteringGeometry};
 pub use sample::ScatteredView;
 pub use shadowing::Shadowing;
 pub use subsurface::{FacetSide, Subsurface, SubsurfaceKeysWithoutRhoS, Transmission};
-pub use terms::{Body, ModelTerms, OutsideDomain, Parameter, ParameterInfo, Term};
+pub use terms::{
+    Body, ModelTerms, OutsideDomain, Parameter, ParameterInfo, SpectralRole, Term,
+};

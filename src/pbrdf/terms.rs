@@ -130,6 +130,17 @@ impl fmt::Display for ModelTerms {
     }
 }
 
+/// How a parameter varies over the wavelengths of a spectral fit (docs/design.md §1.9–1.10).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpectralRole {
+    /// The surface's geometry: one value for every wavelength, always.
+    Shared,
+    /// Shared unless the fit is asked for one value per wavelength (`--per-wavelength`).
+    SharedByDefault,
+    /// One value per wavelength (a material's index, its reflectances).
+    PerWavelength,
+}
+
 /// What the crate knows about one [`Parameter`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ParameterInfo {
@@ -149,6 +160,8 @@ pub struct ParameterInfo {
     pub default_bounds: (f64, f64),
     /// The `#` line above the key in a material file's `[model]`.
     pub comment: &'static str,
+    /// Whether a spectral fit shares it across wavelengths.
+    pub spectral: SpectralRole,
 }
 
 /// Every parameter's entry, in [`Parameter::ALL`] order.
@@ -162,6 +175,7 @@ const REGISTRY: [ParameterInfo; 9] = [
         domain: (limits::MIN_SIGMA, limits::MAX_SIGMA, false),
         default_bounds: (0.005, 1.5),
         comment: "slope parameter σ (dimensionless): Gaussian rms slope per axis; Cauchy a = 2σ² (q = 2 is GGX, α = √2σ)",
+        spectral: SpectralRole::Shared,
     },
     ParameterInfo {
         key: "q",
@@ -173,6 +187,7 @@ const REGISTRY: [ParameterInfo; 9] = [
         domain: (1.0, limits::MAX_Q, true),
         default_bounds: (1.05, 50.0),
         comment: "Cauchy tail exponent q (> 1; > 1.5 with Smith): small q puts more facets at steep tilts",
+        spectral: SpectralRole::Shared,
     },
     ParameterInfo {
         key: "n",
@@ -183,6 +198,7 @@ const REGISTRY: [ParameterInfo; 9] = [
         domain: (limits::MIN_N, limits::MAX_N, false),
         default_bounds: (0.05, 10.0),
         comment: "real part n of the complex refractive index N = n + ik at wavelength_um",
+        spectral: SpectralRole::PerWavelength,
     },
     ParameterInfo {
         key: "k",
@@ -193,6 +209,7 @@ const REGISTRY: [ParameterInfo; 9] = [
         domain: (0.0, limits::MAX_K, false),
         default_bounds: (0.0, 50.0),
         comment: "extinction coefficient k (imaginary part of N, ≥ 0): absorption",
+        spectral: SpectralRole::PerWavelength,
     },
     ParameterInfo {
         key: "rho_d",
@@ -203,6 +220,7 @@ const REGISTRY: [ParameterInfo; 9] = [
         domain: (0.0, 1.0, false),
         default_bounds: (0.0, 1.0),
         comment: "unpolarized diffuse reflectance ρ_d (0–1): adds ρ_d/π to m00 only",
+        spectral: SpectralRole::PerWavelength,
     },
     ParameterInfo {
         key: "rho_s",
@@ -213,6 +231,7 @@ const REGISTRY: [ParameterInfo; 9] = [
         domain: (0.0, 1.0, false),
         default_bounds: (0.0, 1.0),
         comment: "subsurface reflectance ρ_s (0–1): the fraction of the light refracted in that comes back out, p-polarized by the interface",
+        spectral: SpectralRole::PerWavelength,
     },
     ParameterInfo {
         key: "d",
@@ -223,6 +242,7 @@ const REGISTRY: [ParameterInfo; 9] = [
         domain: (0.0, 1.0, false),
         default_bounds: (0.0, 1.0),
         comment: "residual polarization d (0–1) of the subsurface light: D = diag(1, d, −d, −d) in scattering-plane frames",
+        spectral: SpectralRole::SharedByDefault,
     },
     ParameterInfo {
         key: "n_sub",
@@ -233,6 +253,7 @@ const REGISTRY: [ParameterInfo; 9] = [
         domain: (limits::MIN_N, limits::MAX_N, false),
         default_bounds: (1.0, 4.0),
         comment: "real index of the interface the subsurface light crosses (absent: n)",
+        spectral: SpectralRole::SharedByDefault,
     },
     ParameterInfo {
         key: "d_c",
@@ -243,6 +264,7 @@ const REGISTRY: [ParameterInfo; 9] = [
         domain: (-1.0, 1.0, false),
         default_bounds: (-1.0, 1.0),
         comment: "residual circular polarization d_c (−1–1, at least 2d − 1) of the subsurface light: D's m33 = −d_c (absent: d, a mirror's sign; below 0 helicity is kept)",
+        spectral: SpectralRole::SharedByDefault,
     },
 ];
 

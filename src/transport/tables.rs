@@ -710,6 +710,7 @@ mod tests {
                 0.0359674,
             ],
             rho_d: vec![0.0; 9],
+            volume: Default::default(),
             dispersion: None,
         };
         model.band_pbrdf(band).unwrap()

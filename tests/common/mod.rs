@@ -101,6 +101,7 @@ pub fn silicate_truth() -> Material {
             },
             shadowing: Shadowing::Smith,
             rho_d: vec![0.0; wavelength_um.len()],
+            volume: Default::default(),
             wavelength_um,
             n,
             k,

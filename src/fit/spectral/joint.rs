@@ -1,6 +1,7 @@
-//! The joint least-squares problem of a spectral set (docs/design.md §1.9): one measurement per
-//! wavelength, σ and q shared by all, and per wavelength either free n, k, ρ_d (a table) or ρ_d
-//! free with n, k from a Lorentz law whose parameters are shared.
+//! The joint least-squares problem of a spectral set (docs/design.md §1.9–1.10): one measurement
+//! per wavelength, the geometry (σ, q) and the subsurface's d, n_sub, d_c shared by all (unless
+//! asked per wavelength), and per wavelength either free n, k and the body reflectances (a table)
+//! or the reflectances free with n, k from a Lorentz law whose parameters are shared.
 //!
 //! The search vector is laid out as [shared…, family₁(λ₁…λ_K), family₂(λ₁…λ_K), …]: the shared
 //! coordinates (σ, q, then the law's) move every wavelength's residuals, a family's coordinate of
@@ -39,9 +40,11 @@ pub(crate) struct Block<'a> {
 pub(crate) struct JointProblem<'a> {
     pub blocks: Vec<Block<'a>>,
     pub index_model: IndexModel,
-    /// Shared model parameters (σ, q where free), in canonical order.
+    /// Shared model parameters (σ, q and the shared subsurface ones, where free), in canonical
+    /// order.
     pub shared: Vec<Parameter>,
-    /// Per-wavelength parameters (n, k, ρ_d of a table; ρ_d of a law), in canonical order.
+    /// Per-wavelength parameters (n, k, ρ_d, ρ_s of a table; the reflectances of a law), in
+    /// canonical order.
     pub families: Vec<Parameter>,
     pub lower: Vec<f64>,
     pub upper: Vec<f64>,
@@ -50,14 +53,16 @@ pub(crate) struct JointProblem<'a> {
 
 impl<'a> JointProblem<'a> {
     /// The problem over `blocks` (each with a model space whose free parameters are the shared
-    /// ones plus the families) with the law's box, if any, given by `law_bounds`.
+    /// ones plus the families) with the law's box, if any, given by `law_bounds`; `shared` says
+    /// which parameters take one value for every wavelength.
     pub fn new(
         blocks: Vec<Block<'a>>,
         index_model: IndexModel,
         law_bounds: (Vec<f64>, Vec<f64>),
+        shared: &dyn Fn(Parameter) -> bool,
     ) -> JointProblem<'a> {
         let space = blocks[0].objective.space();
-        let is_shared = |p: &Parameter| matches!(p, Parameter::Sigma | Parameter::Q);
+        let is_shared = |p: &Parameter| shared(*p);
         let shared: Vec<Parameter> = space.free().iter().copied().filter(is_shared).collect();
         let families: Vec<Parameter> = space
             .free()
@@ -100,6 +105,13 @@ impl<'a> JointProblem<'a> {
             IndexModel::Table => 0,
             IndexModel::Lorentz(oscillators) => 1 + LAW_PER_OSCILLATOR * oscillators,
         }
+    }
+
+    /// Where `parameter`'s coordinate of wavelength `j` sits in the search vector, when it is a
+    /// family's.
+    pub fn family_coordinate(&self, parameter: Parameter, j: usize) -> Option<usize> {
+        let f = self.families.iter().position(|&p| p == parameter)?;
+        Some(self.family_index(f, j))
     }
 
     /// Where family `f`'s coordinate of wavelength `j` sits in the search vector.

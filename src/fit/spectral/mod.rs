@@ -17,6 +17,7 @@ mod record;
 
 use super::comparison::{aic, bic};
 use super::data::MeasurementData;
+use super::energy::{check_energy, EnergyCheck, ENERGY_TOLERANCE};
 use super::levenberg_marquardt::{levenberg_marquardt, LeastSquares};
 use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
@@ -35,6 +36,7 @@ use joint::{Block, IndexModel, JointProblem};
 use lorentz_start::{law_bounds, lorentz_start};
 use num_complex::Complex64;
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 
 /// How n and k depend on wavelength in a spectral fit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -86,6 +88,9 @@ pub struct SpectralFit {
     pub n_errors: Vec<f64>,
     pub k_errors: Vec<f64>,
     pub rho_d_errors: Vec<f64>,
+    /// 1-σ errors of the other per-wavelength parameters (ρ_s; d, n_sub, d_c when fitted per
+    /// wavelength) at each wavelength.
+    pub volume_errors: BTreeMap<Parameter, Vec<f64>>,
     pub chi2: f64,
     pub observations: usize,
     pub degrees_of_freedom: usize,
@@ -102,6 +107,10 @@ pub struct SpectralFit {
     pub history: StageHistory,
     /// Model evaluations of the joint stage (residual vectors of every wavelength).
     pub evaluations: u64,
+    /// What the energy constraint did, one line per wavelength it acted on.
+    pub energy: Vec<String>,
+    /// Names of the coordinates (as in `names`) resting on a bound of their search interval.
+    pub at_bound: Vec<String>,
 }
 
 /// A fitted spectral set.
@@ -182,7 +191,7 @@ fn fit_table(
 ) -> Result<SpectralFit, FitError> {
     let space = model_space(kind, options)?;
     let spaces = vec![space; sets.len()];
-    let problem = joint_problem(sets, data, &spaces, options, IndexModel::Table, None);
+    let mut problem = joint_problem(sets, data, &spaces, options, IndexModel::Table, None);
     let median = |p: Parameter| {
         let mut v: Vec<f64> = alone.iter().map(|f| f.value(p)).collect();
         v.sort_by(f64::total_cmp);
@@ -195,7 +204,7 @@ fn fit_table(
     for &p in &problem.families {
         start.extend(alone.iter().map(|fit| to_search(p, fit.value(p))));
     }
-    solve(&problem, sets, &start, options, kind, Dispersion::Table)
+    solve(&mut problem, sets, &start, options, kind, Dispersion::Table)
 }
 
 /// The Lorentz fit with `oscillators`, started from the `table` fit.
@@ -227,7 +236,7 @@ fn fit_lorentz(
         wavelengths[wavelengths.len() - 1],
     );
     let model = IndexModel::Lorentz(oscillators);
-    let problem = joint_problem(sets, data, &spaces, options, model, Some(bounds));
+    let mut problem = joint_problem(sets, data, &spaces, options, model, Some(bounds));
     let shared_start = |p: Parameter| {
         let i = table.names.iter().position(|n| n == p.name());
         to_search(p, i.map_or(1.0, |i| table.values[i]))
@@ -236,15 +245,13 @@ fn fit_lorentz(
     start.extend(law_start);
     for &p in &problem.families {
         for j in 0..sets.len() {
-            let value = match p {
-                Parameter::RhoD => table.model.rho_d[j],
-                _ => 0.0,
-            };
+            let node = table.model.at(table.model.wavelength_um[j]).ok();
+            let value = node.and_then(|m| m.parameter(p)).unwrap_or(0.0);
             start.push(to_search(p, value));
         }
     }
     solve(
-        &problem,
+        &mut problem,
         sets,
         &start,
         options,
@@ -276,12 +283,18 @@ fn joint_problem<'a>(
             }
         })
         .collect();
-    JointProblem::new(blocks, index_model, law_bounds.unwrap_or_default())
+    JointProblem::new(
+        blocks,
+        index_model,
+        law_bounds.unwrap_or_default(),
+        &|p| options.shared_across_wavelengths(p),
+    )
 }
 
-/// Polishes `problem` from `start` and gathers everything about the optimum.
+/// Polishes `problem` from `start` (holding energy at every wavelength) and gathers everything
+/// about the optimum.
 fn solve(
-    problem: &JointProblem,
+    problem: &mut JointProblem,
     sets: &[MeasurementSet],
     start: &[f64],
     options: &FitOptions,
@@ -289,7 +302,8 @@ fn solve(
     dispersion: Dispersion,
 ) -> Result<SpectralFit, FitError> {
     let settings = &options.settings.levenberg_marquardt;
-    let (best, history) = levenberg_marquardt(problem, start, settings);
+    let (best, history, energy) = polish_conserving_energy(problem, start, settings);
+    let problem = &*problem;
     let invalid = || FitError::Optimizer {
         file: sets[0].source.clone(),
         stage: "joint lm".into(),
@@ -311,7 +325,7 @@ fn solve(
     let (errors, correlation, _) =
         linearized_errors(&(physical.transpose() * &physical), reduced_chi2);
     let law = problem.law(&best);
-    let model = spectral_model(sets, &values, kind, options, law.clone());
+    let model = spectral_model(problem, &values, law.clone());
     let wavelength_errors = WavelengthErrors::new(
         problem,
         &coordinates,
@@ -320,6 +334,7 @@ fn solve(
         &errors,
         &correlation,
     );
+    let at_bound = coordinates_at_bound(problem, &coordinates, &best);
     Ok(SpectralFit {
         distribution: kind,
         dispersion,
@@ -329,6 +344,7 @@ fn solve(
         n_errors: wavelength_errors.n,
         k_errors: wavelength_errors.k,
         rho_d_errors: wavelength_errors.rho_d,
+        volume_errors: wavelength_errors.volume,
         errors,
         correlation,
         chi2,
@@ -342,7 +358,83 @@ fn solve(
         normalized_residuals: blocks.normalized_residuals,
         evaluations: history.evaluations,
         history,
+        energy,
+        at_bound,
     })
+}
+
+/// Rounds of the joint energy constraint (each may move the facets and so the bounds).
+const ENERGY_ROUNDS: usize = 4;
+
+/// Levenberg–Marquardt from `start` with docs/design.md §1.10's energy constraint at every
+/// wavelength, as one wavelength's fit holds it ([`super::energy`]): where a wavelength's model
+/// reflects more than 1, its body reflectance gets the largest value that conserves energy as
+/// the upper end of its box, and the whole problem is polished again (the joint form of the
+/// active set). Returns the optimum, the history and what the constraint did.
+fn polish_conserving_energy(
+    problem: &mut JointProblem,
+    start: &[f64],
+    settings: &super::levenberg_marquardt::LevenbergMarquardtSettings,
+) -> (Vec<f64>, StageHistory, Vec<String>) {
+    let (mut best, mut history) = levenberg_marquardt(problem, start, settings);
+    let mut notes = Vec::new();
+    for _ in 0..ENERGY_ROUNDS {
+        let mut held = false;
+        for j in 0..problem.blocks.len() {
+            let values = problem.block_values(&best, j);
+            let at = crate::text::number(problem.blocks[j].wavelength_um);
+            match check_energy(problem.blocks[j].objective.space(), &values) {
+                EnergyCheck::Conserved => {}
+                EnergyCheck::FacetsExceed {
+                    theta_deg,
+                    reflectance,
+                } => notes.push(format!(
+                    "not conserved at {at} µm: the facets alone reflect {reflectance:.4} at θ = \
+                     {theta_deg}°"
+                )),
+                EnergyCheck::HoldBody { parameter, limit } => {
+                    let Some(c) = problem.family_coordinate(parameter, j) else {
+                        continue;
+                    };
+                    problem.upper[c] = to_search(parameter, limit).max(problem.lower[c]);
+                    best[c] = best[c].min(problem.upper[c]);
+                    held = true;
+                    notes.push(format!(
+                        "{parameter} at {at} µm held at {limit:.6}, where the hemispherical \
+                         reflectance reaches 1 + {ENERGY_TOLERANCE}"
+                    ));
+                }
+            }
+        }
+        if !held {
+            break;
+        }
+        let (polished, more) = levenberg_marquardt(problem, &best, settings);
+        best = polished;
+        history.iterations += more.iterations;
+        history.evaluations += more.evaluations;
+        history.best_cost.extend(more.best_cost);
+        history.termination = more.termination;
+    }
+    (best, history, notes)
+}
+
+/// The names of the coordinates resting on a bound of their search interval (within 1e-6 of
+/// its width; a held reflectance counts).
+fn coordinates_at_bound(
+    problem: &JointProblem,
+    coordinates: &[(String, Option<Parameter>, Option<usize>)],
+    best: &[f64],
+) -> Vec<String> {
+    coordinates
+        .iter()
+        .enumerate()
+        .filter(|&(c, _)| {
+            let margin = 1e-6 * (problem.upper[c] - problem.lower[c]);
+            best[c] <= problem.lower[c] + margin || best[c] >= problem.upper[c] - margin
+        })
+        .map(|(_, coordinate)| coordinate.0.clone())
+        .collect()
 }
 
 /// What each wavelength's block of the joint problem gives at the optimum.
@@ -395,31 +487,28 @@ fn physical_coordinates(
     (physical_values, physical)
 }
 
-/// The fitted spectral model: each wavelength's block `values`, and the `law` when n and k
-/// follow one.
+/// The fitted spectral model: each wavelength's model (its block `values` in its block's space:
+/// every term the fit had, as a grey fit writes it), and the `law` when n and k follow one.
 fn spectral_model(
-    sets: &[MeasurementSet],
+    problem: &JointProblem,
     values: &[super::parameters::ParameterValues],
-    kind: DistributionKind,
-    options: &FitOptions,
     law: Option<LorentzDispersion>,
 ) -> SpectralModel {
-    SpectralModel {
-        distribution: kind.with_parameters(|p| values[0].get(p)),
-        shadowing: options.shadowing,
-        wavelength_um: sets.iter().map(|s| s.wavelength_um).collect(),
-        n: values.iter().map(|v| v.get(Parameter::N)).collect(),
-        k: values.iter().map(|v| v.get(Parameter::K)).collect(),
-        rho_d: values.iter().map(|v| v.get(Parameter::RhoD)).collect(),
-        dispersion: law,
-    }
+    let nodes: Vec<_> = problem
+        .blocks
+        .iter()
+        .zip(values)
+        .map(|(block, v)| block.objective.space().model_spec(v, block.wavelength_um))
+        .collect();
+    SpectralModel::from_nodes(&nodes, law)
 }
 
-/// 1-σ errors of n, k and ρ_d at each wavelength.
+/// 1-σ errors of n, k, ρ_d and the other per-wavelength parameters at each wavelength.
 struct WavelengthErrors {
     n: Vec<f64>,
     k: Vec<f64>,
     rho_d: Vec<f64>,
+    volume: BTreeMap<Parameter, Vec<f64>>,
 }
 
 impl WavelengthErrors {
@@ -447,10 +536,17 @@ impl WavelengthErrors {
             None => (family_errors(Parameter::N), family_errors(Parameter::K)),
             Some(law) => propagate_law_errors(law, problem, wavelengths, errors, correlation),
         };
+        let volume = problem
+            .families
+            .iter()
+            .filter(|p| !matches!(p, Parameter::N | Parameter::K | Parameter::RhoD))
+            .map(|&p| (p, family_errors(p)))
+            .collect();
         WavelengthErrors {
             n,
             k,
             rho_d: family_errors(Parameter::RhoD),
+            volume,
         }
     }
 }

@@ -233,6 +233,7 @@ mod tests {
                 n: vec![0.5, 1.4, 2.1],
                 k: vec![0.5, 2.1, 0.1],
                 rho_d: vec![0.0, 0.01, 0.02],
+                volume: Default::default(),
                 dispersion: None,
             }),
             fit: None,
