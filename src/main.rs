@@ -227,12 +227,14 @@ struct FitArgs {
     /// wavelength (table), or from a Lorentz law of N oscillators (lorentz:N).
     #[arg(long, default_value = "table")]
     dispersion: String,
-    /// Model terms (docs/design.md §1.10): external+depolarizer (default), external+subsurface,
-    /// internal+subsurface, internal+depolarizer; several comma-separated (or `all`) are each
-    /// fitted and compared by AIC (and by --cv).
-    #[arg(long, default_value = "external+depolarizer")]
+    /// Model terms (docs/design.md §1.10): auto (default: external+depolarizer,
+    /// external+subsurface and internal+subsurface each fitted, the admissible one that predicts
+    /// best by 5-fold cross-validation kept), or one of those and internal+depolarizer; several
+    /// comma-separated (or `all`) are compared by AIC (and by --cv).
+    #[arg(long, default_value = irpol::app::fit::AUTO_TERMS)]
     terms: String,
-    /// Score each set of terms by K-fold cross-validation and keep the one that predicts best.
+    /// Score each set of terms by K-fold cross-validation (2–20 folds) and keep the one that
+    /// predicts best.
     #[arg(long, value_name = "K")]
     cv: Option<usize>,
     /// Library folder for the material TOMLs.
@@ -550,10 +552,12 @@ fn fit_and_summarize(
             MaterialFit::Spectral(outcome) => spectral_summary_line(outcome, entry),
         };
         say!("{line}");
-        if let MaterialFit::Grey(grey) = outcome {
-            if let Some(choice) = &grey.terms_choice {
-                say!("{}", choice.table());
-            }
+        let choice = match outcome {
+            MaterialFit::Grey(grey) => &grey.terms_choice,
+            MaterialFit::Spectral(spectral) => &spectral.terms_choice,
+        };
+        if let Some(choice) = choice {
+            say!("{}", choice.table());
         }
     }
     for report in &written.reports {

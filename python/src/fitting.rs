@@ -1,7 +1,7 @@
 //! `irpol fit` without writing: the library's fit of each material among the inputs, returned
 //! with its library entry, the uncertainties and correlations, χ² and the per-point residuals.
 
-use crate::errors::{bad_argument, raised};
+use crate::errors::raised;
 use crate::material::PyMaterial;
 use crate::measurements::{measurement_args, set_dict};
 use irpol::app::fit::FitFlags;
@@ -15,13 +15,14 @@ use std::path::PathBuf;
 
 /// Fits every material among `inputs` (CSV files or folders) with the options `irpol fit` takes
 /// as flags (same names, same defaults, same messages; `layout`, `wavelength_um`, `theta_i_deg`
-/// are `--layout`, `--wavelength`, `--theta-i`; `terms` one set of `--terms`); one dict per material, in the order `irpol fit`
+/// are `--layout`, `--wavelength`, `--theta-i`; `terms` is `--terms`, `auto` by default); one
+/// dict per material, in the order `irpol fit`
 /// reports them.
 #[pyfunction]
 #[pyo3(signature = (inputs, *, distribution = None, shadowing = "smith".to_owned(), free = None,
     fix = None, optimizer = "ga+lm".to_owned(), seed = None, robust = None,
     dispersion = "table".to_owned(), layout = None, wavelength_um = None, theta_i_deg = None,
-    terms = "external+depolarizer".to_owned()))]
+    terms = irpol::app::fit::AUTO_TERMS.to_owned()))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_materials(
     py: Python<'_>,
@@ -39,13 +40,6 @@ pub fn fit_materials(
     theta_i_deg: Option<Vec<f64>>,
     terms: String,
 ) -> PyResult<Vec<Bound<'_, PyDict>>> {
-    if terms.contains(',') || terms.trim() == "all" {
-        return Err(bad_argument(format!(
-            "terms = '{}': fit one set of terms at a time (choosing among several, by AIC and \
-             cross-validation, is `irpol fit --terms LIST --cv K`)",
-            irpol::text::shown(&terms)
-        )));
-    }
     let flags = FitFlags {
         distribution,
         shadowing,

@@ -37,9 +37,9 @@ pub struct FitFlags {
     pub robust: Option<String>,
     /// `table` or `lorentz:N`.
     pub dispersion: String,
-    /// The model's terms, or several to choose among: `external+depolarizer` (default),
-    /// `external+subsurface`, `internal+subsurface`, `internal+depolarizer`, comma-separated, or
-    /// `all`.
+    /// The model's terms, or several to choose among: `auto` (the default: the admissible set
+    /// that predicts best, docs/design.md §1.10), `external+depolarizer`, `external+subsurface`,
+    /// `internal+subsurface`, `internal+depolarizer`, comma-separated, or `all`.
     pub terms: String,
     /// K-fold cross-validation (K ≥ 2) of each candidate set of terms.
     pub cv: Option<usize>,
@@ -57,7 +57,7 @@ impl Default for FitFlags {
             seed: FitOptions::default().seed,
             robust: None,
             dispersion: "table".into(),
-            terms: ModelTerms::default().to_string(),
+            terms: AUTO_TERMS.to_owned(),
             cv: None,
         }
     }
@@ -91,7 +91,8 @@ impl FitFlags {
         if let Some(loss) = &self.robust {
             options.robust = Some(RobustLoss::parse(loss)?);
         }
-        let candidates = parse_terms(&self.terms)?;
+        options.choose_terms = self.terms.trim() == AUTO_TERMS;
+        let candidates = terms_with_parameters(parse_terms(&self.terms)?, &options)?;
         options.terms = candidates[0];
         if candidates.len() > 1 {
             options.term_candidates = candidates;
@@ -101,9 +102,48 @@ impl FitFlags {
     }
 }
 
-/// `--terms`: one or more sets of model terms, comma-separated, or `all`.
+/// `--terms auto`: choose among [`ModelTerms::ALL`] (docs/design.md §1.10).
+pub const AUTO_TERMS: &str = "auto";
+
+/// The `candidates` that have every parameter `--free` and `--fix` name: under `auto` the others
+/// are dropped (`--fix rho_s=…` asks for a subsurface term); a set given by name that lacks one
+/// is refused, so that no flag is silently ignored.
+fn terms_with_parameters(
+    candidates: Vec<ModelTerms>,
+    options: &FitOptions,
+) -> Result<Vec<ModelTerms>, AppError> {
+    let named: Vec<crate::pbrdf::Parameter> = options
+        .free
+        .iter()
+        .flatten()
+        .chain(options.fixed.keys())
+        .copied()
+        .collect();
+    let has_all = |t: &ModelTerms| named.iter().all(|&p| t.has(p));
+    if options.choose_terms {
+        let kept: Vec<ModelTerms> = candidates.into_iter().filter(has_all).collect();
+        if kept.is_empty() {
+            return Err(AppError::invalid(
+                "--free/--fix name parameters of different terms (rho_d belongs to the \
+                 depolarizer, rho_s, d, n_sub, d_c to the subsurface term): give --terms",
+            ));
+        }
+        return Ok(kept);
+    }
+    for terms in &candidates {
+        if let Some(p) = named.iter().find(|&&p| !terms.has(p)) {
+            return Err(AppError::invalid(format!(
+                "--free/--fix name {p}, which the terms {terms} do not have: drop it or choose \
+                 terms that have it (--terms)"
+            )));
+        }
+    }
+    Ok(candidates)
+}
+
+/// `--terms`: one or more sets of model terms, comma-separated, or `all` or `auto`.
 fn parse_terms(text: &str) -> Result<Vec<ModelTerms>, AppError> {
-    if text.trim() == "all" {
+    if text.trim() == "all" || text.trim() == AUTO_TERMS {
         return Ok(ModelTerms::ALL.to_vec());
     }
     let mut list = Vec::new();
@@ -111,7 +151,7 @@ fn parse_terms(text: &str) -> Result<Vec<ModelTerms>, AppError> {
         let terms = ModelTerms::parse(name).ok_or_else(|| {
             let known: Vec<String> = ModelTerms::ALL.iter().map(|t| t.to_string()).collect();
             AppError::invalid(format!(
-                "unknown terms '{name}' in --terms: use {} (comma-separated) or all",
+                "unknown terms '{name}' in --terms: use {} (comma-separated), all or auto",
                 known.join(", ")
             ))
         })?;

@@ -7,16 +7,19 @@
 //! so the global search would find the same basin at ten times the cost.
 //!
 //! Score = Σ r² over held-out observations / their number (≈ 1 for a model that predicts within
-//! the stated uncertainties). The chosen terms are those with the lowest cross-validated score
-//! when folds were asked for, else the lowest AIC; both are reported side by side.
+//! the stated uncertainties), with its standard error from the folds' scatter. Only physically
+//! admissible models compete ([`super::admissible`]); among them the kept terms are the fewest
+//! parameters whose score is within one standard error of the best (the one-standard-error rule:
+//! data made by §1.3's model come back as §1.3's model), or the lowest AIC without folds. Both
+//! are reported side by side.
 
+use super::admissible::why_inadmissible;
 use super::data::MeasurementData;
 use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
 use super::options::FitOptions;
-use super::outcome::{fit_measurement, FitOutcome};
+use super::outcome::{finish, fit_distributions, fit_measurement, FitOutcome, Fitted};
 use super::stages::Optimizer;
-use super::terms_choice::lowest;
 pub use super::terms_choice::{TermsChoice, TermsScore};
 use super::FitError;
 use crate::measure::MeasurementSet;
@@ -24,65 +27,80 @@ use crate::pbrdf::ModelTerms;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 
+/// Most folds `--cv` takes: each fold is a refit, and past ten or twenty folds the score
+/// changes less than its own scatter while the cost keeps growing.
+pub const MAX_FOLDS: usize = 20;
+
+/// Folds the default choice of terms takes ([`FitOptions::choose_terms`]).
+pub const DEFAULT_FOLDS: usize = 5;
+
+/// Fewest rows per fold for the default choice to cross-validate; a smaller set is compared by
+/// AIC (docs/design.md §1.10).
+pub const MIN_ROWS_PER_FOLD: usize = 10;
+
 /// Fits one grey measurement as `options` ask: its `terms` alone, or choosing among
 /// `term_candidates` (by cross-validation with `cv_folds`, else by AIC).
 pub fn fit_grey(set: &MeasurementSet, options: &FitOptions) -> Result<FitOutcome, FitError> {
     if options.term_candidates.is_empty() && options.cv_folds.is_none() {
         return fit_measurement(set, options);
     }
-    let candidates = if options.term_candidates.is_empty() {
-        vec![options.terms]
-    } else {
-        options.term_candidates.clone()
-    };
-    let (mut outcome, choice) = fit_choosing_terms(set, options, &candidates, options.cv_folds)?;
+    let (mut outcome, choice) =
+        fit_choosing_terms(set, options, &candidates(options), folds_for(set, options)?)?;
     outcome.terms_choice = Some(choice);
     Ok(outcome)
 }
 
-/// Fits `set` with each of `candidates` (in order) and keeps the one that predicts best
-/// (module docs). `folds` of `Some(K)` needs 2 ≤ K ≤ rows.
+/// The candidate sets of terms `options` ask to choose among (its `terms` alone when none).
+pub(super) fn candidates(options: &FitOptions) -> Vec<ModelTerms> {
+    if options.term_candidates.is_empty() {
+        vec![options.terms]
+    } else {
+        options.term_candidates.clone()
+    }
+}
+
+/// The folds of `set`'s choice: `--cv K` as given (2 ≤ K ≤ min(rows, [`MAX_FOLDS`])), or for
+/// the default choice [`DEFAULT_FOLDS`] where each fold has [`MIN_ROWS_PER_FOLD`] rows (else
+/// AIC).
+pub(super) fn folds_for(
+    set: &MeasurementSet,
+    options: &FitOptions,
+) -> Result<Option<usize>, FitError> {
+    let rows = set.points.len();
+    match options.cv_folds {
+        Some(k) if k < 2 || k > rows.min(MAX_FOLDS) => Err(FitError::Options(format!(
+            "--cv {k}: the folds must number from 2 to {} (each fold refits the model; 5 or \
+             10 are usual; the measurement has {rows} rows)",
+            rows.min(MAX_FOLDS)
+        ))),
+        Some(k) => Ok(Some(k)),
+        None if options.choose_terms && rows >= DEFAULT_FOLDS * MIN_ROWS_PER_FOLD => {
+            Ok(Some(DEFAULT_FOLDS))
+        }
+        None => Ok(None),
+    }
+}
+
+/// Fits `set` with each of `candidates` (in order) and keeps the admissible one that predicts
+/// best ([`TermsChoice::choose`]). `folds` of `Some(K)` needs 2 ≤ K ≤ rows.
 pub fn fit_choosing_terms(
     set: &MeasurementSet,
     options: &FitOptions,
     candidates: &[ModelTerms],
     folds: Option<usize>,
 ) -> Result<(FitOutcome, TermsChoice), FitError> {
-    if let Some(k) = folds {
-        if k < 2 || k > set.points.len() {
-            return Err(FitError::Options(format!(
-                "--cv {k}: the folds must number from 2 to the rows of the measurement ({})",
-                set.points.len()
-            )));
-        }
-    }
-    let mut outcomes = Vec::new();
+    let data = MeasurementData::new(set)?;
+    let mut fitted = Vec::new();
     let mut scores = Vec::new();
     for &terms in candidates {
-        let options = FitOptions {
-            terms,
-            ..options.clone()
-        };
-        let outcome = fit_measurement(set, &options)?;
-        let cv_score = match folds {
-            Some(k) => Some(cross_validate(set, &options, &outcome.chosen, k)?),
-            None => None,
-        };
-        scores.push(TermsScore {
-            terms,
-            distribution: outcome.chosen.distribution,
-            free_parameters: outcome.chosen.free.len(),
-            reduced_chi2: outcome.chosen.reduced_chi2,
-            aic: outcome.chosen.aic,
-            cv_score,
-        });
-        outcomes.push(outcome);
+        let options = options.with_terms(terms);
+        let (fit, score) = score_terms(set, &data, &options, folds)?;
+        fitted.push(fit);
+        scores.push(score);
     }
-    let chosen = match folds {
-        Some(_) => lowest(scores.iter().map(|s| s.cv_score.unwrap_or(f64::INFINITY))),
-        None => lowest(scores.iter().map(|s| s.aic)),
-    };
-    let outcome = outcomes.swap_remove(chosen);
+    let chosen = TermsChoice::choose(&scores, folds.is_some());
+    let options = options.with_terms(candidates[chosen]);
+    let outcome = finish(set, &data, &options, fitted.swap_remove(chosen))?;
     Ok((
         outcome,
         TermsChoice {
@@ -91,6 +109,75 @@ pub fn fit_choosing_terms(
             folds,
         },
     ))
+}
+
+/// One candidate's fits (`options.terms`) and scores: χ², AIC, the folds' held-out residuals
+/// when `folds` are asked for, and whether the model is admissible.
+pub(super) fn score_terms(
+    set: &MeasurementSet,
+    data: &MeasurementData,
+    options: &FitOptions,
+    folds: Option<usize>,
+) -> Result<(Fitted, TermsScore), FitError> {
+    let fitted = fit_distributions(set, data, options)?;
+    let fit = &fitted.chosen;
+    let folds = match folds {
+        Some(k) => cross_validate(set, options, fit, k)?,
+        None => Vec::new(),
+    };
+    let score = TermsScore {
+        terms: options.terms,
+        distribution: fit.distribution,
+        free_parameters: fit.free.len(),
+        reduced_chi2: fit.reduced_chi2,
+        aic: fit.aic,
+        folds,
+        inadmissible: why_inadmissible(&[&fit.model], &[&fit.model_muellers]),
+    };
+    Ok((fitted, score))
+}
+
+/// Chooses the terms of a material measured at several wavelengths as one (docs/design.md
+/// §1.10): each candidate fitted at every wavelength, its scores added up over the wavelengths
+/// (the folds' held-out residuals fold by fold) and its admissibility judged on all of them
+/// together. Returns the kept terms and the record of the choice.
+pub(super) fn choose_spectral_terms(
+    sets: &[MeasurementSet],
+    options: &FitOptions,
+) -> Result<TermsChoice, FitError> {
+    let folds = sets
+        .iter()
+        .map(|set| folds_for(set, options))
+        .collect::<Result<Vec<_>, _>>()?;
+    // One rule for the whole set: folds only where every wavelength can be folded.
+    let folds = folds.iter().copied().min().flatten();
+    let data = sets
+        .iter()
+        .map(MeasurementData::new)
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut scores = Vec::new();
+    for terms in candidates(options) {
+        let options = options.with_terms(terms);
+        let parts = sets
+            .iter()
+            .zip(&data)
+            .map(|(set, data)| score_terms(set, data, &options, folds))
+            .collect::<Result<Vec<_>, _>>()?;
+        let models: Vec<_> = parts.iter().map(|p| &p.0.chosen.model).collect();
+        let muellers: Vec<_> = parts
+            .iter()
+            .map(|p| p.0.chosen.model_muellers.as_slice())
+            .collect();
+        let inadmissible = why_inadmissible(&models, &muellers);
+        let part_scores: Vec<TermsScore> = parts.into_iter().map(|p| p.1).collect();
+        scores.push(TermsScore::combined(&part_scores, inadmissible));
+    }
+    let chosen = TermsChoice::choose(&scores, folds.is_some());
+    Ok(TermsChoice {
+        scores,
+        chosen,
+        folds,
+    })
 }
 
 /// The rows of each of `k` folds: a seeded shuffle dealt round-robin.
@@ -115,21 +202,22 @@ pub fn subset(set: &MeasurementSet, rows: &[usize]) -> MeasurementSet {
     }
 }
 
-/// K-fold cross-validated score of the family of `fit` (module docs). Each fold's refit is
-/// constrained like the whole-data fit (energy, [`super::energy`]).
+/// Σ r² and the count of the held-out observations of each of K folds, for the family of `fit`
+/// (module docs). Each fold's refit is constrained like the whole-data fit (energy,
+/// [`super::energy`]).
 fn cross_validate(
     set: &MeasurementSet,
     options: &FitOptions,
     fit: &ModelFit,
     k: usize,
-) -> Result<f64, FitError> {
+) -> Result<Vec<(f64, usize)>, FitError> {
     let options = FitOptions {
         distribution: Some(fit.distribution),
         optimizer: Optimizer::parse("lm").expect("lm is a stage"),
         start: fit.free.iter().copied().zip(fit.values.clone()).collect(),
         ..options.clone()
     };
-    let (mut total, mut count) = (0.0, 0usize);
+    let mut folds = Vec::with_capacity(k);
     for held_out in fold_rows(set.points.len(), k, options.seed) {
         let training: Vec<usize> = (0..set.points.len())
             .filter(|r| held_out.binary_search(r).is_err())
@@ -148,10 +236,9 @@ fn cross_validate(
         let residuals = Objective::new(&test_data, &space, None)
             .normalized_residuals(&refit.parameter_values(&effective))
             .unwrap_or_default();
-        total += residuals.iter().map(|r| r * r).sum::<f64>();
-        count += residuals.len();
+        folds.push((residuals.iter().map(|r| r * r).sum::<f64>(), residuals.len()));
     }
-    Ok(total / count.max(1) as f64)
+    Ok(folds)
 }
 
 #[cfg(test)]

@@ -102,8 +102,7 @@ pub fn fit_inputs_with(
             super::cross_validation::fit_grey(&sets[0], options)
                 .map(|o| MaterialFit::Grey(Box::new(o)))
         } else {
-            fit_spectral(sets, options, options.dispersion)
-                .map(|o| MaterialFit::Spectral(Box::new(o)))
+            fit_spectral_choosing_terms(sets, options).map(|o| MaterialFit::Spectral(Box::new(o)))
         };
         progress.advance(1);
         let mut outcome = outcome.inspect_err(|_| progress.abandon())?;
@@ -112,6 +111,22 @@ pub fn fit_inputs_with(
     }
     progress.end();
     Ok(outcomes)
+}
+
+/// The joint fit of a spectral set (`fit_spectral`), with its terms chosen for the whole set
+/// first when `options` ask for a choice (docs/design.md §1.10).
+fn fit_spectral_choosing_terms(
+    sets: Vec<MeasurementSet>,
+    options: &FitOptions,
+) -> Result<SpectralFitOutcome, FitError> {
+    if options.term_candidates.is_empty() && options.cv_folds.is_none() {
+        return fit_spectral(sets, options, options.dispersion);
+    }
+    let choice = super::cross_validation::choose_spectral_terms(&sets, options)?;
+    let options = options.with_terms(choice.scores[choice.chosen].terms);
+    let mut outcome = fit_spectral(sets, &options, options.dispersion)?;
+    outcome.terms_choice = Some(choice);
+    Ok(outcome)
 }
 
 /// Writes how the files were read into the fit record: the layout given (a layout the file

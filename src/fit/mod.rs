@@ -13,6 +13,7 @@
 //!
 //! Entry points: [`fit_measurement`] for one set, [`fit_files`] for `irpol fit`.
 
+mod admissible;
 mod comparison;
 mod cross_validation;
 mod data;
@@ -40,8 +41,10 @@ mod uncertainty;
 mod validation;
 
 pub use comparison::{aic, bic, Candidate, ModelComparison};
+pub use admissible::{why_inadmissible, STRONG_ABSORPTION_K};
 pub use cross_validation::{
-    fit_choosing_terms, fit_grey, fold_rows, subset, TermsChoice, TermsScore,
+    fit_choosing_terms, fit_grey, fold_rows, subset, TermsChoice, TermsScore, DEFAULT_FOLDS,
+    MAX_FOLDS,
 };
 pub use data::{
     ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00,

@@ -24,6 +24,11 @@ pub struct FitOptions {
     pub term_candidates: Vec<ModelTerms>,
     /// K of K-fold cross-validation (`--cv K`), reported beside AIC and deciding the terms.
     pub cv_folds: Option<usize>,
+    /// The default choice of terms (`irpol fit` without `--terms`, docs/design.md §1.10):
+    /// without `cv_folds`, the candidates are cross-validated with
+    /// [`super::cross_validation::DEFAULT_FOLDS`] where the set is large enough, else compared
+    /// by AIC.
+    pub choose_terms: bool,
     /// Adjustable parameters; `None` = every parameter the terms fit by default
     /// ([`ModelTerms::fitted_by_default`]) that is not in `fixed`. q is ignored for the Gaussian.
     pub free: Option<Vec<Parameter>>,
@@ -55,6 +60,7 @@ impl Default for FitOptions {
             terms: ModelTerms::default(),
             term_candidates: Vec::new(),
             cv_folds: None,
+            choose_terms: false,
             free: None,
             fixed: BTreeMap::new(),
             start: BTreeMap::new(),
@@ -94,6 +100,14 @@ impl FitOptions {
                 }
                 Ok(free.clone())
             }
+        }
+    }
+
+    /// These options with `terms` as the model's terms.
+    pub fn with_terms(&self, terms: ModelTerms) -> FitOptions {
+        FitOptions {
+            terms,
+            ..self.clone()
         }
     }
 

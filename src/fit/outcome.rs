@@ -32,30 +32,72 @@ pub struct FitOutcome {
 /// the alternative. Deterministic for a given `options.seed`.
 pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<FitOutcome, FitError> {
     let data = MeasurementData::new(set)?;
+    let fitted = fit_distributions(set, &data, options)?;
+    finish(set, &data, options, fitted)
+}
+
+/// The fits of one measurement before the profile bounds: the kept distribution's, the other's
+/// and their comparison.
+#[derive(Clone, Debug)]
+pub(super) struct Fitted {
+    pub chosen: ModelFit,
+    pub alternative: Option<ModelFit>,
+    pub comparison: Option<ModelComparison>,
+}
+
+/// [`fit_measurement`]'s fits of every requested distribution, and which is kept.
+pub(super) fn fit_distributions(
+    set: &MeasurementSet,
+    data: &MeasurementData,
+    options: &FitOptions,
+) -> Result<Fitted, FitError> {
     let (first, second) = match options.distribution {
-        Some(kind) => (fit_model(set, &data, kind, options)?, None),
+        Some(kind) => (fit_model(set, data, kind, options)?, None),
         None => {
             let (cauchy, gaussian) = rayon::join(
-                || fit_model(set, &data, DistributionKind::Cauchy, options),
-                || fit_model(set, &data, DistributionKind::Gaussian, options),
+                || fit_model(set, data, DistributionKind::Cauchy, options),
+                || fit_model(set, data, DistributionKind::Gaussian, options),
             );
             (cauchy?, Some(gaussian?))
         }
     };
-    let (chosen, alternative, comparison) = match second {
-        None => (first, None, None),
+    Ok(match second {
+        None => Fitted {
+            chosen: first,
+            alternative: None,
+            comparison: None,
+        },
         Some(second) => {
             let comparison = ModelComparison::among(&[first.candidate(), second.candidate()])
                 .expect("two fits compare");
-            if comparison.preferred == first.distribution {
-                (first, Some(second), Some(comparison))
+            let (chosen, alternative) = if comparison.preferred == first.distribution {
+                (first, second)
             } else {
-                (second, Some(first), Some(comparison))
+                (second, first)
+            };
+            Fitted {
+                chosen,
+                alternative: Some(alternative),
+                comparison: Some(comparison),
             }
         }
-    };
-    let mut chosen = chosen;
-    chosen.add_profile_bounds(&data, options)?;
+    })
+}
+
+/// The outcome of the `fitted` model that is kept: its profile bounds (each costs dozens of
+/// local fits, so only the kept fit gets them) and its library entry.
+pub(super) fn finish(
+    set: &MeasurementSet,
+    data: &MeasurementData,
+    options: &FitOptions,
+    fitted: Fitted,
+) -> Result<FitOutcome, FitError> {
+    let Fitted {
+        mut chosen,
+        alternative,
+        comparison,
+    } = fitted;
+    chosen.add_profile_bounds(data, options)?;
     let options = &chosen.effective_options(options);
     let material = Material {
         name: set.material.clone(),
@@ -63,7 +105,7 @@ pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<Fit
         model: crate::material::MaterialModel::Grey(chosen.model.clone()),
         fit: Some(fit_record(
             set,
-            &data,
+            data,
             options,
             &chosen,
             alternative.as_ref(),

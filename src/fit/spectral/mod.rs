@@ -126,6 +126,8 @@ pub struct SpectralFitOutcome {
     pub alternative: Option<SpectralFit>,
     /// Each wavelength's own fit (chosen distribution), where the joint fit started.
     pub per_wavelength: Vec<ModelFit>,
+    /// How the model's terms were chosen for the whole set, when there was a choice.
+    pub terms_choice: Option<super::TermsChoice>,
 }
 
 /// Fits the sets (one material, one per wavelength, ascending) jointly.
@@ -178,6 +180,7 @@ pub fn fit_spectral(
         table,
         alternative,
         per_wavelength,
+        terms_choice: None,
     })
 }
 
