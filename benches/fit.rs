@@ -51,7 +51,7 @@ fn shipped(name: &str) -> MeasurementSet {
 fn objective(c: &mut Criterion) {
     let set = synthetic();
     let data = MeasurementData::new(&set).unwrap();
-    let values = ParameterValues([0.15, 2.5, 1.6, 0.05, 0.01, 0.5, 0.0, 1.5, 0.0]);
+    let values = ParameterValues([0.15, 2.5, 1.6, 0.05, 0.01, 0.5, 0.0, 1.5, 0.0, 0.0]);
     for kind in [DistributionKind::Cauchy, DistributionKind::Gaussian] {
         let space = ModelSpace::new(
             kind,

@@ -61,7 +61,7 @@ fn tolerance(parameter: Parameter, true_value: f64) -> f64 {
         Parameter::K => 0.02,
         Parameter::RhoD => 0.005,
         // Not in the shipped measurements' model (docs/design.md §1.10's terms).
-        Parameter::RhoS | Parameter::D | Parameter::NSub | Parameter::DC => {
+        Parameter::RhoS | Parameter::D | Parameter::NSub | Parameter::DC | Parameter::D1 => {
             unreachable!("{parameter}")
         }
     }

@@ -145,6 +145,7 @@ fn materials() -> Vec<(String, Pbrdf)> {
                     d: sub_d,
                     n_sub: None,
                     d_c,
+                    d1: None,
                 }),
             )
             .unwrap()

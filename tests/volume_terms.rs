@@ -37,6 +37,7 @@ fn subsurface(rho_s: f64, d: f64) -> Option<Subsurface> {
         d,
         n_sub: None,
         d_c: None,
+        d1: None,
     })
 }
 
@@ -118,6 +119,7 @@ fn subsurface_term_conserves_energy_and_stays_realizable() {
                     d,
                     n_sub: Some(n),
                     d_c,
+                    d1: None,
                 }),
             )
             .unwrap();
@@ -160,6 +162,7 @@ fn an_unrealizable_subsurface_depolarizer_is_refused() {
                 d,
                 n_sub: None,
                 d_c: Some(d_c),
+                d1: None,
             }),
         )
     };

@@ -272,6 +272,9 @@ fn volume_terms(model: &irpol::material::ModelSpec) -> String {
         if let Some(d_c) = s.d_c {
             text.push_str(&format!(", d_c={}", py_float(d_c)));
         }
+        if let Some(d1) = s.d1 {
+            text.push_str(&format!(", d1={}", py_float(d1)));
+        }
     }
     text
 }

@@ -65,6 +65,10 @@ pub struct ModelArgs {
     /// Residual circular polarization d_c of the subsurface term (needs --rho-s; default --d).
     #[arg(long = "d-c", allow_negative_numbers = true)]
     pub d_c: Option<f64>,
+    /// Change of the subsurface term's residual polarization with the scattering angle Θ,
+    /// d(Θ) = d + d1 cos Θ (needs --rho-s; default 0).
+    #[arg(long, allow_negative_numbers = true)]
+    pub d1: Option<f64>,
     /// Shadowing: none, torrance-sparrow or smith (default smith, as `fit`; with --material,
     /// the material's own).
     #[arg(long)]
@@ -85,7 +89,7 @@ pub enum ModelArgsError {
     UnknownShadowing(String),
     #[error("unknown facet side '{}': use external or internal", crate::text::shown(.0))]
     UnknownFacet(String),
-    #[error("--d, --n-sub and --d-c belong to the subsurface term: give --rho-s too")]
+    #[error("--d, --n-sub, --d-c and --d1 belong to the subsurface term: give --rho-s too")]
     PolarizationWithoutSubsurface,
     #[error(
         "give either --material or model parameters (--distribution --sigma --q --n --k \
@@ -171,7 +175,7 @@ impl ModelArgs {
     /// `--facet`, `--rho-s`, `--d`, `--n-sub` and `--d-c` applied to `model` (docs/design.md
     /// §1.10).
     fn with_volume_terms(&self, model: Pbrdf) -> Result<Pbrdf, ModelArgsError> {
-        let subsurface = Subsurface::from_keys(self.rho_s, self.d, self.n_sub, self.d_c)
+        let subsurface = Subsurface::from_keys(self.rho_s, self.d, self.n_sub, self.d_c, self.d1)
             .map_err(|_| ModelArgsError::PolarizationWithoutSubsurface)?;
         if self.facet.is_none() && subsurface.is_none() {
             return Ok(model);
@@ -200,6 +204,7 @@ impl ModelArgs {
             ("--d", self.d.is_some()),
             ("--n-sub", self.n_sub.is_some()),
             ("--d-c", self.d_c.is_some()),
+            ("--d1", self.d1.is_some()),
         ]
         .into_iter()
         .filter_map(|(flag, set)| set.then_some(flag))
@@ -267,6 +272,9 @@ pub fn model_header(model: &Pbrdf) -> String {
             }
             if let Some(d_c) = s.d_c {
                 header.push_str(&format!(", d_c = {d_c}"));
+            }
+            if let Some(d1) = s.d1 {
+                header.push_str(&format!(", d1 = {d1}"));
             }
         }
         header.push('\n');

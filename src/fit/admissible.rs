@@ -92,6 +92,7 @@ mod tests {
             d: None,
             n_sub: None,
             d_c: None,
+            d1: None,
             wavelength_um: 1.064,
         }
     }

@@ -121,15 +121,15 @@ fn local_stages(optimizer: &Optimizer) -> Vec<Stage> {
         .collect()
 }
 
-/// Restart points of the local stages (physical σ, q, n, k, ρ_d, ρ_s, d, n_sub, d_c in [`Parameter::ALL`]
+/// Restart points of the local stages (physical σ, q, n, k, ρ_d, ρ_s, d, n_sub, d_c, d1 in [`Parameter::ALL`]
 /// order; only the free parameters are taken from them): smooth, medium and rough surfaces with
 /// low and high index, each with some absorption so that no restart sits on the k = 0
 /// stationary boundary.
 const RESTARTS: [[f64; Parameter::ALL.len()]; 4] = [
-    [0.03, 3.0, 2.0, 0.1, 0.01, 0.5, 0.1, 2.0, 0.1],
-    [0.1, 2.0, 1.5, 0.3, 0.01, 0.8, 0.3, 1.5, -0.1],
-    [0.3, 3.0, 1.5, 0.05, 0.03, 0.3, 0.05, 1.3, 0.0],
-    [0.1, 8.0, 3.0, 1.0, 0.01, 0.9, 0.5, 2.5, 0.5],
+    [0.03, 3.0, 2.0, 0.1, 0.01, 0.5, 0.1, 2.0, 0.1, 0.0],
+    [0.1, 2.0, 1.5, 0.3, 0.01, 0.8, 0.3, 1.5, -0.1, 0.0],
+    [0.3, 3.0, 1.5, 0.05, 0.03, 0.3, 0.05, 1.3, 0.0, 0.0],
+    [0.1, 8.0, 3.0, 1.0, 0.01, 0.9, 0.5, 2.5, 0.5, 0.0],
 ];
 /// Values of k tried from a result in the k = 0 trap.
 const EXTINCTION_RESTARTS: [f64; 2] = [0.1, 1.0];
@@ -167,7 +167,8 @@ fn trap_at(objective: &Objective, point: &[f64]) -> Option<Trap> {
             | Parameter::RhoS
             | Parameter::D
             | Parameter::NSub
-            | Parameter::DC => false,
+            | Parameter::DC
+            | Parameter::D1 => false,
         }
     });
     let zero_extinction = space.free().contains(&Parameter::K)

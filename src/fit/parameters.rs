@@ -16,6 +16,7 @@
 //! | ρ_s, d    | [0, 1]                              | ρ_s, d             | enter the subsurface term linearly |
 //! | n_sub     | [1, 4]                              | n_sub              | as n                              |
 //! | d_c       | [−1, 1]                             | d_c                | enters m33 linearly               |
+//! | d1        | [−1, 1]                             | d1                 | as d                              |
 //!
 //! The genetic stage samples the search box; the local stages add a sine map on top of it
 //! (MINUIT's bounded transform) so that Nelder–Mead runs unconstrained and can settle exactly on
@@ -42,6 +43,7 @@ impl Parameter {
             Parameter::D => 0.0,
             Parameter::NSub => 1.5,
             Parameter::DC => 0.0,
+            Parameter::D1 => 0.0,
         }
     }
 
@@ -58,13 +60,14 @@ impl Parameter {
             Parameter::D => 0.1,
             Parameter::NSub => 1.4,
             Parameter::DC => 0.0,
+            Parameter::D1 => 0.0,
         }
     }
 }
 
 /// One value per [`Parameter`], in canonical order.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ParameterValues(pub [f64; 9]);
+pub struct ParameterValues(pub [f64; Parameter::COUNT]);
 
 impl ParameterValues {
     pub fn get(&self, parameter: Parameter) -> f64 {
@@ -104,6 +107,7 @@ pub struct ParameterBounds {
     pub d: Interval,
     pub n_sub: Interval,
     pub d_c: Interval,
+    pub d1: Interval,
 }
 
 /// Lowest q searched with Smith shadowing: Λ of the Cauchy distribution exists only for q > 3/2
@@ -127,6 +131,7 @@ impl Default for ParameterBounds {
             d: interval(Parameter::D),
             n_sub: interval(Parameter::NSub),
             d_c: interval(Parameter::DC),
+            d1: interval(Parameter::D1),
         }
     }
 }
@@ -143,6 +148,7 @@ impl ParameterBounds {
             Parameter::D => self.d,
             Parameter::NSub => self.n_sub,
             Parameter::DC => self.d_c,
+            Parameter::D1 => self.d1,
         }
     }
 
@@ -196,7 +202,8 @@ pub fn to_search(parameter: Parameter, value: f64) -> f64 {
         | Parameter::RhoS
         | Parameter::D
         | Parameter::NSub
-        | Parameter::DC => value,
+        | Parameter::DC
+        | Parameter::D1 => value,
         Parameter::K => (value / K_SCALE).asinh(),
     }
 }
@@ -211,7 +218,8 @@ pub fn from_search(parameter: Parameter, coordinate: f64) -> f64 {
         | Parameter::RhoS
         | Parameter::D
         | Parameter::NSub
-        | Parameter::DC => coordinate,
+        | Parameter::DC
+        | Parameter::D1 => coordinate,
         Parameter::K => K_SCALE * coordinate.sinh(),
     }
 }
@@ -226,7 +234,8 @@ pub fn value_per_coordinate(parameter: Parameter, coordinate: f64) -> f64 {
         | Parameter::RhoS
         | Parameter::D
         | Parameter::NSub
-        | Parameter::DC => 1.0,
+        | Parameter::DC
+        | Parameter::D1 => 1.0,
         Parameter::K => K_SCALE * coordinate.cosh(),
     }
 }

@@ -173,6 +173,7 @@ impl ModelSpace {
             d: values.get(Parameter::D),
             n_sub: Some(values.get(Parameter::NSub)),
             d_c: Some(values.get(Parameter::DC)),
+            d1: Some(values.get(Parameter::D1)),
         })
     }
 
@@ -188,6 +189,7 @@ impl ModelSpace {
             d: self.subsurface(values).map(|s| s.d),
             n_sub: self.subsurface(values).and_then(|s| s.n_sub),
             d_c: self.subsurface(values).and_then(|s| s.d_c),
+            d1: self.subsurface(values).and_then(|s| s.d1),
             wavelength_um,
         }
     }

@@ -92,6 +92,9 @@ pub struct ModelSpec {
     /// The subsurface term's circular residual polarization (absent: d).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub d_c: Option<f64>,
+    /// The change of its residual polarization with the scattering angle (absent: 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d1: Option<f64>,
     pub wavelength_um: f64,
 }
 
@@ -107,6 +110,7 @@ impl ModelSpec {
             Parameter::D => self.d,
             Parameter::NSub => self.rho_s.map(|_| self.n_sub.unwrap_or(self.n)),
             Parameter::DC => self.subsurface().map(|s| s.circular()),
+            Parameter::D1 => self.subsurface().map(|s| s.d1.unwrap_or(0.0)),
             slope => self.distribution.parameter(slope),
         }
     }
@@ -128,6 +132,7 @@ impl ModelSpec {
             d: self.d.unwrap_or(0.0),
             n_sub: self.n_sub,
             d_c: self.d_c,
+            d1: self.d1,
         })
     }
 
@@ -527,6 +532,7 @@ mod tests {
                 d: None,
                 n_sub: None,
                 d_c: None,
+                d1: None,
                 wavelength_um: 9.925,
             }),
             fit: None,
@@ -553,6 +559,7 @@ mod tests {
             d: subsurface.then_some(0.02 + if per_wavelength_d { 0.01 * j } else { 0.0 }),
             n_sub: subsurface.then_some(1.05),
             d_c: subsurface.then_some(-0.015),
+            d1: subsurface.then_some(0.004),
             wavelength_um,
         }
     }

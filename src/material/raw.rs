@@ -33,6 +33,7 @@ pub(super) struct RawModel<V> {
     d: Option<V>,
     n_sub: Option<V>,
     d_c: Option<V>,
+    d1: Option<V>,
     wavelength_um: V,
     dispersion: Option<LorentzDispersion>,
 }
@@ -107,7 +108,7 @@ impl TryFrom<RawModel<f64>> for ModelSpec {
             return Err(ModelTableError::GreyDispersion);
         }
         // Refuses d, n_sub, d_c without rho_s; the spec keeps the keys as written.
-        Subsurface::from_keys(raw.rho_s, raw.d, raw.n_sub, raw.d_c)?;
+        Subsurface::from_keys(raw.rho_s, raw.d, raw.n_sub, raw.d_c, raw.d1)?;
         Ok(ModelSpec {
             distribution,
             shadowing: raw.shadowing,
@@ -119,6 +120,7 @@ impl TryFrom<RawModel<f64>> for ModelSpec {
             d: raw.rho_s.map(|_| raw.d.unwrap_or(0.0)),
             n_sub: raw.n_sub,
             d_c: raw.d_c,
+            d1: raw.d1,
             wavelength_um: check_wavelength(raw.wavelength_um)?,
         })
     }
@@ -143,6 +145,7 @@ impl TryFrom<RawModel<PerWavelength>> for MaterialModel {
             present(&raw.d),
             present(&raw.n_sub),
             present(&raw.d_c),
+            present(&raw.d1),
         )?;
         let rho_d = match raw.rho_d.unwrap_or(Shared(0.0)) {
             Shared(r) => vec![r; wavelength_um.len()],
@@ -161,6 +164,7 @@ impl TryFrom<RawModel<PerWavelength>> for MaterialModel {
                 d: raw.d,
                 n_sub: raw.n_sub,
                 d_c: raw.d_c,
+                d1: raw.d1,
             },
             dispersion: raw.dispersion,
         };
@@ -193,6 +197,7 @@ impl RawModel<PerWavelength> {
             d: optional(&self.d)?,
             n_sub: optional(&self.n_sub)?,
             d_c: optional(&self.d_c)?,
+            d1: optional(&self.d1)?,
             wavelength_um: one(&self.wavelength_um)?,
             dispersion: self.dispersion.clone(),
         })

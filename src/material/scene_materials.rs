@@ -32,6 +32,7 @@ pub struct InlineMaterialConfig {
     pub d: Option<f64>,
     pub n_sub: Option<f64>,
     pub d_c: Option<f64>,
+    pub d1: Option<f64>,
 }
 
 fn smith() -> crate::pbrdf::Shadowing {
@@ -291,7 +292,7 @@ pub fn share_wavelength_nodes(
 
 pub fn inline_pbrdf(m: &InlineMaterialConfig) -> Result<Pbrdf, InlineMaterialError> {
     let distribution = slope_distribution(&m.distribution, m.sigma, m.q)?;
-    let subsurface = Subsurface::from_keys(m.rho_s, m.d, m.n_sub, m.d_c)?;
+    let subsurface = Subsurface::from_keys(m.rho_s, m.d, m.n_sub, m.d_c, m.d1)?;
     Pbrdf::new(
         distribution,
         m.shadowing,

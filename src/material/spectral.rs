@@ -43,7 +43,7 @@ pub struct SpectralModel {
 /// The volume terms of a spectral model (docs/design.md §1.10): which side of the facets reflects,
 /// and the subsurface term's parameters, each shared by every wavelength (one number: the fit
 /// shared it) or one per table wavelength. Absent keys mean what they mean in a grey model: no
-/// subsurface term without ρ_s, d = 0, n_sub = n, d_c = d.
+/// subsurface term without ρ_s, d = 0, n_sub = n, d_c = d, d1 = 0.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SpectralVolume {
     #[serde(default, skip_serializing_if = "FacetSide::is_external")]
@@ -56,6 +56,8 @@ pub struct SpectralVolume {
     pub n_sub: Option<PerWavelength>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub d_c: Option<PerWavelength>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d1: Option<PerWavelength>,
 }
 
 /// A model parameter over a spectral table: one number for every wavelength, or one per
@@ -95,12 +97,13 @@ impl PerWavelength {
 
 impl SpectralVolume {
     /// The subsurface keys by name, as a material file writes them.
-    pub fn keys(&self) -> [(&'static str, Option<&PerWavelength>); 4] {
+    pub fn keys(&self) -> [(&'static str, Option<&PerWavelength>); 5] {
         [
             ("rho_s", self.rho_s.as_ref()),
             ("d", self.d.as_ref()),
             ("n_sub", self.n_sub.as_ref()),
             ("d_c", self.d_c.as_ref()),
+            ("d1", self.d1.as_ref()),
         ]
     }
 }
@@ -211,6 +214,7 @@ impl SpectralModel {
             d: rho_s.map(|_| volume(&self.volume.d).unwrap_or(0.0)),
             n_sub: volume(&self.volume.n_sub),
             d_c: volume(&self.volume.d_c),
+            d1: volume(&self.volume.d1),
             wavelength_um,
         })
     }
@@ -237,6 +241,7 @@ impl SpectralModel {
                 d: volume(|m| m.d),
                 n_sub: volume(|m| m.n_sub),
                 d_c: volume(|m| m.d_c),
+                d1: volume(|m| m.d1),
             },
             dispersion,
         }

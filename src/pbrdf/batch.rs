@@ -334,6 +334,7 @@ mod tests {
             d: 0.2,
             n_sub: None,
             d_c: None,
+            d1: None,
         };
         let with_subsurface =
             model(Shadowing::Smith).with_volume(FacetSide::External, Some(subsurface));

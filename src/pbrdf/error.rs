@@ -36,6 +36,13 @@ pub enum ModelError {
         number(*.d_c)
     )]
     UnrealizableSubsurface { d: f64, d_c: f64 },
+    #[error(
+        "d = {}, d1 = {}: the residual polarization d + d1 cos Θ reaches |d| + |d1| > 1 at some \
+         scattering angle; keep |d| + |d1| ≤ 1",
+        number(*.d),
+        number(*.d1)
+    )]
+    ResidualAboveOne { d: f64, d1: f64 },
     #[error(transparent)]
     Outside(#[from] super::OutsideDomain),
     #[error("a band material needs one model per wavelength node, all with the same slope distribution and shadowing")]

@@ -270,9 +270,18 @@ impl Pbrdf {
             if let Some(d_c) = terms.d_c {
                 Parameter::DC.check(d_c)?;
             }
+            if let Some(d1) = terms.d1 {
+                Parameter::D1.check(d1)?;
+            }
+            if terms.largest_residual() > 1.0 {
+                return Err(ModelError::ResidualAboveOne {
+                    d: terms.d,
+                    d1: terms.d1.unwrap_or(0.0),
+                });
+            }
             if !terms.is_realizable() {
                 return Err(ModelError::UnrealizableSubsurface {
-                    d: terms.d,
+                    d: terms.largest_residual(),
                     d_c: terms.circular(),
                 });
             }
@@ -298,6 +307,8 @@ impl Pbrdf {
             s.transmission(facet.cos_i),
             s.transmission(facet.cos_r),
             geometry.scattering_plane_turn(),
+            // cos Θ = −ω_i·ω_r = −cos 2β (docs/design.md §1.1).
+            1.0 - 2.0 * facet.cos2_beta,
         ))
     }
 

@@ -21,6 +21,10 @@
 //!   matrix fixed in the macro frames cannot give. D is realizable (Cloude) for
 //!   2|d| − 1 ≤ d_c ≤ 1 ([`Subsurface::is_realizable`]); the model accepts d ∈ [0, 1] and refuses
 //!   an unrealizable d_c.
+//! - d may change with the scattering angle Θ between the incident beam (travelling along −ω_i)
+//!   and the scattered one (ω_r), cos Θ = −ω_i·ω_r = 1 − 2cos²β: d(Θ) = d + d1 cos Θ, as single
+//!   scattering by particles polarizes differently forward and backward (docs/design.md §1.10).
+//!   The bounds below hold with the largest |d(Θ)|, |d| + |d1|.
 //! - The interface has the material's index N, or n_sub + ik where given ([`Subsurface`]).
 //! - Z = (1 − R̄) + |d|·|Ā|, R̄ = 2∫₀¹ R(μ) μ dμ, Ā = 2∫₀¹ T−(μ) μ dμ, the normalization that
 //!   conserves energy: for light of intensity I_t after the interface (I_t = T+(θ_i) unpolarized)
@@ -98,22 +102,26 @@ pub struct Subsurface {
     pub n_sub: Option<f64>,
     /// The circular residual polarization (D's m33 = −d_c); absent: d.
     pub d_c: Option<f64>,
+    /// The residual polarization's change with the scattering angle Θ, d(Θ) = d + d1 cos Θ;
+    /// absent: 0.
+    pub d1: Option<f64>,
 }
 
 /// d, n_sub or d_c given without ρ_s (in a material file, a scene's inline material or on the
 /// command line): they describe a subsurface term that is not there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("d, n_sub and d_c need rho_s: they belong to the subsurface term")]
+#[error("d, n_sub, d_c and d1 need rho_s: they belong to the subsurface term")]
 pub struct SubsurfaceKeysWithoutRhoS;
 
 impl Subsurface {
     /// The subsurface term its keys describe, wherever they are written: none without ρ_s, d
-    /// absent is 0, n_sub and d_c absent take their defaults (n, d).
+    /// absent is 0, n_sub, d_c and d1 absent take their defaults (n, d, 0).
     pub fn from_keys(
         rho_s: Option<f64>,
         d: Option<f64>,
         n_sub: Option<f64>,
         d_c: Option<f64>,
+        d1: Option<f64>,
     ) -> Result<Option<Subsurface>, SubsurfaceKeysWithoutRhoS> {
         match rho_s {
             Some(rho_s) => Ok(Some(Subsurface {
@@ -121,12 +129,18 @@ impl Subsurface {
                 d: d.unwrap_or(0.0),
                 n_sub,
                 d_c,
+                d1,
             })),
-            None if d.is_some() || n_sub.is_some() || d_c.is_some() => {
+            None if d.is_some() || n_sub.is_some() || d_c.is_some() || d1.is_some() => {
                 Err(SubsurfaceKeysWithoutRhoS)
             }
             None => Ok(None),
         }
+    }
+
+    /// The largest |d(Θ)| over all scattering angles: |d| + |d1|.
+    pub fn largest_residual(&self) -> f64 {
+        self.d.abs() + self.d1.unwrap_or(0.0).abs()
     }
 
     /// d_c, or d where it is not given (the mirror-signed D of the module docs).
@@ -134,11 +148,12 @@ impl Subsurface {
         self.d_c.unwrap_or(self.d)
     }
 
-    /// Whether D = diag(1, d, −d, −d_c) is a sum of Jones matrices: its coherency eigenvalues
-    /// are (1 − d_c)/4 twice, (1 + 2d + d_c)/4 and (1 − 2d + d_c)/4, so d_c ∈ [2|d| − 1, 1].
+    /// Whether D = diag(1, d, −d, −d_c) is a sum of Jones matrices at every scattering angle:
+    /// its coherency eigenvalues are (1 − d_c)/4 twice, (1 + 2d + d_c)/4 and (1 − 2d + d_c)/4,
+    /// so d_c ∈ [2|d(Θ)| − 1, 1] for the largest |d(Θ)| = |d| + |d1|.
     pub fn is_realizable(&self) -> bool {
         let d_c = self.circular();
-        d_c <= 1.0 && d_c >= 2.0 * self.d.abs() - 1.0
+        d_c <= 1.0 && d_c >= 2.0 * self.largest_residual() - 1.0
     }
 }
 
@@ -177,7 +192,8 @@ impl PreparedSubsurface {
         let n = terms.n_sub.unwrap_or(index.n);
         let permittivity = RefractiveIndex::new(n, index.k).permittivity();
         let (mean_reflectance, mean_minus) = interface_means(permittivity);
-        let z = (1.0 - mean_reflectance) + terms.d.abs() * mean_minus.abs();
+        // |d(Θ)| ≤ |d| + |d1| at every Θ: the bound of the module docs holds with it.
+        let z = (1.0 - mean_reflectance) + terms.largest_residual() * mean_minus.abs();
         PreparedSubsurface {
             terms,
             permittivity,
@@ -191,17 +207,20 @@ impl PreparedSubsurface {
         Transmission::at(cos_theta, self.permittivity)
     }
 
-    /// The term's Mueller matrix from T(θ_i), T(θ_r) and `plane` = (C, S) = (cos, sin) of
-    /// 2η_i + 2η_r, the turn of the scattering plane against the psps frames (module docs).
+    /// The term's Mueller matrix from T(θ_i), T(θ_r), `plane` = (C, S) = (cos, sin) of
+    /// 2η_i + 2η_r, the turn of the scattering plane against the psps frames, and cos Θ of the
+    /// scattering angle (module docs).
     #[inline]
     pub(super) fn mueller(
         &self,
         incident: Transmission,
         scattered: Transmission,
         plane: (f64, f64),
+        cos_scattering: f64,
     ) -> Mueller {
         let (i, r, k) = (incident, scattered, self.scale);
-        let (dc, ds) = (self.terms.d * plane.0, self.terms.d * plane.1);
+        let d = self.terms.d + self.terms.d1.unwrap_or(0.0) * cos_scattering;
+        let (dc, ds) = (d * plane.0, d * plane.1);
         let mut m = Mueller::zeros();
         // T(θ_r) · [[1,0,0,0],[0,dC,dS,0],[0,dS,−dC,0],[0,0,0,−d]] · T(θ_i), multiplied out.
         m[(0, 0)] = k * (r.plus * i.plus + dc * r.minus * i.minus);

@@ -33,6 +33,8 @@ pub enum Parameter {
     NSub,
     /// Residual circular polarization d_c of the subsurface light (D's m33 is −d_c).
     DC,
+    /// How the residual polarization changes with the scattering angle Θ: d(Θ) = d + d1 cos Θ.
+    D1,
 }
 
 /// A term of the model: F = facet term + ideal depolarizer (docs/design.md §1.3).
@@ -165,7 +167,7 @@ pub struct ParameterInfo {
 }
 
 /// Every parameter's entry, in [`Parameter::ALL`] order.
-const REGISTRY: [ParameterInfo; 9] = [
+const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "sigma",
         aliases: &[],
@@ -266,6 +268,17 @@ const REGISTRY: [ParameterInfo; 9] = [
         comment: "residual circular polarization d_c (−1–1, at least 2d − 1) of the subsurface light: D's m33 = −d_c (absent: d, a mirror's sign; below 0 helicity is kept)",
         spectral: SpectralRole::SharedByDefault,
     },
+    ParameterInfo {
+        key: "d1",
+        aliases: &[],
+        label: "d1",
+        unit: "dimensionless",
+        term: Term::Subsurface,
+        domain: (-1.0, 1.0, false),
+        default_bounds: (-1.0, 1.0),
+        comment: "change of the residual polarization with the scattering angle Θ (between the incident and the scattered beam): d(Θ) = d + d1 cos Θ, |d| + |d1| ≤ 1 (absent: 0)",
+        spectral: SpectralRole::SharedByDefault,
+    },
 ];
 
 /// A parameter value outside the values a model accepts.
@@ -285,7 +298,10 @@ fn range(parameter: Parameter) -> String {
 
 impl Parameter {
     /// All parameters in their canonical order (the order of vectors and matrices in a fit).
-    pub const ALL: [Parameter; 9] = [
+    /// The number of parameters.
+    pub const COUNT: usize = 10;
+
+    pub const ALL: [Parameter; Parameter::COUNT] = [
         Parameter::Sigma,
         Parameter::Q,
         Parameter::N,
@@ -295,6 +311,7 @@ impl Parameter {
         Parameter::D,
         Parameter::NSub,
         Parameter::DC,
+        Parameter::D1,
     ];
 
     /// The parameter's entry in the registry.

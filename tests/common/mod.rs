@@ -70,6 +70,7 @@ pub fn write_truth_library(dir: &Path) {
                 d: None,
                 n_sub: None,
                 d_c: None,
+                d1: None,
                 wavelength_um,
             }),
             fit: None,

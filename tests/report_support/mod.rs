@@ -23,6 +23,7 @@ pub fn truth() -> ModelSpec {
         d: None,
         n_sub: None,
         d_c: None,
+        d1: None,
         wavelength_um: 9.925,
     }
 }

@@ -683,6 +683,7 @@ mod tests {
             d: None,
             n_sub: None,
             d_c: None,
+            d1: None,
             wavelength_um: 10.0,
         }
     }
