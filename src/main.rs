@@ -224,8 +224,10 @@ struct FitArgs {
     #[arg(long)]
     robust: Option<String>,
     /// For a material measured at several wavelengths (a spectral set): n, k free at each
-    /// wavelength (table), or from a Lorentz law of N oscillators (lorentz:N).
-    #[arg(long, default_value = "table")]
+    /// wavelength (table), n from Cauchy's normal dispersion A + B/λ² with B ≥ 0 (cauchy), or
+    /// n, k from a Lorentz law of N oscillators (lorentz:N); auto (default): cauchy for a model
+    /// with the subsurface term (a transparent dielectric), else table.
+    #[arg(long, default_value = "auto")]
     dispersion: String,
     /// Model terms (docs/design.md §1.10): auto (default: external+depolarizer,
     /// external+subsurface and internal+subsurface each fitted, the admissible one that predicts
@@ -585,17 +587,25 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
         format!("{}–{}", significant(lo, 3), significant(hi, 3))
     };
     let (first, last) = model.range_um();
+    let terms = match model.terms() {
+        t if t == irpol::pbrdf::ModelTerms::default() => String::new(),
+        t => format!(" {t}"),
+    };
     format!(
-        "{}: {} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={}{} → {}",
+        "{}: {}{terms} {}, {} wavelengths {first}–{last} µm: {} n {} k {} χ²_red={}{}{} → {}",
         outcome.material.name,
         chosen.distribution.name(),
-        chosen.dispersion,
+        match chosen.dispersion {
+            irpol::fit::Dispersion::Cauchy => "normal dispersion (Cauchy)".to_owned(),
+            other => other.to_string(),
+        },
         model.wavelength_um.len(),
         shared.join(" "),
         range(&model.n),
         range(&model.k),
         chi2(chosen.reduced_chi2),
         realizability_clause(&outcome.measurements),
+        identification_clause(outcome.material.fit.as_ref()),
         entry.display()
     )
 }
@@ -634,7 +644,7 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
         .as_ref()
         .map_or(String::new(), |c| format!("; {}", c.summary()));
     format!(
-        "{}: {}{} {}{}{} χ²_red={}{}{comparison} → {}",
+        "{}: {}{} {}{}{} χ²_red={}{}{}{comparison} → {}",
         outcome.material.name,
         chosen.distribution.name(),
         if chosen.terms == irpol::pbrdf::ModelTerms::default() {
@@ -647,8 +657,21 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
         listed(" (fixed: ", &fixed, " ", ")"),
         chi2(chosen.reduced_chi2),
         realizability_clause(std::slice::from_ref(&outcome.measurement)),
+        identification_clause(record),
         entry.display()
     )
+}
+
+/// `; NOT DETERMINED by the data: d (at a bound of its search interval), …` (docs/design.md
+/// §1.10 "Identification"): a number the data do not determine must not read as a measurement.
+fn identification_clause(record: Option<&irpol::material::FitRecord>) -> String {
+    let notes: Vec<String> = record
+        .map(|r| r.identification())
+        .unwrap_or_default()
+        .into_iter()
+        .map(|(name, why)| format!("{name} {why}"))
+        .collect();
+    listed("; NOT DETERMINED by the data: ", &notes, ", ", "")
 }
 
 /// `; k of N rows not realizable beyond 2σ` (Cloude's test against each row's uncertainty), or

@@ -21,7 +21,7 @@ use std::path::PathBuf;
 #[pyfunction]
 #[pyo3(signature = (inputs, *, distribution = None, shadowing = "smith".to_owned(), free = None,
     fix = None, optimizer = "ga+lm".to_owned(), seed = None, robust = None,
-    dispersion = "table".to_owned(), layout = None, wavelength_um = None, theta_i_deg = None,
+    dispersion = "auto".to_owned(), layout = None, wavelength_um = None, theta_i_deg = None,
     terms = irpol::app::fit::AUTO_TERMS.to_owned()))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_materials(

@@ -56,7 +56,7 @@ impl Default for FitFlags {
             optimizer: "ga+lm".into(),
             seed: FitOptions::default().seed,
             robust: None,
-            dispersion: "table".into(),
+            dispersion: "auto".into(),
             terms: AUTO_TERMS.to_owned(),
             cv: None,
         }

@@ -5,7 +5,7 @@ use super::data::MeasurementData;
 use super::options::FitOptions;
 use super::outcome::FitOutcome;
 use super::space::ModelSpace;
-use super::spectral::{fit_spectral, SpectralFitOutcome};
+use super::spectral::{fit_spectral, fit_spectral_from, SpectralFitOutcome};
 use super::FitError;
 use crate::material::Material;
 use crate::measure::{
@@ -93,6 +93,7 @@ pub fn fit_inputs_with(
 ) -> Result<Vec<MaterialFit>, FitError> {
     let materials = read_all(inputs, reading)?;
     validate_options(options)?;
+    refuse_law_of_one_wavelength(&materials, options)?;
 
     progress.begin("fitting", materials.len() as u64);
     let mut outcomes = Vec::with_capacity(materials.len());
@@ -122,9 +123,9 @@ fn fit_spectral_choosing_terms(
     if options.term_candidates.is_empty() && options.cv_folds.is_none() {
         return fit_spectral(sets, options, options.dispersion);
     }
-    let choice = super::cross_validation::choose_spectral_terms(&sets, options)?;
+    let (choice, alone) = super::cross_validation::choose_spectral_terms(&sets, options)?;
     let options = options.with_terms(choice.scores[choice.chosen].terms);
-    let mut outcome = fit_spectral(sets, &options, options.dispersion)?;
+    let mut outcome = fit_spectral_from(sets, &options, options.dispersion, Some(alone))?;
     outcome.terms_choice = Some(choice);
     Ok(outcome)
 }
@@ -194,6 +195,31 @@ fn check_folder_materials(folder: &Path, sets: &[MeasurementSet]) -> Result<(), 
 }
 
 /// Builds the model spaces the options ask for, which checks bounds, free and fixed values.
+/// A dispersion law (`--dispersion cauchy` or `lorentz:N`) needs a material measured at two
+/// wavelengths or more: refused up front, naming the file and its one wavelength.
+fn refuse_law_of_one_wavelength(
+    materials: &[Vec<MeasurementSet>],
+    options: &FitOptions,
+) -> Result<(), FitError> {
+    if matches!(
+        options.dispersion,
+        super::Dispersion::Table | super::Dispersion::Auto
+    ) {
+        return Ok(());
+    }
+    match materials.iter().find(|sets| sets.len() == 1) {
+        Some(sets) => Err(FitError::Options(format!(
+            "--dispersion {}: {} measures '{}' at one wavelength ({} µm); a dispersion law \
+             relates several: fit it without --dispersion (or give its other wavelengths)",
+            options.dispersion,
+            sets[0].source.display(),
+            sets[0].material,
+            crate::text::number(sets[0].wavelength_um)
+        ))),
+        None => Ok(()),
+    }
+}
+
 fn validate_options(options: &FitOptions) -> Result<(), FitError> {
     let free = options.free_parameters()?;
     for kind in options.distributions() {

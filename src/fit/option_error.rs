@@ -43,7 +43,7 @@ pub enum OptionError {
     )]
     UnknownStage { stage: String, text: String },
     #[error(
-        "unknown dispersion '{}': use table or lorentz:N with N = 1…6 oscillators",
+        "unknown dispersion '{}': use auto, table, cauchy or lorentz:N with N = 1…6 oscillators",
         shown(.0)
     )]
     UnknownDispersion(String),

@@ -112,6 +112,10 @@ pub(super) fn finish(
             comparison.as_ref(),
         )),
     };
+    let mut material = material;
+    if let Some(record) = &mut material.fit {
+        record.mark_non_finite_as_undetermined();
+    }
     Ok(FitOutcome {
         measurement: set.clone(),
         material,
@@ -257,6 +261,13 @@ pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap
             format!(
                 "{k}-fold cross-validation (rows dealt by a shuffle seeded with the fit's seed)"
             ),
+        );
+    } else if options.choose_terms {
+        settings.insert(
+            "terms_choice".into(),
+            "auto: the admissible terms that predict best (5-fold cross-validation, AIC on small \
+             sets; docs/design.md §1.10)"
+                .into(),
         );
     }
     if !options.fixed.is_empty() {

@@ -238,7 +238,12 @@ fn entry_for<'e, T>(entries: &'e [(&str, T)], path: &str) -> Option<&'e T> {
 }
 
 /// `text` (a serialized material) with the comments added; the values are untouched.
-pub(super) fn commented(text: &str) -> Result<String, toml_edit::TomlError> {
+/// `identification` lists the fitted parameters the data do not determine, with why
+/// ([`super::FitRecord::identification`]): each gets a line of its own above its `[model]` key.
+pub(super) fn commented(
+    text: &str,
+    identification: &[(String, String)],
+) -> Result<String, toml_edit::TomlError> {
     let mut document: DocumentMut = text.parse()?;
     let root = document.as_table_mut();
     explain_keys(root, &Keys::Fixed(TOP).comments());
@@ -248,7 +253,30 @@ pub(super) fn commented(text: &str) -> Result<String, toml_edit::TomlError> {
             .set_prefix(format!("{}\n{explained}", comment_lines(HEADER)));
     }
     decorate_tables(root, "");
+    if let Some(Item::Table(model)) = root.get_mut("model") {
+        mark_undetermined(model, identification);
+    }
     Ok(document.to_string())
+}
+
+/// Adds `# NOT DETERMINED by the data: why` above each `[model]` key that `identification`
+/// names (a spectral coordinate such as `n(0.351um)` marks its table, `n`).
+fn mark_undetermined(model: &mut Table, identification: &[(String, String)]) {
+    for (name, why) in identification {
+        // A dispersion law's coordinates (cauchy_a, eps_inf, …) shape the n table.
+        let key = match name.split('(').next().unwrap_or(name) {
+            base if model.contains_key(base) => base,
+            _ => "n",
+        };
+        if let Some(mut key) = model.key_mut(key) {
+            let decor = key.leaf_decor_mut();
+            let prefix = decor.prefix().and_then(|p| p.as_str()).unwrap_or("").to_owned();
+            decor.set_prefix(format!(
+                "{prefix}{}",
+                comment_lines(&format!("NOT DETERMINED by the data: {name} {why}"))
+            ));
+        }
+    }
 }
 
 /// Comments the subtables of `table` (whose dotted path is `path`) and their keys, recursively.

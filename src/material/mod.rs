@@ -229,6 +229,65 @@ pub struct FitRecord {
     pub global_iterations: usize,
 }
 
+/// |ρ| above which two fitted parameters count as one combination the data determine, not two
+/// (docs/design.md §1.10 "Identification").
+pub const STRONG_CORRELATION: f64 = 0.98;
+
+impl FitRecord {
+    /// The fitted parameters the data do not determine (docs/design.md §1.10
+    /// "Identification"), each with why: resting on a bound of its search interval, without
+    /// sensitivity or a profile wider than its range (undetermined), or correlated beyond
+    /// |ρ| = [`STRONG_CORRELATION`] with another. Names as in `free_parameters`; a pair is named
+    /// once, by its first member.
+    pub fn identification(&self) -> Vec<(String, String)> {
+        let mut notes: Vec<(String, String)> = Vec::new();
+        for name in &self.at_bound {
+            notes.push((name.clone(), "at a bound of its search interval".into()));
+        }
+        for name in &self.undetermined {
+            if !self.at_bound.contains(name) {
+                notes.push((name.clone(), "not determined (no sensitivity)".into()));
+            }
+        }
+        let names = &self.free_parameters;
+        for (a, row) in self.correlation.iter().enumerate().take(names.len()) {
+            for (b, &rho) in row.iter().enumerate().take(names.len()).skip(a + 1) {
+                if rho.abs() > STRONG_CORRELATION {
+                    notes.push((
+                        names[a].clone(),
+                        format!("correlated with {} (ρ = {})", names[b], significant(rho, 3)),
+                    ));
+                }
+            }
+        }
+        notes
+    }
+
+    /// Keeps the record writable when the data do not determine a parameter at all (its 1-σ
+    /// error infinite, as for a subsurface term's d and d_c when ρ_s → 0): the parameter is listed
+    /// as undetermined, its error left out of `uncertainty` and its correlations written as 0,
+    /// instead of the whole entry being refused for a non-finite number.
+    pub fn mark_non_finite_as_undetermined(&mut self) {
+        let infinite: Vec<String> = self
+            .uncertainty
+            .iter()
+            .filter(|(_, e)| !e.is_finite())
+            .map(|(name, _)| name.clone())
+            .collect();
+        for name in infinite {
+            self.uncertainty.remove(&name);
+            if !self.undetermined.contains(&name) {
+                self.undetermined.push(name);
+            }
+        }
+        for value in self.correlation.iter_mut().flatten() {
+            if !value.is_finite() {
+                *value = 0.0;
+            }
+        }
+    }
+}
+
 /// What the data say about a parameter they do not determine: a one-sided bound on each side of
 /// the fitted value from the profile likelihood (χ² minimized over the other parameters rises by
 /// z² s² there, z the one-sided quantile of `confidence`). A missing side means the data allow
@@ -393,7 +452,12 @@ impl Material {
             });
         }
         let text = toml::to_string_pretty(self).map_err(|e| error(&e))?;
-        comments::commented(&text).map_err(|e| error(&e))
+        let identification = self
+            .fit
+            .as_ref()
+            .map(FitRecord::identification)
+            .unwrap_or_default();
+        comments::commented(&text, &identification).map_err(|e| error(&e))
     }
 
     /// Writes the TOML atomically: a temporary file in the same folder, then a rename, so a failed

@@ -247,6 +247,16 @@ impl SpectralModel {
         }
     }
 
+    /// The model's terms (docs/design.md §1.10), as [`ModelSpec::terms`] says them.
+    pub fn terms(&self) -> crate::pbrdf::ModelTerms {
+        let body = if self.volume.rho_s.is_some() {
+            crate::pbrdf::Body::Subsurface
+        } else {
+            crate::pbrdf::Body::Depolarizer
+        };
+        crate::pbrdf::ModelTerms::new(self.volume.facet, body)
+    }
+
     /// The first and last table wavelengths, µm.
     pub fn range_um(&self) -> (f64, f64) {
         (

@@ -27,6 +27,9 @@ pub(crate) enum IndexModel {
     /// From a law of this many oscillators: shared coordinates ε_∞, then
     /// [`LAW_PER_OSCILLATOR`] per oscillator, all in physical units.
     Lorentz(usize),
+    /// n from Cauchy's normal dispersion n = A + B/λ² (shared coordinates A and B ≥ 0, B in
+    /// µm²); k free per wavelength.
+    Cauchy,
 }
 
 /// One wavelength's measurement and model family.
@@ -104,7 +107,13 @@ impl<'a> JointProblem<'a> {
         match self.index_model {
             IndexModel::Table => 0,
             IndexModel::Lorentz(oscillators) => 1 + LAW_PER_OSCILLATOR * oscillators,
+            IndexModel::Cauchy => 2,
         }
+    }
+
+    /// The law's coordinates of search vector `s`.
+    pub fn law_coordinates<'s>(&self, s: &'s [f64]) -> &'s [f64] {
+        &s[self.shared.len()..self.shared_len()]
     }
 
     /// Where `parameter`'s coordinate of wavelength `j` sits in the search vector, when it is a
@@ -124,7 +133,7 @@ impl<'a> JointProblem<'a> {
         let IndexModel::Lorentz(_) = self.index_model else {
             return None;
         };
-        Some(law_of(&s[self.shared.len()..self.shared_len()]))
+        Some(law_of(self.law_coordinates(s)))
     }
 
     /// The full parameter values of wavelength `j` at search vector `s`.
@@ -142,13 +151,22 @@ impl<'a> JointProblem<'a> {
             })
             .collect();
         let mut values = space.values(&block_search);
+        let wavelength_um = self.blocks[j].wavelength_um;
         if let Some(law) = self.law(s) {
-            let index = law.index(self.blocks[j].wavelength_um);
+            let index = law.index(wavelength_um);
             values.set(Parameter::N, index.n);
             values.set(Parameter::K, index.k);
         }
+        if let (IndexModel::Cauchy, &[a, b]) = (&self.index_model, self.law_coordinates(s)) {
+            values.set(Parameter::N, cauchy_index(a, b, wavelength_um));
+        }
         values
     }
+}
+
+/// Cauchy's normal dispersion n = A + B/λ² (λ in µm, B in µm²; docs/design.md §1.10).
+pub(crate) fn cauchy_index(a: f64, b: f64, wavelength_um: f64) -> f64 {
+    a + b / (wavelength_um * wavelength_um)
 }
 
 impl LeastSquares for JointProblem<'_> {

@@ -17,7 +17,9 @@ mod record;
 
 use super::comparison::{aic, bic};
 use super::data::MeasurementData;
+use super::admissible::STRONG_ABSORPTION_K;
 use super::energy::{check_energy, EnergyCheck, ENERGY_TOLERANCE};
+use super::space::VOLUME_MIN_N;
 use super::levenberg_marquardt::{levenberg_marquardt, LeastSquares};
 use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
@@ -46,6 +48,20 @@ pub enum Dispersion {
     Table,
     /// A Lorentz law of this many oscillators (docs/design.md §1.9).
     Lorentz(usize),
+    /// A dielectric's normal dispersion n = A + B/λ², B ≥ 0, with k free at each wavelength
+    /// (docs/design.md §1.10).
+    Cauchy,
+    /// The default of `irpol fit`: [`Dispersion::Cauchy`] for a model whose body term lets light
+    /// into the material (the subsurface term: a transparent dielectric, whose index falls with
+    /// λ between absorption bands) when no wavelength absorbs strongly, else
+    /// [`Dispersion::Table`].
+    Auto,
+}
+
+/// Whether [`Dispersion::Auto`] takes Cauchy's law for the `table` fit of `options`' terms.
+fn normal_dispersion_applies(options: &FitOptions, table: &SpectralFit) -> bool {
+    options.terms.body == crate::pbrdf::Body::Subsurface
+        && table.model.k.iter().all(|&k| k < STRONG_ABSORPTION_K)
 }
 
 impl Dispersion {
@@ -54,6 +70,12 @@ impl Dispersion {
         let text = text.trim();
         if text == "table" {
             return Ok(Dispersion::Table);
+        }
+        if text == "cauchy" {
+            return Ok(Dispersion::Cauchy);
+        }
+        if text == "auto" {
+            return Ok(Dispersion::Auto);
         }
         match text.strip_prefix("lorentz:").map(str::parse::<usize>) {
             Some(Ok(n)) if (1..=6).contains(&n) => Ok(Dispersion::Lorentz(n)),
@@ -67,6 +89,8 @@ impl std::fmt::Display for Dispersion {
         match self {
             Dispersion::Table => f.write_str("table"),
             Dispersion::Lorentz(n) => write!(f, "lorentz:{n}"),
+            Dispersion::Cauchy => f.write_str("cauchy"),
+            Dispersion::Auto => f.write_str("auto"),
         }
     }
 }
@@ -113,6 +137,22 @@ pub struct SpectralFit {
     pub at_bound: Vec<String>,
 }
 
+impl SpectralFit {
+    /// The fitted value of a shared `parameter` (a free coordinate's, else the first
+    /// wavelength's model's); 0 for one the model lacks.
+    fn value(&self, parameter: Parameter) -> f64 {
+        match self.names.iter().position(|n| n == parameter.name()) {
+            Some(i) => self.values[i],
+            None => self
+                .model
+                .nodes()
+                .next()
+                .and_then(|m| m.parameter(parameter))
+                .unwrap_or(0.0),
+        }
+    }
+}
+
 /// A fitted spectral set.
 #[derive(Clone, Debug)]
 pub struct SpectralFitOutcome {
@@ -136,21 +176,38 @@ pub fn fit_spectral(
     options: &FitOptions,
     dispersion: Dispersion,
 ) -> Result<SpectralFitOutcome, FitError> {
+    fit_spectral_from(sets, options, dispersion, None)
+}
+
+/// [`fit_spectral`], with each wavelength's own fits of every distribution (in the order of
+/// `options.distributions()`) given in `alone` where they were already made (the choice of
+/// terms made them).
+pub(crate) fn fit_spectral_from(
+    sets: Vec<MeasurementSet>,
+    options: &FitOptions,
+    dispersion: Dispersion,
+    alone: Option<Vec<Vec<ModelFit>>>,
+) -> Result<SpectralFitOutcome, FitError> {
     let data = sets
         .iter()
         .map(MeasurementData::new)
         .collect::<Result<Vec<_>, _>>()?;
+    let kinds = options.distributions();
+    let alone = alone.map_or_else(|| vec![None; kinds.len()], |a| a.into_iter().map(Some).collect());
     // Both distributions at once: their 2 × K wavelength fits share the cores instead of each
     // distribution's K waiting for its slowest (each fit is seeded, so the result is the same).
-    let mut fits = options
-        .distributions()
+    let mut fits = kinds
         .into_par_iter()
-        .map(|kind| {
-            let alone = sets
-                .par_iter()
-                .zip(&data)
-                .map(|(set, data)| fit_model(set, data, kind, options))
-                .collect::<Result<Vec<_>, _>>()?;
+        .zip(alone)
+        .map(|(kind, given)| {
+            let alone = match given {
+                Some(fits) => fits,
+                None => sets
+                    .par_iter()
+                    .zip(&data)
+                    .map(|(set, data)| fit_model(set, data, kind, options))
+                    .collect::<Result<Vec<_>, _>>()?,
+            };
             let joint = fit_table(&sets, &data, kind, options, &alone)?;
             Ok((joint, alone))
         })
@@ -164,6 +221,11 @@ pub fn fit_spectral(
             fit_lorentz(&sets, &data, options, &table, oscillators)?,
             Some(table),
         ),
+        Dispersion::Cauchy => (fit_cauchy(&sets, &data, options, &table)?, Some(table)),
+        Dispersion::Auto if normal_dispersion_applies(options, &table) => {
+            (fit_cauchy(&sets, &data, options, &table)?, Some(table))
+        }
+        Dispersion::Auto => (table, None),
     };
     let material = record::material(
         &sets,
@@ -261,6 +323,65 @@ fn fit_lorentz(
         kind,
         Dispersion::Lorentz(oscillators),
     )
+}
+
+/// The fit with Cauchy's normal dispersion (n = A + B/λ², B ≥ 0), started from the `table`
+/// fit: A and B from a least-squares line of its n against 1/λ², B held at 0 where the table's n
+/// rises with λ. Refused for a material that absorbs (k ≥ [`STRONG_ABSORPTION_K`] at a
+/// wavelength): near an absorption band n follows no normal-dispersion law.
+fn fit_cauchy(
+    sets: &[MeasurementSet],
+    data: &[MeasurementData],
+    options: &FitOptions,
+    table: &SpectralFit,
+) -> Result<SpectralFit, FitError> {
+    let model = &table.model;
+    if let Some(j) = (0..model.k.len()).find(|&j| model.k[j] >= STRONG_ABSORPTION_K) {
+        return Err(FitError::Options(format!(
+            "--dispersion cauchy is a transparent dielectric's normal dispersion, but {} absorbs \
+             (k = {} at {} µm): use --dispersion table or lorentz:N",
+            sets[0].material,
+            crate::text::significant(model.k[j], 3),
+            crate::text::number(model.wavelength_um[j])
+        )));
+    }
+    let kind = table.distribution;
+    let free: Vec<Parameter> = options
+        .free_parameters()?
+        .into_iter()
+        .filter(|p| *p != Parameter::N)
+        .collect();
+    let mut law_options = options.clone();
+    law_options.free = Some(free);
+    let space = model_space(kind, &law_options)?;
+    let spaces = vec![space; sets.len()];
+    let bounds = (vec![VOLUME_MIN_N, 0.0], vec![10.0, 1.0]);
+    let mut problem = joint_problem(sets, data, &spaces, options, IndexModel::Cauchy, Some(bounds));
+    let (a, b) = cauchy_start(&model.wavelength_um, &model.n);
+    let mut start: Vec<f64> = problem
+        .shared
+        .iter()
+        .map(|&p| to_search(p, table.value(p)))
+        .collect();
+    start.extend([a, b]);
+    for &p in &problem.families {
+        for j in 0..sets.len() {
+            let node = model.at(model.wavelength_um[j]).ok();
+            start.push(to_search(p, node.and_then(|m| m.parameter(p)).unwrap_or(0.0)));
+        }
+    }
+    solve(&mut problem, sets, &start, options, kind, Dispersion::Cauchy)
+}
+
+/// A and B ≥ 0 of the least-squares line n = A + B x, x = 1/λ², through the table's `n`.
+fn cauchy_start(wavelengths: &[f64], n: &[f64]) -> (f64, f64) {
+    let x: Vec<f64> = wavelengths.iter().map(|w| 1.0 / (w * w)).collect();
+    let count = x.len() as f64;
+    let (mean_x, mean_n) = (x.iter().sum::<f64>() / count, n.iter().sum::<f64>() / count);
+    let sxx: f64 = x.iter().map(|x| (x - mean_x).powi(2)).sum();
+    let sxn: f64 = x.iter().zip(n).map(|(x, n)| (x - mean_x) * (n - mean_n)).sum();
+    let b = if sxx > 0.0 { (sxn / sxx).max(0.0) } else { 0.0 };
+    ((mean_n - b * mean_x).max(VOLUME_MIN_N), b)
 }
 
 fn joint_problem<'a>(
@@ -536,6 +657,10 @@ impl WavelengthErrors {
                 .collect::<Vec<_>>()
         };
         let (n, k) = match law {
+            None if problem.index_model == IndexModel::Cauchy => (
+                cauchy_errors(problem, wavelengths, errors, correlation),
+                family_errors(Parameter::K),
+            ),
             None => (family_errors(Parameter::N), family_errors(Parameter::K)),
             Some(law) => propagate_law_errors(law, problem, wavelengths, errors, correlation),
         };
@@ -564,6 +689,10 @@ fn coordinates(
         .iter()
         .map(|&p| (p.name().to_owned(), Some(p), None))
         .collect();
+    if problem.index_model == IndexModel::Cauchy {
+        out.push(("cauchy_a".into(), None, None));
+        out.push(("cauchy_b_um2".into(), None, None));
+    }
     if let IndexModel::Lorentz(oscillators) = problem.index_model {
         out.push(("eps_inf".into(), None, None));
         for o in 1..=oscillators {
@@ -579,6 +708,26 @@ fn coordinates(
         }
     }
     out
+}
+
+/// 1-σ errors of a Cauchy law's n at each wavelength: g·C·g with g = ∂n/∂(A, B) = (1, 1/λ²).
+fn cauchy_errors(
+    problem: &JointProblem,
+    wavelengths: &[f64],
+    errors: &[f64],
+    correlation: &[Vec<f64>],
+) -> Vec<f64> {
+    let (a, b) = (problem.shared.len(), problem.shared.len() + 1);
+    wavelengths
+        .iter()
+        .map(|w| {
+            let g = 1.0 / (w * w);
+            let covariance = correlation[a][b] * errors[a] * errors[b];
+            (errors[a].powi(2) + 2.0 * g * covariance + g * g * errors[b].powi(2))
+                .max(0.0)
+                .sqrt()
+        })
+        .collect()
 }
 
 /// 1-σ errors of a law's n and k at each wavelength, g·C·g with g = ∂(n, k)/∂(law) by central

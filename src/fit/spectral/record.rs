@@ -53,7 +53,7 @@ pub(super) fn material(
         uncertainty: shared_uncertainty(chosen),
         correlation: chosen.correlation.clone(),
         undetermined: Vec::new(),
-        at_bound: Vec::new(),
+        at_bound: chosen.at_bound.clone(),
         profile_bounds: BTreeMap::new(),
         uncertainty_per_wavelength: uncertainty_per_wavelength(chosen),
         wavelengths: wavelength_quality(sets, chosen),
@@ -63,6 +63,8 @@ pub(super) fn material(
         convergence: chosen.history.best_cost.clone(),
         global_iterations: 0,
     };
+    let mut record = record;
+    record.mark_non_finite_as_undetermined();
     Material {
         name: sets[0].material.clone(),
         tool_version: format!("irpol {}", env!("CARGO_PKG_VERSION")),
@@ -94,7 +96,8 @@ fn shared_uncertainty(chosen: &SpectralFit) -> BTreeMap<String, f64> {
         .collect()
 }
 
-/// 1-σ errors of n, k and ρ_d at each wavelength, by name.
+/// 1-σ errors of n, k, ρ_d and the other per-wavelength parameters at each wavelength, by
+/// name.
 fn uncertainty_per_wavelength(chosen: &SpectralFit) -> BTreeMap<String, Vec<f64>> {
     [
         ("n", &chosen.n_errors),
@@ -102,6 +105,7 @@ fn uncertainty_per_wavelength(chosen: &SpectralFit) -> BTreeMap<String, Vec<f64>
         ("rho_d", &chosen.rho_d_errors),
     ]
     .into_iter()
+    .chain(chosen.volume_errors.iter().map(|(p, e)| (p.name(), e)))
     .map(|(name, errors)| (name.to_owned(), errors.clone()))
     .collect()
 }
