@@ -239,6 +239,10 @@ struct FitArgs {
     /// predicts best.
     #[arg(long, value_name = "K")]
     cv: Option<usize>,
+    /// A spectral fit's subsurface parameters to free at each wavelength instead of sharing
+    /// them, e.g. d,n_sub (of d, n_sub, d_c, d1).
+    #[arg(long, value_name = "LIST")]
+    per_wavelength: Option<String>,
     /// Library folder for the material TOMLs.
     #[arg(long, default_value = "fits")]
     out: PathBuf,
@@ -410,6 +414,7 @@ fn fit(args: FitArgs) -> anyhow::Result<()> {
         dispersion: args.dispersion,
         terms: args.terms,
         cv: args.cv,
+        per_wavelength: args.per_wavelength,
     };
     let reading = args.measurements.read_options()?;
     fit_and_summarize(

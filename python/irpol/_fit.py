@@ -81,19 +81,21 @@ def fit(
     optimizer: str = "ga+lm",
     seed: Optional[int] = None,
     robust: Optional[str] = None,
-    dispersion: str = "table",
+    dispersion: str = "auto",
     layout: Optional[Union[str, "os.PathLike[str]"]] = None,
     wavelength: Optional[float] = None,
     theta_i: Optional[Sequence[float]] = None,
-    terms: str = "external+depolarizer",
+    terms: str = "auto",
 ) -> List[FitResult]:
     """Fits every material among `inputs` (measurement CSVs or folders of them) as
     ``irpol fit`` does, with its options (same names, values and defaults: `free` as
     ``"sigma,q,n,k,rho"`` or a list, `fix` as ``"k=0.1,rho=0"`` or a dict, `optimizer` as
-    ``"ga+lm"``, `robust` as ``"huber:2"``, `dispersion` as ``"table"`` or ``"lorentz:N"``;
+    ``"ga+lm"``, `robust` as ``"huber:2"``, `dispersion` as ``"auto"``, ``"table"``,
+    ``"cauchy"`` or ``"lorentz:N"``;
     `layout` an instrument layout TOML, `wavelength` (µm) and `theta_i` (degrees) the rows kept,
-    as ``--layout``, ``--wavelength``, ``--theta-i``; `terms` the model's terms, one set of
-    ``--terms`` such as ``"internal+subsurface"``). Nothing is written. One :class:`FitResult` per material, in the order ``irpol fit`` prints
+    as ``--layout``, ``--wavelength``, ``--theta-i``; `terms` the model's terms as
+    ``--terms`` takes them: ``"auto"`` (the default: the admissible set that predicts best), one
+    set such as ``"internal+subsurface"``, several comma-separated, or ``"all"``). Nothing is written. One :class:`FitResult` per material, in the order ``irpol fit`` prints
     them. Raises OSError (unreadable input) or ValueError (bad data or options)."""
     if isinstance(inputs, (str, os.PathLike)):
         inputs = [inputs]

@@ -178,8 +178,6 @@ def test_fit_with_volume_terms_equals_irpol_fit(tmp_path):
     model = result.material
     assert 'facet = "internal"' in result.toml
     assert model.n == pytest.approx(1.35, abs=0.005) and model.sigma == pytest.approx(0.8, abs=0.01)
-    with pytest.raises(ValueError, match="one set of terms at a time"):
-        irpol.fit(source, terms="all")
 
 
 def test_validate_equals_irpol_validate(tmp_path):

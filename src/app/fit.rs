@@ -43,6 +43,9 @@ pub struct FitFlags {
     pub terms: String,
     /// K-fold cross-validation (K ≥ 2) of each candidate set of terms.
     pub cv: Option<usize>,
+    /// Parameters a spectral fit frees at each wavelength instead of sharing them, e.g.
+    /// `d,n_sub` (docs/design.md §1.10).
+    pub per_wavelength: Option<String>,
 }
 
 impl Default for FitFlags {
@@ -59,6 +62,7 @@ impl Default for FitFlags {
             dispersion: "auto".into(),
             terms: AUTO_TERMS.to_owned(),
             cv: None,
+            per_wavelength: None,
         }
     }
 }
@@ -98,8 +102,36 @@ impl FitFlags {
             options.term_candidates = candidates;
         }
         options.cv_folds = self.cv;
+        if let Some(list) = &self.per_wavelength {
+            options.per_wavelength = per_wavelength_parameters(list)?;
+        }
         Ok(options)
     }
+}
+
+/// `--per-wavelength LIST`: parameters a spectral fit shares unless told (the subsurface's d,
+/// n_sub, d_c, d1); the geometry's σ, q are refused (the surface is one at every wavelength),
+/// and so is a parameter already free at each wavelength.
+fn per_wavelength_parameters(list: &str) -> Result<Vec<crate::pbrdf::Parameter>, AppError> {
+    let parameters = parse_parameter_list(list)?;
+    for p in &parameters {
+        match p.info().spectral {
+            crate::pbrdf::SpectralRole::SharedByDefault => {}
+            crate::pbrdf::SpectralRole::Shared => {
+                return Err(AppError::invalid(format!(
+                    "--per-wavelength {p}: the slope parameters describe the surface's geometry, \
+                     which does not depend on wavelength; they are always shared"
+                )))
+            }
+            crate::pbrdf::SpectralRole::PerWavelength => {
+                return Err(AppError::invalid(format!(
+                    "--per-wavelength {p}: {p} is fitted at each wavelength already; the list \
+                     takes d, n_sub, d_c, d1"
+                )))
+            }
+        }
+    }
+    Ok(parameters)
 }
 
 /// `--terms auto`: choose among [`ModelTerms::ALL`] (docs/design.md §1.10).

@@ -5,7 +5,7 @@
 use super::{material_pbrdf, AppError};
 use crate::atomic::OutputSet;
 use crate::fit::{validate_model, Validation};
-use crate::material::Material;
+use crate::material::{Material, MaterialModel};
 use crate::measure::{collect_measurement_files, MeasurementSet, ReadOptions};
 use crate::report::fit_report::encode_validation_report;
 use std::path::{Path, PathBuf};
@@ -50,8 +50,13 @@ pub fn validate_sets(
         let wavelength = material.model.spectral().map(|_| set.wavelength_um);
         let model = material_pbrdf(material, wavelength, None)?;
         let validation = validate_model(&model, &set)?;
+        // A spectral material's page shows its model at the set's wavelength.
+        let at_wavelength = Material {
+            model: MaterialModel::Grey(material.at(set.wavelength_um)?),
+            ..material.clone()
+        };
         let report = encode_validation_report(
-            material,
+            &at_wavelength,
             &set,
             &validation_summary(&validation),
             reports_dir,

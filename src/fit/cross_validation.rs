@@ -15,11 +15,11 @@
 
 use super::admissible::why_inadmissible;
 use super::data::MeasurementData;
+use super::levenberg_marquardt::LevenbergMarquardtSettings;
 use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
 use super::options::FitOptions;
 use super::outcome::{finish, fit_distributions, fit_measurement, FitOutcome, Fitted};
-use super::levenberg_marquardt::LevenbergMarquardtSettings;
 use super::stages::Optimizer;
 pub use super::terms_choice::{TermsChoice, TermsScore};
 use super::FitError;
@@ -263,7 +263,10 @@ fn cross_validate(
         let residuals = Objective::new(&test_data, &space, None)
             .normalized_residuals(&refit.parameter_values(&effective))
             .unwrap_or_default();
-        folds.push((residuals.iter().map(|r| r * r).sum::<f64>(), residuals.len()));
+        folds.push((
+            residuals.iter().map(|r| r * r).sum::<f64>(),
+            residuals.len(),
+        ));
     }
     Ok(folds)
 }

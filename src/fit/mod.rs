@@ -40,8 +40,8 @@ mod terms_choice;
 mod uncertainty;
 mod validation;
 
-pub use comparison::{aic, bic, Candidate, ModelComparison};
 pub use admissible::{why_inadmissible, STRONG_ABSORPTION_K};
+pub use comparison::{aic, bic, Candidate, ModelComparison};
 pub use cross_validation::{
     fit_choosing_terms, fit_grey, fold_rows, subset, TermsChoice, TermsScore, DEFAULT_FOLDS,
     MAX_FOLDS,

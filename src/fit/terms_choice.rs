@@ -150,7 +150,9 @@ impl TermsChoice {
             .filter(|&i| score(i) <= threshold)
             .min_by(|&a, &b| {
                 let key = |i: usize| (scores[i].free_parameters, score(i));
-                key(a).partial_cmp(&key(b)).unwrap_or(std::cmp::Ordering::Equal)
+                key(a)
+                    .partial_cmp(&key(b))
+                    .unwrap_or(std::cmp::Ordering::Equal)
             })
             .unwrap_or(best)
     }

@@ -270,7 +270,11 @@ fn mark_undetermined(model: &mut Table, identification: &[(String, String)]) {
         };
         if let Some(mut key) = model.key_mut(key) {
             let decor = key.leaf_decor_mut();
-            let prefix = decor.prefix().and_then(|p| p.as_str()).unwrap_or("").to_owned();
+            let prefix = decor
+                .prefix()
+                .and_then(|p| p.as_str())
+                .unwrap_or("")
+                .to_owned();
             decor.set_prefix(format!(
                 "{prefix}{}",
                 comment_lines(&format!("NOT DETERMINED by the data: {name} {why}"))

@@ -637,7 +637,10 @@ mod tests {
             .into_iter()
             .chain([ModelTerms::new(FacetSide::Internal, Body::Depolarizer)]);
         for (terms, per_wavelength_d) in terms.flat_map(|t| [(t, false), (t, true)]) {
-            let nodes = [node(terms, 0.351, per_wavelength_d), node(terms, 1.064, per_wavelength_d)];
+            let nodes = [
+                node(terms, 0.351, per_wavelength_d),
+                node(terms, 1.064, per_wavelength_d),
+            ];
             let material = Material {
                 name: "twin".into(),
                 tool_version: "irpol test".into(),
@@ -683,7 +686,8 @@ mod tests {
         let short = format!("{}\nd = [0.02{}", &text[..start], &text[end..]);
         let error = Material::from_toml(&short, path).unwrap_err().to_string();
         assert!(
-            error.contains("d has 1 values for 2 wavelengths") && error.contains("1.064 µm has none"),
+            error.contains("d has 1 values for 2 wavelengths")
+                && error.contains("1.064 µm has none"),
             "{error}"
         );
     }

@@ -30,6 +30,4 @@ pub use model::{Pbrdf, ScatteringGeometry};
 pub use sample::ScatteredView;
 pub use shadowing::Shadowing;
 pub use subsurface::{FacetSide, Subsurface, SubsurfaceKeysWithoutRhoS, Transmission};
-pub use terms::{
-    Body, ModelTerms, OutsideDomain, Parameter, ParameterInfo, SpectralRole, Term,
-};
+pub use terms::{Body, ModelTerms, OutsideDomain, Parameter, ParameterInfo, SpectralRole, Term};

@@ -15,11 +15,10 @@ mod joint;
 mod lorentz_start;
 mod record;
 
+use super::admissible::STRONG_ABSORPTION_K;
 use super::comparison::{aic, bic};
 use super::data::MeasurementData;
-use super::admissible::STRONG_ABSORPTION_K;
 use super::energy::{check_energy, EnergyCheck, ENERGY_TOLERANCE};
-use super::space::VOLUME_MIN_N;
 use super::levenberg_marquardt::{levenberg_marquardt, LeastSquares};
 use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
@@ -28,6 +27,7 @@ use super::parameters::{
     from_search, to_search, value_per_coordinate, DistributionKind, Parameter,
 };
 use super::space::ModelSpace;
+use super::space::VOLUME_MIN_N;
 use super::stages::StageHistory;
 use super::uncertainty::linearized_errors;
 use super::FitError;
@@ -193,7 +193,10 @@ pub(crate) fn fit_spectral_from(
         .map(MeasurementData::new)
         .collect::<Result<Vec<_>, _>>()?;
     let kinds = options.distributions();
-    let alone = alone.map_or_else(|| vec![None; kinds.len()], |a| a.into_iter().map(Some).collect());
+    let alone = alone.map_or_else(
+        || vec![None; kinds.len()],
+        |a| a.into_iter().map(Some).collect(),
+    );
     // Both distributions at once: their 2 × K wavelength fits share the cores instead of each
     // distribution's K waiting for its slowest (each fit is seeded, so the result is the same).
     let mut fits = kinds
@@ -356,7 +359,14 @@ fn fit_cauchy(
     let space = model_space(kind, &law_options)?;
     let spaces = vec![space; sets.len()];
     let bounds = (vec![VOLUME_MIN_N, 0.0], vec![10.0, 1.0]);
-    let mut problem = joint_problem(sets, data, &spaces, options, IndexModel::Cauchy, Some(bounds));
+    let mut problem = joint_problem(
+        sets,
+        data,
+        &spaces,
+        options,
+        IndexModel::Cauchy,
+        Some(bounds),
+    );
     let (a, b) = cauchy_start(&model.wavelength_um, &model.n);
     let mut start: Vec<f64> = problem
         .shared
@@ -367,10 +377,20 @@ fn fit_cauchy(
     for &p in &problem.families {
         for j in 0..sets.len() {
             let node = model.at(model.wavelength_um[j]).ok();
-            start.push(to_search(p, node.and_then(|m| m.parameter(p)).unwrap_or(0.0)));
+            start.push(to_search(
+                p,
+                node.and_then(|m| m.parameter(p)).unwrap_or(0.0),
+            ));
         }
     }
-    solve(&mut problem, sets, &start, options, kind, Dispersion::Cauchy)
+    solve(
+        &mut problem,
+        sets,
+        &start,
+        options,
+        kind,
+        Dispersion::Cauchy,
+    )
 }
 
 /// A and B ≥ 0 of the least-squares line n = A + B x, x = 1/λ², through the table's `n`.
@@ -379,7 +399,11 @@ fn cauchy_start(wavelengths: &[f64], n: &[f64]) -> (f64, f64) {
     let count = x.len() as f64;
     let (mean_x, mean_n) = (x.iter().sum::<f64>() / count, n.iter().sum::<f64>() / count);
     let sxx: f64 = x.iter().map(|x| (x - mean_x).powi(2)).sum();
-    let sxn: f64 = x.iter().zip(n).map(|(x, n)| (x - mean_x) * (n - mean_n)).sum();
+    let sxn: f64 = x
+        .iter()
+        .zip(n)
+        .map(|(x, n)| (x - mean_x) * (n - mean_n))
+        .sum();
     let b = if sxx > 0.0 { (sxn / sxx).max(0.0) } else { 0.0 };
     ((mean_n - b * mean_x).max(VOLUME_MIN_N), b)
 }
@@ -407,12 +431,9 @@ fn joint_problem<'a>(
             }
         })
         .collect();
-    JointProblem::new(
-        blocks,
-        index_model,
-        law_bounds.unwrap_or_default(),
-        &|p| options.shared_across_wavelengths(p),
-    )
+    JointProblem::new(blocks, index_model, law_bounds.unwrap_or_default(), &|p| {
+        options.shared_across_wavelengths(p)
+    })
 }
 
 /// Polishes `problem` from `start` (holding energy at every wavelength) and gathers everything

@@ -311,6 +311,22 @@ fn caveat_rows(fit: &FitRecord) -> Vec<Row> {
             Tone::Muted,
         ));
     }
+    let correlated: Vec<String> = fit
+        .identification()
+        .into_iter()
+        .filter(|(_, why)| why.starts_with("correlated"))
+        .map(|(name, why)| format!("{} {why}", symbol(&name)))
+        .collect();
+    if !correlated.is_empty() {
+        rows.push(Row::Text(
+            format!(
+                "determined only in combination (|ρ| > {}): {}",
+                crate::material::STRONG_CORRELATION,
+                correlated.join("; ")
+            ),
+            Tone::Warning,
+        ));
+    }
     if !fit.profile_bounds.is_empty() {
         let names: Vec<&str> = fit.profile_bounds.keys().map(|n| symbol(n)).collect();
         rows.push(Row::Text(

@@ -45,15 +45,24 @@ fn shared_lines(model: &SpectralModel, fit: Option<&FitRecord>) -> Vec<Line> {
     };
     let mut lines = vec![
         Line::Heading(format!(
-            "Shared by every wavelength ({} slopes, {} shadowing)",
+            "Shared by every wavelength ({} slopes, {} shadowing, terms {})",
             model.distribution.name(),
-            model.shadowing.name()
+            model.shadowing.name(),
+            model.terms()
         )),
         row("σ".into(), model.distribution.sigma(), "sigma"),
     ];
     if let Some(q) = model.distribution.parameter(Parameter::Q) {
         lines.push(row("q".into(), q, "q"));
     }
+    // The subsurface parameters the fit shared (one number); per-wavelength ones are in the
+    // table below.
+    for (name, value) in model.volume.keys() {
+        if let Some(crate::material::PerWavelength::Shared(v)) = value {
+            lines.push(row(name.to_owned(), *v, name));
+        }
+    }
+
     if let Some(law) = &model.dispersion {
         lines.push(row("ε∞".into(), law.eps_inf, "eps_inf"));
         for (j, o) in law.oscillators.iter().enumerate() {
@@ -122,7 +131,16 @@ fn quality_lines(outcome: &SpectralFitOutcome, fit: Option<&FitRecord>) -> Vec<L
 /// n, k, ρd ± 1σ, χ²/obs and points at each wavelength.
 fn wavelength_lines(outcome: &SpectralFitOutcome, model: &SpectralModel) -> Vec<Line> {
     let fit = &outcome.chosen;
-    let header = ["λ (µm)", "n ± 1σ", "k ± 1σ", "ρd ± 1σ", "χ²/obs", "points"];
+    let rho_s = match &model.volume.rho_s {
+        Some(crate::material::PerWavelength::Each(values)) => Some(values),
+        _ => None,
+    };
+    let body = if rho_s.is_some() {
+        "ρs ± 1σ"
+    } else {
+        "ρd ± 1σ"
+    };
+    let header = ["λ (µm)", "n ± 1σ", "k ± 1σ", body, "χ²/obs", "points"];
     let mut lines = vec![
         Line::Heading("Per wavelength".into()),
         Line::Cells(header.iter().map(|h| h.to_string()).collect(), true),
@@ -145,7 +163,15 @@ fn wavelength_lines(outcome: &SpectralFitOutcome, model: &SpectralModel) -> Vec<
                 number(w),
                 value(&model.n, &fit.n_errors),
                 value(&model.k, &fit.k_errors),
-                value(&model.rho_d, &fit.rho_d_errors),
+                match rho_s {
+                    Some(values) => value(
+                        values,
+                        fit.volume_errors
+                            .get(&Parameter::RhoS)
+                            .map_or(&[][..], |e| e.as_slice()),
+                    ),
+                    None => value(&model.rho_d, &fit.rho_d_errors),
+                },
                 chi2,
                 points,
             ],
