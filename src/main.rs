@@ -925,10 +925,12 @@ fn demo() -> anyhow::Result<()> {
         measurements.display(),
         fits.display()
     );
+    // The product's default, as `irpol fit` with no flag runs it (terms chosen, docs/design.md
+    // §1.10).
     fit_and_summarize(
         &[measurements],
         &ReadOptions::default(),
-        &FitOptions::default(),
+        &FitFlags::default().options()?,
         &fits,
         &reports,
     )?;

@@ -102,7 +102,11 @@ mod tests {
         // PTFE fitted with facets and an ideal depolarizer (measured at 0.351 µm: 0.661 + 0.413i).
         let stand_in = model(0.661, 0.413, 0.0);
         let why = why_inadmissible(&[&stand_in], &[&[]]).unwrap();
-        assert!(why.starts_with("n = 0.661 < 1 at 1.064 µm"), "{why}");
+        assert!(why.starts_with("n = 0.661"), "{why}");
+        assert!(
+            why.contains(" < 1 at 1.064 µm without an absorption band"),
+            "{why}"
+        );
         // Silicate glass at 8 µm, beside its band.
         let glass = model(0.518, 0.544, 0.0);
         assert_eq!(why_inadmissible(&[&glass], &[&[]]), None);
