@@ -180,11 +180,50 @@ fn ptfe_volume_fit(c: &mut Criterion) {
     group.finish();
 }
 
+/// The product's default (`irpol fit` with no flag: three sets of terms, each with both slope
+/// laws, 5-fold cross-validated, the kept one's profile bounds) on NIST's PTFE: one wavelength
+/// (1824 rows × 16) and both as one spectral material (docs/design.md §1.10). Targets: ≤ 3 s and
+/// ≤ 8 s.
+fn ptfe_default_fit(c: &mut Criterion) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/ptfe");
+    let layout = Layout::read(&root.join("layout.toml")).unwrap();
+    let sets = read_with_layout(&root.join("PTFE_351_1064.csv"), &layout).unwrap();
+    let options = irpol::app::fit::FitFlags::default().options().unwrap();
+    let mut group = c.benchmark_group("ptfe_default");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(60));
+    for set in &sets {
+        let name = format!("grey_{}um", set.wavelength_um);
+        group.bench_function(name, |b| {
+            b.iter(|| fit_grey(black_box(set), &options).unwrap())
+        });
+    }
+    let path = root.join("PTFE_351_1064.csv");
+    let reading = irpol::measure::ReadOptions {
+        layout: Some(layout.clone()),
+        ..Default::default()
+    };
+    group.bench_function("spectral_both", |b| {
+        b.iter(|| {
+            irpol::fit::fit_inputs_with(
+                std::slice::from_ref(&path),
+                &reading,
+                &options,
+                &irpol::progress::Silent,
+            )
+            .unwrap()
+        })
+    });
+    group.finish();
+}
+
 criterion_group!(
     benches,
     objective,
     default_fit,
     spectral_fit,
-    ptfe_volume_fit
+    ptfe_volume_fit,
+    ptfe_default_fit
 );
 criterion_main!(benches);

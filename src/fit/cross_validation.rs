@@ -275,6 +275,53 @@ fn cross_validate(
 mod tests {
     use super::*;
 
+    /// `--cv K` is bounded before any work (each fold is a refit): 2 ≤ K ≤ min(rows, 20); the
+    /// default choice folds only a set with 10 rows a fold, else compares by AIC.
+    #[test]
+    fn folds_are_bounded_up_front() {
+        let point = crate::measure::MeasurementPoint {
+            theta_i_deg: 30.0,
+            phi_i_deg: 0.0,
+            theta_r_deg: 30.0,
+            phi_r_deg: 180.0,
+            values: vec![0.1],
+            uncertainties: vec![None],
+            line: 2,
+        };
+        let rows = |n: usize| MeasurementSet {
+            source: "rows.csv".into(),
+            sha256: String::new(),
+            material: "rows".into(),
+            wavelength_um: 10.0,
+            metadata: Default::default(),
+            elements: vec![0],
+            points: vec![point.clone(); n],
+            merged: Vec::new(),
+            notes: Vec::new(),
+        };
+        let set = rows(1824);
+        let with = |cv: Option<usize>, choose_terms: bool| FitOptions {
+            cv_folds: cv,
+            choose_terms,
+            ..FitOptions::default()
+        };
+        let refused = folds_for(&set, &with(Some(1824), false))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            refused.contains("--cv 1824: the folds must number from 2 to 20"),
+            "{refused}"
+        );
+        assert!(folds_for(&set, &with(Some(1), false)).is_err());
+        assert_eq!(folds_for(&set, &with(Some(20), false)).unwrap(), Some(20));
+        assert_eq!(
+            folds_for(&set, &with(None, true)).unwrap(),
+            Some(DEFAULT_FOLDS)
+        );
+        assert_eq!(folds_for(&set, &with(None, false)).unwrap(), None);
+        assert_eq!(folds_for(&rows(49), &with(None, true)).unwrap(), None);
+    }
+
     #[test]
     fn folds_partition_the_rows_and_depend_on_the_seed() {
         let folds = fold_rows(103, 5, 7);
