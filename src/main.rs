@@ -274,6 +274,9 @@ fn print_line(line: std::fmt::Arguments) {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // One interrupt handler for every command that writes (validate, report, figure, scene
+    // init as well as fit, render, thermal and demo): it removes what the library staged.
+    cli::signals::watch_interrupts();
     let outcome = run(cli.command);
     // A run that ends (refused a write, or just finished) while the interrupt handler clears up
     // must not exit under it: the handler removes the temporaries and exits with 128 + signal.
