@@ -5,6 +5,7 @@ pub mod error;
 pub mod evaluate;
 pub mod fit;
 pub mod render;
+pub mod render_cost;
 pub mod saved_thermal;
 pub mod scene_init;
 pub mod selection;
