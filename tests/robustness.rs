@@ -617,3 +617,35 @@ fn a_fit_whose_entry_or_index_is_a_folder_writes_nothing() {
         );
     }
 }
+
+/// A render's time is estimated before any work from its expensive dimensions (frames, pixels ×
+/// path vertices, wavelength nodes) and refused beyond `--max-minutes` with the estimate and the
+/// value to give (issue 42: `--times` took 1e5 frames, ≈ 13 h, without a word).
+#[test]
+fn a_render_estimated_beyond_its_limit_is_refused_before_any_work() {
+    let many_paths = scene("m.obj", "[render]\nsamples = 4000000000\n");
+    refuse(
+        &[
+            ("scene.toml", many_paths.as_bytes()),
+            ("m.obj", TRIANGLE_OBJ),
+        ],
+        RENDER,
+        "scene.toml: this render is estimated at ",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let day = manifest("scenes/car_day.toml");
+    let args = [
+        "render",
+        day.to_str().unwrap(),
+        "--times",
+        "0:100000:1",
+        "--out",
+        "out",
+    ];
+    let run = irpol(dir.path(), &args);
+    assert_refused(&run, "(100001 frames × ");
+    assert!(run
+        .stderr
+        .contains("more than --max-minutes 60: give --max-minutes "));
+    assert!(snapshot(dir.path()).is_empty(), "files were written");
+}
