@@ -12,8 +12,8 @@
 //!
 //! Each property runs a fixed number of cases from a fixed seed, so that CI's pass is the same
 //! pass every time (the scene loader, the slowest reader, a tenth as many cases); together they
-//! take well under 30 s in a release build. Raise `FUZZ_CASES` and change `FUZZ_SEED`
-//! (environment) to fuzz longer or elsewhere, e.g.
+//! take about half a minute in a release build on two shared cores. Raise `FUZZ_CASES` and
+//! change `FUZZ_SEED` (environment) to fuzz longer or elsewhere, e.g.
 //! `FUZZ_CASES=100000 FUZZ_SEED=7 cargo test --release --test fuzz_readers`.
 
 use irpol::app::evaluate::{parse_geometry_csv, write_mueller_csv};
@@ -727,6 +727,17 @@ fn the_seeds_are_read() {
             .unwrap()
             .band_rows(&irpol::optics::Band::lwir(), 290.0)
             .unwrap();
+    }
+    for seed in tiny_atmosphere_seeds() {
+        parse_table(Path::new("t.csv"), &seed)
+            .unwrap()
+            .band_rows(&irpol::optics::Band::lwir(), 290.0)
+            .unwrap();
+    }
+    for (layout, table) in layout_seeds().iter().zip(layout_table_seeds()) {
+        let layout = irpol::measure::Layout::parse(Path::new("l.toml"), &text(layout)).unwrap();
+        let sets = irpol::measure::parse_with_layout(Path::new("t.csv"), &table, &layout).unwrap();
+        assert!(!sets.is_empty());
     }
     load_scene_text(Path::new("fuzz/scene.toml"), &text(&scene_seeds()[0])).unwrap();
     for seed in sweep_seeds() {
