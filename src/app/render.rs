@@ -48,8 +48,10 @@ pub fn render_scene_within(
     if scene.thermal.is_some() {
         return Err(AppError::ThermalNeedsInstant(scene_path.to_owned()));
     }
-    check_estimate(&scene, 1, max_minutes)?;
-    render_loaded(&scene, out_dir, progress, start)
+    let estimate = check_estimate(&scene, 1, max_minutes)?;
+    let mut summary = render_loaded(&scene, out_dir, progress, start)?;
+    summary.warnings.extend(estimate.advice());
+    Ok(summary)
 }
 
 fn render_loaded(
@@ -129,9 +131,13 @@ pub fn render_scene_at_within(
             vec![(at - setup.site.start_utc).num_milliseconds() as f64 / 1000.0]
         }
     };
-    check_estimate(&scene, times.len(), max_minutes)?;
+    let estimate = check_estimate(&scene, times.len(), max_minutes)?;
     let solution = solve(&scene, scene_path, &times, progress)?;
-    render_solution_at(&scene, &solution, &times, out_dir, progress)
+    let mut renders = render_solution_at(&scene, &solution, &times, out_dir, progress)?;
+    if let Some(first) = renders.first_mut() {
+        first.summary.warnings.extend(estimate.advice());
+    }
+    Ok(renders)
 }
 
 /// Renders a thermal scene at each of `times` (recorded in `solution`). One instant renders into
