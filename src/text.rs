@@ -119,7 +119,13 @@ pub fn numerals_shortened(text: &str, cut_at_end: bool) -> std::borrow::Cow<'_, 
             .is_some_and(|&b| b.is_ascii_alphanumeric() || b == b'_');
         let reaches_end = end == bytes.len() && cut_at_end;
         if end - i > LONG_NUMERAL_CHARS && !reaches_end && !word_follows {
-            if let Ok(value) = text[i..end].parse::<f64>() {
+            // A numeral beyond f64 (1e999, or 1e-999 read as 0) keeps its own spelling: "inf" or
+            // "0" would be another value than the one written.
+            let numeral = &text[i..end];
+            let value = numeral.parse::<f64>().ok().filter(|v| {
+                v.is_finite() && (*v != 0.0 || !numeral.bytes().any(|b| matches!(b, b'1'..=b'9')))
+            });
+            if let Some(value) = value {
                 out.push_str(&text[copied..i]);
                 out.push_str(&number(value));
                 copied = end;
@@ -315,6 +321,12 @@ mod tests {
         assert_eq!(shown("m00 2026-06-21 abc123"), "m00 2026-06-21 abc123");
         let hash = format!("{}ab _{}", "1".repeat(25), "2".repeat(25));
         assert_eq!(shown_at_most(&hash, 100), hash);
+        // Numerals beyond f64 are not shown as inf or 0.
+        let huge = format!("x {} y", "9".repeat(400));
+        assert_eq!(shown_at_most(&huge, 1000), huge);
+        let tiny = format!("x 0.{}1 y", "0".repeat(400));
+        assert_eq!(shown_at_most(&tiny, 1000), tiny);
+        assert_eq!(shown_at_most(&"0".repeat(30), 100), "0");
         // A numeral cut by the text's end is not shortened into another value.
         let cut = "9".repeat(5000);
         assert!(shown(&cut).starts_with("9999"), "{}", shown(&cut));
