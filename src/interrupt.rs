@@ -1,9 +1,40 @@
 //! Interrupts and output writes. The library never handles signals; it only counts
 //! its writes of output sets and refuses to start new ones once the binary's SIGINT/SIGTERM
 //! handler has set [`INTERRUPTED`]. The handler then waits for the writes under way to finish,
-//! removes the temporaries and exits.
+//! removes the temporaries and exits. Every staged write records where its temporaries are
+//! ([`note_temporaries_in`], [`note_staging_folder`]), so one handler, installed once for every
+//! command, finds them all whichever command wrote them.
 
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// Folders this process stages `.<name>.<pid>.tmp` files in, and its staging folders: what an
+/// interrupt handler removes ([`staged_so_far`]).
+static STAGED: Mutex<(Vec<PathBuf>, Vec<PathBuf>)> = Mutex::new((Vec::new(), Vec::new()));
+
+/// Records that this process stages temporary files in `dir`.
+pub fn note_temporaries_in(dir: &Path) {
+    if let Ok(mut staged) = STAGED.lock() {
+        if !staged.0.iter().any(|d| d == dir) {
+            staged.0.push(dir.to_owned());
+        }
+    }
+}
+
+/// Records a staging folder of this process (removed whole on an interrupt).
+pub fn note_staging_folder(folder: &Path) {
+    if let Ok(mut staged) = STAGED.lock() {
+        if !staged.1.iter().any(|d| d == folder) {
+            staged.1.push(folder.to_owned());
+        }
+    }
+}
+
+/// (folders holding this process's temporaries, its staging folders) recorded so far.
+pub fn staged_so_far() -> (Vec<PathBuf>, Vec<PathBuf>) {
+    STAGED.lock().map(|s| s.clone()).unwrap_or_default()
+}
 
 /// Whether process `pid` still runs (Linux /proc): temporaries of one that does not were left by a
 /// SIGKILL and may be removed.

@@ -10,7 +10,7 @@ use irpol::app::evaluate::{
 };
 use irpol::app::fit::{fit_and_write, FitFlags};
 use irpol::app::render::{
-    default_output_dir, render_scene, render_scene_at, Instants, TimedRender,
+    default_output_dir, render_scene_at_within, render_scene_within, Instants, TimedRender,
 };
 use irpol::app::scene_init::write_starter_scene;
 use irpol::app::sun::{given_times, write_sun_csv};
@@ -121,6 +121,10 @@ enum Command {
         /// preview.gif animating S0 and DoLP.
         #[arg(long)]
         times: Option<String>,
+        /// Refuse, before any work, a render estimated to take longer (frames × pixels × path
+        /// vertices × wavelength nodes; docs/commands.md, `irpol render`).
+        #[arg(long, default_value_t = irpol::app::render_cost::DEFAULT_MAX_MINUTES)]
+        max_minutes: f64,
     },
     /// Temperatures from a scene's [thermal] model: temperatures.csv (min/mean/max per part),
     /// a PLY per recorded step, temperatures.png and summary.json (docs/scenes.md, "Thermal").
@@ -282,6 +286,9 @@ fn print_line(line: std::fmt::Arguments) {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // One interrupt handler for every command that writes (validate, report, figure, scene
+    // init as well as fit, render, thermal and demo): it removes what the library staged.
+    cli::signals::watch_interrupts();
     let outcome = run(cli.command);
     // A run that ends (refused a write, or just finished) while the interrupt handler clears up
     // must not exit under it: the handler removes the temporaries and exits with 128 + signal.
@@ -348,9 +355,10 @@ fn run(command: Command) -> anyhow::Result<()> {
             time,
             time_utc,
             times,
+            max_minutes,
         } => match Instants::from_flags(time, time_utc, times.as_deref())? {
-            Some(instants) => render_instants(&scene, out, &instants),
-            None => render_and_summarize(&scene, out),
+            Some(instants) => render_instants(&scene, out, &instants, max_minutes),
+            None => render_and_summarize(&scene, out, max_minutes),
         },
         Command::Thermal { scene, out } => thermal_and_summarize(&scene, out),
         Command::Scene {
@@ -717,10 +725,14 @@ fn listed(open: &str, items: &[String], separator: &str, close: &str) -> String 
     }
 }
 
-fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {
+fn render_and_summarize(
+    scene: &Path,
+    out: Option<PathBuf>,
+    max_minutes: f64,
+) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| default_output_dir(scene));
     cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
-    let summary = render_scene(scene, &out, &TerminalProgress::new())?;
+    let summary = render_scene_within(scene, &out, max_minutes, &TerminalProgress::new())?;
     warn_once(&summary.warnings);
     let temperature = summary
         .apparent_temperature_k
@@ -743,11 +755,17 @@ fn render_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()
     Ok(())
 }
 
-fn render_instants(scene: &Path, out: Option<PathBuf>, instants: &Instants) -> anyhow::Result<()> {
+fn render_instants(
+    scene: &Path,
+    out: Option<PathBuf>,
+    instants: &Instants,
+    max_minutes: f64,
+) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| default_output_dir(scene));
     // One instant or a whole series: one output set staged beside the folder.
     cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
-    let renders = render_scene_at(scene, &out, instants, &TerminalProgress::new())?;
+    let progress = TerminalProgress::new();
+    let renders = render_scene_at_within(scene, &out, instants, max_minutes, &progress)?;
     report_instants(scene, &out, &renders);
     Ok(())
 }
@@ -941,7 +959,11 @@ fn demo() -> anyhow::Result<()> {
         }
     }
     say!("the car scene, with the shipped library (fits/):");
-    render_and_summarize(Path::new("scenes/car.toml"), Some(out.join("car")))?;
+    render_and_summarize(
+        Path::new("scenes/car.toml"),
+        Some(out.join("car")),
+        irpol::app::render_cost::DEFAULT_MAX_MINUTES,
+    )?;
     demo_day(&out)?;
     say!(
         "open {0}/reports/index.html for the fits, {0}/car/composite.png for the imagery, \

@@ -1,17 +1,19 @@
-//! Bounded fuzzing of every reader of user files and flags: the measurement CSV reader, the OBJ
-//! and PLY mesh readers, the material TOML loader (grey and spectral), the eval geometry reader,
+//! Bounded fuzzing of every reader of user files and flags: the measurement CSV reader, instrument
+//! layouts and the tables read through them, the OBJ and PLY mesh readers, the material TOML loader (grey and spectral), the eval geometry reader,
 //! the thermal weather CSV reader, the atmosphere table reader, the scene loader (a thermal scene's keys), the `--times`
 //! sweep and the `sun --times-file` reader get random bytes and mutations of real inputs (the
 //! shipped measurements and materials, excerpts of the car mesh, small PLY files, weather CSVs, a
 //! thermal scene, sweeps and instants), some with runs of thousands of one character. Whatever
 //! they are fed, they must return — a value or an error whose message is one line of at most a
-//! few hundred characters without control characters — and never panic. (The sweep specs of
+//! few hundred characters without control characters — and never panic. Refusals of layouts,
+//! layout tables, atmosphere tables and EPW/TMY3 files must name the file at fault and the line
+//! (`file:line:`); EPW header lines in any shape keep every hourly row. (The sweep specs of
 //! `python -m irpol.dataset` are read in Python; what they reach in Rust is the scene loader.)
 //!
 //! Each property runs a fixed number of cases from a fixed seed, so that CI's pass is the same
 //! pass every time (the scene loader, the slowest reader, a tenth as many cases); together they
-//! take well under 30 s in a release build. Raise `FUZZ_CASES` and change `FUZZ_SEED`
-//! (environment) to fuzz longer or elsewhere, e.g.
+//! take about half a minute in a release build on two shared cores. Raise `FUZZ_CASES` and
+//! change `FUZZ_SEED` (environment) to fuzz longer or elsewhere, e.g.
 //! `FUZZ_CASES=100000 FUZZ_SEED=7 cargo test --release --test fuzz_readers`.
 
 use irpol::app::evaluate::{parse_geometry_csv, write_mueller_csv};
@@ -171,6 +173,13 @@ const TOKENS: &[&str] = &[
     "# wavelength_um: ",
     "m00",
     "u_m00",
+    "1e-310",
+    "5e-324",
+    "1e13",
+    "\"thetar\"",
+    "f_r11",
+    "DATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n",
+    "COMMENTS 2,\n",
 ];
 
 /// One edit of an input.
@@ -356,6 +365,67 @@ fn atmosphere_seeds() -> Vec<Vec<u8>> {
     ]
 }
 
+/// Atmosphere rows with subnormal and tiny transmittances beside ordinary ones (the log-linear
+/// interpolation once overflowed between 1e-310 and 0.5).
+fn tiny_atmosphere_seeds() -> Vec<Vec<u8>> {
+    vec![
+        b"range_m,transmittance,path_radiance_w_m2_sr\n100,1e-310,1.2\n1000,0.5,8.4\n\
+          2000,5e-324,9\n3000,1,0\n"
+            .to_vec(),
+    ]
+}
+
+/// The shipped PTFE layout, and one with the usual conventions.
+fn layout_seeds() -> Vec<Vec<u8>> {
+    vec![
+        shipped("data/ptfe/layout.toml"),
+        b"[columns]\ntheta_i_deg = \"ti\"\ntheta_r_deg = \"tr\"\nphi_r_deg = \"pr\"\n\
+          m00 = \"M11\"\nelements = { m01 = \"M12\", m10 = \"M21\" }\n[conventions]\n\
+          normalized = false\nangle_unit = \"deg\"\n"
+            .to_vec(),
+    ]
+}
+
+/// The head of the shipped PTFE table (both wavelengths), and a small table for the second seed.
+fn layout_table_seeds() -> Vec<Vec<u8>> {
+    let text = String::from_utf8(shipped("data/ptfe/PTFE_351_1064.csv")).unwrap();
+    let mut lines: Vec<&str> = text.lines().take(12).collect();
+    lines.extend(text.lines().skip(1830).take(8));
+    vec![
+        (lines.join("\n") + "\n").into_bytes(),
+        b"# wavelength_um: 10\nti,tr,pr,M11,M12,M21\n30,20,180,0.5,0.1,0.2\n-40,35,0,0.3,0,0\n"
+            .to_vec(),
+    ]
+}
+
+/// A refusal names the file at fault and the line, `file:line:`, as the CLI prints it (every
+/// refusal of a layout, a table read through one or an EPW/TMY3 file is about a line).
+fn check_names_file(message: &str, files: &[&str]) -> Result<(), TestCaseError> {
+    check_message(message)?;
+    let named = files.iter().any(|file| {
+        message
+            .strip_prefix(file)
+            .and_then(|rest| rest.strip_prefix(':'))
+            .is_some_and(|rest| rest.starts_with(|c: char| c.is_ascii_digit()))
+    });
+    prop_assert!(
+        named,
+        "{message:?} does not start with file:line of {files:?}"
+    );
+    Ok(())
+}
+
+/// A refusal starts with the file at fault, `file:`, and its line where it is about one
+/// (an atmosphere table's refusal of the whole table, e.g. a band it does not cover, has none).
+fn check_names_file_maybe_line(message: &str, file: &str) -> Result<(), TestCaseError> {
+    check_message(message)?;
+    prop_assert!(
+        message.starts_with(&format!("{file}:")),
+        "{message:?} does not start with {file}"
+    );
+    Ok(())
+}
+
 fn material_seeds() -> Vec<Vec<u8>> {
     ["paper_paint", "anodized_panel", "silicate_glass"]
         .iter()
@@ -517,7 +587,80 @@ proptest! {
                     prop_assert!(path.is_finite() && path >= 0.0, "L {path} at {r} m");
                 }
             }
-            Err(e) => check_message(&e.to_string())?,
+            Err(e) => check_names_file_maybe_line(&e.to_string(), "fuzz.csv")?,
+        }
+    }
+
+    #[test]
+    fn layouts_refuse_naming_their_file_and_keep_values_finite(
+        layout in prop_oneof![mutated(layout_seeds()), noise()],
+        table in prop_oneof![mutated(layout_table_seeds()), noise()],
+    ) {
+        use irpol::measure::{parse_with_layout, Layout, MAX_MUELLER_SR};
+        let (layout_file, table_file) = ("fuzz/layout.toml", "fuzz/table.csv");
+        let layout = match Layout::parse(Path::new(layout_file), &text(&layout)) {
+            Ok(layout) => layout,
+            Err(e) => return check_names_file(&e.to_string(), &[layout_file]),
+        };
+        match parse_with_layout(Path::new(table_file), &table, &layout) {
+            Ok(sets) => {
+                for point in sets.iter().flat_map(|s| &s.points) {
+                    prop_assert!(point.values.iter().all(|v| v.abs() <= MAX_MUELLER_SR));
+                    prop_assert!((0.0..90.0).contains(&point.theta_i_deg));
+                    prop_assert!((0.0..90.0).contains(&point.theta_r_deg));
+                }
+            }
+            Err(e) => check_names_file(&e.to_string(), &[table_file, layout_file])?,
+        }
+    }
+
+    #[test]
+    fn the_shipped_layout_reads_mutated_tables_or_names_the_line(
+        table in mutated(layout_table_seeds()),
+    ) {
+        use irpol::measure::{parse_with_layout, Layout};
+        let layout = Layout::parse(Path::new("fuzz/layout.toml"), &text(&layout_seeds()[0])).unwrap();
+        if let Err(e) = parse_with_layout(Path::new("fuzz/table.csv"), &table, &layout) {
+            check_names_file(&e.to_string(), &["fuzz/table.csv", "fuzz/layout.toml"])?;
+        }
+    }
+
+    #[test]
+    fn tiny_transmittances_interpolate_finitely(
+        bytes in mutated(tiny_atmosphere_seeds()),
+    ) {
+        let band = irpol::optics::Band::lwir();
+        let read = parse_table(Path::new("fuzz.csv"), &bytes)
+            .and_then(|table| table.band_rows(&band, 290.0));
+        match read {
+            Ok(rows) => {
+                for k in 0..=64 {
+                    let r = k as f64 * 60.0;
+                    let (tau, path) = rows.at(r);
+                    prop_assert!((0.0..=1.0).contains(&tau), "τ {tau} at {r} m");
+                    prop_assert!(path.is_finite() && path >= 0.0, "L {path} at {r} m");
+                }
+            }
+            Err(e) => check_names_file_maybe_line(&e.to_string(), "fuzz.csv")?,
+        }
+    }
+
+    /// EPW header lines after LOCATION dropped, doubled or reordered: every hourly row is still
+    /// read (the header is told by content, not counted), and a refusal names file:line.
+    #[test]
+    fn epw_headers_in_any_shape_keep_every_row(
+        keep in proptest::collection::vec(0usize..7, 0..10),
+    ) {
+        let (seed, _) = station_seeds().swap_remove(0);
+        let text = text(&seed);
+        let lines: Vec<&str> = text.lines().collect();
+        let mut edited = vec![lines[0]];
+        edited.extend(keep.iter().map(|&k| lines[1 + k]));
+        edited.extend(&lines[8..]);
+        let bytes = (edited.join("\n") + "\n").into_bytes();
+        match StationWeather::parse(Path::new("fuzz.epw"), &bytes, StationFormat::Epw, None) {
+            Ok(file) => prop_assert_eq!(file.records.len(), lines.len() - 8),
+            Err(e) => check_names_file(&e.to_string(), &["fuzz.epw"])?,
         }
     }
 
@@ -545,7 +688,7 @@ proptest! {
                     Err(e) => check_message(&e.to_string())?,
                 }
             }
-            Err(e) => check_message(&e.to_string())?,
+            Err(e) => check_names_file(&e.to_string(), &["fuzz.epw"])?,
         }
     }
 
@@ -584,6 +727,17 @@ fn the_seeds_are_read() {
             .unwrap()
             .band_rows(&irpol::optics::Band::lwir(), 290.0)
             .unwrap();
+    }
+    for seed in tiny_atmosphere_seeds() {
+        parse_table(Path::new("t.csv"), &seed)
+            .unwrap()
+            .band_rows(&irpol::optics::Band::lwir(), 290.0)
+            .unwrap();
+    }
+    for (layout, table) in layout_seeds().iter().zip(layout_table_seeds()) {
+        let layout = irpol::measure::Layout::parse(Path::new("l.toml"), &text(layout)).unwrap();
+        let sets = irpol::measure::parse_with_layout(Path::new("t.csv"), &table, &layout).unwrap();
+        assert!(!sets.is_empty());
     }
     load_scene_text(Path::new("fuzz/scene.toml"), &text(&scene_seeds()[0])).unwrap();
     for seed in sweep_seeds() {

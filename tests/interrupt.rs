@@ -378,3 +378,41 @@ fn an_interrupted_demo_leaves_no_staging_folder() {
     let left = staged_under(dir.path());
     assert!(left.is_empty(), "left {left:?}");
 }
+
+/// `irpol validate` interrupted while its pages are staged: the one handler shared by every
+/// command that writes removes the staged pages and exits with 128 + SIGTERM (issue 42: validate
+/// had no handler and left `.…png.PID.tmp`).
+#[test]
+fn an_interrupted_validate_leaves_no_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let reports = dir.path().join("reports");
+    let path = |p: &str| root.join(p).display().to_string();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_irpol"))
+        .args([
+            "validate".to_string(),
+            path("fits/rough_paint.toml"),
+            path("data/ptfe/PTFE_351_1064.csv"),
+            "--layout".into(),
+            path("data/ptfe/layout.toml"),
+            "--reports".into(),
+            reports.display().to_string(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // The first page is staged while the second is drawn.
+    while !reports.is_dir() || temporaries(&[&reports]).is_empty() {
+        let ended = child.try_wait().unwrap();
+        assert!(ended.is_none(), "validate ended before a page was staged");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert_eq!(child.wait().unwrap().code(), Some(128 + 15));
+    let left = staged_under(dir.path());
+    assert!(left.is_empty(), "left {left:?}");
+}

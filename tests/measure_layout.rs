@@ -941,3 +941,57 @@ fn the_shipped_ptfe_rows_are_all_realizable() {
         assert!(at_1 == 0 && smallest > 0.05, "{smallest}");
     }
 }
+
+/// A layout table meets the value limit of every table reader (±1e12 sr⁻¹), its normalized
+/// elements once multiplied by m00, refused at file:line:column (issue 42: m00 = 1e13 was fitted,
+/// a normalized 1e308 became inf).
+#[test]
+fn layout_values_meet_the_limit_of_every_table_reader() {
+    let table = |row: &str| format!("# wavelength_um: 10\nti,tr,pr,M11,M12\n{row}\n");
+    assert_eq!(
+        table_message(GOOD_LAYOUT, &table("30,20,180,1e13,0.1")),
+        "mem/table.csv:3:11: column 'M11': 1e13 sr⁻¹ is beyond ±1e12 sr⁻¹, far above any \
+         measurable BRDF (the mirror peak of the smoothest model is ~1e7 sr⁻¹): a fit of it has \
+         no finite χ²"
+    );
+    assert!(table_message(GOOD_LAYOUT, &table("30,20,180,0.5,-2e12"))
+        .starts_with("mem/table.csv:3:15: column 'M12': -2e12 sr⁻¹ is beyond ±1e12 sr⁻¹"));
+    let normalized = GOOD_LAYOUT.replace("index_base = 1", "index_base = 1\nnormalized = true");
+    assert!(
+        table_message(&normalized, &table("30,20,180,2,1e308"))
+            .starts_with("mem/table.csv:3:13: column 'M12': 1e308 sr⁻¹ is beyond ±1e12 sr⁻¹"),
+        "{}",
+        table_message(&normalized, &table("30,20,180,2,1e308"))
+    );
+    // 1e12 / m00 passes alone, not once multiplied by m00 = 10.
+    assert!(table_message(&normalized, &table("30,20,180,10,1e12"))
+        .starts_with("mem/table.csv:3:14: column 'M12': 1e12 × m00 = 1e13 sr⁻¹ is beyond"));
+    let layout = Layout::parse(Path::new("mem/layout.toml"), &normalized).unwrap();
+    let sets = parse_with_layout(
+        Path::new("t.csv"),
+        table("30,20,180,10,1e11").as_bytes(),
+        &layout,
+    )
+    .unwrap();
+    assert_eq!(sets[0].points[0].values, [10.0, 1e12]);
+}
+
+/// One column named for two roles is refused at the second role's value, naming both roles and
+/// the column (issue 42: θ_i and θ_r both `thetar` read every row as specular).
+#[test]
+fn one_column_for_two_roles_is_refused_naming_both() {
+    assert_eq!(
+        layout_message(&GOOD_LAYOUT.replace("theta_i_deg = \"ti\"", "theta_i_deg = \"tr\"")),
+        "mem/layout.toml:3:15: column 'tr' is named for both theta_i_deg and theta_r_deg: one \
+         column holds one role; fix [columns] theta_r_deg"
+    );
+    assert_eq!(
+        layout_message(&GOOD_LAYOUT.replace("phi_r_deg = \"pr\"", "phi_r_deg = \"M11\"")),
+        "mem/layout.toml:5:7: column 'M11' is named for both phi_r_deg and m00: one column holds \
+         one role; fix [columns] m00"
+    );
+    assert!(layout_message(
+        &GOOD_LAYOUT.replace("elements = \"M{i}{j}\"", "elements = { m01 = \"ti\" }")
+    )
+    .contains("column 'ti' is named for both theta_i_deg and m01"));
+}

@@ -553,3 +553,99 @@ fn readers_escape_control_characters_and_cut_long_excerpts() {
         "not a valid material TOML: line 6",
     );
 }
+
+// ---- Issue 42 ---------------------------------------------------------------------------------
+
+/// One rule for echoing a user's number (issue 42): at most 12 significant digits, the exponent
+/// kept — for flags, a crate's message about them and the TOML reader's own message.
+#[test]
+fn user_numbers_are_echoed_short_with_their_exponent() {
+    let (ptfe, layout) = (
+        shipped("data/ptfe/PTFE_351_1064.csv"),
+        shipped("data/ptfe/layout.toml"),
+    );
+    let paint = shipped("fits/rough_paint.toml");
+    let files: [(&str, &[u8]); 3] = [
+        ("p.csv", &ptfe),
+        ("layout.toml", &layout),
+        ("m.toml", &paint),
+    ];
+    let validate = "validate m.toml p.csv --layout layout.toml --reports reports --wavelength";
+    refuse(
+        &files,
+        &format!("{validate} 1e308"),
+        "at the selected wavelength 1e308 µm;",
+    );
+    refuse(
+        &files,
+        &format!("{validate} 1e-300"),
+        "at the selected wavelength 1e-300 µm;",
+    );
+    refuse(
+        &[],
+        "sun --latitude 1e308 --longitude 0 --time-utc 2026-06-21T10:00:00Z",
+        "invalid latitude 1e308",
+    );
+    let tiny_samples = scene("m.obj", "[render]\nsamples = 1e-300\n");
+    refuse(
+        &[
+            ("scene.toml", tiny_samples.as_bytes()),
+            ("m.obj", TRIANGLE_OBJ),
+        ],
+        RENDER,
+        "invalid type: floating point `1e-300`",
+    );
+}
+
+/// A library entry or the index that is a folder is found before anything is written: the fit's
+/// outputs are put in place together or not at all (issue 42: the reports were written first).
+#[test]
+fn a_fit_whose_entry_or_index_is_a_folder_writes_nothing() {
+    let csv = shipped("measurements/paper_paint.csv");
+    for folder in ["fits/paper_paint.toml", "reports/index.html"] {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("paper_paint.csv"), &csv).unwrap();
+        std::fs::create_dir_all(dir.path().join(folder)).unwrap();
+        let before = snapshot(dir.path());
+        let command = format!("fit paper_paint.csv {QUICK_FIT}");
+        let args: Vec<&str> = command.split(' ').collect();
+        let run = irpol(dir.path(), &args);
+        assert_refused(&run, &format!("{folder}: cannot write: it is a folder"));
+        assert!(
+            snapshot(dir.path()) == before,
+            "{folder}: files were written"
+        );
+    }
+}
+
+/// A render's time is estimated before any work from its expensive dimensions (frames, pixels ×
+/// path vertices, wavelength nodes) and refused beyond `--max-minutes` with the estimate and the
+/// value to give (issue 42: `--times` took 1e5 frames, ≈ 13 h, without a word).
+#[test]
+fn a_render_estimated_beyond_its_limit_is_refused_before_any_work() {
+    let many_paths = scene("m.obj", "[render]\nsamples = 4000000000\n");
+    refuse(
+        &[
+            ("scene.toml", many_paths.as_bytes()),
+            ("m.obj", TRIANGLE_OBJ),
+        ],
+        RENDER,
+        "scene.toml: this render is estimated at ",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let day = manifest("scenes/car_day.toml");
+    let args = [
+        "render",
+        day.to_str().unwrap(),
+        "--times",
+        "0:100000:1",
+        "--out",
+        "out",
+    ];
+    let run = irpol(dir.path(), &args);
+    assert_refused(&run, "(100001 frames × ");
+    assert!(run
+        .stderr
+        .contains("more than --max-minutes 60: give --max-minutes "));
+    assert!(snapshot(dir.path()).is_empty(), "files were written");
+}

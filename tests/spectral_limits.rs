@@ -104,3 +104,86 @@ fn wavelengths_within_the_tolerance_are_a_duplicate_not_a_descent() {
         assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     }
 }
+
+/// `validate` of a file holding several wavelengths writes one page per wavelength, each named
+/// with its wavelength (issue 42: every page had one name, the second write failed and the first
+/// page stayed). The shipped PTFE table without `--wavelength`.
+#[test]
+fn validate_writes_one_page_per_wavelength_of_a_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let reports = dir.path().join("reports");
+    let (ok, stdout, stderr) = irpol(&[
+        "validate",
+        manifest("fits/rough_paint.toml").to_str().unwrap(),
+        manifest("data/ptfe/PTFE_351_1064.csv").to_str().unwrap(),
+        "--layout",
+        manifest("data/ptfe/layout.toml").to_str().unwrap(),
+        "--theta-i",
+        "45",
+        "--reports",
+        reports.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let mut pages: Vec<String> = std::fs::read_dir(&reports)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    pages.sort();
+    assert_eq!(
+        pages,
+        [
+            "rough_paint_validation_PTFE_351_1064_0.351um.png",
+            "rough_paint_validation_PTFE_351_1064_1.064um.png"
+        ]
+    );
+    for page in &pages {
+        assert!(stdout.contains(page.as_str()), "{stdout}");
+    }
+}
+
+/// A spectral material evaluated outside its table is refused naming the material's file and
+/// where the wavelength came from: the flag, or the measurement file (issue 42: neither was named).
+#[test]
+fn a_wavelength_outside_a_spectral_table_names_the_material_and_data_files() {
+    let glass = manifest("fits/silicate_glass.toml");
+    let glass = glass.to_str().unwrap();
+    let (ok, _, stderr) = irpol(&[
+        "eval",
+        "--material",
+        glass,
+        "--wavelength",
+        "20",
+        "--theta-i",
+        "30",
+        "--theta-r",
+        "30",
+    ]);
+    assert!(!ok);
+    let needle = format!(
+        "{glass}: material 'silicate_glass': wavelength 20 µm is outside its table, 8–14 µm \
+         (given by --wavelength)"
+    );
+    assert!(stderr.contains(&needle), "{needle}: {stderr}");
+    let dir = tempfile::tempdir().unwrap();
+    let reports = dir.path().join("reports");
+    let data = manifest("data/ptfe/PTFE_351_1064.csv");
+    let (ok, _, stderr) = irpol(&[
+        "validate",
+        glass,
+        data.to_str().unwrap(),
+        "--layout",
+        manifest("data/ptfe/layout.toml").to_str().unwrap(),
+        "--reports",
+        reports.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    let needle = format!("(the wavelength of {})", data.display());
+    assert!(
+        stderr.contains(&format!(
+            "{glass}: material 'silicate_glass': wavelength 0.351 µm"
+        )) && stderr.contains(&needle),
+        "{needle}: {stderr}"
+    );
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    assert!(!reports.exists());
+}

@@ -299,6 +299,36 @@ fn bad_files_are_refused_by_line_with_what_to_fix() {
     assert_eq!(file.records[30].end_utc, epw_sample().records[30].end_utc);
 }
 
+/// The header is told by its keywords, not counted: without its DATA PERIODS line (or with a
+/// third COMMENTS line) an EPW keeps every hourly row (issue 42: the first row was skipped unread).
+#[test]
+fn epw_header_lines_are_recognised_by_content_not_counted() {
+    let text = std::fs::read_to_string(sample("munich_3days.epw")).unwrap();
+    let full = parse_epw(&text).unwrap();
+    let without: String = text
+        .lines()
+        .filter(|l| !l.starts_with("DATA PERIODS"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let read = parse_epw(&without).unwrap();
+    assert_eq!(read.records.len(), full.records.len());
+    assert_eq!(read.records[0].end_utc, full.records[0].end_utc);
+    assert_eq!(read.records[0].values, full.records[0].values);
+    assert_eq!(read.records[0].line, full.records[0].line - 1);
+    let extra = text.replacen("COMMENTS 2,", "COMMENTS 2,\nCOMMENTS 3,more", 1);
+    assert_eq!(parse_epw(&extra).unwrap().records.len(), full.records.len());
+    // Only LOCATION: the data rows still start on line 2 and are read whole.
+    let bare: String = text
+        .lines()
+        .enumerate()
+        .filter(|(i, l)| *i == 0 || l.starts_with(|c: char| c.is_ascii_digit()))
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    let read = parse_epw(&bare).unwrap();
+    assert_eq!(read.records.len(), full.records.len());
+    assert_eq!(read.records[0].line, 2);
+}
+
 /// The sample file's weather in a scene of one sunlit horizontal plate, with the site and start
 /// from the file.
 fn plate_scene(dir: &Path) -> PathBuf {

@@ -5,6 +5,7 @@ pub mod error;
 pub mod evaluate;
 pub mod fit;
 pub mod render;
+pub mod render_cost;
 pub mod saved_thermal;
 pub mod scene_init;
 pub mod selection;
@@ -22,7 +23,7 @@ use crate::pbrdf::{
     DistributionError, DistributionKind, FacetSide, ModelError, Pbrdf, Shadowing, Subsurface,
 };
 use crate::text::shown;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// A pBRDF chosen on the command line: a material file, or parameters (the flags of `eval` and
 /// `emissivity`).
@@ -116,10 +117,38 @@ pub enum ModelArgsError {
         first_um: f64,
         last_um: f64,
     },
+    /// A spectral material evaluated outside its table: the material file is named, and the
+    /// measurement file whose wavelength it was.
+    #[error("{}: {error} ({origin})", crate::text::path(path))]
+    AtWavelength {
+        path: PathBuf,
+        origin: WavelengthOrigin,
+        error: MaterialError,
+    },
     #[error(transparent)]
     Material(#[from] MaterialError),
     #[error(transparent)]
     Model(#[from] ModelError),
+}
+
+/// Where the wavelength a material is evaluated at comes from, as a message names it.
+#[derive(Debug, Clone)]
+pub enum WavelengthOrigin {
+    /// `--wavelength`.
+    Flag,
+    /// The wavelength of a measurement set of this file.
+    Data(PathBuf),
+}
+
+impl std::fmt::Display for WavelengthOrigin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            WavelengthOrigin::Flag => write!(f, "given by --wavelength"),
+            WavelengthOrigin::Data(file) => {
+                write!(f, "the wavelength of {}", crate::text::path(file))
+            }
+        }
+    }
 }
 
 /// A distribution error as the command line says it: of `--q`, not of the file key `q`.
@@ -143,7 +172,8 @@ impl ModelArgs {
         if let Some(path) = &self.material {
             self.refuse_parameters()?;
             let material = Material::load(path)?;
-            return material_pbrdf(&material, self.wavelength_um, shadowing);
+            let at = self.wavelength_um.map(|um| (um, WavelengthOrigin::Flag));
+            return material_pbrdf_from(&material, path, at, shadowing);
         }
         if self.wavelength_um.is_some() {
             return Err(ModelArgsError::WavelengthWithoutMaterial);
@@ -241,6 +271,31 @@ pub fn material_pbrdf(
         spec.shadowing = shadowing;
     }
     Ok(spec.pbrdf()?)
+}
+
+/// [`material_pbrdf`] of the material in file `path`, at a wavelength from `origin`: a
+/// wavelength outside a spectral table is refused naming the material's file and where the
+/// wavelength came from (the flag, or the measurement file).
+pub fn material_pbrdf_from(
+    material: &Material,
+    path: &Path,
+    wavelength_um: Option<(f64, WavelengthOrigin)>,
+    shadowing: Option<Shadowing>,
+) -> Result<Pbrdf, ModelArgsError> {
+    let (wavelength, origin) = match wavelength_um {
+        Some((um, origin)) => (Some(um), Some(origin)),
+        None => (None, None),
+    };
+    material_pbrdf(material, wavelength, shadowing).map_err(|error| match (error, origin) {
+        (ModelArgsError::Material(error @ MaterialError::OutsideTable { .. }), Some(origin)) => {
+            ModelArgsError::AtWavelength {
+                path: path.to_owned(),
+                origin,
+                error,
+            }
+        }
+        (error, _) => error,
+    })
 }
 
 /// `#` lines stating the model a table was computed with (`eval`, `emissivity` output): the

@@ -2,6 +2,7 @@
 //! its thermal run (docs/design.md §2.6).
 
 use super::error::single_line;
+use super::render_cost::{check_estimate, DEFAULT_MAX_MINUTES};
 use super::AppError;
 use crate::atomic::StagedFolder;
 use crate::output::figure::SeriesPreview;
@@ -31,12 +32,26 @@ pub fn render_scene(
     out_dir: &Path,
     progress: &dyn Progress,
 ) -> Result<RenderSummary, AppError> {
+    render_scene_within(scene_path, out_dir, DEFAULT_MAX_MINUTES, progress)
+}
+
+/// [`render_scene`], refused before any work when its estimate ([`check_estimate`]) is over
+/// `max_minutes`.
+pub fn render_scene_within(
+    scene_path: &Path,
+    out_dir: &Path,
+    max_minutes: f64,
+    progress: &dyn Progress,
+) -> Result<RenderSummary, AppError> {
     let start = Instant::now();
     let scene = load_scene(scene_path)?;
     if scene.thermal.is_some() {
         return Err(AppError::ThermalNeedsInstant(scene_path.to_owned()));
     }
-    render_loaded(&scene, out_dir, progress, start)
+    let estimate = check_estimate(&scene, 1, max_minutes)?;
+    let mut summary = render_loaded(&scene, out_dir, progress, start)?;
+    summary.warnings.extend(estimate.advice());
+    Ok(summary)
 }
 
 fn render_loaded(
@@ -92,6 +107,18 @@ pub fn render_scene_at(
     instants: &Instants,
     progress: &dyn Progress,
 ) -> Result<Vec<TimedRender>, AppError> {
+    render_scene_at_within(scene_path, out_dir, instants, DEFAULT_MAX_MINUTES, progress)
+}
+
+/// [`render_scene_at`], refused before the thermal run when the frames' estimate
+/// ([`check_estimate`]) is over `max_minutes`.
+pub fn render_scene_at_within(
+    scene_path: &Path,
+    out_dir: &Path,
+    instants: &Instants,
+    max_minutes: f64,
+    progress: &dyn Progress,
+) -> Result<Vec<TimedRender>, AppError> {
     let scene = load_scene(scene_path)?;
     let setup = scene
         .thermal
@@ -104,8 +131,13 @@ pub fn render_scene_at(
             vec![(at - setup.site.start_utc).num_milliseconds() as f64 / 1000.0]
         }
     };
+    let estimate = check_estimate(&scene, times.len(), max_minutes)?;
     let solution = solve(&scene, scene_path, &times, progress)?;
-    render_solution_at(&scene, &solution, &times, out_dir, progress)
+    let mut renders = render_solution_at(&scene, &solution, &times, out_dir, progress)?;
+    if let Some(first) = renders.first_mut() {
+        first.summary.warnings.extend(estimate.advice());
+    }
+    Ok(renders)
 }
 
 /// Renders a thermal scene at each of `times` (recorded in `solution`). One instant renders into

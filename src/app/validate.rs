@@ -1,8 +1,9 @@
 //! `irpol validate MATERIAL.toml DATA...` (docs/design.md §4): how a material's model predicts
 //! measurements it was not fitted to — one summary line per measurement set, and a report page
-//! each (`<reports>/<material>_validation_<data>.png`), written atomically.
+//! each (`<reports>/<material>_validation_<data>.png`, `<data>_<λ>um` for each wavelength of a
+//! file that holds several), written atomically.
 
-use super::{material_pbrdf, AppError};
+use super::{material_pbrdf_from, AppError, WavelengthOrigin};
 use crate::atomic::OutputSet;
 use crate::fit::{validate_model, Validation};
 use crate::material::{Material, MaterialModel};
@@ -27,17 +28,20 @@ pub fn validate_and_report(
     reading: &ReadOptions,
     reports_dir: &Path,
 ) -> Result<Vec<SetValidation>, AppError> {
+    let material_path = material;
     let material = Material::load(material)?;
     let mut sets = Vec::new();
     for file in collect_measurement_files(inputs)? {
         sets.extend(reading.read(&file)?);
     }
-    validate_sets(&material, sets, reports_dir)
+    validate_sets(&material, material_path, sets, reports_dir)
 }
 
-/// [`validate_and_report`] of sets already read (a layout or a row selection applied).
+/// [`validate_and_report`] of sets already read (a layout or a row selection applied);
+/// `material_path` is the material's file, which messages name.
 pub fn validate_sets(
     material: &Material,
+    material_path: &Path,
     sets: Vec<MeasurementSet>,
     reports_dir: &Path,
 ) -> Result<Vec<SetValidation>, AppError> {
@@ -46,9 +50,15 @@ pub fn validate_sets(
     }
     let mut outputs = OutputSet::new();
     let mut results = Vec::new();
-    for set in sets {
-        let wavelength = material.model.spectral().map(|_| set.wavelength_um);
-        let model = material_pbrdf(material, wavelength, None)?;
+    let names = page_names(&sets);
+    for (set, data_name) in sets.into_iter().zip(names) {
+        let wavelength = material.model.spectral().map(|_| {
+            (
+                set.wavelength_um,
+                WavelengthOrigin::Data(set.source.clone()),
+            )
+        });
+        let model = material_pbrdf_from(material, material_path, wavelength, None)?;
         let validation = validate_model(&model, &set)?;
         // A spectral material's page shows its model at the set's wavelength.
         let at_wavelength = Material {
@@ -58,6 +68,7 @@ pub fn validate_sets(
         let report = encode_validation_report(
             &at_wavelength,
             &set,
+            &data_name,
             &validation_summary(&validation),
             reports_dir,
         )?;
@@ -82,6 +93,35 @@ pub fn validate_sets(
         source,
     })?;
     Ok(results)
+}
+
+/// The data part of each set's page name, one distinct name per set: the file's stem, with the
+/// set's wavelength where several sets share the stem (a file of several wavelengths, docs/
+/// design.md §1.9), and a count where even that is shared (two folders' files of one name).
+fn page_names(sets: &[MeasurementSet]) -> Vec<String> {
+    let stem = |set: &MeasurementSet| {
+        set.source
+            .file_stem()
+            .map_or_else(|| "data".into(), |s| s.to_string_lossy().into_owned())
+    };
+    let stems: Vec<String> = sets.iter().map(stem).collect();
+    let mut names: Vec<String> = sets
+        .iter()
+        .zip(&stems)
+        .map(
+            |(set, stem)| match stems.iter().filter(|s| *s == stem).count() {
+                1 => stem.clone(),
+                _ => format!("{stem}_{}um", crate::text::number(set.wavelength_um)),
+            },
+        )
+        .collect();
+    for k in 0..names.len() {
+        let repeats = names[..k].iter().filter(|n| **n == names[k]).count();
+        if repeats > 0 {
+            names[k] = format!("{}_{}", names[k], repeats + 1);
+        }
+    }
+    names
 }
 
 /// `m00 RMS 3.1 % · m_ij/m00 RMS 0.0123 · χ²/obs 4.2 (σ from the file) · max |r| 12.3`.

@@ -242,8 +242,12 @@ impl BandRows {
         let i = upper - 1;
         let t = (range - self.ranges_m[i]) / (self.ranges_m[i + 1] - self.ranges_m[i]);
         let (tau_a, tau_b) = (self.transmittance[i], self.transmittance[i + 1]);
-        let (tau, share) = if tau_a > 0.0 && tau_b > 0.0 {
-            let d = (tau_b / tau_a).ln();
+        let ratio = tau_b / tau_a;
+        let (tau, share) = if tau_a > 0.0 && tau_b > 0.0 && !(1e-300..1e300).contains(&ratio) {
+            // A subnormal or tiny τ next to a large one: the ratio (or e^d) leaves f64.
+            log_linear_wide(tau_a, tau_b, t)
+        } else if tau_a > 0.0 && tau_b > 0.0 {
+            let d = ratio.ln();
             // (τ − τ_a)/(τ_b − τ_a) = (e^(t d) − 1)/(e^d − 1), without the cancellation of
             // the difference where τ hardly changes; t where it does not change at all.
             let share = if d == 0.0 {
@@ -258,6 +262,22 @@ impl BandRows {
         let (l_a, l_b) = (self.path_radiance[i], self.path_radiance[i + 1]);
         (tau, l_a + share * (l_b - l_a))
     }
+}
+
+/// τ log-linear between `tau_a` and `tau_b` (both > 0) at fraction `t`, and the share
+/// (τ − τ_a)/(τ_b − τ_a), for pairs whose ratio leaves f64's range (τ = 1e-310 beside 0.5
+/// made e^d infinite and the pixels NaN): the logarithms taken apart, and for a rising τ the
+/// share's exponentials divided by e^d first.
+fn log_linear_wide(tau_a: f64, tau_b: f64, t: f64) -> (f64, f64) {
+    let (ln_a, ln_b) = (tau_a.ln(), tau_b.ln());
+    let d = ln_b - ln_a;
+    let tau = (ln_a + t * d).exp();
+    let share = if d < 0.0 {
+        (t * d).exp_m1() / d.exp_m1()
+    } else {
+        (((t - 1.0) * d).exp() - (-d).exp()) / -(-d).exp_m1()
+    };
+    (tau, share.clamp(0.0, 1.0))
 }
 
 /// Band rows of a spectral table: at each range, τ weighted by R(λ) B_λ(`reference_k`) and L_λ
@@ -333,6 +353,35 @@ mod tests {
         assert_eq!((t, p), (0.5, 2.5));
         assert_eq!(table.at(15.0), (0.0, 5.0));
         assert_eq!(table.at(10.0), (0.0, 5.0));
+    }
+
+    /// Subnormal and tiny transmittances beside ordinary ones (issue 42: 1e-310 made NaN
+    /// pixels): finite, within the rows' bounds, the endpoints reproduced.
+    #[test]
+    fn subnormal_transmittances_interpolate_finitely() {
+        for tiny in [1e-310, 5e-324, 1e-300, 1e-200] {
+            let table = rows(&[0.0, 10.0, 20.0], &[1.0, tiny, 0.5], &[0.0, 5.0, 2.0]);
+            for k in 0..=40 {
+                let r = k as f64 * 0.5;
+                let (t, p) = table.at(r);
+                assert!(t.is_finite() && p.is_finite(), "{tiny} at {r}: {t}, {p}");
+                assert!((0.0..=1.0).contains(&t), "{tiny} at {r}: τ {t}");
+                assert!((0.0..=5.0).contains(&p), "{tiny} at {r}: L {p}");
+            }
+            assert_eq!(table.at(20.0), (0.5, 2.0));
+            let (t, p) = table.at(10.0);
+            assert!(
+                (t - tiny).abs() <= tiny * 1e-9 + 1e-321 && (p - 5.0).abs() < 1e-12,
+                "{t} {p}"
+            );
+            // Log-linear: halfway between τ and 0.5 lies √(0.5 τ).
+            let (t, _) = table.at(15.0);
+            let expected = 0.5f64.sqrt() * tiny.sqrt();
+            assert!(
+                (t - expected).abs() <= expected * 1e-9,
+                "{tiny}: {t} vs {expected}"
+            );
+        }
     }
 
     #[test]

@@ -23,9 +23,20 @@ impl OutputSet {
     }
 
     /// Writes `bytes` to a temporary file beside `target` (creating its folder), synced to disk.
+    /// Refused before anything is written where the target cannot be replaced by a file (it
+    /// is a folder) or is already staged in this set (two outputs of one name: the second
+    /// would overwrite the first).
     pub fn stage(&mut self, target: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let _guard = WriteGuard::start()?;
+        if self.staged.iter().any(|(_, staged)| staged == target) {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                "two outputs of this run have this name; nothing was written",
+            ));
+        }
+        check_replaceable(target)?;
         let dir = parent_of(target);
+        crate::interrupt::note_temporaries_in(dir);
         self.create_dir(dir)?;
         remove_stale_temporaries(target);
         let temp = temporary_beside(target);
@@ -46,9 +57,19 @@ impl OutputSet {
         Ok(())
     }
 
-    /// Renames every staged file over its target, in staging order.
+    /// Renames every staged file over its target, in staging order, once every target is
+    /// checked to be replaceable (none became a folder since it was staged): a set that cannot
+    /// be put in place whole is not put in place at all.
     pub fn commit(mut self) -> std::io::Result<()> {
         let _guard = WriteGuard::start()?;
+        for (_, target) in &self.staged {
+            check_replaceable(target).map_err(|error| {
+                std::io::Error::new(
+                    error.kind(),
+                    format!("{}: {error}", crate::text::path(target)),
+                )
+            })?;
+        }
         let staged = std::mem::take(&mut self.staged);
         let mut renames = staged.iter();
         for (temp, target) in renames.by_ref() {
@@ -62,6 +83,17 @@ impl OutputSet {
         }
         self.created_dirs.clear();
         Ok(())
+    }
+}
+
+/// Refuses a `target` a file cannot be renamed over: a folder (a symbolic link is replaced
+/// itself, as a file).
+fn check_replaceable(target: &Path) -> std::io::Result<()> {
+    match std::fs::symlink_metadata(target) {
+        Ok(meta) if meta.is_dir() => Err(std::io::Error::other(
+            "it is a folder, not a file; nothing was written (move the folder away)",
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -113,5 +145,45 @@ mod tests {
         set.commit().unwrap();
         assert_eq!(std::fs::read_to_string(&old).unwrap(), "new");
         assert_eq!(std::fs::read_to_string(new_dir.join("b.txt")).unwrap(), "b");
+    }
+
+    /// A target that is a folder, or one staged twice, is refused before any file of the set is
+    /// replaced (issue 42: `fit` wrote its reports, then failed on `fits/X.toml` being a folder;
+    /// `validate` staged two pages of one name and lost the first).
+    #[test]
+    fn a_set_with_an_unreplaceable_or_repeated_target_changes_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, folder) = (dir.path().join("a.txt"), dir.path().join("X.toml"));
+        std::fs::write(&a, "old").unwrap();
+        std::fs::create_dir(&folder).unwrap();
+        let mut set = OutputSet::new();
+        set.stage(&a, b"new").unwrap();
+        let error = set.stage(&folder, b"entry").unwrap_err();
+        assert!(error.to_string().contains("it is a folder"), "{error}");
+        drop(set);
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old");
+        assert!(folder.is_dir());
+
+        // A folder appearing after staging: the commit refuses before the first rename.
+        let late = dir.path().join("late.toml");
+        let mut set = OutputSet::new();
+        set.stage(&a, b"new").unwrap();
+        set.stage(&late, b"entry").unwrap();
+        std::fs::create_dir(&late).unwrap();
+        let error = set.commit().unwrap_err();
+        assert!(
+            error.to_string().contains("late.toml: it is a folder"),
+            "{error}"
+        );
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old");
+
+        let mut set = OutputSet::new();
+        set.stage(&a, b"one").unwrap();
+        let error = set.stage(&a, b"two").unwrap_err();
+        assert!(error.to_string().contains("two outputs"), "{error}");
+        drop(set);
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old");
+        let entries = std::fs::read_dir(dir.path()).unwrap().count();
+        assert_eq!(entries, 3, "no temporary left");
     }
 }

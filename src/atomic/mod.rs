@@ -36,7 +36,9 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
 /// [`write_atomically`], a link never replaces an existing file, so a file that appears between
 /// a caller's check and the write is not overwritten either (the error is `AlreadyExists`).
 pub fn write_new_file(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let _guard = crate::interrupt::WriteGuard::start()?;
     let dir = parent_of(path);
+    crate::interrupt::note_temporaries_in(dir);
     std::fs::create_dir_all(dir)?;
     let temp = temporary_beside(path);
     let written = write_synced(&temp, bytes).and_then(|()| std::fs::hard_link(&temp, path));

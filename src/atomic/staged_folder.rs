@@ -43,6 +43,7 @@ impl StagedFolder {
         fs::create_dir_all(parent_of(target))?;
         remove_stale_staging(target);
         let staging = staging_folder(target, std::process::id());
+        crate::interrupt::note_staging_folder(&staging);
         if staging.exists() {
             fs::remove_dir_all(&staging)?;
         }

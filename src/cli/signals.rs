@@ -37,6 +37,12 @@ pub fn remove_on_interrupt(staging: Vec<PathBuf>, temporaries_in: Vec<PathBuf>) 
     });
 }
 
+/// Starts watching for SIGINT/SIGTERM for any command: every write goes through the library's
+/// staged writes, which record where their temporaries are, so one handler removes them all.
+pub fn watch_interrupts() {
+    remove_on_interrupt(Vec::new(), Vec::new());
+}
+
 /// Waits for good once an interrupt is being handled: the handler's thread clears up and exits
 /// the process; returning from `main` first would cut its clean-up short (a run's own write,
 /// refused after the signal, ends the run with an error at once).
@@ -56,12 +62,16 @@ fn clean_up_after_interrupt() {
     let Ok(lists) = TO_REMOVE.lock() else {
         return;
     };
-    let (staging, temporaries_in) = &*lists;
-    for path in staging {
+    let (mut staging, mut temporaries_in) = lists.clone();
+    // What the library recorded staging, whichever command did it.
+    let (library_temporaries, library_staging) = irpol::interrupt::staged_so_far();
+    staging.extend(library_staging);
+    temporaries_in.extend(library_temporaries);
+    for path in &staging {
         let _ = std::fs::remove_dir_all(path);
     }
     let suffix = format!(".{}.tmp", std::process::id());
-    for dir in temporaries_in {
+    for dir in &temporaries_in {
         let Ok(entries) = std::fs::read_dir(dir) else {
             continue;
         };

@@ -183,7 +183,8 @@ pub fn sun_position_with(
         latitude_deg,
         longitude_deg,
         time: format_time_utc(time),
-        reason,
+        // The crate's message echoes the value whole (309 digits for 1e308).
+        reason: crate::text::parser_message(&reason, 200),
     };
     let delta_t = match options.delta_t_s {
         Some(value) => value,

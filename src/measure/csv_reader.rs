@@ -454,11 +454,8 @@ fn store_value(
             if index == 0 && value < 0.0 {
                 return Err(MeasureErrorKind::NegativeM00 { value: shown(text) });
             }
-            if value.abs() > MAX_MUELLER_SR {
-                return Err(MeasureErrorKind::ElementTooLarge {
-                    column: name.to_owned(),
-                    value: shown(text),
-                });
+            if let Some(kind) = element_value_refusal(name, value, text) {
+                return Err(kind);
             }
             if let Some(slot) = layout.slot(index) {
                 point.values[slot] = value;
@@ -483,6 +480,22 @@ fn store_value(
         }
     }
     Ok(())
+}
+
+/// Why a Mueller element of `value` sr⁻¹ (read from column `name` as `text`) cannot be measured
+/// data, if it cannot: beyond ±[`MAX_MUELLER_SR`]. Every table reader (§2.1 files and layouts,
+/// whose normalized elements are checked once multiplied by m00) refuses through this one check.
+pub(crate) fn element_value_refusal(
+    name: &str,
+    value: f64,
+    text: &str,
+) -> Option<MeasureErrorKind> {
+    (!value.is_finite() || value.abs() > MAX_MUELLER_SR).then(|| {
+        MeasureErrorKind::ElementTooLarge {
+            column: name.to_owned(),
+            value: shown(text),
+        }
+    })
 }
 
 /// Why a wavelength_um field's (finite) value is not a wavelength irpol models, if it is not.

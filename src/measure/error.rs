@@ -161,6 +161,12 @@ pub enum MeasureErrorKind {
         role: &'static str,
         layout: String,
     },
+    #[error("column '{column}' is named for both {first_role} and {second_role}: one column holds one role; fix [columns] {second_role}")]
+    LayoutColumnTwoRoles {
+        column: String,
+        first_role: &'static str,
+        second_role: &'static str,
+    },
     #[error("the element pattern '{pattern}' of the layout {layout} matches no column of the header row (it names {names}): fix the pattern or index_base")]
     ElementPatternMatchesNothing {
         pattern: String,

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::MeasurementSet;
-use crate::text::{counted, significant};
+use crate::text::{counted, significant_trimmed};
 
 /// A row is at a chosen θ_i when within this of it: instruments write angles rounded to 0.01°–0.1°,
 /// and the grids worth selecting are whole degrees apart.
@@ -64,7 +64,7 @@ impl RowSelection {
         if let Some(um) = self.wavelength_um {
             if !(um.is_finite() && um > 0.0) {
                 return Err(SelectionError::BadWavelength {
-                    value: um.to_string(),
+                    value: crate::text::number(um),
                     reason: "not a positive number of micrometres",
                 });
             }
@@ -75,7 +75,7 @@ impl RowSelection {
             .find(|t| !(t.is_finite() && (0.0..90.0).contains(*t)))
         {
             Some(t) => Err(SelectionError::BadThetaI {
-                value: t.to_string(),
+                value: crate::text::number(*t),
             }),
             None => Ok(()),
         }
@@ -179,14 +179,9 @@ fn keep_wavelength(
     Ok(vec![set])
 }
 
-/// `value` to 6 significant digits without trailing zeros (75, 1.064).
+/// `value` to 6 significant digits without trailing zeros (75, 1.064, 1e-300).
 fn short(value: f64) -> String {
-    let text = significant(value, 6);
-    if text.contains('.') {
-        text.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        text
-    }
+    significant_trimmed(value, 6)
 }
 
 fn listed(values: &[f64]) -> String {

@@ -7,20 +7,38 @@ use crate::atomic::StagedFolder;
 use crate::scene::Scene;
 use crate::thermal_scene::{part_series, PartSeries, SolveStats, ThermalSolution};
 use std::collections::BTreeSet;
-use std::fmt::Write as _;
 use std::io;
 use std::path::Path;
 
-/// `temperatures.csv`: `time_s,part,t_surface_min_k,t_surface_mean_k,t_surface_max_k`.
+/// `temperatures.csv`: `time_s,part,t_surface_min_k,t_surface_mean_k,t_surface_max_k`, written
+/// by the csv crate, so a part named `ball, left` or `say "hi"` is one quoted field (RFC 4180).
 pub fn temperatures_csv(times_s: &[f64], parts: &[PartSeries]) -> String {
-    let mut csv = String::from("time_s,part,t_surface_min_k,t_surface_mean_k,t_surface_max_k\n");
+    let mut csv = csv::WriterBuilder::new()
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_writer(Vec::new());
+    let header = [
+        "time_s",
+        "part",
+        "t_surface_min_k",
+        "t_surface_mean_k",
+        "t_surface_max_k",
+    ];
+    // Writing into memory cannot fail.
+    let _ = csv.write_record(header);
     for (i, t) in times_s.iter().enumerate() {
         for part in parts {
             let [lo, mean, hi] = part.surface_k[i];
-            let _ = writeln!(csv, "{t},{},{lo:.4},{mean:.4},{hi:.4}", part.name);
+            let _ = csv.write_record([
+                t.to_string(),
+                part.name.clone(),
+                format!("{lo:.4}"),
+                format!("{mean:.4}"),
+                format!("{hi:.4}"),
+            ]);
         }
     }
-    csv
+    let bytes = csv.into_inner().unwrap_or_default();
+    String::from_utf8(bytes).unwrap_or_default()
 }
 
 /// The name of the PLY of recorded instant `index` at `time_s`.
@@ -143,4 +161,37 @@ fn earlier_outputs(out_dir: &Path) -> BTreeSet<String> {
 
 fn is_surface_ply(name: &str) -> bool {
     name.starts_with("surface_") && name.ends_with("s.ply")
+}
+
+#[cfg(test)]
+mod csv_tests {
+    use super::*;
+
+    /// A part name with a comma or a quote is one quoted field: every row has the header's five
+    /// fields (issue 42: `ball, left` made six).
+    #[test]
+    fn part_names_are_quoted_as_csv_fields() {
+        let parts = [
+            PartSeries {
+                name: "ball, left".into(),
+                surface_k: vec![[290.0, 291.0, 292.0]],
+            },
+            PartSeries {
+                name: "say \"hi\"".into(),
+                surface_k: vec![[1.0, 2.0, 3.0]],
+            },
+        ];
+        let text = temperatures_csv(&[0.0], &parts);
+        let mut reader = csv::Reader::from_reader(text.as_bytes());
+        let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+        assert_eq!(rows.len(), 2);
+        assert!(rows.iter().all(|r| r.len() == 5), "{text}");
+        assert_eq!(&rows[0][1], "ball, left");
+        assert_eq!(&rows[1][1], "say \"hi\"");
+        assert!(text.starts_with("time_s,part,t_surface_min_k,"), "{text}");
+        assert!(
+            text.contains("\n0,\"ball, left\",290.0000,291.0000,292.0000\n"),
+            "{text}"
+        );
+    }
 }

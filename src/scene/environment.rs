@@ -219,7 +219,11 @@ fn validate_sky_table(elevation_deg: &[f64], values: &[f64]) -> Result<(), Envir
         return Err("environment.sky.elevation_deg must be strictly increasing".into());
     }
     if let Some(v) = values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-        return Err(format!("environment.sky table value {v} must be finite and ≥ 0").into());
+        return Err(format!(
+            "environment.sky table value {} must be finite and ≥ 0",
+            crate::text::number(*v)
+        )
+        .into());
     }
     Ok(())
 }

@@ -28,12 +28,12 @@ struct RawLayout {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawColumns {
-    theta_i_deg: String,
-    phi_i_deg: Option<String>,
-    theta_r_deg: String,
-    phi_r_deg: Option<String>,
-    wavelength_um: Option<String>,
-    m00: Option<String>,
+    theta_i_deg: Spanned<String>,
+    phi_i_deg: Option<Spanned<String>>,
+    theta_r_deg: Spanned<String>,
+    phi_r_deg: Option<Spanned<String>>,
+    wavelength_um: Option<Spanned<String>>,
+    m00: Option<Spanned<String>>,
     /// A pattern string or a table of element names; told apart by hand for a clear message.
     elements: Option<Spanned<toml::Value>>,
 }
@@ -148,9 +148,12 @@ fn column_roles(
     };
     // The m00 column: named, else the element pattern's or table's own m00.
     let pattern_m00 = elements.remove(&0);
-    let m00 = match (raw.m00, pattern_m00) {
+    let elements_span = raw.elements.as_ref().map_or(0..0, |e| e.span());
+    let m00 = match (raw.m00.clone(), pattern_m00) {
         (Some(named), _) => named,
-        (None, Some(from_elements)) if !conventions.normalized => from_elements,
+        (None, Some(from_elements)) if !conventions.normalized => {
+            Spanned::new(elements_span.clone(), from_elements)
+        }
         (None, _) => {
             let (span, message) = match &raw_conventions.normalized {
                 Some(normalized) if conventions.normalized => (
@@ -172,16 +175,69 @@ fn column_roles(
             ));
         }
     };
+    let mut roles: Vec<(&'static str, &Spanned<String>)> = vec![
+        ("theta_i_deg", &raw.theta_i_deg),
+        ("theta_r_deg", &raw.theta_r_deg),
+    ];
+    let optional = [
+        ("phi_i_deg", &raw.phi_i_deg),
+        ("phi_r_deg", &raw.phi_r_deg),
+        ("wavelength_um", &raw.wavelength_um),
+    ];
+    roles.extend(
+        optional
+            .iter()
+            .filter_map(|(role, c)| c.as_ref().map(|c| (*role, c))),
+    );
+    roles.push(("m00", &m00));
+    let element_roles: Vec<(&'static str, Spanned<String>)> = elements
+        .iter()
+        .map(|(&i, c)| {
+            (
+                MUELLER_ELEMENT_NAMES[i],
+                Spanned::new(elements_span.clone(), c.clone()),
+            )
+        })
+        .collect();
+    roles.extend(element_roles.iter().map(|(role, c)| (*role, c)));
+    check_one_role_per_column(text, &roles)?;
+    let inner = |c: Option<Spanned<String>>| c.map(Spanned::into_inner);
     Ok(ColumnRoles {
-        theta_i: raw.theta_i_deg,
-        phi_i: raw.phi_i_deg,
-        theta_r: raw.theta_r_deg,
-        phi_r: raw.phi_r_deg,
-        wavelength: raw.wavelength_um,
-        m00,
+        theta_i: raw.theta_i_deg.into_inner(),
+        phi_i: inner(raw.phi_i_deg),
+        theta_r: raw.theta_r_deg.into_inner(),
+        phi_r: inner(raw.phi_r_deg),
+        wavelength: inner(raw.wavelength_um),
+        m00: m00.into_inner(),
         elements,
         pattern,
     })
+}
+
+/// Refuses a column named for two roles (θ_i and θ_r both "thetar" would read every row as
+/// specular), at the second role's value, naming both roles and the column.
+fn check_one_role_per_column(
+    text: &str,
+    roles: &[(&'static str, &Spanned<String>)],
+) -> Result<(), Refusal> {
+    for (k, (role, column)) in roles.iter().enumerate() {
+        let earlier = roles[..k]
+            .iter()
+            .find(|(_, c)| c.get_ref() == column.get_ref());
+        if let Some((first_role, _)) = earlier {
+            let (line, column_number) = line_and_column(text, column.span().start);
+            return Err(Refusal::new(
+                line,
+                column_number,
+                MeasureErrorKind::LayoutColumnTwoRoles {
+                    column: shown(column.get_ref()),
+                    first_role,
+                    second_role: role,
+                },
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The file's column name of each Mueller element, by row-major element index.

@@ -12,8 +12,8 @@ use super::uncertainty::apply_uncertainty_model;
 use super::{AngleUnit, Layout, MuellerBasis, SpecularAzimuth};
 use crate::measure::columns::wrong_delimiter;
 use crate::measure::csv_reader::{
-    decode_utf8, hex, last_column, numbered_lines, parse_number, same_wavelength,
-    wavelength_refusal,
+    decode_utf8, element_value_refusal, hex, last_column, numbered_lines, parse_number,
+    same_wavelength, wavelength_refusal,
 };
 use crate::measure::error::{MeasureError, MeasureErrorKind, Refusal};
 use crate::measure::fields::{split_fields, Field};
@@ -443,6 +443,19 @@ impl Cells<'_> {
         Ok(degrees)
     }
 
+    /// The value limit of every table reader on an element as written (`value`) and in sr⁻¹
+    /// (`sr`, the written one times m00 where the layout says normalized): a normalized 1e308
+    /// would otherwise become inf.
+    fn check_element(&self, field: usize, value: f64, sr: f64) -> Result<(), Refusal> {
+        let name = &self.names[field];
+        let text = &self.fields[field].text;
+        let refusal = element_value_refusal(name, value, text).or_else(|| {
+            let product = format!("{} × m00 = {}", shown(text), crate::text::number(sr));
+            element_value_refusal(name, sr, &product)
+        });
+        refusal.map_or(Ok(()), |kind| Err(self.refusal(field, kind)))
+    }
+
     /// The row's Mueller elements in sr⁻¹, psps, aligned with the resolved elements.
     fn elements(
         &self,
@@ -468,6 +481,7 @@ impl Cells<'_> {
                 _ if layout.conventions.normalized => value * m00,
                 _ => value,
             };
+            self.check_element(field, value, matrix[index])?;
         }
         if layout.conventions.mueller_convention == MuellerBasis::Xyxy {
             xyxy_to_psps(&mut matrix, phi_i_deg, phi_r_deg);

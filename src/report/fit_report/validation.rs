@@ -48,20 +48,18 @@ fn draw_incidence_key<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Encodes `<out_dir>/<material>_validation_<data stem>.png`; `summary` is the line of errors
-/// printed under the title.
+/// Encodes `<out_dir>/<material>_validation_<data_name>.png` (`data_name`: the data file's stem,
+/// with its wavelength where a file holds several); `summary` is the line of errors printed under
+/// the title.
 pub fn encode_validation_report(
     material: &Material,
     set: &MeasurementSet,
+    data_name: &str,
     summary: &str,
     out_dir: &Path,
 ) -> Result<EncodedReport, ReportError> {
     let stem = report_stem(&material.name)?;
-    let data_stem = set
-        .source
-        .file_stem()
-        .map_or_else(|| "data".into(), |s| s.to_string_lossy().into_owned());
-    let png = out_dir.join(format!("{stem}_validation_{data_stem}.png"));
+    let png = out_dir.join(format!("{stem}_validation_{data_name}.png"));
     let data = ReportData::new(material, set)?;
     let title = format!(
         "Validation: {} predicting {} ({} rows × {} Mueller elements, λ = {} µm)",

@@ -1,5 +1,5 @@
 //! EnergyPlus weather files (EPW), as the EnergyPlus Auxiliary Programs documentation defines
-//! them: eight header lines, the first `LOCATION,city,state,country,source,WMO,latitude,longitude,
+//! them: header lines (told by their keywords, normally eight), the first `LOCATION,city,state,country,source,WMO,latitude,longitude,
 //! time zone,elevation` (° north, ° east, hours east of UTC, m), then one comma-separated row per
 //! hour: year, month, day, hour (1…24, the end of the hour in local standard time), minute, the
 //! data source flags, and the fields below (1-based positions); a value at or above its missing
@@ -55,8 +55,26 @@ const LAYOUT: [(Field, usize, &str, f64); FIELDS] = [
     (Field::OpaqueCover, 24, "opaque sky cover (tenths)", 99.0),
 ];
 
-/// Header lines before the first data row.
-const HEADER_LINES: usize = 8;
+/// The keywords that start the header lines after LOCATION (EnergyPlus Auxiliary Programs,
+/// "EnergyPlus Weather File (EPW) Data Dictionary"). The header is told by these, not by a count:
+/// a file that lacks one of them (its DATA PERIODS line, say) must not lose its first data row.
+const HEADER_KEYWORDS: [&str; 6] = [
+    "DESIGN CONDITIONS",
+    "TYPICAL/EXTREME PERIODS",
+    "GROUND TEMPERATURES",
+    "HOLIDAYS/DAYLIGHT SAVINGS",
+    "COMMENTS",
+    "DATA PERIODS",
+];
+
+/// Whether `line` is one of the EPW header lines after LOCATION (its first field one of
+/// [`HEADER_KEYWORDS`], `COMMENTS 1` and `COMMENTS 2` alike).
+fn is_header_line(line: &str) -> bool {
+    let first = line.split(',').next().unwrap_or("").trim();
+    HEADER_KEYWORDS
+        .iter()
+        .any(|k| first.to_ascii_uppercase().starts_with(k))
+}
 
 /// Reads an EPW file's bytes; `year` replaces every row's year (a typical-year file).
 pub(super) fn parse(
@@ -91,17 +109,13 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
         ));
     };
     let station = location(first).map_err(|problem| (1, problem.0))?;
-    for _ in 1..HEADER_LINES {
-        if lines.next().is_none() {
-            let message = format!(
-                "the file ends inside its {HEADER_LINES} header lines (LOCATION … DATA PERIODS)"
-            );
-            return Err((text.lines().count() as u64, message));
-        }
+    let mut lines = lines.peekable();
+    let mut header_end = 1;
+    while let Some(&(number, _)) = lines.peek().filter(|(_, line)| is_header_line(line)) {
+        header_end = number;
+        lines.next();
     }
-    let records = read_records(lines, HEADER_LINES as u64, |row| {
-        record(row, year, &station)
-    })?;
+    let records = read_records(lines, header_end, |row| record(row, year, &station))?;
     Ok((station, records))
 }
 
