@@ -124,7 +124,8 @@ mod tests {
     #[test]
     fn in_the_plane_of_incidence_only_the_circular_sign_changes() {
         let ior = crate::optics::RefractiveIndex::new(1.5, 0.1);
-        let (r_s, r_p) = crate::optics::fresnel_amplitudes(30f64.to_radians().cos(), ior);
+        let (r_s, r_p) =
+            crate::optics::fresnel_amplitudes(30f64.to_radians().cos(), ior.permittivity());
         let m = crate::optics::fresnel_mueller(r_s, r_p);
         let l = Direction::from_degrees(30.0, 0.0).vector;
         let v = Direction::from_degrees(30.0, 180.0).vector;

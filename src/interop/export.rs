@@ -28,6 +28,16 @@ pub struct ExportOptions {
     pub grid: Option<[usize; 3]>,
 }
 
+impl ExportOptions {
+    /// Refuses what no material could be exported with ([`check_wavelengths`], [`check_grid`]).
+    pub fn check(&self) -> Result<(), ExportError> {
+        if let Some(wavelengths_nm) = &self.wavelengths_nm {
+            check_wavelengths(wavelengths_nm)?;
+        }
+        self.grid.map_or(Ok(()), check_grid)
+    }
+}
+
 /// An exported table and what the user should know about it.
 pub struct Export {
     pub table: PbsdfTable,
@@ -128,10 +138,8 @@ pub fn export_material(
         .wavelengths_nm
         .clone()
         .unwrap_or_else(|| default_wavelengths(&material.model));
+    options.check()?;
     check_wavelengths(&wavelengths_nm)?;
-    if let Some(counts) = options.grid {
-        check_grid(counts)?;
-    }
     let (models, notes) = models_at(material, &wavelengths_nm)?;
     let grid = material_grid(&models, options.grid);
     Ok(Export {

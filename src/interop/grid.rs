@@ -17,7 +17,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 /// Relative m00 error and absolute m_ij/m00 error allowed per axis, per interpolation step.
 /// Chosen (with [`MIN_NODES`]) so that every shipped material meets the bars of
 /// docs/design.md §2.10 (median 1 %, 95th percentile 5 % of m00; 0.01 in m_ij/m00).
-pub const M00_TOLERANCE: f64 = 0.02;
+pub const M00_TOLERANCE: f64 = 0.015;
 pub const RATIO_TOLERANCE: f64 = 0.004;
 
 /// Fewest nodes per axis, and most (Mitsuba's tables have no limit; 1024 keeps a table of one
@@ -159,7 +159,7 @@ fn nodes_from_density(density: &[f64], (lo, hi): (f64, f64), count: Option<usize
     }
     let total = cumulative[density.len() - 1];
     let count = count
-        .unwrap_or_else(|| (total.ceil() as usize + 1).clamp(MIN_NODES, MAX_NODES))
+        .unwrap_or_else(|| ((total - 1e-9).ceil() as usize + 1).clamp(MIN_NODES, MAX_NODES))
         .max(2);
     let mut nodes: Vec<f64> = (0..count)
         .map(|k| {
@@ -196,7 +196,8 @@ mod tests {
         let peaked: Vec<f64> = (0..101).map(|i| if i < 10 { 100.0 } else { 0.0 }).collect();
         let nodes = nodes_from_density(&peaked, (0.0, 1.0), Some(20));
         assert_eq!(nodes.len(), 20);
-        assert!(nodes.iter().filter(|&&x| x < 0.1).count() > 10);
+        // Uniform nodes would put 2 of 20 there; the capped peak draws about 9.
+        assert!(nodes.iter().filter(|&&x| x < 0.1).count() >= 8);
         assert!(nodes.windows(2).all(|w| w[1] > w[0]));
     }
 }

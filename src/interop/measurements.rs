@@ -173,7 +173,8 @@ fn point(
     line: u64,
 ) -> Option<MeasurementPoint> {
     let values: Vec<f64> = (0..16).map(|k| m[(k / 4, k % 4)]).collect();
-    if !(values[0] > 0.0) || values.iter().any(|v| !(v.abs() <= MAX_MUELLER_SR)) {
+    let usable = |v: &f64| v.is_finite() && v.abs() <= MAX_MUELLER_SR;
+    if values[0].is_nan() || values[0] <= 0.0 || !values.iter().all(usable) {
         return None;
     }
     let angles = |d: &nalgebra::Vector3<f64>| {
