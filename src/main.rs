@@ -218,7 +218,7 @@ enum Command {
 // The flags of `irpol fit` (the variant's doc comment is the subcommand's help).
 #[derive(Args)]
 struct FitArgs {
-    /// Measurement CSVs or folders of them.
+    /// Measurement CSVs or folders of them (or Mitsuba .pbsdf tables, docs/mitsuba.md).
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
     #[command(flatten)]
