@@ -327,3 +327,38 @@ fn export_then_fit_recovers_grey_and_spectral_materials() {
         }
     }
 }
+
+/// `irpol validate` takes a table as measurements: the material predicts its own export to
+/// float32 (the inverse conversion is exact), one report page per wavelength.
+#[test]
+fn validate_reads_a_table_and_writes_a_page_per_wavelength() {
+    let dir = tempfile::tempdir().unwrap();
+    let material = fits("paper_paint");
+    let out = irpol(
+        &[
+            "export", &material, "--to", "mitsuba", "--out", "p.pbsdf", "--grid", "9,9,9",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success());
+    std::fs::create_dir(dir.path().join("reports")).unwrap();
+    let out = irpol(
+        &["validate", &material, "p.pbsdf", "--reports", "reports"],
+        dir.path(),
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        stdout.matches("m00 relative RMS 0.00 %").count(),
+        5,
+        "{stdout}"
+    );
+    for um in [8, 9, 10, 11, 12] {
+        let page = format!("reports/paper_paint_validation_p_{um}um.png");
+        assert!(dir.path().join(page).is_file());
+    }
+}

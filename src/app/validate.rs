@@ -7,7 +7,7 @@ use crate::atomic::OutputSet;
 use crate::fit::{validate_model, Validation};
 use crate::material::Material;
 use crate::measure::{collect_measurement_files, MeasurementSet, ReadOptions};
-use crate::report::fit_report::encode_validation_report;
+use crate::report::fit_report::{encode_validation_report, validation_data_name};
 use std::path::{Path, PathBuf};
 
 /// One measurement set as `validate` scored it.
@@ -46,7 +46,9 @@ pub fn validate_sets(
     }
     let mut outputs = OutputSet::new();
     let mut results = Vec::new();
-    for set in sets {
+    let sets_of = |source: &Path| sets.iter().filter(|s| s.source == source).count();
+    let counts: Vec<usize> = sets.iter().map(|s| sets_of(&s.source)).collect();
+    for (set, count) in sets.into_iter().zip(counts) {
         let wavelength = material.model.spectral().map(|_| set.wavelength_um);
         let model = material_pbrdf(material, wavelength, None)?;
         let validation = validate_model(&model, &set)?;
@@ -55,6 +57,7 @@ pub fn validate_sets(
             &set,
             &validation_summary(&validation),
             reports_dir,
+            &validation_data_name(&set, count),
         )?;
         let mut report_path = PathBuf::new();
         for (path, bytes) in report.files {

@@ -23,7 +23,7 @@ pub(crate) use table::{
     fitted_cells, format_plain, format_with_uncertainty, is_free, parameters, preference,
     sha_prefix, FOOTNOTE_BOUND, FOOTNOTE_PROFILE,
 };
-pub use validation::encode_validation_report;
+pub use validation::{encode_validation_report, validation_data_name};
 
 use super::ReportError;
 use crate::atomic::write_atomically;

@@ -48,19 +48,31 @@ fn draw_incidence_key<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Encodes `<out_dir>/<material>_validation_<data stem>.png`; `summary` is the line of errors
-/// printed under the title.
+/// The data part of a validation page's name: the file stem of `set`'s source, and
+/// `_<λ>um` when that file gave several sets (one per wavelength: a spectral CSV or a Mitsuba
+/// table), so that their pages do not overwrite each other.
+pub fn validation_data_name(set: &MeasurementSet, sets_of_file: usize) -> String {
+    let stem = set
+        .source
+        .file_stem()
+        .map_or_else(|| "data".into(), |s| s.to_string_lossy().into_owned());
+    match sets_of_file {
+        0 | 1 => stem,
+        _ => format!("{stem}_{}um", set.wavelength_um),
+    }
+}
+
+/// Encodes `<out_dir>/<material>_validation_<data name>.png`; `summary` is the line of errors
+/// printed under the title; `data_name` is the data file's stem, with the wavelength when the
+/// file holds several ([`validation_data_name`]).
 pub fn encode_validation_report(
     material: &Material,
     set: &MeasurementSet,
     summary: &str,
     out_dir: &Path,
+    data_stem: &str,
 ) -> Result<EncodedReport, ReportError> {
     let stem = report_stem(&material.name)?;
-    let data_stem = set
-        .source
-        .file_stem()
-        .map_or_else(|| "data".into(), |s| s.to_string_lossy().into_owned());
     let png = out_dir.join(format!("{stem}_validation_{data_stem}.png"));
     let data = ReportData::new(material, set)?;
     let title = format!(
