@@ -362,3 +362,31 @@ fn validate_reads_a_table_and_writes_a_page_per_wavelength() {
         assert!(dir.path().join(page).is_file());
     }
 }
+
+/// Acceptance 5 (by hand: `cargo test --release --test mitsuba_interop -- --ignored`): a table of
+/// the size of a KAIST file (~240 MB) is read as measurements within 10 s.
+#[test]
+#[ignore]
+fn a_240_mb_table_reads_within_ten_seconds() {
+    let dir = tempfile::tempdir().unwrap();
+    let options = ExportOptions {
+        grid: Some([151, 80, 62]),
+        ..ExportOptions::default()
+    };
+    let table = export_material(&shipped("rough_paint"), &options)
+        .unwrap()
+        .table;
+    let path = dir.path().join("big.pbsdf");
+    std::fs::write(&path, table.to_bytes()).unwrap();
+    drop(table);
+    let bytes = std::fs::metadata(&path).unwrap().len();
+    let start = std::time::Instant::now();
+    let sets = irpol::interop::read_table_measurements(&path).unwrap();
+    let seconds = start.elapsed().as_secs_f64();
+    let rows: usize = sets.iter().map(|s| s.points.len()).sum();
+    println!(
+        "{:.0} MB table: {rows} rows in {seconds:.1} s",
+        bytes as f64 / 1e6
+    );
+    assert!(bytes > 230_000_000 && seconds <= 10.0);
+}
