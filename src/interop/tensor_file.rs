@@ -289,8 +289,8 @@ impl FieldData {
     }
 }
 
-/// The bytes of a tensor file holding `fields`, each field's data 8-byte aligned as Mitsuba's
-/// own writer (`mi.tensor_io.write`) places it.
+/// The bytes of a tensor file holding `fields`, each field's data 8-byte aligned (Mitsuba 3.9.1
+/// loads such files: scripts/check_mitsuba_export.py).
 pub fn tensor_file_bytes(fields: &[FieldData]) -> Vec<u8> {
     let header_len: usize = 12
         + 2

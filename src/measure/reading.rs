@@ -23,6 +23,16 @@ pub fn read_measurement_file(
     layout: Option<&Layout>,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
     if starts_as_tensor_file(path) {
+        if layout.is_some() {
+            return Err(Refusal::new(
+                1,
+                1,
+                MeasureErrorKind::Table(crate::interop::TensorError::file(
+                    "--layout reads CSV tables; a Mitsuba table has its own layout: drop --layout",
+                )),
+            )
+            .in_file(path));
+        }
         return crate::interop::read_table_measurements(path);
     }
     let bytes = read_bytes(path)?;
