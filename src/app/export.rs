@@ -50,12 +50,19 @@ pub fn parse_wavelengths(text: &str) -> Result<Vec<u16>, AppError> {
         .collect()
 }
 
-/// Exports `material` to `out` (a file; an existing folder is refused).
+/// Exports the material file `material` to `out` (a file; an existing folder is refused).
 pub fn export_to_mitsuba(
     material: &Path,
     out: &Path,
     options: &ExportOptions,
 ) -> Result<ExportSummary, AppError> {
+    check_request(out, options)?;
+    let loaded = Material::load(material)?;
+    export_material_to(&loaded, out, options).map_err(|e| e.named(&crate::text::path(material)))
+}
+
+/// The refusals that need no material: `out` a folder, options no table can have.
+fn check_request(out: &Path, options: &ExportOptions) -> Result<(), AppError> {
     if out.is_dir() {
         return Err(AppError::invalid(format!(
             "--out {}: is a folder; give the table's file name, e.g. {}",
@@ -65,14 +72,48 @@ pub fn export_to_mitsuba(
     }
     options
         .check()
-        .map_err(|e| AppError::invalid(e.to_string()))?;
-    let loaded = Material::load(material)?;
-    let export = export_material(&loaded, options)
-        .map_err(|e| AppError::invalid(format!("{}: {e}", crate::text::path(material))))?;
+        .map_err(|e| AppError::invalid(e.to_string()))
+}
+
+/// [`export_to_mitsuba`] of a material in memory (the Python `irpol.export_pbsdf`).
+pub fn export_loaded(
+    material: &Material,
+    out: &Path,
+    options: &ExportOptions,
+) -> Result<ExportSummary, AppError> {
+    check_request(out, options)?;
+    export_material_to(material, out, options)
+        .map_err(|e| e.named(&format!("material '{}'", material.name)))
+}
+
+/// Why an export of a checked request failed: the material cannot be tabulated, or the write.
+enum ExportFailure {
+    Export(crate::interop::ExportError),
+    Write(AppError),
+}
+
+impl ExportFailure {
+    /// The application error, a refusal prefixed by what names the material.
+    fn named(self, material: &str) -> AppError {
+        match self {
+            ExportFailure::Export(e) => AppError::invalid(format!("{material}: {e}")),
+            ExportFailure::Write(e) => e,
+        }
+    }
+}
+
+fn export_material_to(
+    material: &Material,
+    out: &Path,
+    options: &ExportOptions,
+) -> Result<ExportSummary, ExportFailure> {
+    let export = export_material(material, options).map_err(ExportFailure::Export)?;
     let bytes = export.table.to_bytes();
-    write_atomically(out, &bytes).map_err(|source| AppError::Write {
-        path: out.to_owned(),
-        source,
+    write_atomically(out, &bytes).map_err(|source| {
+        ExportFailure::Write(AppError::Write {
+            path: out.to_owned(),
+            source,
+        })
     })?;
     Ok(ExportSummary {
         path: out.to_owned(),
