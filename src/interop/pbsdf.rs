@@ -121,7 +121,8 @@ impl<R: Read + Seek> PbsdfFile<R> {
             field("M")?,
         );
         let grid = PbsdfGrid {
-            phi_d: read_angles(&mut source, &phi, std::f64::consts::PI)?,
+            // Any turn is a direction; a [0, 2π] table (which Mitsuba clamps) still reads.
+            phi_d: read_angles(&mut source, &phi, std::f64::consts::TAU)?,
             theta_d: read_angles(&mut source, &td, std::f64::consts::FRAC_PI_2)?,
             theta_h: read_angles(&mut source, &th, std::f64::consts::FRAC_PI_2)?,
         };
@@ -174,7 +175,7 @@ impl<R: Read + Seek> PbsdfFile<R> {
 const ANGLE_SLACK: f64 = 1e-5;
 
 /// An angle field: shape (1, N) or (N,), N ≥ 2, float, finite, strictly increasing, within
-/// [0, π/2] for θ and [−π, π] for φ_d (`limit` the upper end).
+/// [0, π/2] for θ and [−2π, 2π] for φ_d (`limit` the upper end; φ_d is −limit to limit).
 fn read_angles(
     source: &mut (impl Read + Seek),
     field: &FieldInfo,
