@@ -17,6 +17,7 @@ pub mod atomic;
 pub mod elementary;
 pub mod emitter;
 pub mod fit;
+pub mod interop;
 pub mod interrupt;
 pub mod material;
 pub mod measure;

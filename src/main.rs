@@ -8,6 +8,7 @@ use cli::progress::TerminalProgress;
 use irpol::app::evaluate::{
     geometry_table, write_emissivity_csv, write_mueller_csv, GeometryTable,
 };
+use irpol::app::export::{export_to_mitsuba, parse_grid, parse_wavelengths};
 use irpol::app::fit::{fit_and_write, FitFlags};
 use irpol::app::render::{
     default_output_dir, render_scene_at_within, render_scene_within, Instants, TimedRender,
@@ -80,8 +81,29 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
-    /// Fits pBRDF models to measurement CSVs and writes the material library.
+    /// Fits pBRDF models to measurement CSVs (or Mitsuba .pbsdf tables) and writes the
+    /// material library.
     Fit(FitArgs),
+    /// Writes a material as a table another renderer loads: Mitsuba 3's measured_polarized
+    /// .pbsdf (docs/mitsuba.md). Prints the file's size and grid.
+    Export {
+        /// The material TOML.
+        material: PathBuf,
+        /// The target format.
+        #[arg(long, value_parser = ["mitsuba"])]
+        to: String,
+        /// The table file to write (replaced atomically if it exists; a folder is refused).
+        #[arg(long)]
+        out: PathBuf,
+        /// Exactly five increasing wavelengths in whole nm (stock Mitsuba reads five); default
+        /// 8000,9000,10000,11000,12000 for a grey material, five across a spectral one's table.
+        #[arg(long)]
+        wavelengths_nm: Option<String>,
+        /// Node counts NPHI,NTD,NTH (each 2..=1024) instead of the sizes chosen for the
+        /// material; the spacing still follows it.
+        #[arg(long)]
+        grid: Option<String>,
+    },
     /// How a material's model predicts measurements it was not fitted to: per-element RMS
     /// errors (absolute and of m_ij/m00), normalized residuals, and a report page per file.
     Validate {
@@ -200,7 +222,7 @@ enum Command {
 // The flags of `irpol fit` (the variant's doc comment is the subcommand's help).
 #[derive(Args)]
 struct FitArgs {
-    /// Measurement CSVs or folders of them.
+    /// Measurement CSVs or folders of them (or Mitsuba .pbsdf tables, docs/mitsuba.md).
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
     #[command(flatten)]
@@ -342,6 +364,13 @@ fn run(command: Command) -> anyhow::Result<()> {
         }
         Command::Figure { which, out } => figure(&which, &out),
         Command::Fit(args) => fit(args),
+        Command::Export {
+            material,
+            to: _,
+            out,
+            wavelengths_nm,
+            grid,
+        } => export(&material, &out, wavelengths_nm.as_deref(), grid.as_deref()),
         Command::Validate {
             material,
             data,
@@ -432,6 +461,30 @@ fn fit(args: FitArgs) -> anyhow::Result<()> {
         &args.out,
         &args.reports,
     )
+}
+
+/// `irpol export --to mitsuba`: the table written, then its size, grid and wavelengths.
+fn export(
+    material: &Path,
+    out: &Path,
+    wavelengths_nm: Option<&str>,
+    grid: Option<&str>,
+) -> anyhow::Result<()> {
+    let options = irpol::interop::ExportOptions {
+        wavelengths_nm: wavelengths_nm.map(parse_wavelengths).transpose()?,
+        grid: grid.map(parse_grid).transpose()?,
+    };
+    let summary = export_to_mitsuba(material, out, &options)?;
+    note_all(&summary.notes);
+    let [p, d, h] = summary.grid;
+    let wavelengths: Vec<String> = summary.wavelengths_nm.iter().map(u16::to_string).collect();
+    say!(
+        "wrote {} ({:.1} MB): grid {p} × {d} × {h} (φ_d × θ_d × θ_h), wavelengths {} nm",
+        summary.path.display(),
+        summary.bytes as f64 / 1e6,
+        wavelengths.join(", ")
+    );
+    Ok(())
 }
 
 /// `irpol validate`: one line per measurement set and its report page.

@@ -42,6 +42,8 @@ __all__ = [
     "render",
     "solve_thermal",
     "thermal_keys",
+    "export_pbsdf",
+    "read_pbsdf",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -237,6 +239,35 @@ def validate(
         d["model_mueller"] = np.asarray(d["model_mueller"]).reshape(-1, 4, 4)
         out.append(Validation(**d))
     return out
+
+
+def export_pbsdf(
+    material: Union[Material, PathLike],
+    path: PathLike,
+    *,
+    wavelengths_nm: Optional[Sequence[int]] = None,
+    grid: Optional[Tuple[int, int, int]] = None,
+) -> Dict[str, Any]:
+    """Writes `material` (a Material or a material TOML) as the `.pbsdf` table of Mitsuba 3's
+    ``measured_polarized`` plugin, as ``irpol export --to mitsuba`` (docs/mitsuba.md): five
+    increasing whole-nm `wavelengths_nm` (default: 8000…12000 for a grey material, five across a
+    spectral one's table), `grid` = (N_phi_d, N_theta_d, N_theta_h) node counts (default: chosen
+    for the material). Returns path, bytes, grid, wavelengths_nm and notes. Raises ValueError
+    (refused) or OSError (not written)."""
+    return _irpol.export_pbsdf(
+        _material(material),
+        os.fspath(path),
+        wavelengths_nm=None if wavelengths_nm is None else [int(w) for w in wavelengths_nm],
+        grid=None if grid is None else [int(n) for n in grid],
+    )
+
+
+def read_pbsdf(path: PathLike) -> Dict[str, np.ndarray]:
+    """The fields of a Mitsuba `.pbsdf` table as arrays: phi_d, theta_d, theta_h (radians), wvls
+    (nm) and M (float32, (N_phi_d, N_theta_d, N_theta_h, N_lambda, 4, 4), in the table's frames
+    and Mitsuba's S3 sign; docs/design.md §2.10). To read it as psps measurements, use
+    :func:`read_measurements`. Raises ValueError naming the field when the table is malformed."""
+    return _irpol.read_pbsdf(os.fspath(path))
 
 
 from ._fit import FitResult, fit  # noqa: E402  (needs Measurements)

@@ -5,6 +5,7 @@
 
 mod errors;
 mod fitting;
+mod interop;
 mod material;
 mod measurements;
 mod model;
@@ -34,5 +35,7 @@ fn _irpol(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(thermal::thermal_keys, m)?)?;
     m.add_function(wrap_pyfunction!(thermal::solve_thermal, m)?)?;
     m.add_function(wrap_pyfunction!(validation::validate_material, m)?)?;
+    m.add_function(wrap_pyfunction!(interop::export_pbsdf, m)?)?;
+    m.add_function(wrap_pyfunction!(interop::read_pbsdf, m)?)?;
     Ok(())
 }

@@ -3,6 +3,7 @@
 
 pub mod error;
 pub mod evaluate;
+pub mod export;
 pub mod fit;
 pub mod render;
 pub mod render_cost;

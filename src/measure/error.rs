@@ -49,6 +49,12 @@ pub enum MeasureErrorKind {
     #[error("the folder holds no *.csv files")]
     NoCsvInFolder,
 
+    // --- Mitsuba tensor files (docs/design.md §2.10) ---
+    #[error("Mitsuba table: {0}")]
+    Table(crate::interop::TensorError),
+    #[error("Mitsuba table: no node has both cosines > 0 and a finite m00 > 0 ({skipped} skipped): there is no reflection to fit")]
+    NoTableRows { skipped: usize },
+
     // --- whole-file structure ---
     #[error("invalid UTF-8 (byte 0x{byte:02X}): a measurement CSV must be UTF-8 text")]
     InvalidUtf8 { byte: u8 },

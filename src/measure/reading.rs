@@ -22,8 +22,30 @@ pub fn read_measurement_file(
     path: &Path,
     layout: Option<&Layout>,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
+    if starts_as_tensor_file(path) {
+        if layout.is_some() {
+            return Err(Refusal::new(
+                1,
+                1,
+                MeasureErrorKind::Table(crate::interop::TensorError::file(
+                    "--layout reads CSV tables; a Mitsuba table has its own layout: drop --layout",
+                )),
+            )
+            .in_file(path));
+        }
+        return crate::interop::read_table_measurements(path);
+    }
     let bytes = read_bytes(path)?;
     parse_measurement_file(path, &bytes, layout)
+}
+
+/// Whether the file at `path` begins with a Mitsuba tensor file's magic (docs/design.md §2.10):
+/// such a table is read as measurements without taking its bytes into memory at once.
+fn starts_as_tensor_file(path: &Path) -> bool {
+    let mut head = [0u8; 12];
+    std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
+        .is_ok_and(|()| crate::interop::is_tensor_file(&head))
 }
 
 /// [`read_measurement_file`] of a file's bytes; `source` names them and locates a relative
