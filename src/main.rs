@@ -470,7 +470,7 @@ fn export(
     wavelengths_nm: Option<&str>,
     grid: Option<&str>,
 ) -> anyhow::Result<()> {
-    let options = irpol::interop::ExportOptions {
+    let options = irpol::material::ExportOptions {
         wavelengths_nm: wavelengths_nm.map(parse_wavelengths).transpose()?,
         grid: grid.map(parse_grid).transpose()?,
     };

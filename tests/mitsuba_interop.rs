@@ -1,10 +1,10 @@
 //! Mitsuba 3 interop (docs/design.md §2.10): `.pbsdf` tables written from materials, read back
 //! as measurements, and the grid's accuracy under Mitsuba's own (multilinear, clamped) lookup.
 
-use irpol::interop::export::{export_material, ExportOptions};
 use irpol::interop::lookup::psps_at;
 use irpol::interop::PbsdfTable;
 use irpol::material::Material;
+use irpol::material::{export_material, ExportOptions};
 use irpol::optics::{Direction, Mueller};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -381,7 +381,7 @@ fn a_240_mb_table_reads_within_ten_seconds() {
     drop(table);
     let bytes = std::fs::metadata(&path).unwrap().len();
     let start = std::time::Instant::now();
-    let sets = irpol::interop::read_table_measurements(&path).unwrap();
+    let sets = irpol::measure::read_table_measurements(&path).unwrap();
     let seconds = start.elapsed().as_secs_f64();
     let rows: usize = sets.iter().map(|s| s.points.len()).sum();
     println!(

@@ -4,7 +4,8 @@
 use crate::errors::{bad_argument, raised};
 use crate::material::PyMaterial;
 use irpol::app::export::export_loaded;
-use irpol::interop::{ExportOptions, PbsdfFile};
+use irpol::interop::PbsdfFile;
+use irpol::material::ExportOptions;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

@@ -4,8 +4,8 @@
 
 use super::AppError;
 use crate::atomic::write_atomically;
-use crate::interop::export::{export_material, ExportOptions};
 use crate::material::Material;
+use crate::material::{export_material, ExportOptions};
 use std::path::{Path, PathBuf};
 
 /// What was written, for the caller to print.
@@ -88,7 +88,7 @@ pub fn export_loaded(
 
 /// Why an export of a checked request failed: the material cannot be tabulated, or the write.
 enum ExportFailure {
-    Export(crate::interop::ExportError),
+    Export(crate::material::ExportError),
     Write(AppError),
 }
 

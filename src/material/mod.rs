@@ -2,10 +2,12 @@
 //! was fitted, and its uncertainties. Written atomically; read by `render` and `report`.
 
 mod comments;
+pub mod pbsdf_export;
 mod raw;
 mod scene_materials;
 mod spectral;
 
+pub use pbsdf_export::{export_material, Export, ExportError, ExportOptions};
 pub use raw::ModelTableError;
 pub use scene_materials::{
     inline_pbrdf, share_wavelength_nodes, InlineMaterialConfig, InlineMaterialError,

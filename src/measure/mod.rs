@@ -32,6 +32,7 @@ mod fingerprint;
 mod layout;
 mod merge;
 mod metadata;
+mod pbsdf;
 mod reading;
 mod realizability;
 mod selection;
@@ -51,6 +52,7 @@ pub use layout::{
     MuellerBasis, SpecularAzimuth, UncertaintyModel,
 };
 pub use merge::{merge_repeat_measurements, MergeError, SAME_WAVELENGTH_UM};
+pub use pbsdf::read_table_measurements;
 pub use reading::{
     parse_measurement_file, read_measurement_file, ReadError, ReadOptions, LAYOUT_KEY,
 };

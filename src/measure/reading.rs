@@ -33,7 +33,7 @@ pub fn read_measurement_file(
             )
             .in_file(path));
         }
-        return crate::interop::read_table_measurements(path);
+        return super::pbsdf::read_table_measurements(path);
     }
     let bytes = read_bytes(path)?;
     parse_measurement_file(path, &bytes, layout)

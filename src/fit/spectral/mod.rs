@@ -311,13 +311,7 @@ fn fit_lorentz(
     };
     let mut start: Vec<f64> = problem.shared.iter().map(|&p| shared_start(p)).collect();
     start.extend(law_start);
-    for &p in &problem.families {
-        for j in 0..sets.len() {
-            let node = table.model.at(table.model.wavelength_um[j]).ok();
-            let value = node.and_then(|m| m.parameter(p)).unwrap_or(0.0);
-            start.push(to_search(p, value));
-        }
-    }
+    start.extend(family_starts(&problem, table));
     solve(
         &mut problem,
         sets,
@@ -374,15 +368,7 @@ fn fit_cauchy(
         .map(|&p| to_search(p, table.value(p)))
         .collect();
     start.extend([a, b]);
-    for &p in &problem.families {
-        for j in 0..sets.len() {
-            let node = model.at(model.wavelength_um[j]).ok();
-            start.push(to_search(
-                p,
-                node.and_then(|m| m.parameter(p)).unwrap_or(0.0),
-            ));
-        }
-    }
+    start.extend(family_starts(&problem, table));
     solve(
         &mut problem,
         sets,
@@ -391,6 +377,23 @@ fn fit_cauchy(
         kind,
         Dispersion::Cauchy,
     )
+}
+
+/// The start of every per-wavelength coordinate of `problem`: the `table` fit's value of its
+/// parameter at its wavelength (0 where the table's model lacks it).
+fn family_starts(problem: &JointProblem, table: &SpectralFit) -> Vec<f64> {
+    let model = &table.model;
+    let mut start = Vec::new();
+    for &p in &problem.families {
+        for &wavelength_um in &model.wavelength_um {
+            let node = model.at(wavelength_um).ok();
+            start.push(to_search(
+                p,
+                node.and_then(|m| m.parameter(p)).unwrap_or(0.0),
+            ));
+        }
+    }
+    start
 }
 
 /// A and B ≥ 0 of the least-squares line n = A + B x, x = 1/λ², through the table's `n`.

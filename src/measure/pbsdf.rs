@@ -7,9 +7,8 @@
 //! A row's `line` is 1 + the index of its matrix in `M` (node-major, wavelength innermost), so
 //! a message about a row points into the table.
 
-use super::convention::{node_directions, psps_from_table};
-use super::pbsdf::PbsdfFile;
-use super::tensor_file::TensorError;
+use crate::interop::convention::{node_directions, psps_from_table};
+use crate::interop::{PbsdfFile, TensorError};
 use crate::measure::{
     MeasureError, MeasureErrorKind, MeasurementPoint, MeasurementSet, MAX_MUELLER_SR,
 };

@@ -1,10 +1,11 @@
 //! A material as a `.pbsdf` table for Mitsuba 3 (docs/design.md §2.10): the wavelengths it is
-//! tabulated at, its grid ([`super::grid`]) and its values ([`super::tabulate`]).
+//! tabulated at, its grid ([`crate::interop::grid`]) and its values
+//! ([`crate::interop::tabulate`]).
 
-use super::grid::{material_grid, MAX_NODES};
-use super::pbsdf::PbsdfTable;
-use super::tabulate::tabulate;
-use crate::material::{Material, MaterialModel};
+use super::{Material, MaterialModel};
+use crate::interop::grid::{material_grid, MAX_NODES};
+use crate::interop::tabulate::tabulate;
+use crate::interop::PbsdfTable;
 use crate::pbrdf::Pbrdf;
 use crate::text::number;
 
