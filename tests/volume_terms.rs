@@ -77,6 +77,20 @@ fn every_term_is_reciprocal_with_the_facet_terms_q() {
         model(1.6, 0.2, 0.0, FacetSide::Internal, None),
         model(1.0, 0.0, 0.0, FacetSide::External, subsurface(0.8, 0.6)),
         model(1.45, 0.02, 0.05, FacetSide::Internal, subsurface(0.9, 0.3)),
+        // d(Θ) = d + d1 cos Θ: cos Θ = −ω_i·ω_r is symmetric in the two directions.
+        model(
+            1.3,
+            0.0,
+            0.0,
+            FacetSide::External,
+            Some(Subsurface {
+                rho_s: 0.9,
+                d: 0.3,
+                n_sub: Some(1.1),
+                d_c: Some(0.61),
+                d1: Some(-0.5),
+            }),
+        ),
     ];
     for (m, pbrdf) in models.iter().enumerate() {
         for i in directions() {
@@ -99,12 +113,18 @@ fn every_term_is_reciprocal_with_the_facet_terms_q() {
 #[test]
 fn subsurface_term_conserves_energy_and_stays_realizable() {
     let quadrature = HemisphereQuadrature::default();
-    // d_c absent (= d) and at the edge of the realizable values, 2d − 1.
+    // d_c absent (= d) and at the edge of the realizable values, 2d − 1; with d1, the edge
+    // 2(|d| + |d1|) − 1 of an angle-dependent d(Θ) = d + d1 cos Θ (|d| + |d1| up to 1).
     let cases = [0.0, 0.4, 1.0]
         .into_iter()
-        .flat_map(|d| [(d, None), (d, Some(2.0 * d - 1.0))]);
+        .flat_map(|d| [(d, None, None), (d, Some(2.0 * d - 1.0), None)])
+        .chain([
+            (0.3, Some(0.61), Some(-0.5)),
+            (0.0, Some(0.2), Some(0.6)),
+            (0.5, Some(1.0), Some(0.5)),
+        ]);
     for n in [1.0, 1.3, 1.6, 2.4] {
-        for (d, d_c) in cases.clone() {
+        for (d, d_c, d1) in cases.clone() {
             let only_subsurface = Pbrdf::new(
                 SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 },
                 Shadowing::Smith,
@@ -119,7 +139,7 @@ fn subsurface_term_conserves_energy_and_stays_realizable() {
                     d,
                     n_sub: Some(n),
                     d_c,
-                    d1: None,
+                    d1,
                 }),
             )
             .unwrap();
@@ -130,7 +150,7 @@ fn subsurface_term_conserves_energy_and_stays_realizable() {
                 let bound = Transmission::at(theta.to_radians().cos(), eps).plus;
                 assert!(
                     albedo <= bound + 2e-4,
-                    "n {n} d {d} d_c {d_c:?} θ {theta}: {albedo} > {bound}"
+                    "n {n} d {d} d_c {d_c:?} d1 {d1:?} θ {theta}: {albedo} > {bound}"
                 );
                 assert!(albedo <= 1.0);
             }
@@ -142,7 +162,7 @@ fn subsurface_term_conserves_energy_and_stays_realizable() {
                         .fold(f64::INFINITY, f64::min);
                     assert!(
                         lowest >= -1e-12 * m[(0, 0)],
-                        "n {n} d {d} d_c {d_c:?}: {lowest}"
+                        "n {n} d {d} d_c {d_c:?} d1 {d1:?}: {lowest}"
                     );
                 }
             }
@@ -173,6 +193,24 @@ fn an_unrealizable_subsurface_depolarizer_is_refused() {
         "{message}"
     );
     assert!(with(0.0, 1.5).is_err());
+    // d(Θ) = d + d1 cos Θ reaches |d| + |d1|: beyond 1, or with d_c below 2(|d| + |d1|) − 1,
+    // refused.
+    let angular = |d1: f64, d_c: f64| {
+        base.clone().with_volume(
+            FacetSide::Internal,
+            Some(Subsurface {
+                rho_s: 0.5,
+                d: 0.4,
+                n_sub: None,
+                d_c: Some(d_c),
+                d1: Some(d1),
+            }),
+        )
+    };
+    assert!(angular(-0.3, 0.4).is_ok());
+    assert!(angular(-0.3, 0.39).is_err());
+    let message = angular(0.7, 1.0).unwrap_err().to_string();
+    assert!(message.contains("keep |d| + |d1| ≤ 1"), "{message}");
 }
 
 fn volume_data(name: &str) -> irpol::measure::MeasurementSet {
