@@ -6,7 +6,7 @@
 use super::energy::{largest_reflectance, ENERGY_TOLERANCE};
 use crate::material::ModelSpec;
 use crate::optics::{coherency_eigenvalues, Mueller};
-use crate::text::number;
+use crate::text::{number, significant};
 
 /// k at or above which a material absorbs strongly enough for its n to fall below 1 nearby: by
 /// Kramers–Kronig, Re ε < 1 lies on the short-wavelength side of a strong absorption band
@@ -36,7 +36,7 @@ fn index_problem(models: &[&ModelSpec]) -> Option<String> {
     (!absorbs).then(|| {
         format!(
             "n = {} < 1 at {} µm without an absorption band (k < {STRONG_ABSORPTION_K})",
-            significant3(low.n),
+            significant(low.n, 4),
             number(low.wavelength_um)
         )
     })
@@ -49,7 +49,7 @@ fn energy_problem(models: &[&ModelSpec]) -> Option<String> {
         (reflectance > 1.0 + ENERGY_TOLERANCE).then(|| {
             format!(
                 "reflects {} at θ_i = {}° ({} µm)",
-                significant3(reflectance),
+                significant(reflectance, 4),
                 number(theta_deg),
                 number(m.wavelength_um)
             )
@@ -69,10 +69,6 @@ fn realizability_problem(models: &[&ModelSpec], muellers: &[&[Mueller]]) -> Opti
             number(m.wavelength_um)
         ))
     })
-}
-
-fn significant3(value: f64) -> String {
-    crate::text::significant(value, 4)
 }
 
 #[cfg(test)]

@@ -112,10 +112,6 @@ pub(super) fn finish(
             comparison.as_ref(),
         )),
     };
-    let mut material = material;
-    if let Some(record) = &mut material.fit {
-        record.mark_non_finite_as_undetermined();
-    }
     Ok(FitOutcome {
         measurement: set.clone(),
         material,
@@ -153,7 +149,7 @@ fn fit_record(
 ) -> FitRecord {
     let uncertainty = &chosen.uncertainty;
     let (convergence, global_iterations) = chosen.history.best_cost_trace();
-    FitRecord {
+    let mut record = FitRecord {
         source: set.source.clone(),
         source_sha256: set.sha256.clone(),
         source_data: Some(set.source_data(0)),
@@ -217,7 +213,9 @@ fn fit_record(
         }),
         convergence,
         global_iterations,
-    }
+    };
+    record.mark_non_finite_as_undetermined();
+    record
 }
 
 /// The settings that, with the optimizer name and seed, reproduce the fit.

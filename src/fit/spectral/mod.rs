@@ -305,11 +305,7 @@ fn fit_lorentz(
     );
     let model = IndexModel::Lorentz(oscillators);
     let mut problem = joint_problem(sets, data, &spaces, options, model, Some(bounds));
-    let shared_start = |p: Parameter| {
-        let i = table.names.iter().position(|n| n == p.name());
-        to_search(p, i.map_or(1.0, |i| table.values[i]))
-    };
-    let mut start: Vec<f64> = problem.shared.iter().map(|&p| shared_start(p)).collect();
+    let mut start = shared_starts(&problem, table);
     start.extend(law_start);
     start.extend(family_starts(&problem, table));
     solve(
@@ -362,11 +358,7 @@ fn fit_cauchy(
         Some(bounds),
     );
     let (a, b) = cauchy_start(&model.wavelength_um, &model.n);
-    let mut start: Vec<f64> = problem
-        .shared
-        .iter()
-        .map(|&p| to_search(p, table.value(p)))
-        .collect();
+    let mut start = shared_starts(&problem, table);
     start.extend([a, b]);
     start.extend(family_starts(&problem, table));
     solve(
@@ -377,6 +369,15 @@ fn fit_cauchy(
         kind,
         Dispersion::Cauchy,
     )
+}
+
+/// The start of every shared model coordinate of `problem`: the `table` fit's value.
+fn shared_starts(problem: &JointProblem, table: &SpectralFit) -> Vec<f64> {
+    problem
+        .shared
+        .iter()
+        .map(|&p| to_search(p, table.value(p)))
+        .collect()
 }
 
 /// The start of every per-wavelength coordinate of `problem`: the `table` fit's value of its

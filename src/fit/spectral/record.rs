@@ -22,7 +22,7 @@ pub(super) fn material(
     alternative: Option<&SpectralFit>,
 ) -> Material {
     let table_fit = table.unwrap_or(chosen);
-    let record = FitRecord {
+    let mut record = FitRecord {
         source: sets[0].source.clone(),
         source_sha256: sets[0].sha256.clone(),
         source_data: None,
@@ -63,7 +63,6 @@ pub(super) fn material(
         convergence: chosen.history.best_cost.clone(),
         global_iterations: 0,
     };
-    let mut record = record;
     record.mark_non_finite_as_undetermined();
     Material {
         name: sets[0].material.clone(),
