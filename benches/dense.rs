@@ -4,7 +4,7 @@
 //! (`fit_support::dense_geometry`, as `examples/dense_measurements` writes it). Required:
 //! ≤ 20 s and ≤ 1 GB peak RSS for the whole command on the 2-core machine (docs/verification.md).
 
-#[path = "../tests/fit_support/mod.rs"]
+#[path = "../tests/it/fit_support.rs"]
 mod fit_support;
 
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -3,7 +3,7 @@
 //! comparison included) of ~470-point, 9-element measurements — a synthetic goniometer set made
 //! with irpol's pBRDF and two of the shipped SCATMECH files. Target: ≤ 0.1 s wall on 2 cores.
 
-#[path = "../tests/fit_support/mod.rs"]
+#[path = "../tests/it/fit_support.rs"]
 mod fit_support;
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};

@@ -13,7 +13,7 @@
 //! triangles (the shading is done once, outside the timing). Peak memory of reading plus the
 //! hierarchy is measured by `examples/mesh_memory.rs` under `/usr/bin/time -v`.
 
-#[path = "../tests/mesh_support/mod.rs"]
+#[path = "../tests/it/mesh_support.rs"]
 mod mesh_support;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};

@@ -6,7 +6,7 @@
 //! a whole render in memory: per-material tables, ray-tracing hierarchy, rasterization, shading,
 //! noise (file writing excluded).
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/it/common.rs"]
 mod common;
 
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -10,7 +10,7 @@
 //! 1 % of m00 on the others, and u_ columns; ρ_d = 0.01 unless given (0: the fit needs
 //! profile-likelihood bounds); seeded, so a row count always gives the same bytes.
 
-#[path = "../tests/fit_support/mod.rs"]
+#[path = "../tests/it/fit_support.rs"]
 mod fit_support;
 
 use fit_support::{dense_geometry, dense_truth, synthetic_set, to_csv, LINEAR_ELEMENTS};

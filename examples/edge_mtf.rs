@@ -1,10 +1,10 @@
 //! Draws docs/images/edge_mtf.png: the MTF measured on rendered slanted edges (ISO 12233,
 //! `render::camera::slanted_edge`) against the closed form of the optics (docs/design.md §1.11),
-//! for the cases `tests/render_camera.rs` checks.
+//! for the cases `tests/it/render_camera.rs` checks.
 //!
 //! `cargo run --release --example edge_mtf -- docs/images/edge_mtf.png`
 
-#[path = "../tests/camera_support/mod.rs"]
+#[path = "../tests/it/camera_support.rs"]
 mod support;
 
 use irpol::progress::Silent;

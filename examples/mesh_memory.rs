@@ -12,7 +12,7 @@
 //! Every stage's result stays alive to the end (the raw mesh, the shaded one and the
 //! hierarchy), so the peak is an upper bound of what a scene of that mesh holds.
 
-#[path = "../tests/mesh_support/mod.rs"]
+#[path = "../tests/it/mesh_support.rs"]
 mod mesh_support;
 
 use irpol::scene::mesh::{bounding_diagonal, shade_mesh, ObjectShading, Transform};

@@ -41,7 +41,7 @@ REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), 
 def _single_wavelength(path: str) -> bool:
     """Whether a shipped file is of one wavelength (a `# wavelength_um:` header line): the
     cross-checks fit one wavelength; the spectral set (a wavelength_um column) is checked against
-    its truth by tests/spectral_materials.rs."""
+    its truth by tests/it/spectral_materials.rs."""
     with open(path) as f:
         return any(line.startswith("# wavelength_um:") for line in f if line.startswith("#"))
 

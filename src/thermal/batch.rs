@@ -24,7 +24,7 @@
 //! fresh state), E + P changes by exactly hₙ Qₙ₊₁ every sub-step, for any sequence of ω. P is
 //! the BDF2 weights' lag: under a steady step it is ≈ h (Qₙ − Q₁)/2, the difference between the
 //! end-point sum Σ h Q and the integral of the flux. [`BatchReport`] gives both, so
-//! stored + deferred − net in closes to round-off (tests/thermal_batch.rs).
+//! stored + deferred − net in closes to round-off (tests/it/thermal_batch.rs).
 
 // Lane loops index several per-lane arrays at once: plain indices are what the vectorizer
 // turns into one vector operation per statement.
@@ -49,7 +49,7 @@ pub type Lanes = [f64; LANES];
 /// Default longest sub-step (s): one sub-step per 60 s sample, which keeps 2.56 M vertices × 1440
 /// steps within minutes of CPU (~50 ns a vertex-step on the loaded CI machine). Measured against
 /// the adaptive solver over 24 h of diurnal forcing with a shadow that falls and lifts within one
-/// 60 s sample (tests/thermal_batch.rs), largest |ΔT_s| (everywhere / outside the 10 min after a
+/// 60 s sample (tests/it/thermal_batch.rs), largest |ΔT_s| (everywhere / outside the 10 min after a
 /// shadow edge): asphalt over soil 0.221 / 0.043 K at 60 s, 0.057 / 0.010 K at 30 s, 0.011 /
 /// 0.001 K at 15 s; painted steel panel 1.27 / 0.085 K at 60 s, 0.41 / 0.020 K at 30 s,
 /// 0.10 / 0.006 K at 15 s. The error falls as h² and sits where the forcing's slope jumps (the

@@ -314,7 +314,7 @@ impl Default for Resolution {
     /// 0.2 mm first cell, 10 % growth, 3 cells per layer. The growth ratio sets the error (the
     /// vertex-centred scheme is second order in growth − 1): with 20 % a 0.3 m concrete slab under
     /// diurnal forcing was 0.02 K from the converged surface temperature, with 10 % 0.005 K, inside
-    /// §1.8's 0.01 K (tests/thermal_solver.rs); a thin painted panel is within 0.001 K either way.
+    /// §1.8's 0.01 K (tests/it/thermal_solver.rs); a thin painted panel is within 0.001 K either way.
     fn default() -> Self {
         Self {
             first_cell_m: 2e-4,
@@ -329,7 +329,7 @@ impl Resolution {
     /// Its sub-steps of a minute cannot resolve what finer surface cells carry (a minute's
     /// diffusion length in soil or asphalt is ~6 mm); thin layers keep their `min_cells`. On
     /// asphalt over soil this is 44 nodes instead of 61, 1.0 mK from the adaptive solution on the
-    /// default grid on average over a day (0.5 mK on the default grid; tests/thermal_batch.rs).
+    /// default grid on average over a day (0.5 mK on the default grid; tests/it/thermal_batch.rs).
     pub fn batch() -> Self {
         Self {
             first_cell_m: 1e-3,

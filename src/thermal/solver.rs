@@ -26,7 +26,7 @@
 //! otherwise h shrinks and the sub-step is retried. The next h is h·min(4, 0.9 √(tol/err),
 //! 0.9 ΔT_max/|ΔT_s|), capped by [`SolverControl::max_substep_s`], and carries over to the next
 //! output step. The defaults keep surface temperatures within 0.01 K of the time- and
-//! space-converged solution over 48 h of diurnal forcing (§1.8; measured in tests/thermal_solver.rs).
+//! space-converged solution over 48 h of diurnal forcing (§1.8; measured in tests/it/thermal_solver.rs).
 //!
 //! **Forcing in time.** The caller gives the forcing at the start and the end of a step; each
 //! sub-step uses it linearly interpolated to the sub-step's end (backward Euler's evaluation time).

@@ -56,7 +56,7 @@ impl KernelQuadrature {
 
 impl Default for KernelQuadrature {
     /// Within ~1e-4 of `reflected_stokes` with the default hemisphere quadrature for σ 0.03–0.5
-    /// (tests/render_tables.rs); merging at 0.5° changes a smooth sky by < 1e-5.
+    /// (tests/it/render_tables.rs); merging at 0.5° changes a smooth sky by < 1e-5.
     fn default() -> Self {
         KernelQuadrature {
             full_circle: 32,

@@ -57,7 +57,7 @@
 //! clamp the reflection (finite, not exact); with width or height 1 they fall back to bilinear.
 //! All methods keep constants and give finite values at any size ≥ 1 × 1 (tested 1×1 … 16×16).
 //!
-//! **On the car** (`tests/dofp_demosaic.rs`: the shipped car scene rendered without detector noise
+//! **On the car** (`tests/it/dofp_demosaic.rs`: the shipped car scene rendered without detector noise
 //! at 320 × 240, averaged over 2 × 2 blocks into a 160 × 120 truth, ideal polarizer images
 //! mosaicked and demosaicked; PSNR = 10 log10(peak²/MSE), peak = the truth's largest |value| of
 //! the channel, `render::camera::metrics::psnr`):

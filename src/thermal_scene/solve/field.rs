@@ -9,7 +9,7 @@
 //! The forcing is the same §1.8 balance as every other vertex's ([`super::radiation`]); only the
 //! time stepping differs: fixed sub-steps of at most `thermal::batch::BATCH_MAX_SUBSTEP_S`
 //! instead of the adaptive controller, on the grid of `Resolution::batch` (the accuracy both
-//! cost is measured in tests/thermal_batch.rs and tests/thermal_field.rs).
+//! cost is measured in tests/it/thermal_batch.rs and tests/it/thermal_field.rs).
 
 use super::radiation::ShadowInterval;
 use super::{
