@@ -269,6 +269,10 @@ struct FitArgs {
     /// them, e.g. d,n_sub (of d, n_sub, d_c, d1).
     #[arg(long, value_name = "LIST")]
     per_wavelength: Option<String>,
+    /// Refuse up front a fit estimated to take longer than this (the estimate names its
+    /// factors: rows, candidate models, folds, a spectral set's joint coordinates).
+    #[arg(long, value_name = "MINUTES", default_value_t = irpol::fit::cost::DEFAULT_MAX_MINUTES)]
+    max_minutes: f64,
     /// Library folder for the material TOMLs.
     #[arg(long, default_value = "fits")]
     out: PathBuf,
@@ -452,6 +456,7 @@ fn fit(args: FitArgs) -> anyhow::Result<()> {
         terms: args.terms,
         cv: args.cv,
         per_wavelength: args.per_wavelength,
+        max_minutes: args.max_minutes,
     };
     let reading = args.measurements.read_options()?;
     fit_and_summarize(
@@ -730,12 +735,31 @@ fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
 
 /// `; NOT DETERMINED by the data: d (at a bound of its search interval), …` (docs/design.md
 /// §1.10 "Identification"): a number the data do not determine must not read as a measurement.
+/// A spectral fit's per-wavelength coordinates (`rho_d(8.5um)`, …) that share a reason are named
+/// once with their count and range, so 50 wavelengths at a bound make one clause, not 50.
 fn identification_clause(record: Option<&irpol::material::FitRecord>) -> String {
-    let notes: Vec<String> = record
-        .map(|r| r.identification())
-        .unwrap_or_default()
+    let mut groups: Vec<(String, String, Vec<String>)> = Vec::new();
+    for (name, why) in record.map(|r| r.identification()).unwrap_or_default() {
+        let (base, at) = match name.split_once('(') {
+            Some((base, rest)) => (base.to_owned(), Some(rest.trim_end_matches(')').to_owned())),
+            None => (name.clone(), None),
+        };
+        match groups.last_mut() {
+            Some((b, w, ats)) if at.is_some() && *b == base && *w == why && !ats.is_empty() => {
+                ats.extend(at)
+            }
+            _ => groups.push((base, why, at.into_iter().collect())),
+        }
+    }
+    let notes: Vec<String> = groups
         .into_iter()
-        .map(|(name, why)| format!("{name} {why}"))
+        .map(|(base, why, ats)| match ats.as_slice() {
+            [] => format!("{base} {why}"),
+            [at] => format!("{base}({at}) {why}"),
+            [first, .., last] => {
+                format!("{base} at {} wavelengths ({first}–{last}) {why}", ats.len())
+            }
+        })
         .collect();
     listed("; NOT DETERMINED by the data: ", &notes, ", ", "")
 }

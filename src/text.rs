@@ -247,9 +247,30 @@ pub fn counted(count: usize, noun: &str) -> String {
     }
 }
 
+/// `45 s`, `12 min`, `13 h`, `3.2 days`.
+pub fn duration(seconds: f64) -> String {
+    if seconds < 120.0 {
+        format!("{} s", about(seconds))
+    } else if seconds < 7200.0 {
+        format!("{} min", about(seconds / 60.0))
+    } else if seconds < 3.0 * 86_400.0 {
+        format!("{} h", about(seconds / 3600.0))
+    } else {
+        format!("{} days", about(seconds / 86_400.0))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn durations_read_in_their_unit() {
+        assert_eq!(duration(45.0), "45 s");
+        assert_eq!(duration(720.0), "12 min");
+        assert_eq!(duration(13.0 * 3600.0), "13 h");
+        assert_eq!(duration(3.2 * 86_400.0), "3.2 days");
+    }
 
     #[test]
     fn controls_are_escaped_and_long_text_is_cut() {

@@ -51,7 +51,7 @@ pub fn fit_materials(
         dispersion,
         terms,
         cv: None,
-        per_wavelength: None,
+        ..FitFlags::default()
     };
     let options = flags.options().map_err(raised)?;
     let reading = measurement_args(layout, wavelength_um, theta_i_deg)

@@ -46,6 +46,8 @@ pub struct FitFlags {
     /// Parameters a spectral fit frees at each wavelength instead of sharing them, e.g.
     /// `d,n_sub` (docs/design.md §1.10).
     pub per_wavelength: Option<String>,
+    /// The longest fit started without a word (`--max-minutes`, [`crate::fit::cost`]).
+    pub max_minutes: f64,
 }
 
 impl Default for FitFlags {
@@ -63,6 +65,7 @@ impl Default for FitFlags {
             terms: AUTO_TERMS.to_owned(),
             cv: None,
             per_wavelength: None,
+            max_minutes: crate::fit::cost::DEFAULT_MAX_MINUTES,
         }
     }
 }
@@ -102,6 +105,7 @@ impl FitFlags {
             options.term_candidates = candidates;
         }
         options.cv_folds = self.cv;
+        options.max_minutes = self.max_minutes;
         if let Some(list) = &self.per_wavelength {
             options.per_wavelength = per_wavelength_parameters(list)?;
         }

@@ -13,7 +13,7 @@
 
 use super::AppError;
 use crate::scene::{Scene, Transport};
-use crate::text::about;
+use crate::text::{about, duration};
 
 /// The limit of an estimate unless `--max-minutes` says otherwise.
 pub const DEFAULT_MAX_MINUTES: f64 = 60.0;
@@ -137,19 +137,6 @@ pub fn check_estimate(
     )))
 }
 
-/// `45 s`, `12 min`, `13 h`, `3.2 days`.
-pub fn duration(seconds: f64) -> String {
-    if seconds < 120.0 {
-        format!("{} s", about(seconds))
-    } else if seconds < 7200.0 {
-        format!("{} min", about(seconds / 60.0))
-    } else if seconds < 3.0 * 86_400.0 {
-        format!("{} h", about(seconds / 3600.0))
-    } else {
-        format!("{} days", about(seconds / 86_400.0))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -172,13 +159,5 @@ mod tests {
         );
         estimate.band_nodes = 36;
         assert_eq!(estimate.advice(), None);
-    }
-
-    #[test]
-    fn durations_read_in_their_unit() {
-        assert_eq!(duration(45.0), "45 s");
-        assert_eq!(duration(720.0), "12 min");
-        assert_eq!(duration(13.0 * 3600.0), "13 h");
-        assert_eq!(duration(3.2 * 86_400.0), "3.2 days");
     }
 }

@@ -18,6 +18,10 @@ pub enum FitError {
     /// Inconsistent or invalid fit options.
     #[error("invalid fit options: {0}")]
     Options(String),
+    /// A fit refused before any work for what it would cost ([`super::cost`]): the message names
+    /// the file, the estimate's factors and the flag that allows it.
+    #[error("{0}")]
+    Cost(String),
     /// Two inputs of one material that cannot be merged into one measurement set.
     #[error(transparent)]
     Merge(#[from] crate::measure::MergeError),

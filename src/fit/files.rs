@@ -94,6 +94,7 @@ pub fn fit_inputs_with(
     let materials = read_all(inputs, reading)?;
     validate_options(options)?;
     refuse_law_of_one_wavelength(&materials, options)?;
+    super::cost::check_costs(&materials, options)?;
 
     progress.begin("fitting", materials.len() as u64);
     let mut outcomes = Vec::with_capacity(materials.len());

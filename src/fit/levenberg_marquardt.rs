@@ -39,21 +39,15 @@ pub(crate) trait LeastSquares: Sync {
     /// Residuals (whose squares sum to the cost) at search coordinates `s`; `None` where the
     /// model is invalid.
     fn residuals(&self, s: &[f64]) -> Option<DVector<f64>>;
-    /// ∂r/∂s at `s`, where the residuals are `r`.
-    fn jacobian(&self, s: &[f64], r: &DVector<f64>) -> Option<DMatrix<f64>>;
     /// Residual vectors one Jacobian costs (for the evaluation count).
     fn jacobian_evaluations(&self) -> u64 {
         self.lower().len() as u64
     }
-    /// The normal equations (JᵀJ, Jᵀr) of the Jacobian at `s`: all Levenberg–Marquardt needs of
-    /// it.
-    fn normal_equations(
-        &self,
-        s: &[f64],
-        r: &DVector<f64>,
-    ) -> Option<(DMatrix<f64>, DVector<f64>)> {
-        self.jacobian(s, r).map(|j| (j.tr_mul(&j), j.tr_mul(r)))
-    }
+    /// The normal equations (JᵀJ, Jᵀr) of the Jacobian J = ∂r/∂s at `s`, where the residuals
+    /// are `r`: all Levenberg–Marquardt (and the covariance) needs of J, so a problem with many
+    /// residuals never has to hold J whole.
+    fn normal_equations(&self, s: &[f64], r: &DVector<f64>)
+        -> Option<(DMatrix<f64>, DVector<f64>)>;
 }
 
 /// The forward-difference step of coordinate `j` at `s`, pointing into the box at its upper end.
@@ -77,10 +71,6 @@ impl LeastSquares for Objective<'_> {
         let mut r = DVector::zeros(self.observations());
         self.residuals_at(&self.space().values(s), r.as_mut_slice())
             .then_some(r)
-    }
-    /// Forward differences, one column per thread task.
-    fn jacobian(&self, s: &[f64], r: &DVector<f64>) -> Option<DMatrix<f64>> {
-        Some(DMatrix::from_columns(&self.jacobian_columns(s, r)?))
     }
     /// From the columns without assembling J (a measurement's J is tens of thousands of rows):
     /// JᵀJ is symmetric, so each pair of columns is multiplied once.

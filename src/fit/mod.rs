@@ -15,6 +15,7 @@
 
 mod admissible;
 mod comparison;
+pub mod cost;
 mod cross_validation;
 mod data;
 mod energy;

@@ -50,6 +50,9 @@ pub struct FitOptions {
     /// Parameters a spectral fit frees at each wavelength that it would otherwise share
     /// ([`SpectralRole::SharedByDefault`]: the subsurface term's d, n_sub, d_c).
     pub per_wavelength: Vec<Parameter>,
+    /// The longest fit started without a word (`--max-minutes`): a fit estimated longer
+    /// ([`super::cost`]) is refused before any work, naming its factors.
+    pub max_minutes: f64,
 }
 
 impl Default for FitOptions {
@@ -71,6 +74,7 @@ impl Default for FitOptions {
             settings: OptimizerSettings::default(),
             dispersion: super::Dispersion::Table,
             per_wavelength: Vec::new(),
+            max_minutes: super::cost::DEFAULT_MAX_MINUTES,
         }
     }
 }

@@ -236,6 +236,15 @@ fn fitted_with_unknown_fit_key() -> Vec<u8> {
 const MODEL: &str = "--sigma 0.2 --q 2 --n 1.5 --k 0.1";
 
 /// A fit that runs in about a second (one distribution, one local stage).
+/// Whether a material entry holds `nan` or `inf` outside its comments.
+fn has_non_finite_value(entry: &str) -> bool {
+    entry
+        .lines()
+        .filter(|line| !line.trim_start().starts_with('#'))
+        .flat_map(|line| line.split(|c: char| !(c.is_alphanumeric() || c == '_')))
+        .any(|token| token == "nan" || token == "inf")
+}
+
 const QUICK_FIT: &str = "--distribution cauchy --optimizer lm --out fits --reports reports";
 
 const RENDER: &str = "render scene.toml --out out";
@@ -323,12 +332,10 @@ fn extreme_measured_values_fit_and_report_without_hanging() {
         }
         assert_eq!(run.code, Some(0), "{name}: {}", run.stderr);
         let entry = std::fs::read_to_string(dir.path().join("fits/paper_paint.toml")).unwrap();
-        let non_finite = entry
-            .lines()
-            .filter(|line| !line.trim_start().starts_with('#'))
-            .flat_map(|line| line.split(|c: char| !(c.is_alphanumeric() || c == '_')))
-            .any(|token| token == "nan" || token == "inf");
-        assert!(!non_finite, "{name}: a non-finite number in the entry");
+        assert!(
+            !has_non_finite_value(&entry),
+            "{name}: a non-finite number in the entry"
+        );
         // The file's `# material:` header names the outputs.
         for out in [
             "fits/paper_paint.toml",
@@ -337,6 +344,35 @@ fn extreme_measured_values_fit_and_report_without_hanging() {
         ] {
             assert!(dir.path().join(out).is_file(), "{name}: no {out}");
         }
+    }
+}
+
+/// Every measured element subnormal (the data say "nothing scattered"): the data cannot determine
+/// the facet or body parameters, so their uncertainties are infinite. The entry is written with
+/// those parameters flagged as undetermined, for the default terms and for each slope law; it was
+/// once refused as "fits/paper_paint.toml: not written: … is not a finite number", blaming the
+/// output for what the input lacked.
+#[test]
+fn a_fit_the_data_cannot_determine_is_written_with_its_parameters_flagged() {
+    let csv = edited_paint(|_, fields| {
+        for value in &mut fields[4..20] {
+            *value = format!("{:e}", value.parse::<f64>().unwrap() * 1e-310);
+        }
+    });
+    for flags in ["", "--distribution gaussian", "--distribution cauchy"] {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("m.csv"), &csv).unwrap();
+        let command = format!("fit m.csv {flags} --out fits --reports reports");
+        let run = irpol(dir.path(), &command.split_whitespace().collect::<Vec<_>>());
+        assert_eq!(run.code, Some(0), "{flags}: {}", run.stderr);
+        assert!(
+            run.stdout.contains("NOT DETERMINED by the data"),
+            "{flags}: {}",
+            run.stdout
+        );
+        let entry = std::fs::read_to_string(dir.path().join("fits/paper_paint.toml")).unwrap();
+        assert!(entry.contains("undetermined"), "{flags}: {entry}");
+        assert!(!has_non_finite_value(&entry), "{flags}: {entry}");
     }
 }
 
@@ -648,4 +684,54 @@ fn a_render_estimated_beyond_its_limit_is_refused_before_any_work() {
         .stderr
         .contains("more than --max-minutes 60: give --max-minutes "));
     assert!(snapshot(dir.path()).is_empty(), "files were written");
+}
+
+/// A spectral file of `wavelengths` wavelengths, each with the shipped paint's first `rows` rows.
+fn many_wavelengths(wavelengths: usize, rows: usize) -> Vec<u8> {
+    let text = String::from_utf8(shipped("measurements/paper_paint.csv")).unwrap();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header = lines
+        .next()
+        .unwrap()
+        .replacen(",m00,", ",wavelength_um,m00,", 1);
+    let data: Vec<&str> = lines.take(rows).collect();
+    let mut out = format!("# material: paint\n# mueller_convention: psps\n{header}\n");
+    for w in 0..wavelengths {
+        let at = format!("{:.4}", 8.0 + 6.0 * w as f64 / wavelengths as f64);
+        for row in &data {
+            let fields: Vec<&str> = row.split(',').collect();
+            out += &format!("{},{at},{}\n", fields[..4].join(","), fields[4..].join(","));
+        }
+    }
+    out.into_bytes()
+}
+
+/// A fit's cost is estimated before any work, as a render's is (issue 42: a spectral fit of
+/// 2000 wavelengths aborted on a 2.3 GB allocation, one of 300 ran for minutes without a word):
+/// a joint problem past its coordinate limit is refused naming the file and what to do, and a
+/// fit estimated beyond `--max-minutes` names its factors and the value to give.
+#[test]
+fn a_fit_estimated_beyond_its_limits_is_refused_before_any_work() {
+    refuse(
+        &[("many.csv", &many_wavelengths(400, 3))],
+        "fit many.csv --out fits --reports reports",
+        "many.csv: 400 wavelengths make a joint fit of 1206 coordinates, more than the 1000",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("some.csv"), many_wavelengths(50, 40)).unwrap();
+    let run = irpol(
+        dir.path(),
+        &["fit", "some.csv", "--max-minutes", "0.01", "--out", "fits"],
+    );
+    assert_refused(&run, "some.csv: this fit is estimated at ");
+    for factor in [
+        "2000 rows × 6 candidate models × (1 + 5 folds)",
+        "156 coordinates",
+    ] {
+        assert!(run.stderr.contains(factor), "{factor}: {}", run.stderr);
+    }
+    assert!(run
+        .stderr
+        .contains("more than --max-minutes 0.01: give --max-minutes 1 "));
+    assert!(snapshot(dir.path()).len() == 1, "files were written");
 }

@@ -195,11 +195,49 @@ impl LeastSquares for JointProblem<'_> {
             parts?.into_iter().flatten(),
         ))
     }
-    /// Forward differences: one evaluation per shared coordinate (a full column) and one per
-    /// family (every wavelength's member shifted at once, each column nonzero on its own rows).
-    fn jacobian(&self, s: &[f64], r: &DVector<f64>) -> Option<DMatrix<f64>> {
-        let shared = self.shared_len();
-        let shifts: Vec<Vec<usize>> = (0..shared)
+    /// J by forward differences, one evaluation per shared coordinate (a full column) and one
+    /// per family (every wavelength's member shifted at once, each column nonzero on its own
+    /// rows), but never assembled: J has observations × coordinates entries and both grow with
+    /// the wavelengths (2000 wavelengths of 51 rows would need 78 GB). A family's column of
+    /// wavelength j is zero off j's rows, so JᵀJ and Jᵀr are summed wavelength by wavelength
+    /// from its (shared + families) local columns, in memory and time linear in the residuals;
+    /// the entries between two wavelengths' own coordinates are 0.
+    fn normal_equations(
+        &self,
+        s: &[f64],
+        r: &DVector<f64>,
+    ) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        let evaluations = self.shifted_residual_changes(s, r)?;
+        let contributions: Vec<_> = (0..self.blocks.len())
+            .into_par_iter()
+            .map(|j| self.block_normal_equations(j, &evaluations, r))
+            .collect();
+        let mut a = DMatrix::zeros(s.len(), s.len());
+        let mut g = DVector::zeros(s.len());
+        for (coordinates, local_a, local_g) in contributions {
+            for (p, &cp) in coordinates.iter().enumerate() {
+                g[cp] += local_g[p];
+                for (q, &cq) in coordinates.iter().enumerate() {
+                    a[(cp, cq)] += local_a[(p, q)];
+                }
+            }
+        }
+        Some((a, g))
+    }
+    fn jacobian_evaluations(&self) -> u64 {
+        (self.shared_len() + self.families.len()) as u64
+    }
+}
+
+/// The coordinates shifted by one forward-difference evaluation, each with its step, and the
+/// change of the residuals it caused.
+type Shifted = (Vec<(usize, f64)>, DVector<f64>);
+
+impl JointProblem<'_> {
+    /// The forward-difference evaluations of J: the shared coordinates one at a time (in
+    /// order), then each family with every wavelength's member shifted at once.
+    fn shifted_residual_changes(&self, s: &[f64], r: &DVector<f64>) -> Option<Vec<Shifted>> {
+        let shifts: Vec<Vec<usize>> = (0..self.shared_len())
             .map(|i| vec![i])
             .chain((0..self.families.len()).map(|f| {
                 (0..self.blocks.len())
@@ -207,9 +245,7 @@ impl LeastSquares for JointProblem<'_> {
                     .collect()
             }))
             .collect();
-        // Per evaluation: the (coordinate, step) pairs shifted and the change of the residuals.
-        type Shifted = (Vec<(usize, f64)>, DVector<f64>);
-        let evaluations: Option<Vec<Shifted>> = shifts
+        shifts
             .par_iter()
             .map(|coordinates| {
                 let mut shifted = s.to_vec();
@@ -222,24 +258,33 @@ impl LeastSquares for JointProblem<'_> {
                 }
                 Some((steps, self.residuals(&shifted)? - r))
             })
-            .collect();
-        let mut jacobian = DMatrix::zeros(self.observations, s.len());
-        for (steps, difference) in evaluations? {
-            if let [(c, h)] = steps[..] {
-                if c < shared {
-                    jacobian.set_column(c, &(difference / h));
-                    continue;
-                }
-            }
-            for (&(c, h), block) in steps.iter().zip(&self.blocks) {
-                for row in block.rows.clone() {
-                    jacobian[(row, c)] = difference[row] / h;
-                }
-            }
-        }
-        Some(jacobian)
+            .collect()
     }
-    fn jacobian_evaluations(&self) -> u64 {
-        (self.shared_len() + self.families.len()) as u64
+
+    /// Wavelength `j`'s share of the normal equations: the coordinates its rows depend on (the
+    /// shared ones and its own member of each family), and the products of their columns on its
+    /// rows with each other and with its residuals.
+    fn block_normal_equations(
+        &self,
+        j: usize,
+        evaluations: &[Shifted],
+        r: &DVector<f64>,
+    ) -> (Vec<usize>, DMatrix<f64>, DVector<f64>) {
+        let rows = self.blocks[j].rows.clone();
+        let shared = self.shared_len();
+        let (coordinates, columns): (Vec<usize>, Vec<DVector<f64>>) = evaluations
+            .iter()
+            .enumerate()
+            .map(|(e, (steps, difference))| {
+                let (c, h) = if e < shared { steps[0] } else { steps[j] };
+                (c, difference.rows(rows.start, rows.len()) / h)
+            })
+            .unzip();
+        let local_r = r.rows(rows.start, rows.len());
+        let a = DMatrix::from_fn(columns.len(), columns.len(), |p, q| {
+            columns[p].dot(&columns[q])
+        });
+        let g = DVector::from_fn(columns.len(), |p, _| columns[p].dot(&local_r));
+        (coordinates, a, g)
     }
 }

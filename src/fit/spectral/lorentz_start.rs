@@ -129,7 +129,12 @@ impl LeastSquares for PermittivityFit<'_> {
         let r = DVector::from_iterator(2 * self.wavelengths.len(), values);
         r.iter().all(|x| x.is_finite()).then_some(r)
     }
-    fn jacobian(&self, s: &[f64], r: &DVector<f64>) -> Option<DMatrix<f64>> {
+    /// From J by forward differences (a few columns of 2 × wavelengths rows).
+    fn normal_equations(
+        &self,
+        s: &[f64],
+        r: &DVector<f64>,
+    ) -> Option<(DMatrix<f64>, DVector<f64>)> {
         let columns: Option<Vec<DVector<f64>>> = (0..s.len())
             .map(|j| {
                 let mut shifted = s.to_vec();
@@ -138,7 +143,8 @@ impl LeastSquares for PermittivityFit<'_> {
                 self.residuals(&shifted).map(|rh| (rh - r) / h)
             })
             .collect();
-        Some(DMatrix::from_columns(&columns?))
+        let jacobian = DMatrix::from_columns(&columns?);
+        Some((jacobian.tr_mul(&jacobian), jacobian.tr_mul(r)))
     }
 }
 

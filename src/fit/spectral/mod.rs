@@ -459,7 +459,7 @@ fn solve(
         message: format!("the best {kind} {dispersion} model could not be evaluated"),
     };
     let r = problem.residuals(&best).ok_or_else(invalid)?;
-    let jacobian = problem.jacobian(&best, &r).ok_or_else(invalid)?;
+    let (normal_matrix, _) = problem.normal_equations(&best, &r).ok_or_else(invalid)?;
     let values: Vec<_> = (0..sets.len())
         .map(|j| problem.block_values(&best, j))
         .collect();
@@ -470,9 +470,9 @@ fn solve(
     let degrees_of_freedom = observations.saturating_sub(free).max(1);
     let reduced_chi2 = chi2 / degrees_of_freedom as f64;
     let coordinates = coordinates(problem, sets);
-    let (physical_values, physical) = physical_coordinates(&coordinates, &best, jacobian);
-    let (errors, correlation, _) =
-        linearized_errors(&(physical.transpose() * &physical), reduced_chi2);
+    let (physical_values, physical_normal_matrix) =
+        physical_coordinates(&coordinates, &best, normal_matrix);
+    let (errors, correlation, _) = linearized_errors(&physical_normal_matrix, reduced_chi2);
     let law = problem.law(&best);
     let model = spectral_model(problem, &values, law.clone());
     let wavelength_errors = WavelengthErrors::new(
@@ -616,22 +616,25 @@ impl BlockResults {
     }
 }
 
-/// The physical value of each search coordinate at `best`, and the Jacobian with respect to
-/// the physical values (each column divided by its coordinate's d(value)/d(search)).
+/// The physical value of each search coordinate at `best`, and JᵀJ with J taken with respect to
+/// the physical values: D⁻¹ (JᵀJ) D⁻¹, D the diagonal of each coordinate's d(value)/d(search).
 fn physical_coordinates(
     coordinates: &[(String, Option<Parameter>, Option<usize>)],
     best: &[f64],
-    jacobian: nalgebra::DMatrix<f64>,
+    normal_matrix: nalgebra::DMatrix<f64>,
 ) -> (Vec<f64>, nalgebra::DMatrix<f64>) {
-    let mut physical = jacobian;
-    let mut physical_values = Vec::with_capacity(best.len());
-    for (c, coordinate) in coordinates.iter().enumerate() {
-        let (value, per_coordinate) = match coordinate.1 {
+    let (physical_values, per_coordinate): (Vec<f64>, Vec<f64>) = coordinates
+        .iter()
+        .enumerate()
+        .map(|(c, coordinate)| match coordinate.1 {
             Some(p) => (from_search(p, best[c]), value_per_coordinate(p, best[c])),
             None => (best[c], 1.0),
-        };
-        physical_values.push(value);
-        physical.column_mut(c).unscale_mut(per_coordinate);
+        })
+        .unzip();
+    let mut physical = normal_matrix;
+    for (c, &scale) in per_coordinate.iter().enumerate() {
+        physical.column_mut(c).unscale_mut(scale);
+        physical.row_mut(c).unscale_mut(scale);
     }
     (physical_values, physical)
 }
