@@ -1,7 +1,9 @@
 //! Bounded fuzzing of every reader of user files and flags: the measurement CSV reader, instrument
 //! layouts and the tables read through them, the OBJ and PLY mesh readers, the material TOML loader (grey and spectral), the eval geometry reader,
 //! the thermal weather CSV reader, the atmosphere table reader, the scene loader (a thermal scene's keys), the `--times`
-//! sweep and the `sun --times-file` reader get random bytes and mutations of real inputs (the
+//! sweep, the `sun --times-file` reader, the text flags of `irpol fit` (with the cost estimate
+//! of the options they give) and `validate`'s scoring of a material on measurements get random
+//! bytes and mutations of real inputs (the
 //! shipped measurements and materials, excerpts of the car mesh, small PLY files, weather CSVs, a
 //! thermal scene, sweeps and instants), some with runs of thousands of one character. Whatever
 //! they are fed, they must return — a value or an error whose message is one line of at most a
@@ -14,7 +16,7 @@
 //! pass every time (the scene loader, the slowest reader, a tenth as many cases); together they
 //! take about half a minute in a release build on two shared cores. Raise `FUZZ_CASES` and
 //! change `FUZZ_SEED` (environment) to fuzz longer or elsewhere, e.g.
-//! `FUZZ_CASES=100000 FUZZ_SEED=7 cargo test --release --test fuzz_readers`.
+//! `FUZZ_CASES=100000 FUZZ_SEED=7 cargo test --release --test it fuzz_readers`.
 
 use irpol::app::evaluate::{parse_geometry_csv, write_mueller_csv};
 use irpol::app::sun::parse_times;
@@ -708,6 +710,97 @@ proptest! {
             Err(e) => check_message(&e.to_string())?,
         }
     }
+}
+
+/// Valid values of each `irpol fit` flag that takes text, mutated into the fuzzed ones.
+fn fit_flag_seeds() -> Vec<Vec<u8>> {
+    [
+        "auto",
+        "external+subsurface,internal+subsurface",
+        "all",
+        "sigma,q,n,k,rho",
+        "k=0.1,rho=0",
+        "d=0.2,n_sub=1.4",
+        "ga+nm+lm",
+        "huber:2",
+        "cauchy",
+        "lorentz:2",
+        "d,n_sub",
+        "gaussian",
+        "torrance-sparrow",
+    ]
+    .iter()
+    .map(|s| s.as_bytes().to_vec())
+    .collect()
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    /// Every text flag of `irpol fit` (and of Python's `fit`) gives options or one clean line,
+    /// whatever it holds; options that parse get a finite, positive cost estimate on a shipped
+    /// measurement (the estimate every fit is checked against before any work).
+    #[test]
+    fn fit_flags_give_options_or_one_clean_line(
+        flags in prop::collection::vec(prop_oneof![mutated(fit_flag_seeds()), noise()], 10),
+        cv in prop::option::of(0..100_000usize),
+        max_minutes in prop_oneof![Just(60.0), any::<f64>()],
+    ) {
+        use irpol::app::fit::FitFlags;
+        let given = |i: usize| text(&flags[i]);
+        let optional = |i: usize| (flags[i].len() % 3 != 0).then(|| given(i));
+        let flags = FitFlags {
+            distribution: optional(0),
+            shadowing: given(1),
+            free: optional(2),
+            fix: optional(3),
+            optimizer: given(4),
+            seed: 0,
+            robust: optional(5),
+            dispersion: given(6),
+            terms: given(7),
+            cv,
+            per_wavelength: optional(8),
+            max_minutes,
+        };
+        match flags.options() {
+            Ok(options) => {
+                let sets = irpol::measure::read_measurement_sets(&irpol_path(
+                    "measurements/silicate_glass.csv",
+                ))
+                .unwrap();
+                let estimate = irpol::fit::cost::estimate(&sets, &options);
+                prop_assert!(estimate.seconds.is_finite() && estimate.seconds > 0.0);
+            }
+            Err(e) => check_message(&e.to_string())?,
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(scene_config())]
+
+    /// `validate`'s scoring of a shipped material on mutated measurements: a score with finite
+    /// figures, or one clean line; never a panic.
+    #[test]
+    fn validation_scores_any_measurement_or_refuses_cleanly(
+        bytes in mutated(measurement_seeds()),
+    ) {
+        let Ok(set) = parse_measurement_csv(Path::new("fuzz.csv"), &bytes) else {
+            return Ok(());
+        };
+        let material = Material::load(&irpol_path("fits/paper_paint.toml")).unwrap();
+        let model = material.grey_model().unwrap().pbrdf().unwrap();
+        match irpol::fit::validate_model(&model, &set) {
+            Ok(v) => prop_assert!(v.m00_relative_rms().is_finite()),
+            Err(e) => check_message(&e.to_string())?,
+        }
+    }
+}
+
+/// A path inside the repository.
+fn irpol_path(path: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
 }
 
 /// The seeds are valid input, so the mutations start from text that reaches every check.
