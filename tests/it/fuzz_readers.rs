@@ -7,9 +7,10 @@
 //! shipped measurements and materials, excerpts of the car mesh, small PLY files, weather CSVs, a
 //! thermal scene, sweeps and instants), some with runs of thousands of one character. Whatever
 //! they are fed, they must return — a value or an error whose message is one line of at most a
-//! few hundred characters without control characters — and never panic. Refusals of layouts,
-//! layout tables, atmosphere tables and EPW/TMY3 files must name the file at fault and the line
-//! (`file:line:`); EPW header lines in any shape keep every hourly row. (The sweep specs of
+//! few hundred characters without control characters — and never panic. Every reader given a file's
+//! name starts its refusals with it (`file:`); those of layouts, layout tables and EPW/TMY3
+//! files with the line too (`file:line:`). (The OBJ and PLY parsers take bytes alone; their
+//! callers add the file.) EPW header lines in any shape keep every hourly row. (The sweep specs of
 //! `python -m irpol.dataset` are read in Python; what they reach in Rust is the scene loader.)
 //!
 //! Each property runs a fixed number of cases from a fixed seed, so that CI's pass is the same
@@ -517,7 +518,7 @@ proptest! {
     #[test]
     fn times_file_reader_never_panics(bytes in prop_oneof![mutated(times_file_seeds()), noise()]) {
         if let Err(e) = parse_times(Path::new("times.txt"), &text(&bytes)) {
-            check_message(&one_line(&e))?;
+            check_names_file_maybe_line(&one_line(&e), "times.txt")?;
         }
     }
 
@@ -525,7 +526,7 @@ proptest! {
     #[test]
     fn measurement_reader_never_panics(bytes in prop_oneof![mutated(measurement_seeds()), noise()]) {
         if let Err(e) = parse_measurement_csv(Path::new("fuzz.csv"), &bytes) {
-            check_message(&e.to_string())?;
+            check_names_file_maybe_line(&e.to_string(), "fuzz.csv")?;
         }
     }
 
@@ -549,7 +550,7 @@ proptest! {
     fn material_loader_never_panics(bytes in prop_oneof![mutated(material_seeds()), noise()]) {
         match Material::from_toml(&text(&bytes), Path::new("fuzz.toml")) {
             Ok(material) => prop_assert!(material.model.validate().is_ok()),
-            Err(e) => check_message(&e.to_string())?,
+            Err(e) => check_names_file_maybe_line(&e.to_string(), "fuzz.toml")?,
         }
     }
 
@@ -570,7 +571,7 @@ proptest! {
                 let widths: Vec<usize> = reader.records().map(|r| r.unwrap().len()).collect();
                 prop_assert!(widths.windows(2).all(|w| w[0] == w[1]), "ragged output");
             }
-            Err(e) => check_message(&format!("{e:#}"))?,
+            Err(e) => check_names_file_maybe_line(&format!("{e:#}"), "fuzz.csv")?,
         }
     }
 
@@ -707,7 +708,7 @@ proptest! {
                 let middle = weather.at(0.5 * first + 0.5 * last).unwrap();
                 prop_assert!((middle.sun_direction.norm() - 1.0).abs() < 1e-9);
             }
-            Err(e) => check_message(&e.to_string())?,
+            Err(e) => check_names_file_maybe_line(&e.to_string(), "fuzz.csv")?,
         }
     }
 }
