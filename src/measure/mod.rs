@@ -52,7 +52,7 @@ pub use layout::{
     MuellerBasis, SpecularAzimuth, UncertaintyModel,
 };
 pub use merge::{merge_repeat_measurements, MergeError, SAME_WAVELENGTH_UM};
-pub use pbsdf::read_table_measurements;
+pub use pbsdf::{read_table_measurements, MAX_TABLE_ROWS_PER_WAVELENGTH};
 pub use reading::{
     parse_measurement_file, read_measurement_file, ReadError, ReadOptions, LAYOUT_KEY,
 };

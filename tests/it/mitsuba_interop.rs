@@ -328,6 +328,73 @@ fn export_then_fit_recovers_grey_and_spectral_materials() {
     }
 }
 
+/// A table denser than a fit needs is read at an even share of its nodes: about
+/// `MAX_TABLE_ROWS_PER_WAVELENGTH` per wavelength, the same nodes at every wavelength, spread over
+/// every θ_h and φ_d of the grid (a stride would follow the grid), with a note of the count. The
+/// share read still holds the model exactly: rough_paint fits back to its σ, q, n.
+#[test]
+fn a_dense_table_is_read_at_an_even_share_of_its_nodes() {
+    use irpol::measure::{read_table_measurements, MAX_TABLE_ROWS_PER_WAVELENGTH};
+    let dir = tempfile::tempdir().unwrap();
+    let options = ExportOptions {
+        grid: Some([61, 31, 31]),
+        ..ExportOptions::default()
+    };
+    let table = export_material(&shipped("rough_paint"), &options)
+        .unwrap()
+        .table;
+    let path = dir.path().join("dense.pbsdf");
+    std::fs::write(&path, table.to_bytes()).unwrap();
+    let sets = read_table_measurements(&path).unwrap();
+    let cap = MAX_TABLE_ROWS_PER_WAVELENGTH as f64;
+    for set in &sets {
+        let rows = set.points.len() as f64;
+        assert!((rows / cap - 1.0).abs() < 0.05, "{rows} rows");
+        assert!(set
+            .notes
+            .iter()
+            .any(|n| n.contains(" nodes above the horizon read per wavelength")));
+    }
+    let geometry = |s: &irpol::measure::MeasurementSet| -> Vec<u64> {
+        s.points.iter().map(|p| (p.line - 1) / 5).collect()
+    };
+    assert!(sets.windows(2).all(|w| geometry(&w[0]) == geometry(&w[1])));
+    // Spread: every decile of θ_i and of φ_r − φ_i holds about a tenth of the rows.
+    let points = &sets[0].points;
+    for angle in [
+        |p: &irpol::MeasurementPoint| p.theta_i_deg / 90.0,
+        |p: &irpol::MeasurementPoint| (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0) / 360.0,
+    ] {
+        let mut deciles = [0usize; 10];
+        for p in points {
+            deciles[((angle(p) * 10.0) as usize).min(9)] += 1;
+        }
+        assert!(
+            deciles.iter().all(|&d| d > points.len() / 40),
+            "{deciles:?}"
+        );
+    }
+    let fit_options = irpol::fit::FitOptions {
+        distribution: Some(irpol::DistributionKind::Cauchy),
+        ..irpol::fit::FitOptions::default()
+    };
+    let fitted = irpol::fit::fit_measurement(&sets[2], &fit_options).unwrap();
+    let truth = shipped("rough_paint");
+    let truth = truth.grey_model().unwrap();
+    let got = &fitted.chosen.model;
+    for (what, a, b) in [
+        ("n", got.n, truth.n),
+        ("k", got.k, truth.k),
+        (
+            "sigma",
+            got.distribution.sigma(),
+            truth.distribution.sigma(),
+        ),
+    ] {
+        assert!((a / b - 1.0).abs() < 1e-6, "{what}: {a} vs {b}");
+    }
+}
+
 /// `irpol validate` takes a table as measurements: the material predicts its own export to
 /// float32 (the inverse conversion is exact), one report page per wavelength.
 #[test]
