@@ -10,8 +10,13 @@ opposite sign) and compared with `irpol eval` at the same geometries, all 16 ele
 circular ones with their sign. Fails (exit 1) if a material misses the bars: m00 within 1 %
 (median) and 5 % (95th percentile), m_ij/m00 within 0.01 (95th percentile).
 
+Then scripts/check_mitsuba_scene.py (unless --no-scene): a sphere and a plane with exported
+materials under a constant environment and a directional emitter, rendered by Mitsuba and by
+irpol, whose region means of S0..S3 must agree within 1 % (~1.5 min).
+
 Requirements: `pip install mitsuba==3.9.1 drjit==1.5.0 numpy`, a built `irpol` (IRPOL=path, else
 target/release/irpol). Usage: python scripts/check_mitsuba_export.py [--pairs 400] [--seed 41]
+[--no-scene]
 """
 
 import argparse
@@ -123,6 +128,8 @@ def main():
     parser.add_argument("--pairs", type=int, default=400,
                         help="direction pairs per wavelength (3 wavelengths per material)")
     parser.add_argument("--seed", type=int, default=41)
+    parser.add_argument("--no-scene", action="store_true",
+                        help="skip the rendered scene (scripts/check_mitsuba_scene.py)")
     args = parser.parse_args()
     import mitsuba as mi
     mi.set_variant("scalar_spectral_polarized")
@@ -132,6 +139,12 @@ def main():
     if not all(passed):
         sys.exit("FAILED: a material misses the bars (see above)")
     print("all materials within the bars")
+    if not args.no_scene:
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        import check_mitsuba_scene
+        print("Rendered scene (scripts/check_mitsuba_scene.py):", flush=True)
+        if check_mitsuba_scene.main([]) != 0:
+            sys.exit("FAILED: the rendered scene (see above)")
 
 
 if __name__ == "__main__":

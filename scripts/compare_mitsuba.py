@@ -444,8 +444,16 @@ def mitsuba_stokes(mi, scene, spp, seed):
     out = []
     for j in range(4):
         arr = np.array(channels[f"S{j}"], copy=False)
-        out.append(arr[..., 0] if arr.ndim == 3 else arr)
+        out.append(arr @ LUMINANCE if arr.ndim == 3 else arr)
     return np.array(out, np.float64), elapsed
+
+
+# The stokes integrator's channels are sRGB (S0.R, S0.G, S0.B). A spectral variant converts each
+# sample's spectrum to sRGB, and a flat spectrum v becomes (1.206, 0.949, 0.910) v on average (the
+# equal-energy white in sRGB), not v; its luminance (Mitsuba's own weights, which sum to 1) is
+# 1.0010 v (Mitsuba 3.9.1, scalar_spectral_polarized, a constant emitter seen directly).
+# In mono and RGB variants with a grey scene the three channels are equal and this is R.
+LUMINANCE = np.array([0.212671, 0.715160, 0.072169])
 
 
 def mueller_brdf_mitsuba(mi, material, w_i, w_r):
@@ -523,10 +531,12 @@ def brdf_check(mi, irpol, work):
 # ----------------------------------------------------------------------------------------------
 # irpol.
 
-def irpol_pass(irpol, work, width, height, bounces, samples, seed):
+def irpol_pass(irpol, work, width, height, bounces, samples, seed, toml=None):
+    """One irpol render of this script's scene, or of `toml(width, height, bounces, samples, seed)`
+    (a function giving a scene's text; scripts/check_mitsuba_scene.py passes its own)."""
     import tifffile
     scene = work / f"irpol_scene_seed{seed}.toml"
-    scene.write_text(scene_toml(width, height, bounces, samples, seed))
+    scene.write_text((toml or scene_toml)(width, height, bounces, samples, seed))
     out = work / f"irpol_seed{seed}"
     import resource
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
