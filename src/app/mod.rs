@@ -28,56 +28,57 @@ use std::path::{Path, PathBuf};
 
 /// A pBRDF chosen on the command line: a material file, or parameters (the flags of `eval` and
 /// `emissivity`).
-#[derive(Clone, Debug, Default, clap::Args)]
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct ModelArgs {
     /// A material TOML from the library (instead of the parameters below).
-    #[arg(long)]
+    #[cfg_attr(feature = "cli", arg(long))]
     pub material: Option<PathBuf>,
     /// Slope distribution: cauchy or gaussian.
-    #[arg(long)]
+    #[cfg_attr(feature = "cli", arg(long))]
     pub distribution: Option<String>,
     /// Slope parameter σ (rms slope per axis for the Gaussian; a = 2σ² for the Cauchy).
-    #[arg(long, allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
     pub sigma: Option<f64>,
     /// Cauchy exponent q (> 1).
-    #[arg(long, allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
     pub q: Option<f64>,
     /// Real part of the refractive index.
-    #[arg(long, allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
     pub n: Option<f64>,
     /// Extinction coefficient (≥ 0).
-    #[arg(long, allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
     pub k: Option<f64>,
     /// Diffuse (unpolarized) reflectance ρ_d.
-    #[arg(long, allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
     pub rho: Option<f64>,
     /// Which side of the facets reflects: external (relative index N, default) or internal
     /// (1/N, inside grains; docs/design.md §1.10).
-    #[arg(long)]
+    #[cfg_attr(feature = "cli", arg(long))]
     pub facet: Option<String>,
     /// Subsurface reflectance ρ_s: adds the polarized subsurface term (docs/design.md §1.10).
-    #[arg(long = "rho-s", allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long = "rho-s", allow_negative_numbers = true))]
     pub rho_s: Option<f64>,
     /// Residual polarization d of the subsurface term (needs --rho-s; default 0).
-    #[arg(long, allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
     pub d: Option<f64>,
     /// Real index of the subsurface term's interface (needs --rho-s; default --n).
-    #[arg(long = "n-sub", allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long = "n-sub", allow_negative_numbers = true))]
     pub n_sub: Option<f64>,
     /// Residual circular polarization d_c of the subsurface term (needs --rho-s; default --d).
-    #[arg(long = "d-c", allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long = "d-c", allow_negative_numbers = true))]
     pub d_c: Option<f64>,
     /// Change of the subsurface term's residual polarization with the scattering angle Θ,
     /// d(Θ) = d + d1 cos Θ (needs --rho-s; default 0).
-    #[arg(long, allow_negative_numbers = true)]
+    #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
     pub d1: Option<f64>,
     /// Shadowing: none, torrance-sparrow or smith (default smith, as `fit`; with --material,
     /// the material's own).
-    #[arg(long)]
+    #[cfg_attr(feature = "cli", arg(long))]
     pub shadowing: Option<String>,
     /// Wavelength (µm) at which to evaluate a spectral --material (n, k, ρ_d interpolated in its
     /// table; outside it is refused). A grey material is the same at every wavelength.
-    #[arg(long = "wavelength", value_name = "UM")]
+    #[cfg_attr(feature = "cli", arg(long = "wavelength", value_name = "UM"))]
     pub wavelength_um: Option<f64>,
 }
 

@@ -9,26 +9,31 @@ use super::AppError;
 use crate::measure::{Layout, MeasurementSet, ReadOptions, RowSelection};
 
 /// How to read the measurement files: `--layout`, `--wavelength`, `--theta-i`.
-#[derive(Clone, Debug, Default, clap::Args)]
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct MeasurementArgs {
     /// Instrument layout (TOML, docs/design.md §2.8) to read the files through, for files in
     /// an instrument's own columns and conventions; a file may name its own with a
     /// '# layout: FILE' line instead.
-    #[arg(long, value_name = "L.toml")]
+    #[cfg_attr(feature = "cli", arg(long, value_name = "L.toml"))]
     pub layout: Option<PathBuf>,
-    #[command(flatten)]
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub selection: SelectionArgs,
 }
 
 /// Which rows of each file to keep: `--wavelength`, `--theta-i`.
-#[derive(Clone, Debug, Default, clap::Args)]
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct SelectionArgs {
     /// Keep only the rows at this wavelength (µm) of a file that holds several.
-    #[arg(long = "wavelength", value_name = "UM")]
+    #[cfg_attr(feature = "cli", arg(long = "wavelength", value_name = "UM"))]
     pub wavelength_um: Option<f64>,
     /// Keep only the rows at these incidence angles, degrees, comma-separated (a row within
     /// 0.05° of one is kept), e.g. 0,30,60,75.
-    #[arg(long = "theta-i", value_name = "LIST", value_delimiter = ',')]
+    #[cfg_attr(
+        feature = "cli",
+        arg(long = "theta-i", value_name = "LIST", value_delimiter = ',')
+    )]
     pub theta_i_deg: Vec<f64>,
 }
 
