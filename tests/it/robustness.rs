@@ -735,3 +735,61 @@ fn a_fit_estimated_beyond_its_limits_is_refused_before_any_work() {
         .contains("more than --max-minutes 0.01: give --max-minutes 1 "));
     assert!(snapshot(dir.path()).len() == 1, "files were written");
 }
+
+/// `--free`/`--fix` of a parameter the terms lack is refused when the terms are given, and under
+/// the default choice leaves out the sets without it (issue 42: `--fix rho_s=…` with the default
+/// terms and `--fix rho_d=…` with internal+subsurface were ignored, the output byte-identical).
+#[test]
+fn fixing_a_parameter_the_terms_lack_is_refused_or_chooses_terms_that_have_it() {
+    let csv = shipped("measurements/paper_paint.csv");
+    for (flags, needle) in [
+        (
+            "--terms external+depolarizer --fix rho_s=0.1",
+            "--free/--fix name rho_s, which the terms external+depolarizer do not have",
+        ),
+        (
+            "--terms internal+subsurface --fix rho_d=0.1",
+            "--free/--fix name rho_d, which the terms internal+subsurface do not have",
+        ),
+        (
+            "--fix rho_d=0.1,rho_s=0.1",
+            "--free/--fix name parameters of different terms",
+        ),
+    ] {
+        refuse(
+            &[("paint.csv", &csv)],
+            &format!("fit paint.csv {flags} {QUICK_FIT}"),
+            needle,
+        );
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("paint.csv"), &csv).unwrap();
+    let command = format!("fit paint.csv --fix rho_s=0.05 {QUICK_FIT}");
+    let run = irpol(dir.path(), &command.split(' ').collect::<Vec<_>>());
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let entry = std::fs::read_to_string(dir.path().join("fits/paper_paint.toml")).unwrap();
+    assert!(entry.contains("rho_s = 0.05"), "{entry}");
+}
+
+/// The subsurface terms on the shipped glass and paint, whose data cannot determine d and d_c
+/// (ρ_s → 0): fitted, the parameters flagged, the entry written (issue 42: refused with "not
+/// written: … is not a finite number", blaming the data).
+#[test]
+fn subsurface_terms_on_the_shipped_glass_and_paint_are_written_with_their_flags() {
+    for name in ["smooth_glass", "paper_paint"] {
+        let dir = tempfile::tempdir().unwrap();
+        let csv = shipped(&format!("measurements/{name}.csv"));
+        std::fs::write(dir.path().join("m.csv"), csv).unwrap();
+        for terms in ["external+subsurface", "internal+subsurface"] {
+            let command = format!("fit m.csv --terms {terms} {QUICK_FIT}");
+            let run = irpol(dir.path(), &command.split(' ').collect::<Vec<_>>());
+            assert_eq!(run.code, Some(0), "{name} {terms}: {}", run.stderr);
+            assert!(!run.stderr.contains("not written"), "{}", run.stderr);
+            let entry = std::fs::read_to_string(dir.path().join(format!("fits/{name}.toml")));
+            let entry = entry.unwrap();
+            assert!(entry.contains(&format!("terms = \"{terms}\"")), "{entry}");
+            assert!(entry.contains("rho_s = "), "{entry}");
+            assert!(!has_non_finite_value(&entry), "{name} {terms}");
+        }
+    }
+}
