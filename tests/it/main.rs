@@ -48,6 +48,7 @@ mod thermal_field;
 mod thermal_inputs;
 mod thermal_interrupt;
 mod thermal_limits;
+mod thermal_reuse;
 mod thermal_saved;
 mod thermal_scene;
 mod thermal_solver;
