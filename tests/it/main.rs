@@ -21,6 +21,7 @@ mod fuzz_readers;
 mod interrupt;
 mod measure_csv;
 mod measure_layout;
+mod mesh_part_temperatures;
 mod mitsuba_interop;
 mod pbrdf_physics;
 mod ply_binary;
