@@ -256,7 +256,7 @@ fn dofp_panels(scene: &Scene, dofp: &DofpImages, ranged: &[bool]) -> [LinearPane
             &DIVERGING,
         ),
         panel(
-            "AoP error (°) where the true DoLP > 1 %".into(),
+            "AoP error (°), true DoLP > 1 %".into(),
             aop_error,
             Some([-45.0, 45.0]),
             true,
