@@ -1083,7 +1083,6 @@ mod tests {
             fixed,
             symmetric: false,
             map: &THERMAL,
-            format: |v| format!("{v:.1}"),
         };
         let dolp: Vec<f64> = values.iter().map(|t| (t - 280.0) / 10.0).collect();
         SeriesFrame {
@@ -1120,7 +1119,7 @@ mod tests {
                 map: &THERMAL,
                 lo: 0.0,
                 hi: 1.0,
-                format: |v| format!("{v}"),
+                signed: false,
                 clipped: Clipped::default(),
             },
             16,
