@@ -10,7 +10,7 @@ non-zero, runs longer than --timeout seconds, or leaves `git status --porcelain`
 
 Also run, in blocks that hold a command: the set-up lines a reader copies with it (mkdir, cp,
 cat, ln). Not run: usage synopses (`<FILE>`, `[--flag]`, `A | B`) and the commands listed in
-SKIPPED below, each with its reason. Saved thermal runs (out/thermal_runs/) are carried from one
+SKIPPED below, each with its reason. Saved thermal runs (out/thermal/) are carried from one
 file's clone to the next, as a reader's own checkout keeps them: the README and thermal.md tour
 the same day, which is solved once.
 
@@ -180,8 +180,8 @@ def check_file(doc, commands, workdir, env, timeout, runs_from):
     """Runs `commands` of `doc` in a fresh clone; returns (failures, clone path)."""
     clone = workdir / doc.replace("/", "_")
     subprocess.run(["git", "clone", "-q", str(REPO), str(clone)], check=True)
-    if runs_from is not None and (runs_from / "out/thermal_runs").is_dir():
-        shutil.copytree(runs_from / "out/thermal_runs", clone / "out/thermal_runs")
+    if runs_from is not None and (runs_from / "out/thermal").is_dir():
+        shutil.copytree(runs_from / "out/thermal", clone / "out/thermal")
     failures = []
     for number, command, reason in commands:
         where = f"{doc}:{number}"

@@ -146,7 +146,7 @@ enum Command {
         times: Option<String>,
         /// A scene with [thermal]: take its thermal run from this file (a <key>.bin saved by
         /// `irpol thermal` or an earlier render) instead of looking it up by its key in
-        /// thermal_runs/ beside the output folder; refused unless it is this scene's run.
+        /// thermal/ beside the output folder; refused unless it is this scene's run.
         #[arg(long, value_name = "FILE")]
         thermal: Option<PathBuf>,
         /// Refuse, before any work, a render estimated to take longer (frames × pixels × path

@@ -1,7 +1,7 @@
 //! Thermal runs solved once and saved (docs/design.md §2.7): the keys that tell which renders
 //! share a run, the run solved and saved, a scene at an instant of a saved run — bit for bit the
 //! scene [`scene_to_render`] builds by solving the run itself — and the run `irpol thermal` and
-//! `irpol render` take from the store of saved runs (`out/thermal_runs/<key>.bin`) or solve into it.
+//! `irpol render` take from the store of saved runs (`out/thermal/<key>.bin`) or solve into it.
 
 use super::render::{scene_to_render, solution_instant, solve};
 use super::AppError;
@@ -16,14 +16,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The folder where `irpol thermal` and `irpol render` writing into `out_dir` keep the thermal
-/// runs they solve, each as `<key>.bin`, and look for a run before solving it: `thermal_runs/`
+/// runs they solve, each as `<key>.bin`, and look for a run before solving it: `thermal/`
 /// beside `out_dir`, so the default folders `out/<stem>/` and `out/<stem>_thermal/` share
-/// `out/thermal_runs/`.
+/// `out/thermal/`.
 pub fn run_store_beside(out_dir: &Path) -> PathBuf {
-    out_dir
-        .parent()
-        .unwrap_or(Path::new(""))
-        .join("thermal_runs")
+    out_dir.parent().unwrap_or(Path::new("")).join("thermal")
 }
 
 /// Which saved thermal run a command may use.

@@ -1,5 +1,5 @@
 //! `irpol thermal` saves its run by content key beside its output folder
-//! (`out/thermal_runs/<key>.bin`) and `irpol render` at an instant of the run reuses it instead
+//! (`out/thermal/<key>.bin`) and `irpol render` at an instant of the run reuses it instead
 //! of solving again, saying so; a changed scene has another key and is solved; `--thermal FILE`
 //! takes a run from a file and refuses another scene's. A single instant and a series rendered
 //! into one folder keep each other's files.
@@ -22,9 +22,9 @@ fn irpol_in(dir: &Path, args: &[&str]) -> (bool, String) {
     )
 }
 
-/// The saved runs in `dir/out/thermal_runs/`.
+/// The saved runs in `dir/out/thermal/`.
 fn saved_runs(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir.join("out/thermal_runs"))
+    let mut names: Vec<String> = std::fs::read_dir(dir.join("out/thermal"))
         .map(|entries| {
             entries
                 .flatten()
@@ -46,7 +46,7 @@ fn render_reuses_the_run_irpol_thermal_saved_and_solves_a_changed_scene() {
     assert!(ok, "{stderr}");
     let runs = saved_runs(d);
     assert_eq!(runs.len(), 1, "{runs:?}");
-    let file = format!("out/thermal_runs/{}", runs[0]);
+    let file = format!("out/thermal/{}", runs[0]);
     assert!(
         stderr.contains("thermal run solved in") && stderr.contains(&format!("saved to {file}")),
         "{stderr}"
@@ -106,7 +106,7 @@ fn a_damaged_saved_run_is_solved_again_with_a_warning() {
     std::fs::write(d.join("plate.toml"), thermal_plate_scene(|s| s)).unwrap();
     let (ok, stderr) = irpol_in(d, &["thermal", "plate.toml"]);
     assert!(ok, "{stderr}");
-    let file = d.join("out/thermal_runs").join(&saved_runs(d)[0]);
+    let file = d.join("out/thermal").join(&saved_runs(d)[0]);
     let mut bytes = std::fs::read(&file).unwrap();
     let last = bytes.len() - 1;
     bytes[last] ^= 0xff;
