@@ -13,6 +13,7 @@ use irpol::app::fit::{fit_and_write, FitFlags};
 use irpol::app::render::{
     default_output_dir, render_scene_at_within, render_scene_within, Instants, TimedRender,
 };
+use irpol::app::saved_thermal::{run_store_beside, RunSource, SavedRun};
 use irpol::app::scene_init::write_starter_scene;
 use irpol::app::sun::{given_times, write_sun_csv};
 use irpol::app::thermal::{run_thermal, run_thermal_and_render};
@@ -143,6 +144,11 @@ enum Command {
         /// preview.gif animating S0 and DoLP.
         #[arg(long)]
         times: Option<String>,
+        /// A scene with [thermal]: take its thermal run from this file (a <key>.bin saved by
+        /// `irpol thermal` or an earlier render) instead of looking it up by its key in
+        /// thermal/ beside the output folder; refused unless it is this scene's run.
+        #[arg(long, value_name = "FILE")]
+        thermal: Option<PathBuf>,
         /// Refuse, before any work, a render estimated to take longer (frames × pixels × path
         /// vertices × wavelength nodes; docs/commands.md, `irpol render`).
         #[arg(long, default_value_t = irpol::app::render_cost::DEFAULT_MAX_MINUTES)]
@@ -286,8 +292,9 @@ enum SceneCommand {
     /// Writes a commented starter scene (a sphere on a plane, no other file needed) to render
     /// and edit; an existing file is never overwritten.
     Init {
-        /// The scene file to write.
-        #[arg(long, default_value = "scene.toml")]
+        /// The scene file to write (by default under out/, which git ignores, so a checkout
+        /// stays clean).
+        #[arg(long, default_value = "out/scene.toml")]
         out: PathBuf,
     },
 }
@@ -388,9 +395,14 @@ fn run(command: Command) -> anyhow::Result<()> {
             time,
             time_utc,
             times,
+            thermal,
             max_minutes,
         } => match Instants::from_flags(time, time_utc, times.as_deref())? {
-            Some(instants) => render_instants(&scene, out, &instants, max_minutes),
+            Some(instants) => render_instants(&scene, out, &instants, max_minutes, thermal),
+            None if thermal.is_some() => Err(AppError::invalid(
+                "--thermal needs an instant to render: give --time, --time-utc or --times",
+            )
+            .into()),
             None => render_and_summarize(&scene, out, max_minutes),
         },
         Command::Thermal { scene, out } => thermal_and_summarize(&scene, out),
@@ -837,14 +849,49 @@ fn render_instants(
     out: Option<PathBuf>,
     instants: &Instants,
     max_minutes: f64,
+    thermal: Option<PathBuf>,
 ) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| default_output_dir(scene));
     // One instant or a whole series: one output set staged beside the folder.
     cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
     let progress = TerminalProgress::new();
-    let renders = render_scene_at_within(scene, &out, instants, max_minutes, &progress)?;
+    let store = run_store_beside(&out);
+    let saved = match &thermal {
+        Some(file) => SavedRun::File(file),
+        None => SavedRun::Store(&store),
+    };
+    let (renders, source) =
+        render_scene_at_within(scene, &out, instants, max_minutes, saved, &progress)?;
+    note_run_source(&source);
     report_instants(scene, &out, &renders);
     Ok(())
+}
+
+/// The note (and any warning) saying whether a thermal run was solved or taken from a file.
+fn note_run_source(source: &RunSource) {
+    match source {
+        RunSource::Reused(file) => note_all(&[format!(
+            "thermal run reused from {} (solved earlier; delete the file to solve it again)",
+            file.display()
+        )]),
+        RunSource::Solved {
+            seconds,
+            saved,
+            ignored,
+        } => {
+            if let Some(why) = ignored {
+                warn_once(&[format!("{why} (solving it again)")]);
+            }
+            let saved = match saved {
+                Some(file) => format!(
+                    "saved to {} (irpol thermal and render reuse it)",
+                    file.display()
+                ),
+                None => "not saved: its instants need separate runs".to_owned(),
+            };
+            note_all(&[format!("thermal run solved in {seconds:.1} s, {saved}")]);
+        }
+    }
 }
 
 fn report_instants(scene: &Path, out: &Path, renders: &[TimedRender]) {
@@ -893,7 +940,10 @@ fn thermal_output_dir(scene: &Path) -> PathBuf {
 fn thermal_and_summarize(scene: &Path, out: Option<PathBuf>) -> anyhow::Result<()> {
     let out = out.unwrap_or_else(|| thermal_output_dir(scene));
     cli::signals::remove_on_interrupt(vec![staging_folder(&out, std::process::id())], vec![]);
-    let summary = run_thermal(scene, &out, &TerminalProgress::new())?;
+    let store = run_store_beside(&out);
+    let saved = SavedRun::Store(&store);
+    let (summary, source) = run_thermal(scene, &out, saved, &TerminalProgress::new())?;
+    note_run_source(&source);
     report_thermal(scene, &out, &summary);
     Ok(())
 }

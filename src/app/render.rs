@@ -3,6 +3,7 @@
 
 use super::error::single_line;
 use super::render_cost::{check_estimate, DEFAULT_MAX_MINUTES};
+use super::saved_thermal::{obtain_run, RunSource, SavedRun};
 use super::AppError;
 use crate::atomic::StagedFolder;
 use crate::output::figure::SeriesPreview;
@@ -99,15 +100,24 @@ pub struct TimedRender {
     pub summary: RenderSummary,
 }
 
-/// Runs the scene's thermal model through the last instant asked for, then renders the scene at
-/// each instant ([`render_solution_at`]).
+/// Takes the scene's thermal run recording the instants asked for from `saved` or solves it
+/// ([`obtain_run`]), then renders the scene at each instant ([`render_solution_at`]). Returns
+/// the renders and where the run came from.
 pub fn render_scene_at(
     scene_path: &Path,
     out_dir: &Path,
     instants: &Instants,
+    saved: SavedRun,
     progress: &dyn Progress,
-) -> Result<Vec<TimedRender>, AppError> {
-    render_scene_at_within(scene_path, out_dir, instants, DEFAULT_MAX_MINUTES, progress)
+) -> Result<(Vec<TimedRender>, RunSource), AppError> {
+    render_scene_at_within(
+        scene_path,
+        out_dir,
+        instants,
+        DEFAULT_MAX_MINUTES,
+        saved,
+        progress,
+    )
 }
 
 /// [`render_scene_at`], refused before the thermal run when the frames' estimate
@@ -117,8 +127,9 @@ pub fn render_scene_at_within(
     out_dir: &Path,
     instants: &Instants,
     max_minutes: f64,
+    saved: SavedRun,
     progress: &dyn Progress,
-) -> Result<Vec<TimedRender>, AppError> {
+) -> Result<(Vec<TimedRender>, RunSource), AppError> {
     let scene = load_scene(scene_path)?;
     let setup = scene
         .thermal
@@ -132,12 +143,12 @@ pub fn render_scene_at_within(
         }
     };
     let estimate = check_estimate(&scene, times.len(), max_minutes)?;
-    let solution = solve(&scene, scene_path, &times, progress)?;
+    let (solution, source) = obtain_run(&scene, scene_path, &times, saved, progress)?;
     let mut renders = render_solution_at(&scene, &solution, &times, out_dir, progress)?;
     if let Some(first) = renders.first_mut() {
         first.summary.warnings.extend(estimate.advice());
     }
-    Ok(renders)
+    Ok((renders, source))
 }
 
 /// Renders a thermal scene at each of `times` (recorded in `solution`). One instant renders into
@@ -168,9 +179,9 @@ pub fn render_solution_at(
 }
 
 /// A series is one output set: every frame folder, the preview and the manifest are staged
-/// together and replace the folder's earlier outputs (a single render's or another series', frame
-/// folders included) in one step, so an interrupted or failed series leaves the old set whole
-/// and a shorter series leaves no frames of a longer one behind.
+/// together and replace an earlier series' (its frame folders included) in one step, so an
+/// interrupted or failed series leaves the old set whole and a shorter series leaves no frames of
+/// a longer one behind. A single instant rendered into the folder is another set, and is kept.
 fn render_series(
     scene: &Scene,
     solution: &ThermalSolution,
@@ -209,7 +220,7 @@ fn render_series(
     staged
         .write(SERIES_MANIFEST, &manifest)
         .map_err(write_error)?;
-    let earlier = EarlierOutputs::of(out_dir);
+    let earlier = EarlierOutputs::series(out_dir);
     staged
         .commit(&|name| earlier.contains(name))
         .map_err(write_error)?;

@@ -1,6 +1,7 @@
 //! `irpol thermal`: a scene's temperatures over its `[thermal]` run (docs/design.md §1.8, §2.6).
 
 use super::render::{render_solution_at, solve, TimedRender};
+use super::saved_thermal::{obtain_run, RunSource, SavedRun};
 use super::AppError;
 use crate::output::thermal::{write_thermal_outputs, ThermalSummary};
 use crate::progress::Progress;
@@ -9,18 +10,21 @@ use crate::thermal_scene::ThermalSolution;
 use std::path::Path;
 use std::time::Instant;
 
-/// Loads the scene, runs its thermal model and writes `temperatures.csv`, the per-step PLYs, the
-/// plot and `summary.json` into `out_dir` as one set. A bad scene writes nothing.
+/// Loads the scene, takes its thermal run from `saved` or solves it ([`obtain_run`]), and writes
+/// `temperatures.csv`, the per-step PLYs, the plot and `summary.json` into `out_dir` as one set.
+/// A bad scene writes nothing. Returns the summary and where the run came from.
 pub fn run_thermal(
     scene_path: &Path,
     out_dir: &Path,
+    saved: SavedRun,
     progress: &dyn Progress,
-) -> Result<ThermalSummary, AppError> {
+) -> Result<(ThermalSummary, RunSource), AppError> {
     let start = Instant::now();
     let scene = load_scene(scene_path)?;
-    let solution = solve(&scene, scene_path, &[], progress)?;
+    let (solution, source) = obtain_run(&scene, scene_path, &[], saved, progress)?;
     let seconds = start.elapsed().as_secs_f64();
-    write_thermal(&scene, &solution, out_dir, seconds)
+    let summary = write_thermal(&scene, &solution, out_dir, seconds)?;
+    Ok((summary, source))
 }
 
 /// The thermal run written to `thermal_out` and rendered at `times` into `render_out`, from one

@@ -41,7 +41,8 @@ enum Bar {
         map: &'static ColorMap,
         lo: f64,
         hi: f64,
-        format: fn(f64) -> String,
+        /// Tick labels carry their sign (S1, S2, S3, errors).
+        signed: bool,
         clipped: Clipped,
     },
     Cyclic,
@@ -82,7 +83,6 @@ struct LinearPanel {
     /// Symmetric about zero (S1, S2, S3).
     symmetric: bool,
     map: &'static ColorMap,
-    format: fn(f64) -> String,
 }
 
 impl Previews {
@@ -217,11 +217,6 @@ fn dofp_panels(scene: &Scene, dofp: &DofpImages, ranged: &[bool]) -> [LinearPane
         fixed,
         symmetric,
         map,
-        format: if symmetric {
-            format_signed
-        } else {
-            |v| format!("{v:.2}")
-        },
     };
     let method = scene.sensor.dofp.map_or("bilinear", |d| d.demosaic.name());
     let difference = camera_dolp
@@ -261,7 +256,7 @@ fn dofp_panels(scene: &Scene, dofp: &DofpImages, ranged: &[bool]) -> [LinearPane
             &DIVERGING,
         ),
         panel(
-            "AoP error (°) where the true DoLP > 1 %".into(),
+            "AoP error (°), true DoLP > 1 %".into(),
             aop_error,
             Some([-45.0, 45.0]),
             true,
@@ -364,7 +359,7 @@ impl LinearPanel {
             .map(|(fraction, side)| format!("{} {side}", percent(*fraction)))
             .collect();
         if !sides.is_empty() {
-            title += &format!(" — clipped {}", sides.join(", "));
+            title += &format!(" — pixels clipped: {}", sides.join(", "));
         }
         Panel {
             file: self.file,
@@ -374,7 +369,7 @@ impl LinearPanel {
                 map: self.map,
                 lo,
                 hi,
-                format: self.format,
+                signed: self.symmetric,
                 clipped,
             },
         }
@@ -481,7 +476,6 @@ fn linear_panels(scene: &Scene, image: &StokesImage) -> Vec<LinearPanel> {
         fixed,
         symmetric: true,
         map: &DIVERGING,
-        format: format_signed,
     };
     let mut panels = vec![
         LinearPanel {
@@ -494,7 +488,6 @@ fn linear_panels(scene: &Scene, image: &StokesImage) -> Vec<LinearPanel> {
                 S0Colormap::Thermal => &THERMAL,
                 S0Colormap::Gray => &GRAY,
             },
-            format: |v| format!("{v:.1}"),
         },
         stokes(1, settings.s1),
         stokes(2, settings.s2),
@@ -506,7 +499,6 @@ fn linear_panels(scene: &Scene, image: &StokesImage) -> Vec<LinearPanel> {
             fixed: settings.dolp_percent.or(Some([0.0, f64::NAN])),
             symmetric: false,
             map: &SEQUENTIAL,
-            format: |v| format!("{v:.2}"),
         },
     ];
     // S3 only where light was transported between surfaces (the open world has none).
@@ -766,21 +758,69 @@ fn draw_colour_bar(canvas: &mut Canvas, bar: &Bar, layout: &PanelLayout) {
     }
 }
 
-/// The colour bar's tick labels at fractions 0, ¼, ½, ¾, 1 of its range.
+/// The colour bar's ticks, as fractions of its range with their labels: round values (multiples
+/// of a 1-2-5 step, 3–6 of them) for a linear bar, every 45° for the cyclic one.
 fn bar_ticks(bar: &Bar) -> Vec<(f64, String)> {
-    match bar {
-        Bar::Linear { lo, hi, format, .. } => (0..5)
-            .map(|k| {
-                let t = k as f64 / 4.0;
-                (t, format(lo + t * (hi - lo)))
-            })
-            .collect(),
+    match *bar {
+        Bar::Linear { lo, hi, signed, .. } => {
+            let step = tick_step(hi - lo);
+            let first = (lo / step - 1e-6).ceil() as i64;
+            let last = (hi / step + 1e-6).floor() as i64;
+            (first..=last)
+                .map(|k| {
+                    let v = k as f64 * step;
+                    let t = ((v - lo) / (hi - lo)).clamp(0.0, 1.0);
+                    (t, tick_label(v, step, signed))
+                })
+                .collect()
+        }
         Bar::Cyclic => [-90, -45, 0, 45, 90]
             .iter()
             .enumerate()
-            .map(|(k, d)| (k as f64 / 4.0, format!("{d}°")))
+            .map(|(k, &d)| {
+                (
+                    k as f64 / 4.0,
+                    format!("{}°", tick_label(d.into(), 45.0, false)),
+                )
+            })
             .collect(),
     }
+}
+
+/// The smallest step of 1, 2 or 5 times a power of ten that cuts `span` into at most 5 parts.
+fn tick_step(span: f64) -> f64 {
+    let raw = span / 5.0;
+    let decade = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * decade)
+        .find(|&step| step >= raw * (1.0 - 1e-9))
+        .unwrap_or(10.0 * decade)
+}
+
+/// A tick value with the digits its `step` needs (scientific below 1e-4), the minus as '−' and,
+/// when `signed`, a '+' on positive values.
+fn tick_label(v: f64, step: f64, signed: bool) -> String {
+    if v.abs() < step * 1e-6 {
+        return "0".into();
+    }
+    let step_exponent = step.log10().floor() as i32;
+    let digits = if step_exponent >= -4 {
+        format!("{:.*}", (-step_exponent).max(0) as usize, v.abs())
+    } else {
+        let v_exponent = v.abs().log10().floor() as i32;
+        format!(
+            "{:.*e}",
+            (v_exponent - step_exponent).max(0) as usize,
+            v.abs()
+        )
+    };
+    let sign = match (v < 0.0, signed) {
+        (true, _) => "−",
+        (false, true) => "+",
+        (false, false) => "",
+    };
+    format!("{sign}{digits}")
 }
 
 /// The title, the colour bar's ticks and labels, and its frame, drawn with plotters.
@@ -806,9 +846,11 @@ fn draw_panel_text(canvas: &mut Canvas, panel: &Panel, layout: &PanelLayout) -> 
     let top = (title_h + layout.cap_top) as i32;
     for (t, text) in bar_ticks(&panel.bar) {
         let y = top + ((1.0 - t) * (layout.gradient_h as f64 - 1.0)).round() as i32;
-        root.draw(&PathElement::new(vec![(x, y), (x + 4, y)], BLACK))
+        // The mark on the bar's other side from its label, so that it cannot read as a minus.
+        let left = layout.bar_x as i32;
+        root.draw(&PathElement::new(vec![(left - 5, y), (left - 1, y)], BLACK))
             .map_err(draw_error)?;
-        root.draw_text(&text, &label, (x + 6, y))
+        root.draw_text(&text, &label, (x + 5, y))
             .map_err(draw_error)?;
     }
     root.draw(&Rectangle::new(
@@ -824,16 +866,6 @@ fn draw_panel_text(canvas: &mut Canvas, panel: &Panel, layout: &PanelLayout) -> 
 
 fn draw_error<E: std::fmt::Debug>(e: E) -> io::Error {
     io::Error::other(format!("drawing the preview failed: {e:?}"))
-}
-
-fn format_signed(v: f64) -> String {
-    if v == 0.0 {
-        "0".into()
-    } else if v.abs() >= 0.1 {
-        format!("{v:+.3}")
-    } else {
-        format!("{v:+.2e}")
-    }
 }
 
 /// (p_lo, p_hi) quantiles of the values (0, 1 when empty), each moved out by `margin` times
@@ -887,7 +919,6 @@ mod tests {
             fixed,
             symmetric: false,
             map: &THERMAL,
-            format: |v| format!("{v}"),
         }
         .panel(&ranged, &settings)
     }
@@ -898,6 +929,38 @@ mod tests {
                 lo, hi, clipped, ..
             } => (*lo, *hi, clipped.below, clipped.above),
             Bar::Cyclic => unreachable!(),
+        }
+    }
+
+    fn ticks(lo: f64, hi: f64, signed: bool) -> Vec<String> {
+        let bar = Bar::Linear {
+            map: &THERMAL,
+            lo,
+            hi,
+            signed,
+            clipped: Clipped::default(),
+        };
+        let ticks = bar_ticks(&bar);
+        assert!(ticks.iter().all(|(t, _)| (-1e-9..=1.0 + 1e-9).contains(t)));
+        ticks.into_iter().map(|(_, label)| label).collect()
+    }
+
+    #[test]
+    fn colour_bar_ticks_are_round_values_of_a_1_2_5_step() {
+        assert_eq!(ticks(288.37, 319.62, false), ["290", "300", "310"]);
+        assert_eq!(ticks(0.0, 3.7, false), ["0", "1", "2", "3"]);
+        assert_eq!(
+            ticks(-0.0417, 0.0417, true),
+            ["−0.04", "−0.02", "0", "+0.02", "+0.04"]
+        );
+        assert_eq!(ticks(-45.0, 45.0, true), ["−40", "−20", "0", "+20", "+40"]);
+        assert_eq!(
+            ticks(0.0, 2.4e-6, false),
+            ["0", "5e-7", "1.0e-6", "1.5e-6", "2.0e-6"]
+        );
+        for (lo, hi) in [(0.0, 1.0), (287.1, 287.3), (-3e-3, 3e-3), (0.0, 97.3)] {
+            let n = ticks(lo, hi, false).len();
+            assert!((3..=6).contains(&n), "{lo}…{hi}: {n} ticks");
         }
     }
 
@@ -917,7 +980,9 @@ mod tests {
         assert_eq!(panel.colors[950], THERMAL.over);
         assert_eq!(panel.colors[100], THERMAL.at(0.0));
         assert!(
-            panel.title.contains("clipped 10.0 % below, 10.0 % above"),
+            panel
+                .title
+                .contains("pixels clipped: 10.0 % below, 10.0 % above"),
             "{}",
             panel.title
         );
@@ -952,7 +1017,6 @@ mod tests {
             fixed: None,
             symmetric: false,
             map: &THERMAL,
-            format: |v| format!("{v}"),
         }
         .panel(ranged, settings)
     }
@@ -980,7 +1044,7 @@ mod tests {
         assert!(hi < 300.2 && below == 0.0 && above > 0.0, "{hi} {above}");
         assert_eq!(panel.colors[0], THERMAL.over);
         assert!(
-            panel.title.ends_with(" — clipped < 0.1 % above"),
+            panel.title.ends_with(" — pixels clipped: < 0.1 % above"),
             "{}",
             panel.title
         );
@@ -1019,7 +1083,6 @@ mod tests {
             fixed,
             symmetric: false,
             map: &THERMAL,
-            format: |v| format!("{v:.1}"),
         };
         let dolp: Vec<f64> = values.iter().map(|t| (t - 280.0) / 10.0).collect();
         SeriesFrame {
@@ -1056,7 +1119,7 @@ mod tests {
                 map: &THERMAL,
                 lo: 0.0,
                 hi: 1.0,
-                format: |v| format!("{v}"),
+                signed: false,
                 clipped: Clipped::default(),
             },
             16,

@@ -265,7 +265,7 @@ pub fn write_outputs(
     };
     let staged = StagedFolder::begin(out_dir).map_err(write_error)?;
     let summary = stage_outputs(scene, rendered, &staged.root(), out_dir, started)?;
-    let earlier = EarlierOutputs::of(out_dir);
+    let earlier = EarlierOutputs::single(out_dir);
     staged
         .commit(&|name| earlier.contains(name))
         .map_err(write_error)?;
@@ -542,28 +542,41 @@ fn material_summaries(scene: &Scene, rendered: &Rendered) -> Vec<MaterialSummary
 /// The manifest of a render series (`render --times`): its frames and every entry it wrote.
 pub const SERIES_MANIFEST: &str = "series.json";
 
-/// The entries of an output folder that an earlier render or render series wrote: those listed
-/// in its `summary.json` or [`SERIES_MANIFEST`], and frame folders of a series (`NNN_<t>s/` with
-/// a `summary.json`). They are replaced as a set; anything else in the folder is the user's and
-/// is kept.
+/// The entries of an output folder that an earlier output set of the same kind wrote: a single
+/// render's (listed in its `summary.json`) or a series' (listed in [`SERIES_MANIFEST`], and
+/// frame folders `NNN_<t>s/` with a `summary.json`). They are replaced as a set; the other
+/// kind's set (a single instant rendered beside a series) and anything else in the folder, the
+/// user's, are kept.
 pub struct EarlierOutputs {
     dir: std::path::PathBuf,
     listed: Vec<String>,
+    frames: bool,
 }
 
 impl EarlierOutputs {
-    pub fn of(out_dir: &Path) -> EarlierOutputs {
-        let mut listed = listed_files(&out_dir.join("summary.json"));
-        listed.extend(listed_files(&out_dir.join(SERIES_MANIFEST)));
+    /// What an earlier single render into `out_dir` wrote.
+    pub fn single(out_dir: &Path) -> EarlierOutputs {
         EarlierOutputs {
             dir: out_dir.to_owned(),
-            listed,
+            listed: listed_files(&out_dir.join("summary.json")),
+            frames: false,
+        }
+    }
+
+    /// What an earlier series into `out_dir` wrote.
+    pub fn series(out_dir: &Path) -> EarlierOutputs {
+        EarlierOutputs {
+            dir: out_dir.to_owned(),
+            listed: listed_files(&out_dir.join(SERIES_MANIFEST)),
+            frames: true,
         }
     }
 
     pub fn contains(&self, name: &str) -> bool {
         self.listed.iter().any(|f| f == name)
-            || (is_frame_folder_name(name) && self.dir.join(name).join("summary.json").is_file())
+            || (self.frames
+                && is_frame_folder_name(name)
+                && self.dir.join(name).join("summary.json").is_file())
     }
 }
 

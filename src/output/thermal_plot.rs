@@ -10,6 +10,15 @@ use std::io;
 const WIDTH: u32 = 1400;
 const HEIGHT: u32 = 800;
 
+/// Part `i`'s colour and dash pattern (dash and gap in pixels; `None` solid): the ten Tableau 10
+/// colours solid, then dashed, then dotted, so 30 parts are told apart (Tableau 20's light
+/// colours read as their dark companions, so the car's 17 parts seemed to repeat colours).
+fn part_style(i: usize) -> (RGBColor, Option<(u32, u32)>) {
+    let color = TABLEAU20[i % 10];
+    let dash = [None, Some((12, 6)), Some((3, 4))][(i / 10) % 3];
+    (color, dash)
+}
+
 /// Times (h) where the sun's centre crosses the horizon, linear between recorded instants, with
 /// whether it rises there.
 pub fn horizon_crossings(solution: &ThermalSolution) -> Vec<(f64, bool)> {
@@ -86,7 +95,7 @@ fn draw<DB: DrawingBackend>(
         chart.draw_series([Text::new(label, (hour, hi + pad * 0.5), (FONT, 14))])?;
     }
     for (i, part) in parts.iter().enumerate() {
-        let color = TABLEAU20[i % TABLEAU20.len()];
+        let (color, dash) = part_style(i);
         let band: Vec<(f64, f64)> = hours
             .iter()
             .zip(&part.surface_k)
@@ -101,7 +110,15 @@ fn draw<DB: DrawingBackend>(
             .collect();
         chart.draw_series([Polygon::new(band, color.mix(0.15).filled())])?;
         let mean = hours.iter().zip(&part.surface_k).map(|(&h, v)| (h, v[1]));
-        chart.draw_series(LineSeries::new(mean, color.stroke_width(2)))?;
+        match dash {
+            None => chart.draw_series(LineSeries::new(mean, color.stroke_width(2)))?,
+            Some((size, gap)) => chart.draw_series(DashedLineSeries::new(
+                mean,
+                size,
+                gap,
+                color.stroke_width(2),
+            ))?,
+        };
     }
     let dashes = DashedLineSeries::new(hours.iter().copied().zip(air), 8, 5, BLACK.stroke_width(2));
     chart.draw_series(dashes)?;
@@ -123,11 +140,17 @@ fn draw_legend<DB: DrawingBackend>(
         style.clone(),
     ))?;
     for (i, part) in parts.iter().enumerate() {
-        let color = TABLEAU20[i % TABLEAU20.len()];
-        area.draw(&PathElement::new(
-            vec![(8, y + 8), (36, y + 8)],
-            color.stroke_width(3),
-        ))?;
+        let (color, dash) = part_style(i);
+        let (size, gap) = dash.map_or((28, 0), |(d, g)| (d as i32, g as i32));
+        let mut x = 8;
+        while x < 36 {
+            let end = (x + size).min(36);
+            area.draw(&PathElement::new(
+                vec![(x, y + 8), (end, y + 8)],
+                color.stroke_width(3),
+            ))?;
+            x = end + gap;
+        }
         area.draw(&Text::new(part.name.clone(), (44, y), style.clone()))?;
         y += row;
     }

@@ -2,8 +2,11 @@
 //! with a part, optional per-vertex temperatures) and what the renderer draws ([`ShadedMesh`]:
 //! world-space shading vertices, each with one normal and one temperature).
 //!
-//! Temperatures follow the paper's §4: a temperature per part, turned into a temperature per
-//! vertex (a vertex shared by several parts gets their average) and interpolated over triangles.
+//! Temperatures follow the paper's §4, a temperature per part turned into a temperature per
+//! vertex and interpolated over triangles, with one departure: a vertex shared by several parts
+//! is split per part and each copy keeps its own part's temperature (the paper averages them,
+//! which moved a part's typed temperature at its edges: a box's top at 315 K beside 300 K sides
+//! was drawn at ~310 K).
 
 use nalgebra::{Rotation3, Vector3};
 use rustc_hash::FxHashMap;
@@ -231,7 +234,7 @@ pub fn shade_mesh(
         .iter()
         .map(|f| area_normal(f, &positions))
         .collect();
-    let vertex_temperature = vertex_temperatures(raw, setup.part_temperature)?;
+    let temperature = VertexTemperatures::of(raw, setup.part_temperature)?;
     let corner_normals = corner_normals(raw, setup, &face_normals)?;
 
     // One shading vertex per distinct (position, part, normal): creases and part boundaries split
@@ -251,7 +254,7 @@ pub fn shade_mesh(
             triangle[corner] = *index_of.entry(key).or_insert_with(|| {
                 mesh.positions.push(positions[v as usize]);
                 mesh.normals.push(n);
-                mesh.temperatures.push(vertex_temperature[v as usize]);
+                mesh.temperatures.push(temperature.at(v, face.part));
                 (mesh.positions.len() - 1) as u32
             });
         }
@@ -326,54 +329,55 @@ pub fn bounding_diagonal(positions: &[Vector3<f64>]) -> f64 {
     }
 }
 
-/// Per raw vertex: the file's temperature, or the average temperature of the parts that use it.
-fn vertex_temperatures(
-    raw: &RawMesh,
-    part_temperature: &[Option<f64>],
-) -> Result<Vec<f64>, MeshError> {
-    if let Some(temperatures) = &raw.vertex_temperatures {
-        if let Some(i) = temperatures
+/// The temperature of each shading vertex: the file's per raw vertex, or its part's own (shading
+/// vertices are split per part, so a vertex shared by parts has a copy at each one's temperature).
+enum VertexTemperatures<'a> {
+    File(&'a [f64]),
+    Part(&'a [Option<f64>]),
+}
+
+impl<'a> VertexTemperatures<'a> {
+    /// Refused: a file temperature out of range, or a part with faces and no temperature.
+    fn of(
+        raw: &'a RawMesh,
+        part_temperature: &'a [Option<f64>],
+    ) -> Result<VertexTemperatures<'a>, MeshError> {
+        if let Some(temperatures) = &raw.vertex_temperatures {
+            if let Some(i) = temperatures
+                .iter()
+                .position(|t| !super::valid_temperature(*t))
+            {
+                return Err(format!(
+                    "vertex {} has temperature {} K: temperatures must be within [0, {}] K",
+                    i + 1,
+                    crate::text::number(temperatures[i]),
+                    super::MAX_TEMPERATURE_K
+                )
+                .into());
+            }
+            return Ok(VertexTemperatures::File(temperatures));
+        }
+        if let Some(face) = raw
+            .faces
             .iter()
-            .position(|t| !super::valid_temperature(*t))
+            .find(|f| part_temperature[f.part as usize].is_none())
         {
             return Err(format!(
-                "vertex {} has temperature {} K: temperatures must be within [0, {}] K",
-                i + 1,
-                crate::text::number(temperatures[i]),
-                super::MAX_TEMPERATURE_K
+                "part '{}' has no temperature (set temperature_k on the object or the part)",
+                raw.parts[face.part as usize]
             )
             .into());
         }
-        return Ok(temperatures.clone());
+        Ok(VertexTemperatures::Part(part_temperature))
     }
-    // Distinct parts per vertex, so a vertex inside a part is not weighted by its face count.
-    let mut parts_of: Vec<Vec<u32>> = vec![Vec::new(); raw.positions.len()];
-    for face in &raw.faces {
-        for &v in &face.vertices {
-            let parts = &mut parts_of[v as usize];
-            if !parts.contains(&face.part) {
-                parts.push(face.part);
-            }
+
+    /// The temperature of raw vertex `v` on a face of `part`.
+    fn at(&self, v: u32, part: u32) -> f64 {
+        match self {
+            VertexTemperatures::File(t) => t[v as usize],
+            VertexTemperatures::Part(t) => t[part as usize].unwrap_or(0.0),
         }
     }
-    parts_of
-        .iter()
-        .map(|parts| {
-            if parts.is_empty() {
-                return Ok(0.0); // a vertex no face uses is never drawn
-            }
-            let mut sum = 0.0;
-            for &p in parts {
-                sum += part_temperature[p as usize].ok_or_else(|| {
-                    format!(
-                        "part '{}' has no temperature (set temperature_k on the object or the part)",
-                        raw.parts[p as usize]
-                    )
-                })?;
-            }
-            Ok(sum / parts.len() as f64)
-        })
-        .collect()
 }
 
 /// Unit normal at each face corner: the file's normals when given, otherwise the area-weighted
@@ -478,11 +482,11 @@ mod tests {
     }
 
     #[test]
-    fn shared_vertices_get_the_average_part_temperature() {
+    fn shared_vertices_keep_each_part_temperature() {
         let raw = square_with_two_parts();
         let temps = [Some(300.0), Some(320.0)];
         let (mesh, _) = shade_mesh(&raw, &shading(&temps, &[0, 1])).unwrap();
-        // Vertices 1 and 2 are split per part but both copies carry the average 310 K.
+        // Vertices 1 and 2 are split per part, each copy at its own part's temperature.
         assert_eq!(mesh.positions.len(), 6);
         let t_of = |p: Vector3<f64>| {
             mesh.positions
@@ -492,7 +496,8 @@ mod tests {
                 .map(|(_, t)| *t)
                 .collect::<Vec<_>>()
         };
-        assert_eq!(t_of(Vector3::new(1.0, 0.0, 0.0)), vec![310.0, 310.0]);
+        assert_eq!(t_of(Vector3::new(1.0, 0.0, 0.0)), vec![300.0, 320.0]);
+        assert_eq!(t_of(Vector3::new(0.0, 1.0, 0.0)), vec![300.0, 320.0]);
         assert_eq!(t_of(Vector3::new(0.0, 0.0, 0.0)), vec![300.0]);
         assert_eq!(t_of(Vector3::new(1.0, 1.0, 0.0)), vec![320.0]);
         assert_eq!(mesh.triangle_surface, vec![0, 1]);

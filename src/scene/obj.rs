@@ -3,8 +3,8 @@
 //! into triangle fans. Texture and material statements are accepted and ignored; anything else is
 //! refused so that a corrupt file is not half-read. Errors read `line N: what is wrong`.
 //!
-//! Own reader rather than a crate because part boundaries must keep the file's vertex indices (a
-//! vertex shared by two groups gets the average of their temperatures) and every error must name
+//! Own reader rather than a crate because part boundaries must keep the file's vertex indices (the
+//! raw mesh is the file's topology; shading splits vertices per part) and every error must name
 //! its line: `tobj` re-indexes vertices per model and its `LoadError`
 //! variants (`PositionParseError`, `FaceParseError`, …) carry no line or column.
 

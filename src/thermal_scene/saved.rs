@@ -91,15 +91,16 @@ pub enum SavedSolutionError {
     Damaged { path: PathBuf, detail: String },
     /// The file holds the run of other inputs (or of another sample grid) than the scene's.
     #[error(
-        "{}: thermal solution {} was solved for other thermal inputs than this scene's at t = {} \
-         s (key {}): solve this scene's run instead",
-        shown_path(path), short(found), number(*time_s), short(expected)
+        "{}: thermal solution {} was solved for other thermal inputs than this scene's{} (key \
+         {}): solve this scene's run instead",
+        shown_path(path), short(found), at_instant(*time_s), short(expected)
     )]
     KeyMismatch {
         path: PathBuf,
         found: ThermalKey,
         expected: ThermalKey,
-        time_s: f64,
+        /// The instant asked for; `None` for the run on its own sample grid.
+        time_s: Option<f64>,
     },
     #[error("{}: the thermal solution records no t = {} s", shown_path(path), number(*time_s))]
     MissingInstant { path: PathBuf, time_s: f64 },
@@ -119,6 +120,11 @@ pub enum SavedSolutionError {
 /// The first 12 hex digits of a key, as messages show it.
 fn short(key: &ThermalKey) -> &str {
     &key.0[..12.min(key.0.len())]
+}
+
+/// " at t = … s" for an instant, nothing for the run on its own grid.
+fn at_instant(time_s: Option<f64>) -> String {
+    time_s.map_or(String::new(), |t| format!(" at t = {} s", number(t)))
 }
 
 /// Text formatted straight into a SHA-256.
@@ -141,10 +147,7 @@ impl Hashing {
 /// The keys of a thermal scene's runs, one per instant (s from `start_utc`); equal keys share a
 /// run. Refused for a scene without `[thermal]` or an instant outside the run.
 pub fn thermal_keys(scene: &Scene, times_s: &[f64]) -> Result<Vec<ThermalKey>, ThermalRunError> {
-    let setup = scene
-        .thermal
-        .as_deref()
-        .ok_or_else(|| ThermalRunError::NotThermal(shown_path(&scene.path)))?;
+    let setup = thermal_setup(scene)?;
     if let Some(&t) = times_s
         .iter()
         .find(|&&t| !(t.is_finite() && (0.0..=setup.duration_s).contains(&t)))
@@ -157,15 +160,43 @@ pub fn thermal_keys(scene: &Scene, times_s: &[f64]) -> Result<Vec<ThermalKey>, T
     let inputs = inputs_digest(scene, setup);
     Ok(times_s
         .iter()
-        .map(|&t| {
-            let mut digest = inputs.clone();
-            digest.update(b"samples=");
-            for s in sample_times(setup, &[t]).0 {
-                digest.update(s.to_bits().to_le_bytes());
-            }
-            ThermalKey(hex(&digest.finalize()))
-        })
+        .map(|&t| key_of(&inputs, setup, &[t]))
         .collect())
+}
+
+/// The key of the one run that records every one of `times_s`; none given, the run on its own
+/// sample grid (`irpol thermal`'s, which every instant on that grid shares). Refused when the
+/// instants need separate runs.
+pub fn run_key(scene: &Scene, times_s: &[f64]) -> Result<ThermalKey, SavedSolutionError> {
+    if times_s.is_empty() {
+        let setup = thermal_setup(scene)?;
+        return Ok(key_of(&inputs_digest(scene, setup), setup, &[]));
+    }
+    let keys = thermal_keys(scene, times_s)?;
+    match keys.iter().position(|k| k != &keys[0]) {
+        Some(i) => Err(SavedSolutionError::SeparateRuns {
+            first_s: times_s[0],
+            other_s: times_s[i],
+        }),
+        None => Ok(keys[0].clone()),
+    }
+}
+
+fn thermal_setup(scene: &Scene) -> Result<&ThermalSetup, ThermalRunError> {
+    scene
+        .thermal
+        .as_deref()
+        .ok_or_else(|| ThermalRunError::NotThermal(shown_path(&scene.path)))
+}
+
+/// The key of the run whose samples are the grid's and `extra`'s.
+fn key_of(inputs: &Sha256, setup: &ThermalSetup, extra: &[f64]) -> ThermalKey {
+    let mut digest = inputs.clone();
+    digest.update(b"samples=");
+    for s in sample_times(setup, extra).0 {
+        digest.update(s.to_bits().to_le_bytes());
+    }
+    ThermalKey(hex(&digest.finalize()))
 }
 
 fn hex(bytes: &[u8]) -> String {
@@ -377,14 +408,24 @@ pub fn solution_for(
     scene: &Scene,
     time_s: f64,
 ) -> Result<ThermalSolution, SavedSolutionError> {
-    let expected = one_key(scene, time_s)?;
+    solution_recording(path, scene, &[time_s])
+}
+
+/// The solution saved at `path` of the one run of `scene` recording every one of `times_s`
+/// (none: the run on its own grid, [`run_key`]), refused as [`solution_for`] says.
+pub fn solution_recording(
+    path: &Path,
+    scene: &Scene,
+    times_s: &[f64],
+) -> Result<ThermalSolution, SavedSolutionError> {
+    let expected = run_key(scene, times_s)?;
     let (found, solution) = read_solution(path)?;
     if found != expected {
         return Err(SavedSolutionError::KeyMismatch {
             path: path.to_owned(),
             found,
             expected,
-            time_s,
+            time_s: (times_s.len() == 1).then(|| times_s[0]),
         });
     }
     let vertices = scene.mesh.positions.len();
@@ -394,7 +435,8 @@ pub fn solution_for(
             detail: format!("its rows do not hold the scene's {vertices} vertices"),
         });
     }
-    if !solution.times_s.iter().any(|&t| (t - time_s).abs() < 1e-6) {
+    let recorded = |t: f64| solution.times_s.iter().any(|&s| (s - t).abs() < 1e-6);
+    if let Some(&time_s) = times_s.iter().find(|&&t| !recorded(t)) {
         return Err(SavedSolutionError::MissingInstant {
             path: path.to_owned(),
             time_s,
@@ -403,9 +445,41 @@ pub fn solution_for(
     Ok(solution)
 }
 
-fn one_key(scene: &Scene, time_s: f64) -> Result<ThermalKey, ThermalRunError> {
-    let mut keys = thermal_keys(scene, &[time_s])?;
-    Ok(keys.remove(0))
+/// Whether a run was read from its file or solved.
+#[derive(Debug)]
+pub enum RunOrigin {
+    /// Read from the file, solved earlier.
+    Reused,
+    /// Solved and saved to the file; `ignored` says why a file that was there could not be used
+    /// (damaged, another format; `None` when there was none, or it lacked an instant asked for,
+    /// which the new run adds).
+    Solved { ignored: Option<SavedSolutionError> },
+}
+
+/// The run of `scene` recording `times_s` (none: the run on its own grid): read from `path` when
+/// that holds it with every instant ([`solution_recording`]), else solved and saved to `path`
+/// (atomically). Refused when the instants need separate runs.
+pub fn load_or_solve(
+    scene: &Scene,
+    times_s: &[f64],
+    path: &Path,
+    progress: &dyn Progress,
+) -> Result<(ThermalKey, ThermalSolution, RunOrigin), SavedSolutionError> {
+    let key = run_key(scene, times_s)?;
+    let ignored = match solution_recording(path, scene, times_s) {
+        Ok(solution) => return Ok((key, solution, RunOrigin::Reused)),
+        Err(SavedSolutionError::Read { source, .. })
+            if source.kind() == std::io::ErrorKind::NotFound =>
+        {
+            None
+        }
+        Err(SavedSolutionError::MissingInstant { .. }) => None,
+        Err(SavedSolutionError::Run(error)) => return Err(error.into()),
+        Err(other) => Some(other),
+    };
+    let solution = solve_scene(scene, times_s, progress)?;
+    save_solution(path, &key, &solution)?;
+    Ok((key, solution, RunOrigin::Solved { ignored }))
 }
 
 /// Solves the scene's run recording `times_s` (which must share one key) and saves it to `path`,
@@ -417,23 +491,8 @@ pub fn solve_and_save(
     path: &Path,
     progress: &dyn Progress,
 ) -> Result<ThermalKey, SavedSolutionError> {
-    let keys = thermal_keys(scene, times_s)?;
-    let Some(key) = keys.first().cloned() else {
+    if times_s.is_empty() {
         return Err(SavedSolutionError::NoInstants);
-    };
-    if let Some(i) = keys.iter().position(|k| k != &key) {
-        return Err(SavedSolutionError::SeparateRuns {
-            first_s: times_s[0],
-            other_s: times_s[i],
-        });
     }
-    if let Ok((found, saved)) = read_solution(path) {
-        let recorded = |t: f64| saved.times_s.iter().any(|&s| (s - t).abs() < 1e-6);
-        if found == key && times_s.iter().all(|&t| recorded(t)) {
-            return Ok(key);
-        }
-    }
-    let solution = solve_scene(scene, times_s, progress)?;
-    save_solution(path, &key, &solution)?;
-    Ok(key)
+    load_or_solve(scene, times_s, path, progress).map(|(key, _, _)| key)
 }

@@ -182,6 +182,25 @@ fn shipped_examples_are_the_files_the_page_shows() {
     }
 }
 
+/// docs/camera.md's copy-paste block: the shipped snippet is the tables the page shows, and
+/// appended to the car scene it turns the camera on (optics, detector, DoFP array).
+#[test]
+fn the_camera_snippet_turns_the_camera_on() {
+    let snippet =
+        std::fs::read_to_string(root().join("docs/examples/snippets/camera.toml")).unwrap();
+    let tables = &snippet[snippet.find("[sensor.optics]").expect("the optics table")..];
+    assert!(
+        page("camera.md").contains(tables),
+        "docs/camera.md does not show docs/examples/snippets/camera.toml's tables"
+    );
+    let car = std::fs::read_to_string(root().join("scenes/car.toml")).unwrap();
+    // Beside scenes/car.toml, as the page's copy beside car.obj: the same relative paths.
+    let path = root().join("scenes/car_camera.toml");
+    let scene = irpol::scene::load_scene_text(&path, &format!("{car}{snippet}")).unwrap();
+    let dofp = scene.sensor.dofp.expect("a DoFP array");
+    assert_eq!(dofp.demosaic.name(), "newton");
+}
+
 #[test]
 fn the_hand_written_material_is_a_library_entry() {
     let blocks = marked_blocks(&page("materials.md"));

@@ -349,7 +349,9 @@ fn a_spheres_shadow_matches_the_analytic_one() {
 /// smooth_glass windows the car had before its windows became the spectral silicate glass, and
 /// no detector noise: the noise's generator is not the model (the reference was remade without
 /// it when the generator changed: it differed from the noisy one by the noise alone, S0 by
-/// 4e-5 on average with a spread of 0.0071 W m⁻² sr⁻¹, S1 and S2 with √2 × that spread).
+/// 4e-5 on average with a spread of 0.0071 W m⁻² sr⁻¹, S1 and S2 with √2 × that spread). It was
+/// remade again when a part came to keep its own temperature at the vertices it shares with
+/// other parts instead of their mean (the paper's §4): only pixels beside part boundaries moved.
 #[test]
 fn the_open_world_car_is_unchanged() {
     let dir = tempfile::tempdir().unwrap();

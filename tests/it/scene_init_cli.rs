@@ -50,8 +50,10 @@ fn the_starter_scene_renders_and_is_never_overwritten() {
     assert_ne!(written, "# my edits\n");
 }
 
+/// By default the scene goes under `out/` (ignored by git), not into the current folder, which
+/// is a checkout's root when the docs' command is run as written.
 #[test]
-fn init_writes_scene_toml_in_the_current_folder_by_default() {
+fn init_writes_out_scene_toml_by_default() {
     let dir = tempfile::tempdir().unwrap();
     let status = std::process::Command::new(env!("CARGO_BIN_EXE_irpol"))
         .args(["scene", "init"])
@@ -63,5 +65,8 @@ fn init_writes_scene_toml_in_the_current_folder_by_default() {
         "{}",
         String::from_utf8_lossy(&status.stderr)
     );
-    assert!(dir.path().join("scene.toml").is_file());
+    assert!(dir.path().join("out/scene.toml").is_file());
+    assert!(!dir.path().join("scene.toml").exists());
+    let stdout = String::from_utf8_lossy(&status.stdout);
+    assert!(stdout.contains("irpol render out/scene.toml"), "{stdout}");
 }

@@ -385,9 +385,10 @@ fn frame_folders(out: &std::path::Path) -> Vec<String> {
     names
 }
 
-/// A series replaces the folder's earlier outputs as a whole: a shorter or differently stepped
-/// series leaves no frame of the earlier one, a single instant none of a series (and the reverse),
-/// and the user's own files stay.
+/// A series replaces the folder's earlier series as a whole: a shorter or differently stepped
+/// series leaves no frame of the earlier one. A single instant rendered into the folder is an
+/// output set of its own: a series keeps it and it keeps the series (before, `--times` deleted the
+/// `--time-utc` render the docs had just made). The user's own files stay.
 #[test]
 fn a_series_replaces_the_earlier_series_and_keeps_the_users_files() {
     let dir = tempfile::tempdir().unwrap();
@@ -413,15 +414,14 @@ fn a_series_replaces_the_earlier_series_and_keeps_the_users_files() {
     assert_eq!(manifest["frames"][1]["folder"], "001_7200s");
     assert_eq!(manifest["frames"][1]["time_utc"], "2026-06-21T02:00:00Z");
     render(&["--time", "3600"]);
-    assert!(frame_folders(&out).is_empty());
-    assert!(!out.join("preview.gif").exists() && !out.join("series.json").exists());
+    assert_eq!(frame_folders(&out).len(), 4, "the series stays");
+    assert!(out.join("preview.gif").exists() && out.join("series.json").exists());
     assert!(out.join("S0.tif").is_file());
+    let single = std::fs::read(out.join("summary.json")).unwrap();
     render(&["--times", "0:3600:3600"]);
     assert_eq!(frame_folders(&out), ["000_0s", "001_3600s"]);
-    assert!(
-        !out.join("S0.tif").exists(),
-        "the single render's files went"
-    );
+    assert!(out.join("S0.tif").is_file(), "the single render stays");
+    assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), single);
     assert_eq!(
         std::fs::read_to_string(out.join("notes.txt")).unwrap(),
         "mine"
