@@ -151,9 +151,14 @@ mod tests {
 
     #[test]
     fn radians_look_like_radians_and_small_degree_grids_do_not() {
-        let radians = points(&[(0.0, 0.174533), (0.523599, 1.047198), (1.047198, 1.396263)]);
+        let rad = |degrees: f64| degrees.to_radians();
+        let radians = points(&[
+            (0.0, rad(10.0)),
+            (rad(30.0), rad(60.0)),
+            (rad(60.0), rad(80.0)),
+        ]);
         let evidence = radians_evidence(&radians).unwrap();
-        assert_eq!((evidence.largest, evidence.line), (1.396263, 2));
+        assert_eq!((evidence.largest, evidence.line), (rad(80.0), 2));
         // Radians written with one decimal, as a coarse scan would be.
         assert!(radians_evidence(&points(&[(0.5, 0.7), (1.0, 1.2)])).is_some());
         // Whole degrees within 1.6° of the normal.
@@ -165,7 +170,7 @@ mod tests {
 
     #[test]
     fn the_flag_turns_the_refusal_into_a_note() {
-        let radians = points(&[(0.523599, 0.5)]);
+        let radians = points(&[(30f64.to_radians(), 0.5)]);
         let refusal = check_degrees("f.csv", &radians, AngleReading::Auto, "FIX").unwrap_err();
         assert!(
             refusal.kind.to_string().ends_with("FIX"),

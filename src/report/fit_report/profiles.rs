@@ -465,7 +465,7 @@ pub fn draw_profile<DB: DrawingBackend>(
             .into_font()
             .color(&GREY)
             .pos(Pos::new(HPos::Left, VPos::Top));
-        strip.draw_text(FLOOR_LABEL, &style, (y_area as i32, 0))?;
+        strip.draw_text(FLOOR_LABEL, &style, (y_area, 0))?;
     }
     Ok(())
 }
