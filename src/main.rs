@@ -9,7 +9,7 @@ use irpol::app::evaluate::{
     geometry_table, write_emissivity_csv, write_mueller_csv, GeometryTable,
 };
 use irpol::app::export::{export_to_mitsuba, parse_grid, parse_wavelengths};
-use irpol::app::fit::{fit_and_write, FitFlags};
+use irpol::app::fit::{fit_and_write, FitFlags, FitOutput};
 use irpol::app::render::{
     default_output_dir, render_scene_at_within, render_scene_within, Instants, TimedRender,
 };
@@ -20,7 +20,7 @@ use irpol::app::thermal::{run_thermal, run_thermal_and_render};
 use irpol::app::validate::{validate_and_report, validation_summary};
 use irpol::app::{parse_sweep, AppError, MeasurementArgs, ModelArgs};
 use irpol::atomic::staging_folder;
-use irpol::fit::{FitOptions, MaterialFit};
+use irpol::fit::{FitInputs, FitOptions, MaterialFit};
 use irpol::material::MaterialModel;
 use irpol::measure::ReadOptions;
 use irpol::output::thermal::ThermalSummary;
@@ -285,6 +285,10 @@ struct FitArgs {
     /// Folder for the fit reports (PNG, SVG) and index.html.
     #[arg(long, default_value = "reports")]
     reports: PathBuf,
+    /// Refuse a fit that does not describe its data (χ²_red above 10, or a parameter pinned at
+    /// a bound of its search interval other than zero): an error, and nothing written.
+    #[arg(long)]
+    strict: bool,
 }
 
 #[derive(Subcommand)]
@@ -471,13 +475,12 @@ fn fit(args: FitArgs) -> anyhow::Result<()> {
         max_minutes: args.max_minutes,
     };
     let reading = args.measurements.read_options()?;
-    fit_and_summarize(
-        &args.inputs,
-        &reading,
-        &flags.options()?,
-        &args.out,
-        &args.reports,
-    )
+    let output = FitOutput {
+        fits_dir: &args.out,
+        reports_dir: &args.reports,
+        strict: args.strict,
+    };
+    fit_and_summarize(&args.inputs, &reading, &flags.options()?, &output)
 }
 
 /// `irpol export --to mitsuba`: the table written, then its size, grid and wavelengths.
@@ -615,22 +618,22 @@ fn fit_and_summarize(
     inputs: &[PathBuf],
     reading: &ReadOptions,
     options: &FitOptions,
-    fits_dir: &Path,
-    reports_dir: &Path,
+    output: &FitOutput,
 ) -> anyhow::Result<()> {
-    cli::signals::remove_on_interrupt(vec![], vec![fits_dir.to_owned(), reports_dir.to_owned()]);
+    let folders = vec![output.fits_dir.to_owned(), output.reports_dir.to_owned()];
+    cli::signals::remove_on_interrupt(vec![], folders);
+    // The readers' notes are said before the fit starts.
+    let read = FitInputs::read(inputs, reading)?;
+    note_all(&read.notes());
     let written = fit_and_write(
-        inputs,
+        read,
         reading,
         options,
-        fits_dir,
-        reports_dir,
+        output,
         &TerminalProgress::counting(),
     )?;
-    for outcome in &written.outcomes {
-        note_all(&outcome.notes());
-    }
     warn_once(&written.warnings);
+    warn_once(&written.misfits);
     for (outcome, entry) in written.outcomes.iter().zip(&written.entries) {
         let line = match outcome {
             MaterialFit::Grey(outcome) => fit_summary_line(outcome, entry),
@@ -969,6 +972,12 @@ fn report_thermal(scene: &Path, out: &Path, summary: &ThermalSummary) {
 fn print_library(dir: &Path) -> anyhow::Result<()> {
     let library = irpol::material::list_library(dir)?;
     warn_once(&library.warnings());
+    let misfits: Vec<String> = library
+        .materials
+        .iter()
+        .filter_map(|(_, m)| irpol::app::fit::misfit_warning(m))
+        .collect();
+    warn_once(&misfits);
     let materials = library.materials;
     if materials.is_empty() {
         say!("no materials in {}", dir.display());
@@ -1013,10 +1022,11 @@ fn print_library(dir: &Path) -> anyhow::Result<()> {
             .distribution()
             .parameter(irpol::pbrdf::Parameter::Q)
             .map_or("—".into(), |q| format!("{q:.3}"));
-        let chi2 = m
-            .fit
-            .as_ref()
-            .map_or("—".into(), |f| format!("{:.3}", f.reduced_chi2));
+        // A fit that does not describe its data is marked, and said below the table.
+        let chi2 = m.fit.as_ref().map_or("—".into(), |f| {
+            let mark = if f.misfit().is_empty() { "" } else { " !" };
+            format!("{:.3}{mark}", f.reduced_chi2)
+        });
         say!(
             "{:<18} {:<9} {:<17} {:>9} {:>6.3} {:>6} {:>11} {:>11} {:>7} {:>8}",
             m.name,
@@ -1076,8 +1086,11 @@ fn demo() -> anyhow::Result<()> {
         &[measurements],
         &ReadOptions::default(),
         &FitFlags::default().options()?,
-        &fits,
-        &reports,
+        &FitOutput {
+            fits_dir: &fits,
+            reports_dir: &reports,
+            strict: false,
+        },
     )?;
     say!("the paper's model figures:");
     for figure in [PaperFigure::Fig2, PaperFigure::Fig3] {

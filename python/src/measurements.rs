@@ -52,6 +52,7 @@ pub fn measurement_args(
             wavelength_um,
             theta_i_deg: theta_i_deg.unwrap_or_default(),
         },
+        angles: None,
     }
 }
 

@@ -97,6 +97,14 @@ pub enum AppError {
     #[error("cannot draw the animated preview: {0}")]
     Caption(String),
 
+    /// A fit refused by `--strict` because it does not describe its data.
+    #[error("{0}; nothing written (--strict)")]
+    Misfit(String),
+    /// An error of a fit whose files' angles were read as `--angles` said: the readers' notes
+    /// say how, since that may be the cause.
+    #[error("{}; note: {notes}", one_line(error.as_ref()))]
+    WithAngleNotes { error: Box<AppError>, notes: String },
+
     // --- input the application refuses ---
     /// A command-line argument (or the Python argument of the same name) that makes no sense.
     #[error("{0}")]
@@ -187,6 +195,7 @@ impl AppError {
         match self {
             AppError::Stream(_) => true,
             AppError::Image(image::ImageError::IoError(_)) => true,
+            AppError::WithAngleNotes { error, .. } => error.is_io(),
             _ => {
                 self.measure_error()
                     .is_some_and(MeasureError::is_unreadable_path)

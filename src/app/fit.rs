@@ -6,11 +6,11 @@
 use super::AppError;
 use crate::atomic::OutputSet;
 use crate::fit::{
-    fit_inputs_with, parse_parameter_list, parse_parameter_values, Dispersion, DistributionKind,
-    FitOptions, MaterialFit, Optimizer, RobustLoss,
+    fit_read_inputs, parse_parameter_list, parse_parameter_values, Dispersion, DistributionKind,
+    FitInputs, FitOptions, MaterialFit, Optimizer, RobustLoss,
 };
 use crate::material::{list_library, Library, Material};
-use crate::measure::ReadOptions;
+use crate::measure::{is_angle_note, ReadOptions};
 use crate::pbrdf::{ModelTerms, Shadowing};
 use crate::report::fit_report::encode_fit_report;
 use crate::report::index::library_index_html;
@@ -213,19 +213,76 @@ pub struct FitWritten {
     pub index: PathBuf,
     /// Files of the library folder the index skipped (not materials), one warning each.
     pub warnings: Vec<String>,
+    /// Each fit that does not describe its data, one warning each ([`misfit_warning`]).
+    pub misfits: Vec<String>,
 }
 
-/// Fits `inputs` (read as `reading` says) and writes `<fits_dir>/<material>.toml`, `<reports_dir>/<material>.png|svg` and
-/// `<reports_dir>/index.html`, all or nothing.
+/// Where `irpol fit` writes, and whether a fit that does not describe its data is refused.
+pub struct FitOutput<'a> {
+    /// The library folder (`--out`).
+    pub fits_dir: &'a Path,
+    /// The reports' folder (`--reports`).
+    pub reports_dir: &'a Path,
+    /// `--strict`: a misfit is an error and nothing is written.
+    pub strict: bool,
+}
+
+/// `MATERIAL: the fit does not describe its data: χ²_red = 1508 > 10, sigma pinned at a bound
+/// of its search interval`, or `None` for a fit that does ([`crate::material::FitRecord::misfit`]).
+pub fn misfit_warning(material: &Material) -> Option<String> {
+    let misfit = material.fit.as_ref()?.misfit();
+    (!misfit.is_empty()).then(|| {
+        format!(
+            "{}: the fit does not describe its data: {}",
+            material.name,
+            misfit.join(", ")
+        )
+    })
+}
+
+/// Fits `inputs` (read as `reading` says) and writes `<fits_dir>/<material>.toml`,
+/// `<reports_dir>/<material>.png|svg` and `<reports_dir>/index.html`, all or nothing. Any error
+/// repeats the readers' notes about angle units (`--angles`), which may be its cause.
 pub fn fit_and_write(
-    inputs: &[PathBuf],
+    inputs: FitInputs,
     reading: &ReadOptions,
     options: &FitOptions,
-    fits_dir: &Path,
-    reports_dir: &Path,
+    output: &FitOutput,
     progress: &dyn crate::progress::Progress,
 ) -> Result<FitWritten, AppError> {
-    let outcomes = fit_inputs_with(inputs, reading, options, progress)?;
+    let angle_notes: Vec<String> = inputs
+        .notes()
+        .into_iter()
+        .filter(|note| is_angle_note(note))
+        .collect();
+    fit_and_write_read(inputs, reading, options, output, progress).map_err(|error| {
+        if angle_notes.is_empty() {
+            error
+        } else {
+            AppError::WithAngleNotes {
+                error: Box::new(error),
+                notes: angle_notes.join("; "),
+            }
+        }
+    })
+}
+
+fn fit_and_write_read(
+    inputs: FitInputs,
+    reading: &ReadOptions,
+    options: &FitOptions,
+    output: &FitOutput,
+    progress: &dyn crate::progress::Progress,
+) -> Result<FitWritten, AppError> {
+    let (fits_dir, reports_dir) = (output.fits_dir, output.reports_dir);
+    let outcomes = fit_read_inputs(inputs, reading, options, progress)?;
+    let misfits: Vec<String> = outcomes
+        .iter()
+        .filter_map(|o| misfit_warning(o.material()))
+        .collect();
+    if output.strict && !misfits.is_empty() {
+        return Err(AppError::Misfit(misfits.join("; ")));
+    }
     let mut entries = Vec::new();
     let mut report_files = Vec::new();
     let mut reports = Vec::new();
@@ -267,6 +324,7 @@ pub fn fit_and_write(
         reports,
         index,
         warnings,
+        misfits,
     })
 }
 

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use super::AppError;
-use crate::measure::{Layout, MeasurementSet, ReadOptions, RowSelection};
+use crate::measure::{AngleReading, Layout, MeasurementSet, ReadOptions, RowSelection};
 
 /// How to read the measurement files: `--layout`, `--wavelength`, `--theta-i`.
 #[derive(Clone, Debug, Default)]
@@ -19,6 +19,11 @@ pub struct MeasurementArgs {
     pub layout: Option<PathBuf>,
     #[cfg_attr(feature = "cli", command(flatten))]
     pub selection: SelectionArgs,
+    /// How to read the files' angle columns: auto (as declared; angles that look like radians
+    /// declared as degrees are refused), degrees (even if they look like radians), or radians
+    /// (a CSV whose _deg columns hold radians, converted).
+    #[cfg_attr(feature = "cli", arg(long, value_name = "auto|degrees|radians"))]
+    pub angles: Option<String>,
 }
 
 /// Which rows of each file to keep: `--wavelength`, `--theta-i`.
@@ -64,6 +69,10 @@ impl MeasurementArgs {
         Ok(ReadOptions {
             layout,
             selection: self.selection.selection()?,
+            angles: match &self.angles {
+                Some(text) => AngleReading::parse(text).map_err(AppError::invalid)?,
+                None => AngleReading::Auto,
+            },
         })
     }
 }

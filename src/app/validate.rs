@@ -124,13 +124,10 @@ fn page_names(sets: &[MeasurementSet]) -> Vec<String> {
     names
 }
 
-/// `m00 RMS 3.1 % · m_ij/m00 RMS 0.0123 · χ²/obs 4.2 (σ from the file) · max |r| 12.3`.
+/// `m00 RMS 3.1 % · m_ij/m00 RMS 0.0123 · χ²/obs 4.2 (σ from the file's u_ columns) · max |r|
+/// 12.3`.
 pub fn validation_summary(v: &Validation) -> String {
-    let sigma = if v.uncertainties_from_file {
-        "σ from the file"
-    } else {
-        "σ partly from the default noise model"
-    };
+    let sigma = &v.sigma_origin;
     format!(
         "{} rows: m00 relative RMS {:.2} % · m_ij/m00 RMS {:.4} · χ²/obs {:.3} ({sigma}) · max |r| {:.1}",
         v.rows,

@@ -9,8 +9,8 @@ use super::spectral::{fit_spectral, fit_spectral_from, SpectralFitOutcome};
 use super::FitError;
 use crate::material::Material;
 use crate::measure::{
-    collect_measurement_files, merge_repeat_measurements, MeasurementSet, ReadOptions,
-    SAME_WAVELENGTH_UM,
+    collect_measurement_files, merge_repeat_measurements, AngleReading, MeasurementSet,
+    ReadOptions, SAME_WAVELENGTH_UM,
 };
 use crate::progress::Progress;
 use std::path::{Path, PathBuf};
@@ -34,17 +34,44 @@ impl MaterialFit {
     /// What the reader did that the user should know, one line each and each once (the sets
     /// of one file carry the file's notes alike).
     pub fn notes(&self) -> Vec<String> {
-        let all: Vec<&String> = match self {
-            MaterialFit::Grey(o) => o.measurement.notes.iter().collect(),
-            MaterialFit::Spectral(o) => o.measurements.iter().flat_map(|m| &m.notes).collect(),
-        };
-        let mut once: Vec<String> = Vec::new();
-        for note in all {
-            if !once.contains(note) {
-                once.push(note.clone());
-            }
+        match self {
+            MaterialFit::Grey(o) => once([&o.measurement]),
+            MaterialFit::Spectral(o) => once(&o.measurements),
         }
-        once
+    }
+}
+
+/// The notes of `sets`, each once, in order.
+fn once<'a>(sets: impl IntoIterator<Item = &'a MeasurementSet>) -> Vec<String> {
+    let mut once: Vec<String> = Vec::new();
+    for note in sets.into_iter().flat_map(|set| &set.notes) {
+        if !once.contains(note) {
+            once.push(note.clone());
+        }
+    }
+    once
+}
+
+/// Every input of a fit read and checked, before any fitting starts (`irpol fit` prints the
+/// readers' notes before the fit, and repeats those about angle units with any error): the sets
+/// of each material, one per wavelength, ascending.
+#[derive(Clone, Debug)]
+pub struct FitInputs {
+    materials: Vec<Vec<MeasurementSet>>,
+}
+
+impl FitInputs {
+    /// Reads every file among `inputs` (files, or folders of `*.csv`) as `reading` says and
+    /// checks that each set can be fitted; files of one material are merged.
+    pub fn read(inputs: &[PathBuf], reading: &ReadOptions) -> Result<FitInputs, FitError> {
+        Ok(FitInputs {
+            materials: read_all(inputs, reading)?,
+        })
+    }
+
+    /// What the readers did that the user should know, each note once.
+    pub fn notes(&self) -> Vec<String> {
+        once(self.materials.iter().flatten())
     }
 }
 
@@ -91,7 +118,22 @@ pub fn fit_inputs_with(
     options: &FitOptions,
     progress: &dyn Progress,
 ) -> Result<Vec<MaterialFit>, FitError> {
-    let materials = read_all(inputs, reading)?;
+    fit_read_inputs(
+        FitInputs::read(inputs, reading)?,
+        reading,
+        options,
+        progress,
+    )
+}
+
+/// [`fit_inputs_with`] of inputs already read by [`FitInputs::read`] with `reading`.
+pub fn fit_read_inputs(
+    inputs: FitInputs,
+    reading: &ReadOptions,
+    options: &FitOptions,
+    progress: &dyn Progress,
+) -> Result<Vec<MaterialFit>, FitError> {
+    let materials = inputs.materials;
     validate_options(options)?;
     refuse_law_of_one_wavelength(&materials, options)?;
     super::cost::check_costs(&materials, options)?;
@@ -141,6 +183,7 @@ fn record_reading(outcome: &mut MaterialFit, reading: &ReadOptions) {
     if let Some(record) = material.fit.as_mut() {
         record.layout = reading.layout.as_ref().map(|l| l.source.clone());
         record.selection = (!reading.selection.is_everything()).then(|| reading.selection.clone());
+        record.angles = (reading.angles != AngleReading::Auto).then_some(reading.angles);
     }
 }
 

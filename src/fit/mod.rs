@@ -52,7 +52,7 @@ pub use data::{
 };
 pub use energy::{largest_reflectance, ENERGY_TOLERANCE};
 pub use error::FitError;
-pub use files::{fit_files, fit_inputs, fit_inputs_with, MaterialFit};
+pub use files::{fit_files, fit_inputs, fit_inputs_with, fit_read_inputs, FitInputs, MaterialFit};
 pub use global::GeneticSettings;
 pub use levenberg_marquardt::LevenbergMarquardtSettings;
 pub use model_fit::ModelFit;

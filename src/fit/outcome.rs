@@ -8,7 +8,7 @@ use super::options::FitOptions;
 use super::parameters::{DistributionKind, Parameter};
 use super::stages::Stage;
 use super::FitError;
-use crate::material::{AlternativeFit, FitRecord, Material, MergedSource};
+use crate::material::{pinned_at_bound, AlternativeFit, FitRecord, Material, MergedSource};
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
 use std::collections::BTreeMap;
 
@@ -156,6 +156,7 @@ fn fit_record(
         // How the files were read: set by the caller that read them.
         layout: None,
         selection: None,
+        angles: None,
         merged_sources: set
             .merged
             .iter()
@@ -195,6 +196,11 @@ fn fit_record(
         correlation: uncertainty.correlation.clone(),
         undetermined: names(&uncertainty.undetermined),
         at_bound: names(&uncertainty.at_bound),
+        pinned: pinned_at_bound(
+            &names(&uncertainty.at_bound),
+            &names(&chosen.free),
+            &chosen.values,
+        ),
         profile_bounds: uncertainty
             .profile_bounds
             .iter()

@@ -36,8 +36,28 @@ pub struct Validation {
     pub max_abs_residual: f64,
     /// Whether every σ came from the file (else some from the default noise model).
     pub uncertainties_from_file: bool,
+    /// Where the σ came from, in words (`σ from the file's u_ columns`, `σ estimated from the
+    /// data by the layout (mirror pairs)`, `σ partly from the default noise model`).
+    pub sigma_origin: String,
     /// The model's matrix at every row, in row order.
     pub model_muellers: Vec<Mueller>,
+}
+
+/// Where a set's σ came from: a layout's estimate from the data's own scatter fills the same
+/// per-row uncertainties a file's `u_` columns do, so the set's `uncertainty_model` tells them
+/// apart.
+fn sigma_origin(set: &MeasurementSet, sources: &[ErrorSource]) -> String {
+    let estimated = set
+        .metadata
+        .get("uncertainty_model")
+        .and_then(|model| model.strip_prefix("estimate"));
+    let from_rows = sources.iter().filter(|s| **s == ErrorSource::File).count();
+    match (estimated, from_rows) {
+        (Some(how), _) => format!("σ estimated from the data by the layout{how}"),
+        (None, n) if n == sources.len() => "σ from the file's u_ columns".into(),
+        (None, 0) => "σ from the default noise model, 3 % / 1 % of m00".into(),
+        (None, _) => "σ partly from the default noise model".into(),
+    }
 }
 
 impl Validation {
@@ -99,6 +119,7 @@ pub fn validate_model(model: &Pbrdf, set: &MeasurementSet) -> Result<Validation,
         chi2_per_observation: chi2 / (rows * width as f64),
         max_abs_residual: max_abs,
         uncertainties_from_file: data.error_sources().iter().all(|s| *s == ErrorSource::File),
+        sigma_origin: sigma_origin(set, data.error_sources()),
         model_muellers,
     })
 }

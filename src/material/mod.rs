@@ -167,6 +167,10 @@ pub struct FitRecord {
     /// The rows of the sources that were fitted (`--wavelength`, `--theta-i`); absent: all.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub selection: Option<crate::measure::RowSelection>,
+    /// How the sources' angles were read when `irpol fit --angles` said (`degrees` or
+    /// `radians`); absent: as the files declare them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angles: Option<crate::measure::AngleReading>,
     /// Further files of the same material and wavelength fitted with `source` as repeat
     /// measurements, in the order their rows follow its rows; absent for a fit of one file.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -203,6 +207,12 @@ pub struct FitRecord {
     /// Free parameters resting on a bound of their search interval (e.g. ρ_d = 0).
     #[serde(default)]
     pub at_bound: Vec<String>,
+    /// The `at_bound` parameters pinned at a bound other than zero (σ at its largest, q at its
+    /// smallest, n at 10, …): the search wanted to go where the model means nothing, so the fit
+    /// does not describe its data ([`FitRecord::misfit`]). A zero (ρ_d = 0, k = 0, Cauchy B = 0:
+    /// the term absent) is an answer of the data, not a sign of a bad fit.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pinned: Vec<String>,
     /// One-sided profile-likelihood bounds of the parameters whose 1-σ `uncertainty` does not
     /// describe what the data allow: the undetermined ones, and those the data bound from one
     /// side only (a linear 95 % interval reaching an end of the search interval).
@@ -235,7 +245,46 @@ pub struct FitRecord {
 /// (docs/design.md §1.10 "Identification").
 pub const STRONG_CORRELATION: f64 = 0.98;
 
+/// χ²_red above which a fit does not describe its data ([`FitRecord::misfit`]): the model's
+/// residuals are more than three times the stated noise. The shipped fits reach 1.0 (synthetic
+/// data) and 6.0 (NIST's PTFE, whose noise is estimated).
+pub const MISFIT_REDUCED_CHI2: f64 = 10.0;
+
+/// |value| below which a parameter on a bound of its search interval counts as zero (a term
+/// absent, [`FitRecord::pinned`]); a search coordinate at its bound leaves ρ_d ≈ 1e-6.
+pub const ZERO_AT_BOUND: f64 = 1e-4;
+
+/// The parameters of `names` in `at_bound` whose value (aligned with `names`) is not zero: the
+/// record's [`FitRecord::pinned`].
+pub fn pinned_at_bound(at_bound: &[String], names: &[String], values: &[f64]) -> Vec<String> {
+    names
+        .iter()
+        .zip(values)
+        .filter(|(name, value)| at_bound.contains(name) && value.abs() > ZERO_AT_BOUND)
+        .map(|(name, _)| name.clone())
+        .collect()
+}
+
 impl FitRecord {
+    /// Why the fit does not describe its data, one clause each (`χ²_red = 1508 > 10`, `pinned at
+    /// a bound of the search interval: sigma, q`); empty for a fit that does. The fit warns of
+    /// these, `--strict` refuses them, and the report and the library index mark them.
+    pub fn misfit(&self) -> Vec<String> {
+        let chi2 = (self.reduced_chi2 > MISFIT_REDUCED_CHI2).then(|| {
+            format!(
+                "χ²_red = {} > {MISFIT_REDUCED_CHI2}",
+                crate::text::significant_trimmed(self.reduced_chi2, 4)
+            )
+        });
+        let pinned = (!self.pinned.is_empty()).then(|| {
+            format!(
+                "pinned at a bound of the search interval: {}",
+                self.pinned.join(", ")
+            )
+        });
+        chi2.into_iter().chain(pinned).collect()
+    }
+
     /// The fitted parameters the data do not determine (docs/design.md §1.10
     /// "Identification"), each with why: resting on a bound of its search interval, without
     /// sensitivity or a profile wider than its range (undetermined), or correlated beyond

@@ -13,6 +13,7 @@ use super::columns::{parse_header_row, wrong_delimiter, Layout, Quantity};
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
 use super::fields::{split_fields, Field};
 use super::metadata::{split_metadata_line, wavelength_in_range, HeaderWavelength, Metadata};
+use super::units::{check_degrees, converted_note, AngleReading};
 use super::{MeasurementPoint, MeasurementSet, MAX_MUELLER_SR, MIN_UNCERTAINTY_SR};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
 use crate::text::shown;
@@ -54,7 +55,7 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, MeasureError> {
 /// wavelength_um column holds several wavelengths is refused at the first row of a second one
 /// ([`parse_measurement_sets`] reads it).
 pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementSet, MeasureError> {
-    let mut sets = parse_sets(source, bytes, false)?;
+    let mut sets = parse_sets(source, bytes, false, AngleReading::Auto)?;
     Ok(sets.remove(0))
 }
 
@@ -62,7 +63,7 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
 /// §1.9, holds several in its wavelength_um column; most files hold one).
 pub fn read_measurement_sets(path: &Path) -> Result<Vec<MeasurementSet>, MeasureError> {
     let bytes = read_bytes(path)?;
-    parse_sets(path, &bytes, true)
+    parse_sets(path, &bytes, true, AngleReading::Auto)
 }
 
 /// [`read_measurement_sets`] of bytes; `source` names them.
@@ -70,17 +71,35 @@ pub fn parse_measurement_sets(
     source: &Path,
     bytes: &[u8],
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
-    parse_sets(source, bytes, true)
+    parse_sets(source, bytes, true, AngleReading::Auto)
+}
+
+/// [`parse_measurement_sets`] with the angles read as `angles` says (`--angles`): radians
+/// declared as degrees are refused unless it says how to read them.
+pub(crate) fn parse_sets_reading(
+    source: &Path,
+    bytes: &[u8],
+    angles: AngleReading,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    parse_sets(source, bytes, true, angles)
 }
 
 fn parse_sets(
     source: &Path,
     bytes: &[u8],
     spectral: bool,
+    angles: AngleReading,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
     let sha256 = hex(&Sha256::digest(bytes));
     let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
-    let mut parsed = parse_text(text).map_err(|r| r.in_file(source))?;
+    let radians = angles == AngleReading::Radians;
+    let mut parsed = parse_text(text, radians).map_err(|r| r.in_file(source))?;
+    let file = source.display().to_string();
+    let angle_note = if radians {
+        Some(converted_note(&file))
+    } else {
+        check_degrees(&file, &parsed.points, angles, PLAIN_FIX).map_err(|r| r.in_file(source))?
+    };
     let groups = wavelength_groups(&mut parsed, spectral).map_err(|r| r.in_file(source))?;
     let material = match parsed.metadata.material {
         Some(material) => material,
@@ -89,8 +108,9 @@ fn parse_sets(
             .map(|stem| stem.to_string_lossy().into_owned())
             .unwrap_or_default(),
     };
-    let notes: Vec<String> = signed_zenith_note(&source.display().to_string(), parsed.signed_rows)
+    let notes: Vec<String> = angle_note
         .into_iter()
+        .chain(signed_zenith_note(&file, parsed.signed_rows))
         .collect();
     Ok(groups
         .into_iter()
@@ -223,7 +243,11 @@ pub(crate) fn numbered_lines(text: &str) -> Result<Vec<NumberedLine<'_>>, Refusa
     Ok(lines)
 }
 
-fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
+/// How to fix a §2.1 file whose angles look like radians.
+const PLAIN_FIX: &str = "convert them to degrees, or pass --angles radians to convert them as \
+     the file is read (--angles degrees if they are degrees)";
+
+fn parse_text(text: &str, radians: bool) -> Result<ParsedText, Refusal> {
     let lines = numbered_lines(text)?;
     let is_hash_line = |line: &str| line.trim_start().starts_with('#');
 
@@ -248,7 +272,7 @@ fn parse_text(text: &str) -> Result<ParsedText, Refusal> {
     };
     let mut row_wavelengths = Vec::new();
     let mut points = content
-        .map(|&(number, line)| parse_row(number, line, &layout, &wavelength))
+        .map(|&(number, line)| parse_row(number, line, &layout, &wavelength, radians))
         .map(|row| {
             let (point, row_wavelength) = row?;
             row_wavelengths.extend(row_wavelength);
@@ -355,6 +379,7 @@ fn parse_row(
     line: &str,
     layout: &Layout,
     wavelength: &WavelengthCheck,
+    radians: bool,
 ) -> Result<(MeasurementPoint, Option<(HeaderWavelength, u64)>), Refusal> {
     let fields = fields_of(line_number, line)?;
     check_row_fields(line_number, line, &fields, layout.quantities.len())?;
@@ -371,7 +396,18 @@ fn parse_row(
     for ((field, &quantity), name) in fields.iter().zip(&layout.quantities).zip(&layout.names) {
         let refuse = |kind| Refusal::new(line_number, field.column, kind);
         let text = field.text.as_ref();
-        let value = parse_number(name, text).map_err(refuse)?;
+        let mut value = parse_number(name, text).map_err(refuse)?;
+        let is_angle = matches!(
+            quantity,
+            Quantity::ThetaI | Quantity::ThetaR | Quantity::PhiI | Quantity::PhiR
+        );
+        let text = if radians && is_angle {
+            value = value.to_degrees();
+            format!("{text} rad")
+        } else {
+            text.to_owned()
+        };
+        let text = text.as_str();
         if quantity == Quantity::Wavelength {
             if let Some(kind) = wavelength_refusal(value, text) {
                 return Err(refuse(kind));

@@ -202,6 +202,10 @@ pub enum MeasureErrorKind {
     LayoutNegativeM00 { column: String, value: String },
     #[error("header 'layout': the file names the layout {named}, but the layout {given} was given too and reads the table differently: give one of them (drop --layout, or the '# layout:' line)")]
     LayoutsDisagree { named: String, given: String },
+    #[error("{evidence}, but the angles are declared in degrees: {fix}")]
+    LooksLikeRadians { evidence: String, fix: String },
+    #[error("{flag}: {reason}")]
+    AnglesFlag { flag: &'static str, reason: String },
     #[error("header 'layout': '{value}' (looked for at {path}, beside the file): {reason}: fix the path, relative to the measurement file's folder")]
     NamedLayoutUnreadable {
         value: String,

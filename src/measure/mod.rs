@@ -36,6 +36,7 @@ mod pbsdf;
 mod reading;
 mod realizability;
 mod selection;
+mod units;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -58,6 +59,7 @@ pub use reading::{
 };
 pub use realizability::{unrealizable_rows, Realizability};
 pub use selection::{RowSelection, SelectionError, THETA_I_TOLERANCE_DEG};
+pub use units::{is_angle_note, AngleReading};
 
 /// Largest |Mueller element| and uncertainty a measurement file may hold (sr⁻¹): far above the
 /// mirror peak of the smoothest model (σ = 1e-4, ~1e7 sr⁻¹), small enough that every weighted

@@ -4,11 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use super::csv_reader::{decode_utf8, numbered_lines, parse_measurement_sets, read_bytes};
+use super::csv_reader::{decode_utf8, numbered_lines, parse_sets_reading, read_bytes};
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
-use super::layout::{parse_with_layout, Layout};
+use super::layout::{parse_with_layout_reading, Layout};
 use super::metadata::split_metadata_line;
 use super::selection::{RowSelection, SelectionError};
+use super::units::AngleReading;
 use super::MeasurementSet;
 use crate::text::shown;
 
@@ -22,7 +23,27 @@ pub fn read_measurement_file(
     path: &Path,
     layout: Option<&Layout>,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
+    read_file(path, layout, AngleReading::Auto)
+}
+
+/// [`read_measurement_file`] with the angles read as `angles` says (`--angles`).
+fn read_file(
+    path: &Path,
+    layout: Option<&Layout>,
+    angles: AngleReading,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
     if starts_as_tensor_file(path) {
+        if angles != AngleReading::Auto {
+            return Err(Refusal::new(
+                1,
+                1,
+                MeasureErrorKind::AnglesFlag {
+                    flag: "--angles",
+                    reason: "a Mitsuba table has no angle columns to read: drop --angles".into(),
+                },
+            )
+            .in_file(path));
+        }
         if layout.is_some() {
             return Err(Refusal::new(
                 1,
@@ -36,7 +57,7 @@ pub fn read_measurement_file(
         return super::pbsdf::read_table_measurements(path);
     }
     let bytes = read_bytes(path)?;
-    parse_measurement_file(path, &bytes, layout)
+    parse_file(path, &bytes, layout, angles)
 }
 
 /// Whether the file at `path` begins with a Mitsuba tensor file's magic (docs/design.md §2.10):
@@ -55,13 +76,23 @@ pub fn parse_measurement_file(
     bytes: &[u8],
     layout: Option<&Layout>,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
+    parse_file(source, bytes, layout, AngleReading::Auto)
+}
+
+fn parse_file(
+    source: &Path,
+    bytes: &[u8],
+    layout: Option<&Layout>,
+    angles: AngleReading,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    let through = |layout: &Layout| parse_with_layout_reading(source, bytes, layout, angles);
     match (layout, named_layout(source, bytes)?) {
-        (None, None) => parse_measurement_sets(source, bytes),
-        (Some(layout), None) => parse_with_layout(source, bytes, layout),
-        (None, Some((named, _))) => parse_with_layout(source, bytes, &named),
+        (None, None) => parse_sets_reading(source, bytes, angles),
+        (Some(layout), None) => through(layout),
+        (None, Some((named, _))) => through(&named),
         (Some(given), Some((named, at))) => {
             if same_meaning(given, &named) {
-                parse_with_layout(source, bytes, given)
+                through(given)
             } else {
                 Err(at.refusal(MeasureErrorKind::LayoutsDisagree {
                     named: crate::text::path(&named.source),
@@ -144,11 +175,13 @@ fn beside(file: &Path, named: &str) -> PathBuf {
 }
 
 /// How a command reads its measurement files: through which layout (if the files do not name
-/// their own) and which rows it keeps. The default reads every file as it says and keeps all.
+/// their own), which rows it keeps and how it reads their angles (`--angles`). The default reads
+/// every file as it says and keeps all.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ReadOptions {
     pub layout: Option<Layout>,
     pub selection: RowSelection,
+    pub angles: AngleReading,
 }
 
 /// Why a measurement file cannot be read as asked.
@@ -164,13 +197,13 @@ impl ReadOptions {
     /// One file's sets, one per wavelength, ascending ([`read_measurement_file`]), with only the
     /// selected rows.
     pub fn read(&self, path: &Path) -> Result<Vec<MeasurementSet>, ReadError> {
-        let sets = read_measurement_file(path, self.layout.as_ref())?;
+        let sets = read_file(path, self.layout.as_ref(), self.angles)?;
         Ok(self.selection.apply(sets)?)
     }
 
     /// [`ReadOptions::read`] of a file's bytes; `source` names them.
     pub fn parse(&self, source: &Path, bytes: &[u8]) -> Result<Vec<MeasurementSet>, ReadError> {
-        let sets = parse_measurement_file(source, bytes, self.layout.as_ref())?;
+        let sets = parse_file(source, bytes, self.layout.as_ref(), self.angles)?;
         Ok(self.selection.apply(sets)?)
     }
 }

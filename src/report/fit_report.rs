@@ -38,7 +38,6 @@ use data::ReportData;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use plotters::style::FontStyle;
 use profiles::{
     draw_profile, linear_axis, log_axis, profile_series, Domain, Profile, Quantity, BIN_DEGREES,
 };
@@ -47,7 +46,7 @@ use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use style::{
     draw_caption, draw_legend_column, draw_legend_row, draw_note, incidence_color, DrawResult,
-    LegendEntry, LineKind, Marker, YAxis, TITLE_SIZE,
+    LegendEntry, LineKind, Marker, YAxis,
 };
 
 /// Pixel size of the report figure: five columns of panels in three rows.
@@ -326,6 +325,7 @@ fn recorded_reading(material_path: &Path, fit: &FitRecord) -> Result<ReadOptions
     Ok(ReadOptions {
         layout: recorded_layout(material_path, fit)?,
         selection: fit.selection.clone().unwrap_or_default(),
+        angles: fit.angles.unwrap_or_default(),
     })
 }
 
@@ -555,12 +555,41 @@ fn draw_header<DB: DrawingBackend>(
         set.points.len(),
         set.elements.len(),
     );
-    let title_style = (FONT, TITLE_SIZE, FontStyle::Bold)
-        .into_font()
-        .color(&BLACK)
-        .pos(Pos::new(HPos::Left, VPos::Top));
-    root.draw_text(&title, &title_style.into_text_style(root), (24, 14))?;
-    draw_legend_row(root, &header_legend(data), (28, 72))
+    super::draw_title(root, &title, material)?;
+    let mut legend = header_legend(data);
+    if let Ok(spec) = material.grey_model() {
+        legend.extend(critical_angle_note(spec).map(LegendEntry::text));
+    }
+    draw_legend_row(root, &legend, (28, 72))
+}
+
+/// Why the model's curves kink where they do, for a model with internal facets or the
+/// subsurface term: light inside the material is totally reflected beyond the critical angle
+/// asin(1/n) (facets) and asin(1/n_sub) (the subsurface term's interface), and the Fresnel
+/// terms have a branch point there (docs/measurements.md, the PTFE fit).
+fn critical_angle_note(spec: &crate::material::ModelSpec) -> Option<String> {
+    let terms = spec.terms();
+    let internal = terms.facet_side == crate::pbrdf::FacetSide::Internal;
+    let indices: Vec<(&str, f64)> = [("n", Some(spec.n))]
+        .into_iter()
+        .filter(|_| internal || spec.rho_s.is_some())
+        .chain(std::iter::once((
+            "n_sub",
+            spec.parameter(crate::pbrdf::Parameter::NSub),
+        )))
+        .filter_map(|(name, n)| n.filter(|n| *n > 1.0).map(|n| (name, n)))
+        .collect();
+    if indices.is_empty() {
+        return None;
+    }
+    let angles: Vec<String> = indices
+        .iter()
+        .map(|(name, n)| format!("asin(1/{name}) = {:.1}°", (1.0 / n).asin().to_degrees()))
+        .collect();
+    Some(format!(
+        "kinks in the model curves: total internal reflection inside the material beyond {}",
+        angles.join(" and ")
+    ))
 }
 
 /// The key shared by every data panel: the colour of each incidence angle with curves, the

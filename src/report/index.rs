@@ -246,6 +246,20 @@ fn anchor(material: &Material) -> String {
     format!("m-{}", percent_encode(&material.name))
 }
 
+/// The reduced χ² cell: the number, and in red, for a fit that does not describe its data, why
+/// ([`crate::material::FitRecord::misfit`]).
+fn misfit_cell(fit: &crate::material::FitRecord) -> String {
+    let chi2 = format_plain(fit.reduced_chi2);
+    let misfit = fit.misfit();
+    if misfit.is_empty() {
+        return chi2;
+    }
+    format!(
+        "{chi2} <span class=\"warn\">does not describe its data: {}</span>",
+        escape_html(&misfit.join(", "))
+    )
+}
+
 fn summary_table(html: &mut String, materials: &[(PathBuf, Material)]) {
     html.push_str(
         "<table>\n<tr><th>material</th><th>distribution</th><th>shadowing</th><th>λ (µm)</th>\
@@ -256,7 +270,7 @@ fn summary_table(html: &mut String, materials: &[(PathBuf, Material)]) {
         let model = &material.model;
         let (wavelength, cells) = model_cells(material);
         let (chi2, points) = material.fit.as_ref().map_or(("—".into(), "—".into()), |f| {
-            (format_plain(f.reduced_chi2), f.points.to_string())
+            (misfit_cell(f), f.points.to_string())
         });
         let (status, class) = provenance(path, material);
         let _ = write!(

@@ -60,3 +60,46 @@ pub enum ReportError {
     #[error("material name '{name}' cannot name a report file: it must be a plain file name without folders")]
     MaterialName { name: String },
 }
+
+/// A report's title line at the top left, and beside it, in red, the mark of a fit that does
+/// not describe its data ([`crate::material::FitRecord::misfit`]).
+fn draw_title<DB: plotters::prelude::DrawingBackend>(
+    root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    material: &crate::material::Material,
+) -> fit_report::style::DrawResult<DB> {
+    use plotters::prelude::*;
+    use plotters::style::text_anchor::{HPos, Pos, VPos};
+    let style = |size: i32, color: &RGBColor| {
+        (crate::plot_style::FONT, size, FontStyle::Bold)
+            .into_font()
+            .color(color)
+            .pos(Pos::new(HPos::Left, VPos::Top))
+    };
+    let size = fit_report::style::TITLE_SIZE;
+    root.draw_text(title, &style(size, &BLACK).into_text_style(root), (24, 14))?;
+    let misfit = material
+        .fit
+        .as_ref()
+        .map(|f| f.misfit())
+        .unwrap_or_default();
+    if misfit.is_empty() {
+        return Ok(());
+    }
+    let (width, _) = root.estimate_text_size(title, &style(size, &BLACK).into_text_style(root))?;
+    let mark = format!("   —   DOES NOT DESCRIBE ITS DATA: {}", misfit.join(", "));
+    // As large as the rest of the line allows, down to 14 pt.
+    let room = root.dim_in_pixel().0.saturating_sub(48 + width);
+    let mut mark_size = size;
+    while mark_size > 14
+        && root
+            .estimate_text_size(&mark, &style(mark_size, &BLACK).into_text_style(root))?
+            .0
+            > room
+    {
+        mark_size -= 2;
+    }
+    let red = RGBColor(200, 0, 0);
+    let at = (24 + width as i32, 14 + (size - mark_size) / 2);
+    root.draw_text(&mark, &style(mark_size, &red).into_text_style(root), at)
+}

@@ -15,7 +15,7 @@ mod summary;
 
 pub use emissivity::{emissivity_grid, EmissivityGrid};
 
-use super::fit_report::style::{DrawResult, LEGEND_SIZE, TITLE_SIZE};
+use super::fit_report::style::{DrawResult, LEGEND_SIZE};
 use super::fit_report::{draw_error, encode_bitmap, report_stem, EncodedReport};
 use super::ReportError;
 use crate::fit::SpectralFitOutcome;
@@ -25,7 +25,6 @@ use crate::text::number;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use plotters::style::FontStyle;
 use std::path::{Path, PathBuf};
 
 /// Pixel size of the spectral report figure: a header, then two rows of panels.
@@ -163,11 +162,7 @@ impl Figure<'_> {
             points,
             self.outcome.chosen.dispersion,
         );
-        let style = (FONT, TITLE_SIZE, FontStyle::Bold)
-            .into_font()
-            .color(&BLACK)
-            .pos(Pos::new(HPos::Left, VPos::Top));
-        root.draw_text(&title, &style.into_text_style(root), (24, 14))?;
+        super::draw_title(root, &title, material)?;
         let note = format!(
             "σ and q shared by every wavelength; n, k, ρd per wavelength. The fit at each \
              wavelength, against its measurement: {}/<λ>um.png",

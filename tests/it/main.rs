@@ -14,6 +14,7 @@ mod cli;
 mod docs_examples;
 mod dofp_demosaic;
 mod fit_files;
+mod fit_quality;
 mod fit_shipped;
 mod fit_synthetic;
 mod fit_undetermined;

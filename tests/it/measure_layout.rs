@@ -211,14 +211,17 @@ fn the_good_example_reads() {
     assert_eq!(sets[0].points[0].uncertainties, [None, None, None]);
     assert_eq!(sets[0].metadata["uncertainty_model"], "fixed");
     assert!(sets[0].notes.iter().all(|n| !n.contains("radians")));
-    // Radians declared as degrees look like a narrow scan near the normal: a note, not a refusal.
+    // Radians declared as degrees are refused at the row that shows it, saying what to fix.
     let narrow = "# wavelength_um: 10\nti,tr,pr,M11,M12\n0.52,0.35,3.14,0.5,0.1\n";
-    let sets = parse_with_layout(Path::new("t.csv"), narrow.as_bytes(), &layout).unwrap();
-    assert!(sets[0].notes.contains(
-        &"t.csv: every zenith angle is within 0.52° ≤ π/2: if the angles are in radians, the \
-          layout needs angle_unit = \"rad\""
-            .to_string()
-    ));
+    assert_eq!(
+        parse_with_layout(Path::new("t.csv"), narrow.as_bytes(), &layout)
+            .unwrap_err()
+            .to_string(),
+        "t.csv:3:1: every zenith angle is within ±0.52 (≤ π/2 = 1.5708) and not all whole \
+         degrees (0.52 on line 3): these look like radians, but the angles are declared in \
+         degrees: set angle_unit = \"rad\" in the layout mem/layout.toml (--angles degrees if \
+         they are degrees)"
+    );
 }
 
 #[test]
@@ -827,10 +830,11 @@ fn fit_refuses_a_layout_that_does_not_fit_the_file() {
     assert!(!dir.path().join("fits").exists() && !dir.path().join("reports").exists());
 }
 
-/// Radians declared as degrees cannot be refused (a scan near the normal looks the same), so
-/// `irpol fit` says what it suspects.
+/// Radians declared as degrees through a layout: refused before the fit, with the layout's fix;
+/// `--angles degrees` reads them as degrees with a note said before the fit and repeated with a
+/// fit error; `--angles radians` is refused, since the layout states the unit.
 #[test]
-fn fit_warns_when_degrees_look_like_radians() {
+fn fit_refuses_radians_through_a_layout_unless_told() {
     let dir = tempfile::tempdir().unwrap();
     let table = dir.path().join("table.csv");
     let mut text = String::from("# wavelength_um: 10\nti,tr,pr,M11\n");
@@ -841,13 +845,48 @@ fn fit_warns_when_degrees_look_like_radians() {
     let layout = dir.path().join("layout.toml");
     std::fs::write(&layout, GOOD_LAYOUT.replace("elements = \"M{i}{j}\"\n", "")).unwrap();
     let args = ["--layout", layout.to_str().unwrap(), "--free", "sigma,rho"];
-    let (_, _, stderr) = fit_cli(dir.path(), &table, &args);
+    let (ok, _, stderr) = fit_cli(dir.path(), &table, &args);
+    assert!(!ok);
+    let evidence = "every zenith angle is within ±1.2 (≤ π/2 = 1.5708) and not all whole degrees \
+                    (0.5 on line 3): these look like radians";
+    assert_eq!(
+        stderr.trim_end(),
+        format!(
+            "irpol: error: {}:3:1: {evidence}, but the angles are declared in degrees: set \
+             angle_unit = \"rad\" in the layout {} (--angles degrees if they are degrees)",
+            table.display(),
+            layout.display()
+        )
+    );
+    assert!(!dir.path().join("fits").exists());
+    // Told they are degrees: the note comes before the fit's output and with its error (a
+    // dispersion law for one wavelength fails the fit after the files are read).
+    let told = [
+        &args[..],
+        &["--angles", "degrees", "--dispersion", "cauchy"],
+    ]
+    .concat();
+    let (ok, _, stderr) = fit_cli(dir.path(), &table, &told);
+    let note = format!(
+        "{}: {evidence}; read as degrees, as --angles degrees says",
+        table.display()
+    );
+    assert!(!ok);
     assert!(
-        stderr.contains(&format!(
-            "note: {}: every zenith angle is within 1.2° ≤ π/2: if the angles are in radians, \
-             the layout needs angle_unit = \"rad\"",
-            table.display()
-        )),
+        stderr.starts_with(&format!("irpol: note: {note}\n")),
+        "{stderr}"
+    );
+    assert!(
+        stderr.trim_end().ends_with(&format!("; note: {note}")),
+        "{stderr}"
+    );
+    // A layout states its unit: --angles radians is refused, pointing at it.
+    let radians = [&args[..], &["--angles", "radians"]].concat();
+    let (ok, _, stderr) = fit_cli(dir.path(), &table, &radians);
+    assert!(!ok);
+    assert!(stderr.contains("--angles radians: the layout"), "{stderr}");
+    assert!(
+        stderr.contains("fix angle_unit there and drop --angles"),
         "{stderr}"
     );
 }

@@ -6,7 +6,8 @@ use super::super::options::FitOptions;
 use super::super::outcome::settings;
 use super::SpectralFit;
 use crate::material::{
-    DispersionChoice, FitRecord, Material, MaterialModel, MergedSource, WavelengthQuality,
+    pinned_at_bound, DispersionChoice, FitRecord, Material, MaterialModel, MergedSource,
+    WavelengthQuality,
 };
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
 use std::collections::BTreeMap;
@@ -29,6 +30,7 @@ pub(super) fn material(
         // How the files were read: set by the caller that read them.
         layout: None,
         selection: None,
+        angles: None,
         merged_sources: merged_sources(sets),
         points: sets.iter().map(|s| s.points.len()).sum(),
         elements: element_names(sets),
@@ -54,6 +56,7 @@ pub(super) fn material(
         correlation: chosen.correlation.clone(),
         undetermined: Vec::new(),
         at_bound: chosen.at_bound.clone(),
+        pinned: pinned_at_bound(&chosen.at_bound, &chosen.names, &chosen.values),
         profile_bounds: BTreeMap::new(),
         uncertainty_per_wavelength: uncertainty_per_wavelength(chosen),
         wavelengths: wavelength_quality(sets, chosen),

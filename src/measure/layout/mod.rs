@@ -181,5 +181,16 @@ pub fn parse_with_layout(
     bytes: &[u8],
     layout: &Layout,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
-    table::parse_table(source, bytes, layout)
+    table::parse_table(source, bytes, layout, super::AngleReading::Auto)
+}
+
+/// [`parse_with_layout`] with `--angles` (radians declared as degrees are refused unless it
+/// says how to read them).
+pub(crate) fn parse_with_layout_reading(
+    source: &Path,
+    bytes: &[u8],
+    layout: &Layout,
+    angles: super::AngleReading,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    table::parse_table(source, bytes, layout, angles)
 }

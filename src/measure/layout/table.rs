@@ -18,6 +18,7 @@ use crate::measure::csv_reader::{
 use crate::measure::error::{MeasureError, MeasureErrorKind, Refusal};
 use crate::measure::fields::{split_fields, Field};
 use crate::measure::metadata::{split_metadata_line, HeaderWavelength, Metadata};
+use crate::measure::units::{check_degrees, AngleReading};
 use crate::measure::{MeasurementPoint, MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
 use crate::text::shown;
@@ -60,11 +61,50 @@ pub(super) fn parse_table(
     source: &Path,
     bytes: &[u8],
     layout: &Layout,
+    angles: AngleReading,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
     let sha256 = hex(&Sha256::digest(bytes));
     let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
     let parsed = parse_text(text, layout).map_err(|r| r.in_file(source))?;
-    Ok(build_sets(source, sha256, parsed, layout))
+    let angle_note = check_layout_angles(source, &parsed.points, layout, angles)
+        .map_err(|r| r.in_file(source))?;
+    Ok(build_sets(source, sha256, parsed, layout, angle_note))
+}
+
+/// The table's angles against the layout's `angle_unit` and `--angles`: radians declared as
+/// degrees are refused unless `--angles degrees` says they are degrees (then a note); a layout
+/// states its unit, so `--angles` naming the other one is refused.
+fn check_layout_angles(
+    source: &Path,
+    points: &[MeasurementPoint],
+    layout: &Layout,
+    angles: AngleReading,
+) -> Result<Option<String>, Refusal> {
+    let layout_file = crate::text::path(&layout.source);
+    let conflict = match (layout.conventions.angle_unit, angles) {
+        (AngleUnit::Radians, _) if angles != AngleReading::Degrees => return Ok(None),
+        (AngleUnit::Radians, _) => Some(("--angles degrees", "\"rad\"")),
+        (AngleUnit::Degrees, AngleReading::Radians) => Some(("--angles radians", "\"deg\"")),
+        (AngleUnit::Degrees, _) => None,
+    };
+    if let Some((flag, unit)) = conflict {
+        return Err(Refusal::new(
+            1,
+            1,
+            MeasureErrorKind::AnglesFlag {
+                flag,
+                reason: format!(
+                    "the layout {layout_file} says angle_unit = {unit}; a layout states the unit \
+                     of its table's angles: fix angle_unit there and drop --angles"
+                ),
+            },
+        ));
+    }
+    let fix = format!(
+        "set angle_unit = \"rad\" in the layout {layout_file} (--angles degrees if they are \
+         degrees)"
+    );
+    check_degrees(&source.display().to_string(), points, angles, &fix)
 }
 
 fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
@@ -501,6 +541,7 @@ fn build_sets(
     sha256: String,
     parsed: ParsedTable,
     layout: &Layout,
+    angle_note: Option<String>,
 ) -> Vec<MeasurementSet> {
     let file = source.display().to_string();
     let material = match &parsed.metadata.material {
@@ -510,7 +551,8 @@ fn build_sets(
             .map(|stem| stem.to_string_lossy().into_owned())
             .unwrap_or_default(),
     };
-    let file_notes = file_notes(&file, &parsed, layout);
+    let mut file_notes: Vec<String> = angle_note.into_iter().collect();
+    file_notes.extend(file_notes_of(&file, &parsed, layout));
     let mut metadata = parsed.metadata.entries.clone();
     metadata.insert("layout".to_string(), layout.source.display().to_string());
     let groups = wavelength_groups(parsed.points, parsed.wavelengths);
@@ -541,7 +583,7 @@ fn build_sets(
 }
 
 /// What the layout changed, said once per file.
-fn file_notes(file: &str, parsed: &ParsedTable, layout: &Layout) -> Vec<String> {
+fn file_notes_of(file: &str, parsed: &ParsedTable, layout: &Layout) -> Vec<String> {
     let conventions = &layout.conventions;
     let mut done = Vec::new();
     if conventions.angle_unit == AngleUnit::Radians {
@@ -567,9 +609,6 @@ fn file_notes(file: &str, parsed: &ParsedTable, layout: &Layout) -> Vec<String> 
             done.join("; ")
         ));
     }
-    if let Some(note) = radians_note(file, &parsed.points, conventions.angle_unit) {
-        notes.push(note);
-    }
     if parsed.folded_incident > 0 {
         notes.push(format!(
             "{file}: {} with θ_i < 0 read as (|θ_i|, φ_i + 180°)",
@@ -584,23 +623,6 @@ fn file_notes(file: &str, parsed: &ParsedTable, layout: &Layout) -> Vec<String> 
         ));
     }
     notes
-}
-
-/// A warning when degrees are declared but every zenith angle is within π/2 (and some is not 0):
-/// most likely radians. Not refused, since a narrow scan near the normal can look the same.
-fn radians_note(file: &str, points: &[MeasurementPoint], unit: AngleUnit) -> Option<String> {
-    let largest = points
-        .iter()
-        .map(|p| p.theta_i_deg.max(p.theta_r_deg))
-        .fold(0.0, f64::max);
-    (unit == AngleUnit::Degrees && largest > 0.0 && largest <= std::f64::consts::FRAC_PI_2).then(
-        || {
-            format!(
-                "{file}: every zenith angle is within {largest}° ≤ π/2: if the angles are in \
-                 radians, the layout needs angle_unit = \"rad\""
-            )
-        },
-    )
 }
 
 /// The points by wavelength, ascending: all at the header's, or one group per distinct row

@@ -428,8 +428,19 @@ pub fn draw_profile<DB: DrawingBackend>(
     } else {
         (CAPTION_SIZE, 58, 86)
     };
+    // The floor's label goes under the axis description, where no data can be.
+    let floor = (!profile.compact)
+        .then(|| flat_floor(&profile.series, profile.y))
+        .flatten();
+    let (area, strip) = match floor {
+        Some(_) => {
+            let (chart, strip) = area.split_vertically(area.dim_in_pixel().1 - FLOOR_LABEL_ROW);
+            (chart, Some(strip))
+        }
+        None => (area.clone(), None),
+    };
     let x = profile.x_axis.clone();
-    let mut builder = ChartBuilder::on(area);
+    let mut builder = ChartBuilder::on(&area);
     builder
         .caption(&profile.caption, (FONT, caption_size))
         .margin(if profile.compact { 6 } else { 12 })
@@ -440,16 +451,27 @@ pub fn draw_profile<DB: DrawingBackend>(
         YAxis::Log { low, high } => {
             let mut chart = builder.build_cartesian_2d(x, (low..high).log_scale())?;
             draw_axes(&mut chart, profile, &log_tick)?;
-            draw_series(&mut chart, profile)
+            draw_series(&mut chart, profile)?;
         }
         YAxis::Linear { low, high } => {
             let mut chart = builder.build_cartesian_2d(x, low..high)?;
             let decimals = if high - low < 0.05 { 3 } else { 2 };
             draw_axes(&mut chart, profile, &|v: &f64| format!("{v:.decimals$}"))?;
-            draw_series(&mut chart, profile)
+            draw_series(&mut chart, profile)?;
         }
     }
+    if let Some(strip) = strip {
+        let style = (FONT, LEGEND_SIZE)
+            .into_font()
+            .color(&GREY)
+            .pos(Pos::new(HPos::Left, VPos::Top));
+        strip.draw_text(FLOOR_LABEL, &style, (y_area, 0))?;
+    }
+    Ok(())
 }
+
+/// Height of the row under a panel's axis description that holds [`FLOOR_LABEL`], pixels.
+const FLOOR_LABEL_ROW: u32 = 22;
 
 fn draw_axes<DB: DrawingBackend, Y: Ranged<ValueType = f64> + ValueFormatter<f64>>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<DegreeAxis, Y>>,
@@ -511,20 +533,11 @@ fn draw_series<DB: DrawingBackend, Y: Ranged<ValueType = f64> + ValueFormatter<f
         }
         chart.draw_series(visible.map(|p| s.marker.at((p.x, p.value), marker_size, s.color)))?;
     }
-    if let (false, Some(at)) = (profile.compact, flat_floor(&profile.series, axis)) {
-        let style = (FONT, LEGEND_SIZE)
-            .into_font()
-            .color(&GREY)
-            .pos(Pos::new(HPos::Left, VPos::Bottom));
-        chart.draw_series(std::iter::once(
-            EmptyElement::at(at) + Text::new(FLOOR_LABEL, (6, -4), style),
-        ))?;
-    }
     Ok(())
 }
 
 /// The label on a dashed curve running flat along the bottom of a log axis.
-pub const FLOOR_LABEL: &str = "dashed: the competing fit's diffuse floor ρd/π";
+pub const FLOOR_LABEL: &str = "dashed level at the bottom: the competing fit's diffuse floor ρd/π";
 /// A stretch of a dashed curve within 1 % of its first value counts as flat when it covers this
 /// share of the points, in the lowest [`FLOOR_BOTTOM_SHARE`] of the log axis' decades.
 const FLOOR_MIN_SHARE: f64 = 0.15;

@@ -135,6 +135,7 @@ fn wavelength_record(
         source_data: None,
         layout: None,
         selection: None,
+        angles: None,
         merged_sources: Vec::new(),
         points: set.points.len(),
         elements: set
@@ -160,6 +161,7 @@ fn wavelength_record(
         correlation,
         undetermined: Vec::new(),
         at_bound: Vec::new(),
+        pinned: Vec::new(),
         profile_bounds: BTreeMap::new(),
         uncertainty_per_wavelength: BTreeMap::new(),
         wavelengths: Vec::new(),
