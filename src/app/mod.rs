@@ -12,6 +12,7 @@ pub mod scene_init;
 pub mod selection;
 pub mod sun;
 pub mod thermal;
+mod thermal_instant;
 pub mod validate;
 pub mod weather;
 

@@ -1,17 +1,18 @@
 //! `irpol render`: scene file in, output files out; for a scene with `[thermal]`, at instants of
 //! its thermal run (docs/design.md §2.6).
 
-use super::error::single_line;
 use super::render_cost::{check_estimate, DEFAULT_MAX_MINUTES};
 use super::saved_thermal::{obtain_run, RunSource, SavedRun};
+pub use super::thermal_instant::scene_to_render;
+use super::thermal_instant::solution_instant;
 use super::AppError;
 use crate::atomic::StagedFolder;
 use crate::output::figure::SeriesPreview;
 use crate::output::{stage_outputs, write_outputs, EarlierOutputs, RenderSummary, SERIES_MANIFEST};
 use crate::progress::Progress;
 use crate::render::render;
-use crate::scene::{load_scene, load_scene_text, Scene};
-use crate::thermal_scene::{scene_at, solve_scene, ThermalSolution};
+use crate::scene::{load_scene, Scene};
+use crate::thermal_scene::ThermalSolution;
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, DynamicImage, Frame, RgbImage, RgbaImage};
 use std::path::{Path, PathBuf};
@@ -254,45 +255,6 @@ fn series_manifest(scene: &Scene, renders: &[TimedRender]) -> serde_json::Value 
     })
 }
 
-/// The thermal scene with the temperatures of `solution` at `time_s` (an instant of the run).
-pub(super) fn solution_instant(
-    scene: &Scene,
-    solution: &ThermalSolution,
-    time_s: f64,
-) -> Result<Scene, AppError> {
-    let index = solution
-        .times_s
-        .iter()
-        .position(|&t| (t - time_s).abs() < 1e-6)
-        .ok_or(AppError::NotAnInstant(time_s))?;
-    scene_at(scene, solution, index).map_err(|e| AppError::SceneAt {
-        path: scene.path.clone(),
-        message: single_line(&e.to_string()),
-    })
-}
-
-/// The scene of `path` read from `text` (the file's own, or changed by a caller such as the
-/// Python bindings), as it is rendered: itself, or for a scene with `[thermal]` its thermal
-/// solution at `time_s` seconds from `thermal.start_utc`. Refused as `irpol render` refuses a
-/// thermal scene without an instant, or an instant without `[thermal]`.
-pub fn scene_to_render(
-    path: &Path,
-    text: &str,
-    time_s: Option<f64>,
-    progress: &dyn Progress,
-) -> Result<Scene, AppError> {
-    let scene = load_scene_text(path, text)?;
-    match (time_s, scene.thermal.is_some()) {
-        (None, false) => Ok(scene),
-        (None, true) => Err(AppError::ThermalNeedsInstant(path.to_owned())),
-        (Some(_), false) => Err(AppError::InstantNeedsThermal(path.to_owned())),
-        (Some(time_s), true) => {
-            let solution = solve(&scene, path, &[time_s], progress)?;
-            solution_instant(&scene, &solution, time_s)
-        }
-    }
-}
-
 /// The folder of instant `i` at `time_s` in a series, `NNN_<t>s`.
 fn frame_name(i: usize, time_s: f64) -> String {
     format!("{i:03}_{}s", time_s.round())
@@ -364,17 +326,4 @@ fn caption_strip(text: &str, width: u32) -> Result<RgbaImage, AppError> {
     let strip = image::RgbImage::from_raw(width, HEIGHT, rgb)
         .ok_or_else(|| AppError::invalid("caption buffer has the wrong size"))?;
     Ok(image::DynamicImage::ImageRgb8(strip).to_rgba8())
-}
-
-/// The scene's thermal run (recording `times` too), its failure naming the scene file.
-pub(crate) fn solve(
-    scene: &Scene,
-    scene_path: &Path,
-    times: &[f64],
-    progress: &dyn Progress,
-) -> Result<ThermalSolution, AppError> {
-    solve_scene(scene, times, progress).map_err(|source| AppError::ThermalRun {
-        path: scene_path.to_owned(),
-        source: Box::new(source),
-    })
 }

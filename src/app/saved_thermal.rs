@@ -3,7 +3,7 @@
 //! scene [`scene_to_render`] builds by solving the run itself — and the run `irpol thermal` and
 //! `irpol render` take from the store of saved runs (`out/thermal/<key>.bin`) or solve into it.
 
-use super::render::{scene_to_render, solution_instant, solve};
+use super::thermal_instant::{scene_to_render, solution_instant, solve};
 use super::AppError;
 use crate::progress::Progress;
 use crate::scene::{load_scene_text, Scene};
@@ -92,7 +92,7 @@ pub fn obtain_run(
     Ok((solution, source))
 }
 
-/// `error` with the scene's path on a failed run, as [`super::render::solve`] words it.
+/// `error` with the scene's path on a failed run, as [`super::thermal_instant::solve`] words it.
 fn in_scene(scene_path: &Path, error: SavedSolutionError) -> AppError {
     match error {
         SavedSolutionError::Run(source) => AppError::ThermalRun {

@@ -70,7 +70,12 @@ impl MeasurementArgs {
             layout,
             selection: self.selection.selection()?,
             angles: match &self.angles {
-                Some(text) => AngleReading::parse(text).map_err(AppError::invalid)?,
+                Some(text) => AngleReading::parse(text).ok_or_else(|| {
+                    AppError::invalid(format!(
+                        "unknown --angles '{}': use auto, degrees or radians",
+                        crate::text::shown(text)
+                    ))
+                })?,
                 None => AngleReading::Auto,
             },
         })

@@ -1,7 +1,8 @@
 //! `irpol thermal`: a scene's temperatures over its `[thermal]` run (docs/design.md §1.8, §2.6).
 
-use super::render::{render_solution_at, solve, TimedRender};
+use super::render::{render_solution_at, TimedRender};
 use super::saved_thermal::{obtain_run, RunSource, SavedRun};
+use super::thermal_instant::solve;
 use super::AppError;
 use crate::output::thermal::{write_thermal_outputs, ThermalSummary};
 use crate::progress::Progress;

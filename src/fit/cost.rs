@@ -21,8 +21,7 @@ use super::{FitError, FitOptions};
 use crate::measure::MeasurementSet;
 use crate::text::{about, counted, duration, number};
 
-/// The limit of an estimate unless [`FitOptions::max_minutes`] says otherwise.
-pub const DEFAULT_MAX_MINUTES: f64 = 60.0;
+pub use super::options::DEFAULT_MAX_MINUTES;
 
 /// The most coordinates (shared ones plus each wavelength's own) a joint spectral fit takes: its
 /// correlation matrix, written into the material, has their square of entries (1e6 here, ≈ 25 MB

@@ -51,9 +51,13 @@ pub struct FitOptions {
     /// ([`SpectralRole::SharedByDefault`]: the subsurface term's d, n_sub, d_c).
     pub per_wavelength: Vec<Parameter>,
     /// The longest fit started without a word (`--max-minutes`): a fit estimated longer
-    /// ([`super::cost`]) is refused before any work, naming its factors.
+    /// (src/fit/cost.rs) is refused before any work, naming its factors.
     pub max_minutes: f64,
 }
+
+/// The longest fit started without a word unless [`FitOptions::max_minutes`] says otherwise
+/// (src/fit/cost.rs).
+pub const DEFAULT_MAX_MINUTES: f64 = 60.0;
 
 impl Default for FitOptions {
     fn default() -> Self {
@@ -74,7 +78,7 @@ impl Default for FitOptions {
             settings: OptimizerSettings::default(),
             dispersion: super::Dispersion::Table,
             per_wavelength: Vec::new(),
-            max_minutes: super::cost::DEFAULT_MAX_MINUTES,
+            max_minutes: DEFAULT_MAX_MINUTES,
         }
     }
 }

@@ -157,16 +157,7 @@ fn fit_record(
         layout: None,
         selection: None,
         angles: None,
-        merged_sources: set
-            .merged
-            .iter()
-            .map(|file| MergedSource {
-                source: file.path.clone(),
-                source_sha256: file.sha256.clone(),
-                source_data: Some(file.data.clone()),
-                points: file.rows,
-            })
-            .collect(),
+        merged_sources: merged_sources(set),
         points: set.points.len(),
         elements: set
             .elements
@@ -222,6 +213,19 @@ fn fit_record(
     };
     record.mark_non_finite_as_undetermined();
     record
+}
+
+/// The files merged into `set` as repeat measurements, for the record's provenance.
+fn merged_sources(set: &MeasurementSet) -> Vec<MergedSource> {
+    set.merged
+        .iter()
+        .map(|file| MergedSource {
+            source: file.path.clone(),
+            source_sha256: file.sha256.clone(),
+            source_data: Some(file.data.clone()),
+            points: file.rows,
+        })
+        .collect()
 }
 
 /// The settings that, with the optimizer name and seed, reproduce the fit.

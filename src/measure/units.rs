@@ -23,16 +23,13 @@ pub enum AngleReading {
 }
 
 impl AngleReading {
-    /// `auto`, `degrees` or `radians` (the flag's spelling), or the message naming the choices.
-    pub fn parse(text: &str) -> Result<AngleReading, String> {
+    /// `auto`, `degrees` or `radians` (the flag's spelling; `deg`, `rad` too), or `None`.
+    pub fn parse(text: &str) -> Option<AngleReading> {
         match text.trim() {
-            "auto" => Ok(AngleReading::Auto),
-            "degrees" | "deg" => Ok(AngleReading::Degrees),
-            "radians" | "rad" => Ok(AngleReading::Radians),
-            other => Err(format!(
-                "unknown --angles '{}': use auto, degrees or radians",
-                crate::text::shown(other)
-            )),
+            "auto" => Some(AngleReading::Auto),
+            "degrees" | "deg" => Some(AngleReading::Degrees),
+            "radians" | "rad" => Some(AngleReading::Radians),
+            _ => None,
         }
     }
 
@@ -179,7 +176,7 @@ mod tests {
         );
         let note = check_degrees("f.csv", &radians, AngleReading::Degrees, "FIX").unwrap();
         assert!(is_angle_note(&note.unwrap()));
-        assert_eq!(AngleReading::parse("rad"), Ok(AngleReading::Radians));
-        assert!(AngleReading::parse("grad").is_err());
+        assert_eq!(AngleReading::parse("rad"), Some(AngleReading::Radians));
+        assert_eq!(AngleReading::parse("grad"), None);
     }
 }
