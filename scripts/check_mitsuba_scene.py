@@ -149,23 +149,10 @@ def measured(table, name):
 
 def mitsuba_scene(mi, work, tables, width, height, bounces, spp, sampler):
     T = mi.ScalarTransform4f
-    s, p, c = cm.SCENE["sphere"], cm.SCENE["plane"], cm.SCENE["camera"]
-    ply = Path(work) / "icosphere.ply"
-    v, n, f = cm.icosphere(s["radius"], s["subdivisions"])
-    cm.write_ply(ply, v + np.array(s["center"]), n, f)
+    p = cm.SCENE["plane"]
+    scene, ply = cm.mitsuba_scene_base(mi, work, width, height, bounces, spp, sampler)
     return mi.load_dict({
-        "type": "scene",
-        "integrator": {"type": "stokes",
-                       "inner": {"type": "path", "max_depth": bounces + 2, "rr_depth": 5}},
-        "sensor": {
-            "type": "perspective",
-            "fov": c["fov_deg"],
-            "fov_axis": "y",
-            "to_world": T().look_at(origin=c["position"], target=c["look_at"], up=c["up"]),
-            "film": {"type": "hdrfilm", "width": width, "height": height,
-                     "rfilter": {"type": "box"}, "pixel_format": "luminance"},
-            "sampler": {"type": sampler, "sample_count": spp},
-        },
+        **scene,
         "sky": {"type": "constant", "radiance": {"type": "uniform", "value": SKY}},
         "sun": {"type": "directional", "direction": [float(x) for x in -toward_sun()],
                 "irradiance": {"type": "uniform", "value": SUN}},

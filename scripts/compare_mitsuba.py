@@ -404,13 +404,16 @@ def rough_conductor(material):
             "eta": material["n"], "k": material["k"]}
 
 
-def mitsuba_scene(mi, work, width, height, bounces, spp, sampler="independent"):
+def mitsuba_scene_base(mi, work, width, height, bounces, spp, sampler):
+    """What every comparison scene shares: the stokes(path) integrator, the camera and the
+    icosphere's PLY (written into `work`). Returns the scene dict without emitters or shapes, and
+    the PLY's path."""
     T = mi.ScalarTransform4f
-    s, p, c = SCENE["sphere"], SCENE["plane"], SCENE["camera"]
-    ply = work / "icosphere.ply"
+    s, c = SCENE["sphere"], SCENE["camera"]
+    ply = Path(work) / "icosphere.ply"
     v, n, f = icosphere(s["radius"], s["subdivisions"])
     write_ply(ply, v + np.array(s["center"]), n, f)
-    return mi.load_dict({
+    return {
         "type": "scene",
         "integrator": {"type": "stokes",
                        "inner": {"type": "path", "max_depth": bounces + 2, "rr_depth": 5}},
@@ -423,6 +426,15 @@ def mitsuba_scene(mi, work, width, height, bounces, spp, sampler="independent"):
                      "rfilter": {"type": "box"}, "pixel_format": "luminance"},
             "sampler": {"type": sampler, "sample_count": spp},
         },
+    }, ply
+
+
+def mitsuba_scene(mi, work, width, height, bounces, spp, sampler="independent"):
+    T = mi.ScalarTransform4f
+    s, p = SCENE["sphere"], SCENE["plane"]
+    scene, ply = mitsuba_scene_base(mi, work, width, height, bounces, spp, sampler)
+    return mi.load_dict({
+        **scene,
         "sky": {"type": "envmap", "bitmap": envmap_bitmap(mi),
                 "to_world": T().rotate([1.0, 0.0, 0.0], 90.0)},
         "sphere": {"type": "ply", "filename": str(ply), "face_normals": False,
