@@ -142,22 +142,29 @@ fn draw_legend<DB: DrawingBackend>(
     for (i, part) in parts.iter().enumerate() {
         let (color, dash) = part_style(i);
         let (size, gap) = dash.map_or((28, 0), |(d, g)| (d as i32, g as i32));
-        let mut x = 8;
-        while x < 36 {
-            let end = (x + size).min(36);
-            area.draw(&PathElement::new(
-                vec![(x, y + 8), (end, y + 8)],
-                color.stroke_width(3),
-            ))?;
-            x = end + gap;
-        }
+        legend_line(area, y + 8, (size, gap), color.stroke_width(3))?;
         area.draw(&Text::new(part.name.clone(), (44, y), style.clone()))?;
         y += row;
     }
-    area.draw(&PathElement::new(
-        vec![(8, y + 8), (36, y + 8)],
-        BLACK.stroke_width(2),
-    ))?;
+    // The air's dashes as the plot draws them (8 on, 5 off).
+    legend_line(area, y + 8, (8, 5), BLACK.stroke_width(2))?;
     area.draw(&Text::new("air (dashed)", (44, y), style))?;
+    Ok(())
+}
+
+/// A legend's sample line from x = 8 to 36 at height `y`: dashes of `size` pixels `gap` apart
+/// (solid when `gap` is 0).
+fn legend_line<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    y: i32,
+    (size, gap): (i32, i32),
+    style: ShapeStyle,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut x = 8;
+    while x < 36 {
+        let end = (x + size).min(36);
+        area.draw(&PathElement::new(vec![(x, y), (end, y)], style))?;
+        x = end + gap;
+    }
     Ok(())
 }
