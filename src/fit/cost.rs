@@ -59,11 +59,9 @@ pub struct FitEstimate {
 pub fn estimate(sets: &[MeasurementSet], options: &FitOptions) -> FitEstimate {
     let rows: usize = sets.iter().map(|s| s.points.len()).sum();
     let laws = if options.distribution.is_some() { 1 } else { 2 };
-    let terms = if options.choose_terms {
-        3
-    } else {
-        candidates(options).len()
-    };
+    // The sets of terms the fit will score: `--terms auto` puts every admissible set in
+    // `term_candidates` (less those without a parameter --free/--fix name).
+    let terms = candidates(options).len();
     let folds = match options.cv_folds {
         Some(k) => k,
         None if options.choose_terms => DEFAULT_FOLDS,
@@ -160,6 +158,7 @@ mod tests {
                 .unwrap();
         let options = FitOptions {
             choose_terms: true,
+            term_candidates: crate::pbrdf::ModelTerms::ALL.to_vec(),
             ..FitOptions::default()
         };
         let e = estimate(&sets, &options);
