@@ -58,7 +58,7 @@ pub struct FitEstimate {
 /// The estimate of fitting the measurement `sets` of one material (one set per wavelength).
 pub fn estimate(sets: &[MeasurementSet], options: &FitOptions) -> FitEstimate {
     let rows: usize = sets.iter().map(|s| s.points.len()).sum();
-    let laws = if options.distribution.is_some() { 1 } else { 2 };
+    let laws = options.distributions().len();
     // The sets of terms the fit will score: `--terms auto` puts every admissible set in
     // `term_candidates` (less those without a parameter --free/--fix name).
     let terms = candidates(options).len();

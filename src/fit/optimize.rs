@@ -158,18 +158,7 @@ fn trap_at(objective: &Objective, point: &[f64]) -> Option<Trap> {
         let margin = PINNED * (space.upper()[i] - space.lower()[i]);
         let at_lower = point[i] <= space.lower()[i] + margin;
         let at_upper = point[i] >= space.upper()[i] - margin;
-        match p {
-            Parameter::Sigma => at_lower || at_upper,
-            Parameter::Q => at_lower,
-            Parameter::N
-            | Parameter::K
-            | Parameter::RhoD
-            | Parameter::RhoS
-            | Parameter::D
-            | Parameter::NSub
-            | Parameter::DC
-            | Parameter::D1 => false,
-        }
+        p.info().trap.traps(at_lower, at_upper)
     });
     let zero_extinction = space.free().contains(&Parameter::K)
         && !objective.data().has_circular()

@@ -45,42 +45,41 @@ pub(super) struct Fitted {
     pub comparison: Option<ModelComparison>,
 }
 
-/// [`fit_measurement`]'s fits of every requested distribution, and which is kept.
+/// [`fit_measurement`]'s fits of every requested distribution (every slope law the registry
+/// knows, [`DistributionKind::ALL`], unless the options name one), in parallel, and which is
+/// kept: the lowest AIC, the runner-up recorded as the alternative.
 pub(super) fn fit_distributions(
     set: &MeasurementSet,
     data: &MeasurementData,
     options: &FitOptions,
 ) -> Result<Fitted, FitError> {
-    let (first, second) = match options.distribution {
-        Some(kind) => (fit_model(set, data, kind, options)?, None),
-        None => {
-            let (cauchy, gaussian) = rayon::join(
-                || fit_model(set, data, DistributionKind::Cauchy, options),
-                || fit_model(set, data, DistributionKind::Gaussian, options),
-            );
-            (cauchy?, Some(gaussian?))
-        }
-    };
-    Ok(match second {
-        None => Fitted {
-            chosen: first,
+    use rayon::prelude::*;
+    let mut fits = options
+        .distributions()
+        .into_par_iter()
+        .map(|kind| fit_model(set, data, kind, options))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect::<Result<Vec<ModelFit>, FitError>>()?;
+    let candidates: Vec<_> = fits.iter().map(ModelFit::candidate).collect();
+    let Some(comparison) = ModelComparison::among(&candidates) else {
+        let chosen = fits.pop().expect("at least one distribution is fitted");
+        return Ok(Fitted {
+            chosen,
             alternative: None,
             comparison: None,
-        },
-        Some(second) => {
-            let comparison = ModelComparison::among(&[first.candidate(), second.candidate()])
-                .expect("two fits compare");
-            let (chosen, alternative) = if comparison.preferred == first.distribution {
-                (first, second)
-            } else {
-                (second, first)
-            };
-            Fitted {
-                chosen,
-                alternative: Some(alternative),
-                comparison: Some(comparison),
-            }
-        }
+        });
+    };
+    let mut take = |kind: DistributionKind| {
+        let at = fits.iter().position(|f| f.distribution == kind);
+        fits.swap_remove(at.expect("the compared fits are at hand"))
+    };
+    let chosen = take(comparison.preferred);
+    let alternative = take(comparison.rejected);
+    Ok(Fitted {
+        chosen,
+        alternative: Some(alternative),
+        comparison: Some(comparison),
     })
 }
 

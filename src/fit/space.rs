@@ -2,7 +2,8 @@
 //! values of the others, and the box of search coordinates the free ones live in.
 
 use super::parameters::{
-    from_search, to_search, DistributionKind, Parameter, ParameterBounds, ParameterValues,
+    from_search, to_search, DistributionKind, Interval, Parameter, ParameterBounds,
+    ParameterValues,
 };
 use super::FitError;
 use crate::material::ModelSpec;
@@ -46,8 +47,12 @@ impl ModelSpace {
             // With the volume terms n must mean the material's index: an n below 1 would make
             // internal facets external ones of index 1/n (the same ε) and, with its own n_sub,
             // the subsurface term could not tell them apart (docs/design.md §1.10).
-            bounds.n.lower = bounds.n.lower.max(VOLUME_MIN_N);
-            bounds.n.upper = bounds.n.upper.max(bounds.n.lower * 1.5);
+            let n = bounds.get(Parameter::N);
+            let lower = n.lower.max(VOLUME_MIN_N);
+            bounds.set(
+                Parameter::N,
+                Interval::new(lower, n.upper.max(lower * 1.5)),
+            );
         }
         let free: Vec<Parameter> = Parameter::ALL
             .into_iter()

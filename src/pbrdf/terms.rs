@@ -164,7 +164,91 @@ pub struct ParameterInfo {
     pub comment: &'static str,
     /// Whether a spectral fit shares it across wavelengths.
     pub spectral: SpectralRole,
+    /// The value of a parameter that is neither free nor given one: a moderately rough
+    /// dielectric without absorption or diffuse part.
+    pub default_value: f64,
+    /// Where a local search without a global stage starts: inside the box and away from the
+    /// k = 0 boundary, where the linear Mueller elements are stationary in k.
+    pub start: f64,
+    /// How the fit's optimizers see the parameter ([`SearchMap`]).
+    pub search: SearchMap,
+    /// Which end of its search interval makes a local fit's end point suspect ([`TrapRule`]).
+    pub trap: TrapRule,
 }
+
+/// The smooth, monotone map from a parameter's value to the *search coordinate* a fit's
+/// optimizers work in, chosen so that the parameter's plausible range spreads evenly over the
+/// search box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SearchMap {
+    /// The value itself: parameters that enter the Mueller elements (nearly) linearly.
+    Linear,
+    /// ln v: a parameter that spans decades (roughness).
+    Log,
+    /// ln(v − 1): a tail exponent whose tail weight goes as 1/(v − 1).
+    LogAboveOne,
+    /// asinh(v / scale): linear below ~scale (0 is an ordinary point), logarithmic above.
+    Asinh { scale: f64 },
+}
+
+impl SearchMap {
+    /// The search coordinate of `value`.
+    pub fn to_search(self, value: f64) -> f64 {
+        match self {
+            SearchMap::Linear => value,
+            SearchMap::Log => value.ln(),
+            SearchMap::LogAboveOne => (value - 1.0).ln(),
+            SearchMap::Asinh { scale } => (value / scale).asinh(),
+        }
+    }
+
+    /// Inverse of [`SearchMap::to_search`].
+    pub fn from_search(self, coordinate: f64) -> f64 {
+        match self {
+            SearchMap::Linear => coordinate,
+            SearchMap::Log => coordinate.exp(),
+            SearchMap::LogAboveOne => 1.0 + coordinate.exp(),
+            SearchMap::Asinh { scale } => scale * coordinate.sinh(),
+        }
+    }
+
+    /// d(value)/d(coordinate) of [`SearchMap::from_search`], to carry Jacobians to values.
+    pub fn value_per_coordinate(self, coordinate: f64) -> f64 {
+        match self {
+            SearchMap::Linear => 1.0,
+            SearchMap::Log | SearchMap::LogAboveOne => coordinate.exp(),
+            SearchMap::Asinh { scale } => scale * coordinate.cosh(),
+        }
+    }
+}
+
+/// Which bound of its search interval, reached by a local fit, marks the fit as trapped in a
+/// degenerate shape (a surface of no slope or all slope, a tail that holds every facet) and
+/// sends the local stages to restart elsewhere (`fit::optimize`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrapRule {
+    /// Either bound is an ordinary answer (an index, a reflectance).
+    Never,
+    /// Both bounds are degenerate (σ).
+    EitherBound,
+    /// The lower bound is degenerate (q → 1: all facets in the tail).
+    LowerBound,
+}
+
+impl TrapRule {
+    /// Whether a point at the lower (`at_lower`) or the upper (`at_upper`) bound is a trap.
+    pub fn traps(self, at_lower: bool, at_upper: bool) -> bool {
+        match self {
+            TrapRule::Never => false,
+            TrapRule::EitherBound => at_lower || at_upper,
+            TrapRule::LowerBound => at_lower,
+        }
+    }
+}
+
+/// Scale of the asinh search map of k: below ~0.1 the search coordinate is linear in k (k = 0 is
+/// an ordinary point), above it logarithmic (metals reach k ≈ 50 in the LWIR).
+const K_SEARCH_SCALE: f64 = 0.1;
 
 /// Every parameter's entry, in [`Parameter::ALL`] order.
 const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
@@ -178,6 +262,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (0.005, 1.5),
         comment: "slope parameter σ (dimensionless): Gaussian rms slope per axis; Cauchy a = 2σ² (q = 2 is GGX, α = √2σ)",
         spectral: SpectralRole::Shared,
+        default_value: 0.2,
+        start: 0.2,
+        search: SearchMap::Log,
+        trap: TrapRule::EitherBound,
     },
     ParameterInfo {
         key: "q",
@@ -190,6 +278,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (1.05, 50.0),
         comment: "Cauchy tail exponent q (> 1; > 1.5 with Smith): small q puts more facets at steep tilts",
         spectral: SpectralRole::Shared,
+        default_value: 2.0,
+        start: 3.0,
+        search: SearchMap::LogAboveOne,
+        trap: TrapRule::LowerBound,
     },
     ParameterInfo {
         key: "n",
@@ -201,6 +293,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (0.05, 10.0),
         comment: "real part n of the complex refractive index N = n + ik at wavelength_um",
         spectral: SpectralRole::PerWavelength,
+        default_value: 1.5,
+        start: 1.8,
+        search: SearchMap::Linear,
+        trap: TrapRule::Never,
     },
     ParameterInfo {
         key: "k",
@@ -212,6 +308,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (0.0, 50.0),
         comment: "extinction coefficient k (imaginary part of N, ≥ 0): absorption",
         spectral: SpectralRole::PerWavelength,
+        default_value: 0.0,
+        start: 0.1,
+        search: SearchMap::Asinh { scale: K_SEARCH_SCALE },
+        trap: TrapRule::Never,
     },
     ParameterInfo {
         key: "rho_d",
@@ -223,6 +323,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (0.0, 1.0),
         comment: "unpolarized diffuse reflectance ρ_d (0–1): adds ρ_d/π to m00 only",
         spectral: SpectralRole::PerWavelength,
+        default_value: 0.0,
+        start: 0.02,
+        search: SearchMap::Linear,
+        trap: TrapRule::Never,
     },
     ParameterInfo {
         key: "rho_s",
@@ -234,6 +338,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (0.0, 1.0),
         comment: "subsurface reflectance ρ_s (0–1): the fraction of the light refracted in that comes back out, p-polarized by the interface",
         spectral: SpectralRole::PerWavelength,
+        default_value: 0.5,
+        start: 0.5,
+        search: SearchMap::Linear,
+        trap: TrapRule::Never,
     },
     ParameterInfo {
         key: "d",
@@ -245,6 +353,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (0.0, 1.0),
         comment: "residual polarization d (0–1) of the subsurface light: D = diag(1, d, −d, −d) in scattering-plane frames",
         spectral: SpectralRole::SharedByDefault,
+        default_value: 0.0,
+        start: 0.1,
+        search: SearchMap::Linear,
+        trap: TrapRule::Never,
     },
     ParameterInfo {
         key: "n_sub",
@@ -256,6 +368,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (1.0, 4.0),
         comment: "real index of the interface the subsurface light crosses (absent: n)",
         spectral: SpectralRole::SharedByDefault,
+        default_value: 1.5,
+        start: 1.4,
+        search: SearchMap::Linear,
+        trap: TrapRule::Never,
     },
     ParameterInfo {
         key: "d_c",
@@ -267,6 +383,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (-1.0, 1.0),
         comment: "residual circular polarization d_c (−1–1, at least 2d − 1) of the subsurface light: D's m33 = −d_c (absent: d, a mirror's sign; below 0 helicity is kept)",
         spectral: SpectralRole::SharedByDefault,
+        default_value: 0.0,
+        start: 0.0,
+        search: SearchMap::Linear,
+        trap: TrapRule::Never,
     },
     ParameterInfo {
         key: "d1",
@@ -278,6 +398,10 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         default_bounds: (-1.0, 1.0),
         comment: "change of the residual polarization with the scattering angle Θ (between the incident and the scattered beam): d(Θ) = d + d1 cos Θ, |d| + |d1| ≤ 1 (absent: 0)",
         spectral: SpectralRole::SharedByDefault,
+        default_value: 0.0,
+        start: 0.0,
+        search: SearchMap::Linear,
+        trap: TrapRule::Never,
     },
 ];
 
