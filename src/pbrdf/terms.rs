@@ -1,9 +1,18 @@
-//! The vocabulary of the pBRDF model (docs/design.md §1.2–1.3), declared once: its parameters
-//! (σ, q, n, k, ρ_d) with their key in files and on the command line, report label, unit, the
-//! values a model accepts, the default search bounds of a fit and the `#` comment a material file
-//! carries above the key; and its terms (the facet term and the ideal depolarizer) with the
-//! parameters each one owns. The fit, the material files and the reports read this table instead
-//! of repeating it; a new parameter or term is added here (and in the physics that uses it).
+//! The vocabulary of the pBRDF model (docs/design.md §1.2–1.3, §1.10), declared once.
+//!
+//! - Its parameters ([`Parameter`]: the slope parameters, the index N = n + ik, and the body
+//!   terms' ρ_d, ρ_s, d, n_sub, d_c, d1), each with one [`ParameterInfo`] entry: its key in
+//!   files and on the command line, report label, unit, the values a model accepts, the default
+//!   search interval, default and starting value, search map and trap rule of a fit, the `#`
+//!   comment a material file carries above the key, and its role in a spectral fit.
+//! - Its terms ([`Term`]: the facet term, the ideal depolarizer, the polarized subsurface term)
+//!   with the parameters each one owns, and the combinations a fit chooses among
+//!   ([`ModelTerms`]).
+//!
+//! The fit, the material files and the reports read this table instead of repeating it: the
+//! fit's bounds, starts, search coordinates and traps are entries here. The material schema
+//! (`material::ModelSpec`, `material::raw`) and `irpol eval`'s flags still name the subsurface
+//! term's parameters one by one.
 
 use super::limits;
 use super::subsurface::FacetSide;
