@@ -95,7 +95,10 @@ impl ParameterBounds {
         let mut bounds = *self;
         if shadowing == Shadowing::Smith {
             let q = bounds.get(Parameter::Q);
-            bounds.set(Parameter::Q, Interval::new(q.lower.max(SMITH_MIN_Q), q.upper));
+            bounds.set(
+                Parameter::Q,
+                Interval::new(q.lower.max(SMITH_MIN_Q), q.upper),
+            );
         }
         bounds
     }

@@ -2,8 +2,7 @@
 //! values of the others, and the box of search coordinates the free ones live in.
 
 use super::parameters::{
-    from_search, to_search, DistributionKind, Interval, Parameter, ParameterBounds,
-    ParameterValues,
+    from_search, to_search, DistributionKind, Interval, Parameter, ParameterBounds, ParameterValues,
 };
 use super::FitError;
 use crate::material::ModelSpec;
@@ -49,10 +48,7 @@ impl ModelSpace {
             // the subsurface term could not tell them apart (docs/design.md §1.10).
             let n = bounds.get(Parameter::N);
             let lower = n.lower.max(VOLUME_MIN_N);
-            bounds.set(
-                Parameter::N,
-                Interval::new(lower, n.upper.max(lower * 1.5)),
-            );
+            bounds.set(Parameter::N, Interval::new(lower, n.upper.max(lower * 1.5)));
         }
         let free: Vec<Parameter> = Parameter::ALL
             .into_iter()
