@@ -401,4 +401,101 @@ mod tests {
         assert_eq!(grey.at(13.0).unwrap(), grey.at(8.0).unwrap());
         assert_eq!(grey.wavelengths_um(), vec![9.0]);
     }
+
+    mod grey_twins {
+        use super::super::super::{Material, ModelSpec};
+        use super::*;
+        use crate::pbrdf::{Body, FacetSide, ModelTerms};
+        use std::path::Path;
+
+        /// A grey model of each term set at `wavelength_um`, with per-wavelength n, k and
+        /// reflectances and the subsurface's d, n_sub, d_c shared (`per_wavelength_d` makes d
+        /// differ).
+        fn node(terms: ModelTerms, wavelength_um: f64, per_wavelength_d: bool) -> ModelSpec {
+            let j = if wavelength_um < 1.0 { 0.0 } else { 1.0 };
+            let subsurface = terms.body == Body::Subsurface;
+            ModelSpec {
+                distribution: SlopeDistribution::Cauchy {
+                    sigma: 0.62,
+                    q: 2.1,
+                },
+                shadowing: Shadowing::Smith,
+                n: 1.38 - 0.03 * j,
+                k: 0.04 + 0.01 * j,
+                rho_d: if subsurface { 0.0 } else { 0.7 + 0.05 * j },
+                facet: terms.facet_side,
+                rho_s: subsurface.then_some(0.96 - 0.01 * j),
+                d: subsurface.then_some(0.02 + if per_wavelength_d { 0.01 * j } else { 0.0 }),
+                n_sub: subsurface.then_some(1.05),
+                d_c: subsurface.then_some(-0.015),
+                d1: subsurface.then_some(0.004),
+                wavelength_um,
+            }
+        }
+
+        /// docs/design.md §1.10 "spectral materials carry every term": a spectral material written
+        /// and read back is, at each of its wavelengths, the grey material of that wavelength —
+        /// facet side and every subsurface parameter included, whether shared or per wavelength.
+        #[test]
+        fn a_spectral_material_is_its_grey_twin_at_each_wavelength_for_every_term_set() {
+            let terms = ModelTerms::ALL
+                .into_iter()
+                .chain([ModelTerms::new(FacetSide::Internal, Body::Depolarizer)]);
+            for (terms, per_wavelength_d) in terms.flat_map(|t| [(t, false), (t, true)]) {
+                let nodes = [
+                    node(terms, 0.351, per_wavelength_d),
+                    node(terms, 1.064, per_wavelength_d),
+                ];
+                let material = Material {
+                    name: "twin".into(),
+                    tool_version: "irpol test".into(),
+                    model: MaterialModel::Spectral(SpectralModel::from_nodes(&nodes, None)),
+                    fit: None,
+                };
+                let path = Path::new("twin.toml");
+                let text = material.to_toml(path).unwrap();
+                let read = Material::from_toml(&text, path).unwrap();
+                for grey in &nodes {
+                    let spectral = read.at(grey.wavelength_um).unwrap();
+                    assert_eq!(&spectral, grey, "{terms} {text}");
+                    let (a, b) = (spectral.pbrdf().unwrap(), grey.pbrdf().unwrap());
+                    assert_eq!(a.facet_side(), terms.facet_side);
+                    for (ti, tr, phi) in [(0.0, 30.0, 180.0), (45.0, 60.0, 90.0), (75.0, 10.0, 0.0)]
+                    {
+                        let (wi, wr) = (
+                            crate::optics::Direction::from_degrees(ti, 0.0),
+                            crate::optics::Direction::from_degrees(tr, phi),
+                        );
+                        let (ma, mb) = (a.mueller(&wi, &wr), b.mueller(&wi, &wr));
+                        assert!((ma - mb).abs().max() <= 1e-12 * mb[(0, 0)], "{terms}");
+                    }
+                }
+            }
+        }
+
+        /// A subsurface key with a table of the wrong length is refused naming the key and the
+        /// wavelength that has no value.
+        #[test]
+        fn a_spectral_term_key_missing_a_wavelength_is_refused_by_name() {
+            let terms = ModelTerms::new(FacetSide::Internal, Body::Subsurface);
+            let nodes = [node(terms, 0.351, true), node(terms, 1.064, true)];
+            let material = Material {
+                name: "short".into(),
+                tool_version: "irpol test".into(),
+                model: MaterialModel::Spectral(SpectralModel::from_nodes(&nodes, None)),
+                fit: None,
+            };
+            let path = Path::new("short.toml");
+            let text = material.to_toml(path).unwrap();
+            let start = text.find("\nd = [").expect("d is a table");
+            let end = start + text[start..].find(']').unwrap();
+            let short = format!("{}\nd = [0.02{}", &text[..start], &text[end..]);
+            let error = Material::from_toml(&short, path).unwrap_err().to_string();
+            assert!(
+                error.contains("d has 1 values for 2 wavelengths")
+                    && error.contains("1.064 µm has none"),
+                "{error}"
+            );
+        }
+    }
 }
