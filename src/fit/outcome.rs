@@ -254,7 +254,10 @@ pub(super) fn settings(data: &MeasurementData, options: &FitOptions) -> BTreeMap
         "distribution".into(),
         match options.distribution {
             Some(kind) => format!("{kind} (given)"),
-            None => "cauchy and gaussian fitted, lower AIC kept".into(),
+            None => {
+                let laws: Vec<&str> = DistributionKind::ALL.iter().map(|k| k.name()).collect();
+                format!("{} fitted, lower AIC kept", laws.join(" and "))
+            }
         },
     );
     settings.insert("bounds".into(), bounds_setting(options));
