@@ -1,5 +1,5 @@
 //! Draws docs/images/edge_mtf.png: the MTF measured on rendered slanted edges (ISO 12233,
-//! `render::camera::slanted_edge`) against the closed form of the optics (docs/design.md §1.11),
+//! `render::instrument::slanted_edge`) against the closed form of the optics (docs/design.md §1.11),
 //! for the cases `tests/it/render_camera.rs` checks.
 //!
 //! `cargo run --release --example edge_mtf -- docs/images/edge_mtf.png`
@@ -8,8 +8,8 @@
 mod support;
 
 use irpol::progress::Silent;
-use irpol::render::camera::otf::TransferFunction;
-use irpol::render::camera::slanted_edge::slanted_edge_mtf;
+use irpol::render::instrument::otf::TransferFunction;
+use irpol::render::instrument::slanted_edge::slanted_edge_mtf;
 use irpol::render::render;
 use irpol::scene::load_scene_text;
 use plotters::prelude::*;

@@ -88,10 +88,10 @@ pub mod progress;
 pub mod render;
 pub mod report;
 pub mod scene;
-pub mod tables;
 pub mod text;
 pub mod thermal;
 pub mod thermal_scene;
+pub mod toml_table;
 pub mod transport;
 
 pub use app::fit::fit_and_write;

@@ -10,6 +10,7 @@
 use crate::fit::{FitError, OptionError};
 use crate::material::MaterialError;
 use crate::measure::MeasureError;
+use crate::output::figure::PreviewError;
 use crate::pbrdf::ModelError;
 use crate::render::RenderError;
 use crate::report::ReportError;
@@ -267,6 +268,17 @@ pub fn one_line(error: &(dyn Error + 'static)) -> String {
 /// `message` on one line: runs of whitespace (line breaks of a parser's message) as one space.
 pub(crate) fn single_line(message: &str) -> String {
     message.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+impl From<PreviewError> for AppError {
+    /// The animated preview's failures as the application has always reported them.
+    fn from(error: PreviewError) -> AppError {
+        match error {
+            PreviewError::Caption(message) => AppError::Caption(message),
+            PreviewError::CaptionBuffer => AppError::invalid(error.to_string()),
+            PreviewError::Encode(source) => AppError::Image(source),
+        }
+    }
 }
 
 #[cfg(test)]

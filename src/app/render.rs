@@ -7,14 +7,14 @@ pub use super::thermal_instant::scene_to_render;
 use super::thermal_instant::solution_instant;
 use super::AppError;
 use crate::atomic::StagedFolder;
-use crate::output::figure::SeriesPreview;
-use crate::output::{stage_outputs, write_outputs, EarlierOutputs, RenderSummary, SERIES_MANIFEST};
+use crate::output::earlier_outputs::{EarlierOutputs, SERIES_MANIFEST};
+use crate::output::figure::{animated_preview, SeriesPreview};
+use crate::output::summary::RenderSummary;
+use crate::output::{stage_outputs, write_outputs};
 use crate::progress::Progress;
 use crate::render::render;
 use crate::scene::{load_scene, Scene};
 use crate::thermal_scene::ThermalSolution;
-use image::codecs::gif::{GifEncoder, Repeat};
-use image::{Delay, DynamicImage, Frame, RgbImage, RgbaImage};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -214,7 +214,7 @@ fn render_series(
             summary,
         });
     }
-    let gif = animated_preview(&renders, previews)?;
+    let gif = animated_preview(&frame_labels(&renders), previews)?;
     staged.write("preview.gif", &gif).map_err(write_error)?;
     let manifest = serde_json::to_vec_pretty(&series_manifest(scene, &renders))
         .map_err(|e| write_error(std::io::Error::other(e)))?;
@@ -260,70 +260,13 @@ fn frame_name(i: usize, time_s: f64) -> String {
     format!("{i:03}_{}s", time_s.round())
 }
 
-/// One frame of the preview, one second long: the instant of `r` above its S0 and DoLP panels.
-fn preview_frame(r: &TimedRender, s0: RgbImage, dolp: RgbImage) -> Result<Frame, AppError> {
-    let (s0, dolp) = (
-        DynamicImage::ImageRgb8(s0).to_rgba8(),
-        DynamicImage::ImageRgb8(dolp).to_rgba8(),
-    );
-    let label = match &r.summary.thermal_instant {
-        Some(i) => format!("{}   (t = {} s)", i.time_utc, i.time_s),
-        None => format!("t = {} s", r.time_s),
-    };
-    let width = s0.width() + dolp.width();
-    let header = caption_strip(&label, width)?;
-    let top = i64::from(header.height());
-    let mut frame = RgbaImage::from_pixel(
-        width,
-        header.height() + s0.height().max(dolp.height()),
-        image::Rgba([255, 255, 255, 255]),
-    );
-    image::imageops::overlay(&mut frame, &header, 0, 0);
-    image::imageops::overlay(&mut frame, &s0, 0, top);
-    image::imageops::overlay(&mut frame, &dolp, i64::from(s0.width()), top);
-    Ok(Frame::from_parts(
-        frame,
-        0,
-        0,
-        Delay::from_numer_denom_ms(1000, 1),
-    ))
-}
-
-/// The looping animated GIF of the series' `renders`, their S0 and DoLP panels coloured over one
-/// range for the whole series ([`SeriesPreview`]), so frames compare by colour.
-fn animated_preview(renders: &[TimedRender], previews: SeriesPreview) -> Result<Vec<u8>, AppError> {
-    let panels = previews
-        .frames()
-        .map_err(|e| AppError::Caption(e.to_string()))?;
-    let frames = renders
+/// Each frame's caption in the animated preview: its instant.
+fn frame_labels(renders: &[TimedRender]) -> Vec<String> {
+    renders
         .iter()
-        .zip(panels)
-        .map(|(r, [s0, dolp])| preview_frame(r, s0, dolp))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut bytes = Vec::new();
-    {
-        let mut encoder = GifEncoder::new_with_speed(&mut bytes, 10);
-        encoder.set_repeat(Repeat::Infinite)?;
-        encoder.encode_frames(frames)?;
-    }
-    Ok(bytes)
-}
-
-/// A white strip `width` pixels wide with `text` on it.
-fn caption_strip(text: &str, width: u32) -> Result<RgbaImage, AppError> {
-    use plotters::prelude::*;
-    const HEIGHT: u32 = 26;
-    crate::plot_style::register_fonts();
-    let mut rgb = vec![255u8; (width * HEIGHT * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, (width, HEIGHT)).into_drawing_area();
-        let style = (crate::plot_style::FONT, 17).into_font().color(&BLACK);
-        root.draw(&Text::new(text.to_owned(), (8, 4), style))
-            .map_err(|e| AppError::Caption(e.to_string()))?;
-        root.present()
-            .map_err(|e| AppError::Caption(e.to_string()))?;
-    }
-    let strip = image::RgbImage::from_raw(width, HEIGHT, rgb)
-        .ok_or_else(|| AppError::invalid("caption buffer has the wrong size"))?;
-    Ok(image::DynamicImage::ImageRgb8(strip).to_rgba8())
+        .map(|r| match &r.summary.thermal_instant {
+            Some(i) => format!("{}   (t = {} s)", i.time_utc, i.time_s),
+            None => format!("t = {} s", r.time_s),
+        })
+        .collect()
 }

@@ -1,14 +1,16 @@
 //! LWIR polarimetric rendering of a scene held in memory (docs/design.md §1.5–1.7, §2.3): primary
 //! visibility by z-buffered rasterization ([`raster`]), the Stokes vector leaving each visible
 //! point from the scene's integrator ([`crate::transport`]), Gouraud or per-pixel shading, then
-//! the atmosphere ([`sensor`]) and the camera ([`camera`]) onto the [`film`]. Nothing here writes files
+//! the atmosphere ([`atmosphere_path`]), the instrument ([`instrument`]) and its noise
+//! ([`detector_noise`]) onto the [`film`]. Nothing here writes files
 //! (that is [`crate::output`]) or prints (progress goes to a [`Progress`] callback).
 
-pub mod camera;
+pub mod atmosphere_path;
+pub mod detector_noise;
 pub mod dofp;
 pub mod film;
+pub mod instrument;
 pub mod raster;
-pub mod sensor;
 
 use crate::pbrdf::{MaterialOptics, ModelError};
 use crate::progress::Progress;
@@ -23,12 +25,12 @@ use crate::transport::path::{PathTracer, Vertex};
 /// Grid sizes of a material's reflection table, as [`Rendered::table_resolutions`] reports them.
 pub use crate::transport::tables::TableResolution;
 use crate::transport::tables::{MaterialTables, RadianceTable};
+use atmosphere_path::through_atmosphere;
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use raster::{rasterize, FragmentBuffer, NO_TRIANGLE};
 use rayon::prelude::*;
-use sensor::through_atmosphere;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -69,10 +71,10 @@ pub struct Timings {
 pub struct Rendered {
     pub image: StokesImage,
     /// With `[sensor.dofp]`: the raw mosaic and the Stokes images demosaicked from it.
-    pub dofp: Option<camera::DofpImages>,
+    pub dofp: Option<instrument::DofpImages>,
     /// Reconstruction quality of the camera against the noise-free radiance (`None` for the
     /// ideal camera).
-    pub camera_metrics: Option<camera::metrics::CameraMetrics>,
+    pub camera_metrics: Option<instrument::metrics::CameraMetrics>,
     pub timings: Timings,
     pub table_resolutions: Vec<TableResolution>,
 }
@@ -121,7 +123,7 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
     progress.end();
     timings.shade = shade_start.elapsed().as_secs_f64();
     let camera_start = Instant::now();
-    let recording = camera::record(&scene.sensor, image.width, image.height, &mut image.stokes);
+    let recording = instrument::record(&scene.sensor, image.width, image.height, &mut image.stokes);
     image.recorded_polarizers = recording.polarizers;
     timings.camera = camera_start.elapsed().as_secs_f64();
     timings.total = start.elapsed().as_secs_f64();

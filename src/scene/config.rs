@@ -66,11 +66,11 @@
 
 pub use crate::emitter::SunConfig;
 pub use crate::material::InlineMaterialConfig;
-use crate::tables::{optional_table, table, table_list, table_map, table_or_flag};
 pub use crate::thermal::config::{
     BackConfig, BackKeyword, ConvectiveBack, EnclosureConfig, FixedBack, GeneratedWeather,
     InternalHeatConfig, LayerMaterialConfig, PartThermalConfig, ThermalConfig, WeatherConfig,
 };
+use crate::toml_table::{optional_table, table, table_list, table_map, table_or_flag};
 use serde::{Deserialize, Deserializer};
 use std::collections::BTreeMap;
 

@@ -1,6 +1,6 @@
 //! `[sensor]` and its sub-tables (docs/design.md §1.11, §2.3): the band, the NETD, and the camera
 //! between the scene and the Stokes images — optics, detector and the division-of-focal-plane
-//! polarizer array — checked here, applied by `render::camera`. Every default is the ideal camera
+//! polarizer array — checked here, applied by `render::instrument`. Every default is the ideal camera
 //! (point samples, perfect polarizers, no fixed pattern), which renders today's images bit for bit.
 
 use super::config::{DetectorConfig, DofpConfig, OpticsConfig, SceneConfig};
@@ -42,7 +42,7 @@ pub struct Diffraction {
 }
 
 /// `[sensor.detector]`, checked. Offsets are radiances of a polarizer image, σ_o = ½ · offset ·
-/// dL_bb/dT at the NETD reference (the NETD's own conversion, `render::sensor`).
+/// dL_bb/dT at the NETD reference (the NETD's own conversion, `render::detector_noise`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Detector {
     pub fpn_gain_sigma: f64,

@@ -30,11 +30,12 @@
 // turns into one vector operation per statement.
 #![allow(clippy::needless_range_loop)]
 
-use super::layers::{Grid, ThermalError};
-use super::solver::{
-    back_row, check_step_s, crossed, front_row, surface_newton_step, Back, BackRow, Forcing,
-    FrontForcing, MAX_SUBSTEPS_PER_STEP, NEWTON_ITERATIONS, STEFAN_BOLTZMANN,
+use super::forcing::{Back, Forcing, FrontForcing, STEFAN_BOLTZMANN};
+use super::implicit_rows::{
+    back_row, crossed, front_row, surface_newton_step, BackRow, NEWTON_ITERATIONS,
 };
+use super::layers::{Grid, ThermalError};
+use super::solver::{check_step_s, MAX_SUBSTEPS_PER_STEP};
 use crate::optics::MAX_TEMPERATURE_K;
 use crate::text::number;
 

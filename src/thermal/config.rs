@@ -1,7 +1,7 @@
 //! The thermal keys of a scene file (docs/design.md §1.8, §2.4): `[thermal]`, its layer
 //! materials, and the stack of an object or part. Checked by [`super::setup`].
 
-use crate::tables::{table, table_map};
+use crate::toml_table::{table, table_map};
 use serde::{Deserialize, Deserializer};
 use std::collections::BTreeMap;
 

@@ -15,6 +15,8 @@
 pub mod batch;
 pub mod config;
 pub mod convection;
+mod forcing;
+mod implicit_rows;
 pub mod layers;
 pub mod setup;
 pub mod solver;
@@ -23,13 +25,12 @@ pub mod weather;
 pub use batch::{
     BatchForcing, BatchReport, BatchSolver, BatchState, Lanes, BATCH_MAX_SUBSTEP_S, LANES,
 };
+pub use forcing::{Back, Forcing, FrontForcing, STEFAN_BOLTZMANN};
 pub use layers::{
     Grid, Layer, LayerLimit, LayerMaterial, LayerStack, Resolution, ThermalError, LAYER_LIMITS,
     MAX_GRID_NODES,
 };
-pub use solver::{
-    Back, Forcing, FrontForcing, Solver, SolverControl, StepReport, ThermalState, STEFAN_BOLTZMANN,
-};
+pub use solver::{Solver, SolverControl, StepReport, ThermalState};
 pub use weather::{
     simplified_solis, swinbank_longwave_w_m2, ClearDay, ClearSkyIrradiance, Site, SolisAtmosphere,
     StationFormat, StationWeather, Weather, WeatherError, WeatherFormat, WeatherSample,

@@ -13,33 +13,36 @@
 //! F_sky, shadow history and initial temperature have bit-identical forcing, so one solve serves
 //! both (most of a ground plane, the flat panels of a box). This is exact, not an approximation.
 
-use super::exposure::{sky_view_factors, sun_visibility, Occluders, VertexFrame};
+use super::exposure::Occluders;
 use crate::progress::Progress;
 use crate::scene::mesh::{bounding_diagonal, ShadedMesh};
 use crate::scene::Scene;
-use crate::text::{about, number};
 use crate::thermal::convection::mcadams_coefficient;
 use crate::thermal::setup::{SurfaceThermal, ThermalSetup};
 use crate::thermal::{
-    Forcing, FrontForcing, Resolution, Solver, SolverControl, StepReport, ThermalError,
-    ThermalState, WeatherSample,
+    Forcing, FrontForcing, Resolution, Solver, SolverControl, StepReport, ThermalState,
+    WeatherSample,
 };
 use crate::transport::accel::Accelerator;
 use crate::transport::horizon::HorizonMap;
-use nalgebra::Vector3;
 use rayon::prelude::*;
-use std::borrow::Cow;
-use std::collections::HashMap;
 
 mod enclosure;
 mod field;
 mod ground;
 mod radiation;
+mod run_error;
+mod vertices;
+
+pub use run_error::{ThermalRunError, MAX_RECORDED_VALUES, MAX_SHADOW_SAMPLES};
+pub use vertices::vertex_surfaces;
 
 use enclosure::NodeRun;
-use field::{FieldStats, FieldVertices};
+use field::FieldStats;
 use ground::GroundHistory;
-use radiation::{SampleRadiation, ShadowInterval};
+use radiation::SampleRadiation;
+use run_error::{check_sizes, independent_error, step_label, VertexFailure};
+use vertices::{occluding_mesh, sampled_end, shadow_instants, Exposure, ThermalVertices};
 
 /// Surface temperatures of every shading vertex at the recorded instants (saved whole by
 /// [`super::saved`]).
@@ -89,96 +92,6 @@ impl SolveStats {
     }
 }
 
-/// Why a thermal run failed.
-#[derive(Debug, thiserror::Error)]
-pub enum ThermalRunError {
-    #[error("{0} has no [thermal] section")]
-    NotThermal(String),
-    /// The weather has no value at a time the run needs.
-    #[error("{0}")]
-    Weather(crate::thermal::WeatherError),
-    #[error(
-        "thermal time {} s is outside the run 0…{} s",
-        number(*time_s), number(*duration_s)
-    )]
-    OutsideRun { time_s: f64, duration_s: f64 },
-    /// A table of the run would outgrow its limit ([`MAX_SHADOW_SAMPLES`],
-    /// [`MAX_RECORDED_VALUES`]); refused before it is allocated.
-    #[error(
-        "{vertices} {} × {instants} {what} = {} values, more than {}: use a coarser mesh or a \
-         longer {key}",
-        if *what == "shadow instants" { "thermal vertices" } else { "vertices" },
-        about((*vertices as f64) * (*instants as f64)), number(*limit as f64)
-    )]
-    TooLarge {
-        vertices: usize,
-        instants: usize,
-        what: &'static str,
-        key: &'static str,
-        limit: usize,
-    },
-    /// The solve of one part's vertex failed; `part` names it ("objects[0] 'car' part 'hood'"),
-    /// `at` says when. The solver's error is part of the message, said once.
-    #[error("{part}{at}: {error}")]
-    Solver {
-        part: String,
-        at: String,
-        error: ThermalError,
-    },
-    /// An enclosure's air temperature and its members' back faces did not agree (within 1e-3 K)
-    /// after the fixed-point iterations of a step.
-    #[error(
-        "thermal.enclosures.{}{at}: the air temperature did not settle (members and balance {} K \
-         apart after {iterations} iterations); try a smaller time_step_s",
-        crate::text::shown(name), number(*residual_k)
-    )]
-    Enclosure {
-        name: String,
-        at: String,
-        residual_k: f64,
-        iterations: usize,
-    },
-}
-
-/// Most (thermal vertex, shadow instant) pairs: one byte of sun visibility each, one shadow ray
-/// traced each. The shipped car's day is 9694 × 145 = 1.4e6.
-pub const MAX_SHADOW_SAMPLES: usize = 500_000_000;
-
-/// Most (vertex, recorded instant) surface temperatures held (8 bytes each, 0.8 GB at most).
-pub const MAX_RECORDED_VALUES: usize = 100_000_000;
-
-/// Where in the run a vertex's solve failed.
-struct VertexFailure {
-    /// Start of the failed step (s from `start_utc`), `None` before the first step.
-    time_s: Option<f64>,
-    spinup: bool,
-    error: ThermalError,
-}
-
-impl VertexFailure {
-    fn before_run(error: ThermalError) -> VertexFailure {
-        VertexFailure {
-            time_s: None,
-            spinup: false,
-            error,
-        }
-    }
-
-    /// ", step from t = 3600 s" (", spin-up step …"), or nothing.
-    fn at(&self) -> String {
-        step_label(self.time_s, self.spinup)
-    }
-}
-
-/// ", step from t = 3600 s" (", spin-up step …") for a step starting at `time_s`, or nothing.
-fn step_label(time_s: Option<f64>, spinup: bool) -> String {
-    match (time_s, spinup) {
-        (None, _) => String::new(),
-        (Some(t), false) => format!(", step from t = {} s", number(t)),
-        (Some(t), true) => format!(", spin-up step from t = {} s", number(t)),
-    }
-}
-
 const DAY_S: f64 = 86_400.0;
 
 /// The sample times of the run: every `time_step_s`, every `output_step_s`, the end and `extra`
@@ -205,123 +118,6 @@ pub(crate) fn sample_times(setup: &ThermalSetup, extra: &[f64]) -> (Vec<f64>, Ve
         }
     }
     merged.into_iter().unzip()
-}
-
-/// One distinct forcing history: the first vertex that has it stands for all.
-#[derive(Hash, PartialEq, Eq)]
-struct HistoryKey {
-    surface: u32,
-    normal: [u64; 3],
-    sky_view: u64,
-    initial_k: u64,
-    lit: Vec<u8>,
-}
-
-/// The shading vertices the model computes, and what each sees.
-struct ThermalVertices {
-    /// Shading vertex index of each thermal vertex.
-    index: Vec<usize>,
-    /// Surface (part) of each thermal vertex.
-    surface: Vec<u32>,
-    sky_view: Vec<f64>,
-    /// V_sun per thermal vertex and shadow instant, row-major.
-    lit: Vec<u8>,
-    /// Shadow instants per vertex.
-    shadows: usize,
-}
-
-impl ThermalVertices {
-    /// The vertices of parts with a stack, with their sky view and sun visibility traced, and
-    /// apart from them the vertices of upright terrain tiles, solved as fields (see `field`).
-    fn trace(
-        scene: &Scene,
-        setup: &ThermalSetup,
-        occluders: &Occluders,
-        progress: &dyn Progress,
-    ) -> Result<(ThermalVertices, Vec<FieldVertices>), ThermalRunError> {
-        let mesh = &scene.mesh;
-        let all_surfaces = vertex_surfaces(scene);
-        let mut fields = field_sets(scene, setup);
-        let mut index = Vec::new();
-        let mut frames = Vec::new();
-        for (v, &surface) in all_surfaces.iter().enumerate() {
-            if setup.surfaces[surface as usize].is_none() {
-                continue;
-            }
-            let grid = grid_point_of(scene, surface, &mesh.positions[v]);
-            let field = grid.and_then(|(h, g)| {
-                let field = fields.iter_mut().find(|f| f.heightfield == h)?;
-                Some((field, g))
-            });
-            if let Some((field, g)) = field {
-                field.vertex.push(v);
-                field.grid.push(g);
-                continue;
-            }
-            index.push(v);
-            frames.push(VertexFrame {
-                position: mesh.positions[v],
-                normal: mesh.normals[v],
-                grid,
-            });
-        }
-        progress.begin("sky view and shadows", 2);
-        let sky_view = sky_view_factors(occluders, &frames);
-        progress.advance(1);
-        let sun = shadow_instants(setup)
-            .iter()
-            .map(|&t| weather_at(setup, t).map(|w| w.sun_direction))
-            .collect::<Result<Vec<_>, _>>()?;
-        let lit = sun_visibility(occluders, &frames, &sun);
-        progress.advance(1);
-        progress.end();
-        let vertices = ThermalVertices {
-            surface: index.iter().map(|&v| all_surfaces[v]).collect(),
-            index,
-            sky_view,
-            lit,
-            shadows: sun.len(),
-        };
-        fields.retain(|f| !f.vertex.is_empty());
-        Ok((vertices, fields))
-    }
-
-    fn lit(&self, i: usize) -> &[u8] {
-        &self.lit[i * self.shadows..(i + 1) * self.shadows]
-    }
-
-    /// What thermal vertex `i` sees.
-    fn exposure(&self, i: usize, mesh: &ShadedMesh) -> Exposure<'_> {
-        Exposure {
-            normal: mesh.normals[self.index[i]],
-            sky_view: self.sky_view[i],
-            lit: self.lit(i),
-        }
-    }
-
-    /// Each thermal vertex's history class, and one representative vertex per class.
-    fn group(&self, mesh: &ShadedMesh) -> (Vec<usize>, Vec<usize>) {
-        let mut class_of: HashMap<HistoryKey, usize> = HashMap::new();
-        let mut representatives = Vec::new();
-        let class = (0..self.index.len())
-            .map(|i| {
-                let v = self.index[i];
-                let n = mesh.normals[v];
-                let key = HistoryKey {
-                    surface: self.surface[i],
-                    normal: [n.x.to_bits(), n.y.to_bits(), n.z.to_bits()],
-                    sky_view: self.sky_view[i].to_bits(),
-                    initial_k: mesh.temperatures[v].to_bits(),
-                    lit: self.lit(i).to_vec(),
-                };
-                *class_of.entry(key).or_insert_with(|| {
-                    representatives.push(i);
-                    representatives.len() - 1
-                })
-            })
-            .collect();
-        (class, representatives)
-    }
 }
 
 fn weather_at(setup: &ThermalSetup, time_s: f64) -> Result<WeatherSample, ThermalRunError> {
@@ -410,169 +206,6 @@ fn front_convection_w_m2k(model: &SurfaceThermal, w: &WeatherSample) -> f64 {
     model
         .convection_w_m2k
         .unwrap_or(mcadams_coefficient(w.wind_m_s))
-}
-
-/// A part's vertex solve that failed, named by its part.
-fn independent_error(scene: &Scene, surface: usize, failure: VertexFailure) -> ThermalRunError {
-    let object = scene.surfaces[surface].object;
-    ThermalRunError::Solver {
-        part: format!(
-            "objects[{object}] '{}' part '{}'",
-            scene.object_names[object], scene.surfaces[surface].part
-        ),
-        at: failure.at(),
-        error: failure.error,
-    }
-}
-
-/// The run's tables within their limits, before any is allocated: sun visibility per thermal
-/// vertex (outside terrain fields) and shadow instant, surface temperatures per vertex and recorded instant (the instants
-/// themselves are limited by the `[thermal]` keys, [`crate::thermal::setup`]).
-fn check_sizes(scene: &Scene, setup: &ThermalSetup) -> Result<(), ThermalRunError> {
-    let surfaces = vertex_surfaces(scene);
-    // A terrain field's vertices keep no visibility table (see `field`).
-    let fields: Vec<u32> = field_sets(scene, setup).iter().map(|f| f.surface).collect();
-    let thermal = surfaces
-        .iter()
-        .filter(|&&s| setup.surfaces[s as usize].is_some() && !fields.contains(&s))
-        .count();
-    let shadows = shadow_instants_count(setup);
-    let recorded = (setup.duration_s / setup.output_step_s).floor() as usize + 2;
-    let tables = [
-        (
-            thermal,
-            shadows,
-            "shadow instants",
-            "shadow_step_s",
-            MAX_SHADOW_SAMPLES,
-        ),
-        (
-            surfaces.len(),
-            recorded,
-            "recorded instants",
-            "output_step_s",
-            MAX_RECORDED_VALUES,
-        ),
-    ];
-    for (vertices, instants, what, key, limit) in tables {
-        if vertices.saturating_mul(instants) > limit {
-            return Err(ThermalRunError::TooLarge {
-                vertices,
-                instants,
-                what,
-                key,
-                limit,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// An empty field for every upright terrain tile whose part has a stack outside any enclosure
-/// (an enclosure's members are marched with their air node, one at a time).
-fn field_sets(scene: &Scene, setup: &ThermalSetup) -> Vec<FieldVertices> {
-    (scene.heightfields.iter().enumerate())
-        .filter(|(_, hf)| {
-            let model = setup.surfaces[hf.surface as usize].as_ref();
-            model.is_some_and(|m| m.enclosure.is_none())
-        })
-        .map(|(heightfield, hf)| FieldVertices {
-            heightfield,
-            surface: hf.surface,
-            vertex: Vec::new(),
-            grid: Vec::new(),
-        })
-        .collect()
-}
-
-/// (heightfield, grid point) of a vertex of `surface` at `position`, when it is a point of an
-/// upright terrain tile.
-fn grid_point_of(scene: &Scene, surface: u32, position: &Vector3<f64>) -> Option<(usize, usize)> {
-    let h = (scene.heightfields.iter()).position(|hf| hf.surface == surface)?;
-    Some((h, scene.heightfields[h].grid_point(position)?))
-}
-
-/// The triangles that rays must test: all but the upright terrain tiles' (their horizon maps
-/// answer for them).
-fn occluding_mesh(scene: &Scene) -> Cow<'_, ShadedMesh> {
-    if scene.heightfields.is_empty() {
-        return Cow::Borrowed(&scene.mesh);
-    }
-    let terrain = |s: u32| scene.heightfields.iter().any(|hf| hf.surface == s);
-    let mesh = &scene.mesh;
-    let mut kept = ShadedMesh::default();
-    let mut new_index = vec![u32::MAX; mesh.positions.len()];
-    for (triangle, &s) in mesh.triangles.iter().zip(&mesh.triangle_surface) {
-        if terrain(s) {
-            continue;
-        }
-        let corners = triangle.map(|v| {
-            let slot = &mut new_index[v as usize];
-            if *slot == u32::MAX {
-                *slot = kept.positions.len() as u32;
-                kept.positions.push(mesh.positions[v as usize]);
-                kept.normals.push(mesh.normals[v as usize]);
-                kept.temperatures.push(mesh.temperatures[v as usize]);
-            }
-            *slot
-        });
-        kept.triangles.push(corners);
-        kept.triangle_surface.push(s);
-    }
-    Cow::Owned(kept)
-}
-
-/// The surface (object part) of every shading vertex (a shading vertex belongs to one part).
-pub fn vertex_surfaces(scene: &Scene) -> Vec<u32> {
-    let mut surface = vec![0u32; scene.mesh.positions.len()];
-    for (triangle, &s) in scene
-        .mesh
-        .triangles
-        .iter()
-        .zip(&scene.mesh.triangle_surface)
-    {
-        for &v in triangle {
-            surface[v as usize] = s;
-        }
-    }
-    surface
-}
-
-/// The end of the sampled time: the run's, or the spun-up first day's if longer.
-fn sampled_end(setup: &ThermalSetup) -> f64 {
-    if setup.spinup_days > 0 {
-        setup.duration_s.max(DAY_S)
-    } else {
-        setup.duration_s
-    }
-}
-
-/// How many [`shadow_instants`] there are.
-fn shadow_instants_count(setup: &ThermalSetup) -> usize {
-    (sampled_end(setup) / setup.shadow_step_s).ceil() as usize + 1
-}
-
-/// Shadow instants 0, step, 2·step, … through the end of the run (and of the spin-up day).
-fn shadow_instants(setup: &ThermalSetup) -> Vec<f64> {
-    let end = sampled_end(setup);
-    (0..shadow_instants_count(setup))
-        .map(|i| (i as f64 * setup.shadow_step_s).min(end))
-        .collect()
-}
-
-/// What one vertex sees.
-struct Exposure<'a> {
-    normal: nalgebra::Vector3<f64>,
-    sky_view: f64,
-    /// V_sun at each shadow instant.
-    lit: &'a [u8],
-}
-
-impl Exposure<'_> {
-    /// V_sun at `time_s`, linear between shadow instants.
-    fn sun_visible(&self, time_s: f64, step_s: f64) -> f64 {
-        ShadowInterval::at(time_s, step_s, self.lit.len()).visible(self.lit)
-    }
 }
 
 /// The shared inputs of every vertex's solve.

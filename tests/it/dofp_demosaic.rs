@@ -4,8 +4,8 @@
 use crate::common;
 
 use irpol::progress::Silent;
-use irpol::render::camera::metrics::psnr;
 use irpol::render::dofp::{demosaic, mosaic, stokes_from_polarizers, Demosaic};
+use irpol::render::instrument::metrics::psnr;
 use irpol::render::render;
 use irpol::scene::load_scene;
 

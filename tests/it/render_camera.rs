@@ -4,7 +4,7 @@
 use crate::camera_support as support;
 
 use irpol::progress::Silent;
-use irpol::render::camera::slanted_edge::{slanted_edge_mtf, EdgeMtf};
+use irpol::render::instrument::slanted_edge::{slanted_edge_mtf, EdgeMtf};
 use irpol::render::render;
 use irpol::scene::load_scene_text;
 use std::f64::consts::PI;

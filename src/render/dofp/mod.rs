@@ -60,7 +60,7 @@
 //! **On the car** (`tests/it/dofp_demosaic.rs`: the shipped car scene rendered without detector noise
 //! at 320 × 240, averaged over 2 × 2 blocks into a 160 × 120 truth, ideal polarizer images
 //! mosaicked and demosaicked; PSNR = 10 log10(peak²/MSE), peak = the truth's largest |value| of
-//! the channel, `render::camera::metrics::psnr`):
+//! the channel, `render::instrument::metrics::psnr`):
 //!
 //! | method | S0 | S1 | S2 |
 //! |---|---|---|---|

@@ -78,7 +78,7 @@ impl DetectorModel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::camera::ideal_sensor as sensor;
+    use crate::render::instrument::ideal_sensor as sensor;
 
     #[test]
     fn the_pattern_has_its_stated_spread_and_is_fixed_per_seed() {

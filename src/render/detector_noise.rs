@@ -1,6 +1,4 @@
-//! What happens between the surface and the detector: the optional atmospheric path
-//! S_sensor = τ S + L_path δ_j0 with τ and L_path of the scene's [`Atmosphere`] at the pixel's range
-//! (docs/design.md §1.5, §1.12), and detector noise.
+//! Detector noise of a polarimetric camera.
 //!
 //! Noise model: a polarimetric camera records the four polarizer images I(0°, 45°, 90°, 135°); each
 //! gets independent Gaussian noise whose temperature equivalent is the NETD, σ_I = NETD · dI/dT =
@@ -10,31 +8,9 @@
 //! (ChaCha8, one stream per image row), so a render is reproducible whatever the thread count.
 
 use crate::elementary::standard_normal;
-use crate::scene::{Atmosphere, Sensor};
+use crate::scene::Sensor;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-
-/// Atmospheric transmission and path emission for one pixel at `range` metres: the Stokes
-/// vector `s` seen through the path, and its standard error `error` scaled by τ (the path
-/// itself is exact).
-#[inline]
-pub fn through_atmosphere(
-    s: [f64; 4],
-    error: [f64; 4],
-    range: f64,
-    atmosphere: &Atmosphere,
-) -> ([f64; 4], [f64; 4]) {
-    let (tau, path_radiance) = atmosphere.along(range);
-    (
-        [
-            tau * s[0] + path_radiance,
-            tau * s[1],
-            tau * s[2],
-            tau * s[3],
-        ],
-        error.map(|e| e * tau),
-    )
-}
 
 /// Per-row noise generator: σ_I is the radiance noise of each polarizer image.
 pub struct Noise {
@@ -73,23 +49,5 @@ impl Noise {
         (0..width)
             .map(|_| [0; 4].map(|_| standard_normal(&mut rng)))
             .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn atmosphere_blends_toward_path_radiance() {
-        let band = crate::optics::Band::lwir();
-        let atm = Atmosphere::extinction(1e-3, 280.0, &band);
-        let (s, e) = through_atmosphere([10.0, 1.0, -1.0, 0.5], [0.1; 4], 1000.0, &atm);
-        let tau = (-1.0f64).exp();
-        let path = band.radiance(280.0);
-        assert!((s[0] - (10.0 * tau + path * (1.0 - tau))).abs() < 1e-12);
-        assert!(e.iter().all(|e| (e - 0.1 * tau).abs() < 1e-15));
-        assert!((s[1] - tau).abs() < 1e-12 && (s[2] + tau).abs() < 1e-12);
-        assert!((s[3] - 0.5 * tau).abs() < 1e-12);
     }
 }

@@ -242,7 +242,7 @@ fn transpose(grid: &[Complex<f64>], w: usize, h: usize) -> Vec<Complex<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::camera::ideal_sensor as sensor;
+    use crate::render::instrument::ideal_sensor as sensor;
     use crate::scene::Diffraction;
 
     fn optics(f_number: f64, pitch: f64, fill: f64, sigma: f64) -> Optics {

@@ -1,5 +1,5 @@
 //! The camera between the scene's radiance and the images (docs/design.md §1.11): optics blur the
-//! polarizer images ([`otf`]), the detector adds temporal noise (`render::sensor`), its fixed
+//! polarizer images ([`otf`]), the detector adds temporal noise (`render::detector_noise`), its fixed
 //! pattern and quantization ([`detector`]), and a division-of-focal-plane array records one
 //! imperfect polarizer per pixel ([`polarizer_array`]) to be demosaicked (`render::dofp`).
 //! [`metrics`] compares what the camera delivers with the noise-free truth; [`slanted_edge`]
@@ -18,9 +18,9 @@ pub mod otf;
 pub mod polarizer_array;
 pub mod slanted_edge;
 
+use super::detector_noise::Noise;
 use super::dofp::{demosaic, orientation};
 use super::film::polarizer;
-use super::sensor::Noise;
 use crate::scene::Sensor;
 use detector::{DetectorModel, PixelPattern};
 use metrics::CameraMetrics;
