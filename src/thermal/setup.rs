@@ -7,13 +7,11 @@ use super::config::{
     BackConfig, EnclosureConfig, InternalHeatConfig, LayerMaterialConfig, PartThermalConfig,
     ThermalConfig, WeatherConfig,
 };
-use super::{
-    Back, Layer, LayerMaterial, LayerStack, Site, StationFormat, StationWeather, ThermalError,
-    Weather, WeatherError, WeatherFormat,
-};
+use super::{Back, Layer, LayerMaterial, LayerStack, ThermalError};
 use crate::emitter::{parse_time_utc, SunError};
 use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
 use crate::text::{about, number};
+use crate::weather::{Site, StationFormat, StationWeather, Weather, WeatherError, WeatherFormat};
 use std::collections::BTreeMap;
 use std::path::Path;
 

@@ -22,10 +22,11 @@ use crate::thermal::convection::mcadams_coefficient;
 use crate::thermal::setup::{SurfaceThermal, ThermalSetup};
 use crate::thermal::{
     Forcing, FrontForcing, Resolution, Solver, SolverControl, StepReport, ThermalError,
-    ThermalState, WeatherSample,
+    ThermalState,
 };
 use crate::transport::accel::Accelerator;
 use crate::transport::horizon::HorizonMap;
+use crate::weather::WeatherSample;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::borrow::Cow;
@@ -96,7 +97,7 @@ pub enum ThermalRunError {
     NotThermal(String),
     /// The weather has no value at a time the run needs.
     #[error("{0}")]
-    Weather(crate::thermal::WeatherError),
+    Weather(crate::weather::WeatherError),
     #[error(
         "thermal time {} s is outside the run 0…{} s",
         number(*time_s), number(*duration_s)
