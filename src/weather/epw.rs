@@ -6,8 +6,8 @@
 //! marker is missing. Fields beyond 24 (visibility, precipitation, …) are not read.
 
 use super::station::{
-    field_value, header_station, label, read_records, Field, HourRecord, LineRefusal, Missing,
-    Station, StationFormat, StationWeather, FIELDS,
+    field_value, header_station, label, read_records, Field, HourRecord, Missing, Refusal, Station,
+    StationFormat, StationWeather, FIELDS,
 };
 use super::WeatherError;
 use crate::table_text::split_fields;
@@ -102,15 +102,15 @@ pub(super) fn parse(
     })
 }
 
-fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), LineRefusal> {
+fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), Refusal> {
     let mut lines = text.lines().enumerate().map(|(i, l)| (i as u64 + 1, l));
     let Some((_, first)) = lines.next() else {
-        return Err(LineRefusal::at_line(
+        return Err(Refusal::at_line(
             1,
             "empty file: an EPW file starts with a LOCATION line".into(),
         ));
     };
-    let station = location(first).map_err(|problem| LineRefusal::at_line(1, problem))?;
+    let station = location(first).map_err(|problem| Refusal::at_line(1, problem))?;
     let mut lines = lines.peekable();
     let mut header_end = 1;
     while let Some(&(number, _)) = lines.peek().filter(|(_, line)| is_header_line(line)) {

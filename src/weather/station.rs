@@ -162,7 +162,7 @@ pub struct StationWeather {
 }
 
 /// A refusal at a line (before the path is attached).
-pub(super) type LineRefusal = crate::table_text::Refusal<Problem>;
+pub(super) type Refusal = crate::table_text::Refusal<Problem>;
 
 impl StationWeather {
     /// The first instant covered (the first label, UTC).
@@ -184,7 +184,7 @@ impl StationWeather {
         duration_s: Option<f64>,
     ) -> Result<Weather, WeatherError> {
         site.validate()?;
-        let refuse = |refusal: LineRefusal| WeatherError::Station(refusal.in_file(&self.source));
+        let refuse = |refusal: Refusal| WeatherError::Station(refusal.in_file(&self.source));
         let first = self.first_utc().timestamp();
         let last = self.last_utc().timestamp();
         let start = site.start_utc.timestamp();
@@ -203,7 +203,7 @@ impl StationWeather {
                 crate::emitter::format_time_utc(&self.first_utc()),
                 crate::emitter::format_time_utc(&self.last_utc())
             );
-            return Err(refuse(LineRefusal::at_line(line, message.into())));
+            return Err(refuse(Refusal::at_line(line, message.into())));
         }
         let to = (end.clamp(first, last) - first + STATION_STEP_S - 1).div_euclid(STATION_STEP_S);
         let to = to.min((last - first) / STATION_STEP_S).max(from + 1);
@@ -224,9 +224,9 @@ impl StationWeather {
         site: &Site,
         since_first_s: i64,
         at: &DateTime<Utc>,
-    ) -> Result<WeatherSample, LineRefusal> {
+    ) -> Result<WeatherSample, Refusal> {
         let sun = sun_position(site.latitude_deg, site.longitude_deg, at)
-            .map_err(|e| LineRefusal::at_line(self.records[0].line, e.to_string().into()))?;
+            .map_err(|e| Refusal::at_line(self.records[0].line, e.to_string().into()))?;
         let value = |field| self.interpolate(field, since_first_s);
         let air_c = value(Field::DryBulb)?;
         let air_k = air_c + 273.15;
@@ -262,11 +262,11 @@ impl StationWeather {
 
     /// `field` at `since_first_s` after the first label, linear between its knots; a missing
     /// knot that is needed is refused at its line.
-    fn interpolate(&self, field: Field, since_first_s: i64) -> Result<f64, LineRefusal> {
+    fn interpolate(&self, field: Field, since_first_s: i64) -> Result<f64, Refusal> {
         // Hour means sit half an hour before their label: shift time by +30 min onto their knots.
         let t = since_first_s + if field.is_hour_mean() { 1800 } else { 0 };
         let (i, rest) = (t.div_euclid(3600) as usize, t.rem_euclid(3600));
-        let knot = |i: usize| -> Result<f64, LineRefusal> {
+        let knot = |i: usize| -> Result<f64, Refusal> {
             let record = &self.records[i.min(self.records.len() - 1)];
             record.values[field as usize].ok_or_else(|| {
                 let name = &self.field_names[field as usize];
@@ -275,7 +275,7 @@ impl StationWeather {
                      (e.g. from the neighbouring hours) or move the run off it",
                     record.end_local.format("%Y-%m-%d %H:%M")
                 );
-                LineRefusal::at_line(record.line, message.into())
+                Refusal::at_line(record.line, message.into())
             })
         };
         let a = knot(i)?;
@@ -459,7 +459,7 @@ pub(super) fn read_records<'a>(
     lines: impl Iterator<Item = (u64, &'a str)>,
     header_end: u64,
     mut parse: impl FnMut(&str) -> Result<HourRecord, Problem>,
-) -> Result<Vec<HourRecord>, LineRefusal> {
+) -> Result<Vec<HourRecord>, Refusal> {
     let mut records = Vec::new();
     let mut last_line = header_end;
     for (line, row) in lines {
@@ -469,9 +469,9 @@ pub(super) fn read_records<'a>(
         if records.len() == MAX_WEATHER_ROWS {
             let message =
                 format!("more than {MAX_WEATHER_ROWS} rows: split the weather or thin it out");
-            return Err(LineRefusal::at_line(line, message.into()));
+            return Err(Refusal::at_line(line, message.into()));
         }
-        let mut record = parse(row).map_err(|problem| LineRefusal::at_line(line, problem))?;
+        let mut record = parse(row).map_err(|problem| Refusal::at_line(line, problem))?;
         record.line = line;
         records.push(record);
         last_line = line;
@@ -482,18 +482,18 @@ pub(super) fn read_records<'a>(
 
 /// Rows must follow each other by exactly one hour (a typical-year file mixes years: then give
 /// the year to read it in), and there must be at least two.
-pub(super) fn check_sequence(records: &[HourRecord], last_line: u64) -> Result<(), LineRefusal> {
+pub(super) fn check_sequence(records: &[HourRecord], last_line: u64) -> Result<(), Refusal> {
     if records.len() < 2 {
         let message = format!(
             "{} hourly row(s): the weather needs at least two to interpolate between",
             records.len()
         );
-        return Err(LineRefusal::at_line(last_line, message.into()));
+        return Err(Refusal::at_line(last_line, message.into()));
     }
     for pair in records.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);
         if b.end_utc - a.end_utc != TimeDelta::hours(1) {
-            return Err(LineRefusal::at_line(
+            return Err(Refusal::at_line(
                 b.line,
                 Problem(format!(
                     "the row for {} does not follow the row for {} on line {} by one hour: rows \

@@ -6,8 +6,8 @@
 //! no infrared column: the sky's long-wave is always Clark & Allen's. −9900 (NSRDB) is missing.
 
 use super::station::{
-    field_value, header_station, label, read_records, Field, HourRecord, LineRefusal, Missing,
-    Station, StationFormat, StationWeather, FIELDS,
+    field_value, header_station, label, read_records, Field, HourRecord, Missing, Refusal, Station,
+    StationFormat, StationWeather, FIELDS,
 };
 use super::WeatherError;
 use crate::table_text::split_fields;
@@ -77,30 +77,28 @@ fn split(line: &str) -> Vec<String> {
     }
 }
 
-fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), LineRefusal> {
+fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), Refusal> {
     let mut lines = text.lines().enumerate().map(|(i, l)| (i as u64 + 1, l));
     let station = match lines.next() {
-        Some((_, first)) => {
-            site(&split(first)).map_err(|problem| LineRefusal::at_line(1, problem))?
-        }
+        Some((_, first)) => site(&split(first)).map_err(|problem| Refusal::at_line(1, problem))?,
         None => {
-            return Err(LineRefusal::at_line(
+            return Err(Refusal::at_line(
                 1,
                 "empty file: a TMY3 file starts with its site line".into(),
             ))
         }
     };
     let Some((_, header)) = lines.next() else {
-        return Err(LineRefusal::at_line(
+        return Err(Refusal::at_line(
             1,
             "no column header line after the site line".into(),
         ));
     };
     let header = split(header);
-    let find = |name: &str| -> Result<usize, LineRefusal> {
+    let find = |name: &str| -> Result<usize, Refusal> {
         header.iter().position(|h| h == name).ok_or_else(|| {
             let message = format!("missing column '{name}' in the column header line");
-            LineRefusal::at_line(2, message.into())
+            Refusal::at_line(2, message.into())
         })
     };
     let (date, time) = (find(DATE)?, find(TIME)?);
