@@ -1,5 +1,5 @@
 """Cross-check of `irpol sun --clear-sky` against pvlib's simplified Solis model (docs/design.md §1.8; the
-clear day of the thermal weather, src/thermal/weather/solis.rs).
+clear day of the thermal weather, src/weather/solis.rs).
 
     .venv/bin/python scripts/crosscheck_clearsky.py [--irpol PATH] [--year 2026]
 

@@ -88,11 +88,13 @@ pub mod progress;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod table_text;
 pub mod text;
 pub mod thermal;
 pub mod thermal_scene;
 pub mod toml_table;
 pub mod transport;
+pub mod weather;
 
 pub use app::fit::fit_and_write;
 pub use app::render::{render_scene, render_scene_at};

@@ -271,8 +271,8 @@ fn weather(
     step: Option<f64>,
 ) -> anyhow::Result<()> {
     let format = match format {
-        Some("epw") => Some(irpol::thermal::WeatherFormat::Epw),
-        Some(_) => Some(irpol::thermal::WeatherFormat::Tmy3),
+        Some("epw") => Some(irpol::weather::WeatherFormat::Epw),
+        Some(_) => Some(irpol::weather::WeatherFormat::Tmy3),
         None => None,
     };
     let station = irpol::app::weather::read_station(file, format, year)?;

@@ -53,7 +53,7 @@ pub enum AppError {
     Sun(#[from] crate::emitter::SunError),
     /// A weather file refused (`irpol weather`).
     #[error(transparent)]
-    Weather(Box<crate::thermal::WeatherError>),
+    Weather(Box<crate::weather::WeatherError>),
     /// Writing a table to the output stream (stdout for the CLI); kept as the bare I/O error so
     /// that the CLI can tell a reader that went away (`irpol eval … | head`) from a failure.
     #[error(transparent)]
@@ -236,8 +236,8 @@ impl AppError {
     }
 }
 
-impl From<crate::thermal::WeatherError> for AppError {
-    fn from(error: crate::thermal::WeatherError) -> AppError {
+impl From<crate::weather::WeatherError> for AppError {
+    fn from(error: crate::weather::WeatherError) -> AppError {
         AppError::Weather(Box::new(error))
     }
 }

@@ -1,11 +1,11 @@
 //! `irpol sun`: the apparent sun position (SPA, standard atmosphere; see `emitter::sun`) at one site
 //! for one instant or a file of them, as CSV, and with `--clear-sky` the simplified Solis clear-sky
-//! irradiance at that elevation (`thermal::weather::solis`, its default atmosphere). The batch form
+//! irradiance at that elevation (`weather::solis`, its default atmosphere). The batch form
 //! exists so that a cross-check over a year of hours runs one process, not thousands.
 
 use super::AppError;
 use crate::emitter::{format_time_utc, parse_time_utc, sun_position, SunPosition};
-use crate::thermal::{simplified_solis, SolisAtmosphere};
+use crate::weather::{simplified_solis, SolisAtmosphere};
 use chrono::{DateTime, Utc};
 use std::io::Write;
 use std::path::Path;

@@ -6,8 +6,8 @@
 
 use super::AppError;
 use crate::emitter::{format_time_utc, sun_position};
-use crate::thermal::weather::station::{Field, FIELDS};
-use crate::thermal::{Site, StationFormat, StationWeather, WeatherFormat};
+use crate::weather::station::{Field, FIELDS};
+use crate::weather::{Site, StationFormat, StationWeather, WeatherFormat};
 use std::io::Write;
 use std::path::Path;
 

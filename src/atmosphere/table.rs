@@ -1,6 +1,6 @@
 //! The atmosphere table of docs/design.md §2.9: a CSV of a radiative-transfer code's path
-//! transmittance and path radiance over range, refused with `file:line: what is wrong and what to
-//! do` (a whole-file problem without the line).
+//! transmittance and path radiance over range, read by [`crate::table_text`] and refused with
+//! `file:line: what is wrong and what to do` (a whole-file problem without the line).
 //!
 //! Lines starting with `#` are comments (`# source: …` and `# geometry: …` are kept for
 //! `summary.json`), blank lines are skipped; the first other line is the header row, naming the
@@ -15,6 +15,10 @@
 
 use super::{integrate_spectral, BandRows};
 use crate::optics::Band;
+use crate::table_text::{
+    self, is_comment, parse_finite, split_fields, ColumnMap, HeaderProblem, NumberProblem, Problem,
+    TableError,
+};
 use crate::text::{number, shown, shown_at_most};
 use std::path::{Path, PathBuf};
 
@@ -34,16 +38,10 @@ pub enum AtmosphereTableError {
         crate::text::path(file)
     )]
     Read { file: PathBuf, reason: String },
-    /// A problem at a line of the file (1-based).
-    #[error("{}:{line}: {message}", crate::text::path(file))]
-    Line {
-        file: PathBuf,
-        line: usize,
-        message: String,
-    },
-    /// A problem of the whole file (too few rows, the band not covered).
-    #[error("{}: {message}", crate::text::path(file))]
-    Table { file: PathBuf, message: String },
+    /// A problem at a line of the file, or of the whole file (too few rows, the band not
+    /// covered: line 0).
+    #[error(transparent)]
+    Table(TableError<Problem>),
 }
 
 /// An atmosphere table as read, before it meets a sensor band.
@@ -95,16 +93,16 @@ impl AtmosphereTable {
                 &s.transmittance,
                 &s.radiance_per_um,
             )
-            .map_err(|e| AtmosphereTableError::Table {
-                file: self.file.clone(),
-                message: format!(
+            .map_err(|e| {
+                let message = format!(
                     "the wavelengths cover {}–{} µm, not the whole sensor band {}–{} µm: add rows \
                      over the band (or narrow sensor.band_um)",
                     number(e.table_um.0),
                     number(e.table_um.1),
                     number(e.band_um.0),
                     number(e.band_um.1)
-                ),
+                );
+                AtmosphereTableError::Table(Refusal::at_line(0, message.into()).in_file(&self.file))
             }),
         }
     }
@@ -121,26 +119,10 @@ pub fn read_table(path: &Path) -> Result<AtmosphereTable, AtmosphereTableError> 
 
 /// [`read_table`] of a file's bytes; `path` names it in messages.
 pub fn parse_table(path: &Path, bytes: &[u8]) -> Result<AtmosphereTable, AtmosphereTableError> {
-    let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
-    let refuse = |(line, message): Refusal| match line {
-        Some(line) => AtmosphereTableError::Line {
-            file: path.to_owned(),
-            line,
-            message,
-        },
-        None => AtmosphereTableError::Table {
-            file: path.to_owned(),
-            message,
-        },
-    };
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        let line = bytes[..e.valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count()
-            + 1;
-        refuse((
-            Some(line),
+    let refuse = |refusal: Refusal| AtmosphereTableError::Table(refusal.in_file(path));
+    let text = table_text::decode_utf8(bytes).map_err(|refusal| {
+        refuse(at(
+            refusal.line as usize,
             "invalid UTF-8: an atmosphere table must be UTF-8 text (save it as UTF-8)".into(),
         ))
     })?;
@@ -153,8 +135,13 @@ pub fn parse_table(path: &Path, bytes: &[u8]) -> Result<AtmosphereTable, Atmosph
     })
 }
 
-/// A refusal at a line (or of the whole file), before the path is attached.
-type Refusal = (Option<usize>, String);
+/// A refusal at a line (line 0: of the whole file), before the path is attached.
+type Refusal = table_text::Refusal<Problem>;
+
+/// The refusal of line `line` (0: the whole file) saying `message`.
+fn at(line: usize, message: String) -> Refusal {
+    Refusal::at_line(line as u64, Problem(message))
+}
 
 /// The `# source:` and `# geometry:` lines.
 #[derive(Default)]
@@ -230,51 +217,50 @@ impl Column {
     }
 }
 
-/// Where each column is in a row.
-struct Layout {
-    /// Field index of each [`Column`] (by `Column as usize`), if present.
-    index: [Option<usize>; 5],
-    width: usize,
+/// Where each column is in a row, and which kind of table the columns make.
+struct Shape {
+    columns: ColumnMap<Column>,
     spectral: bool,
 }
 
 /// Notes and rows of the text of a table.
 fn parse_text(text: &str) -> Result<(Notes, TableRows), Refusal> {
     let mut notes = Notes::default();
-    let mut layout: Option<Layout> = None;
+    let mut shape: Option<Shape> = None;
     let mut band = BandBuilder::default();
     let mut spectral = SpectralBuilder::default();
     let mut last_line = 0;
-    for (i, raw) in text.lines().enumerate() {
-        let (line, trimmed) = (i + 1, raw.trim());
+    for (number, raw) in table_text::lines(text) {
+        let (line, trimmed) = (number as usize, raw.trim());
         if trimmed.is_empty() {
             continue;
         }
-        if let Some(comment) = trimmed.strip_prefix('#') {
-            notes.take(comment);
+        if is_comment(trimmed) {
+            notes.take(&trimmed[1..]);
             continue;
         }
-        let Some(layout) = &layout else {
-            layout = Some(parse_header(trimmed, line)?);
+        let Some(shape) = &shape else {
+            shape = Some(parse_header(trimmed, line)?);
             continue;
         };
-        let [w, r, t, l] = parse_row(trimmed, line, layout)?;
-        if layout.spectral {
+        let [w, r, t, l] = parse_row(trimmed, line, shape)?;
+        if shape.spectral {
             spectral.push(line, w, r, t, l)?;
         } else {
             band.push(line, r, t, l)?;
         }
         last_line = line;
     }
-    let layout = layout.ok_or((
-        Some(1),
-        "no header row: the file is empty or only comments; the first other line names the \
-         columns ("
-            .to_owned()
-            + KINDS
-            + ")",
-    ))?;
-    let rows = if layout.spectral {
+    let shape = shape.ok_or_else(|| {
+        at(
+            1,
+            format!(
+                "no header row: the file is empty or only comments; the first other line names \
+                 the columns ({KINDS})"
+            ),
+        )
+    })?;
+    let rows = if shape.spectral {
         TableRows::Spectral(spectral.finish(last_line)?)
     } else {
         TableRows::Band(band.finish(last_line)?)
@@ -283,19 +269,24 @@ fn parse_text(text: &str) -> Result<(Notes, TableRows), Refusal> {
 }
 
 /// The header row: known names, no duplicates, exactly the columns of one kind.
-fn parse_header(text: &str, line: usize) -> Result<Layout, Refusal> {
-    let refuse = |message: String| Err((Some(line), message));
-    let mut index = [None; 5];
-    let names: Vec<&str> = text.split(',').map(str::trim).collect();
-    for (i, name) in names.iter().enumerate() {
-        let Some(&(column, _)) = COLUMNS.iter().find(|(_, known)| known == name) else {
-            return refuse(unknown_column(name));
-        };
-        if index[column as usize].replace(i).is_some() {
-            return refuse(format!("column '{name}' appears twice: keep one"));
-        }
-    }
-    let has = |column: Column| index[column as usize].is_some();
+fn parse_header(text: &str, line: usize) -> Result<Shape, Refusal> {
+    let refuse = |message: String| Err(at(line, message));
+    let fields = split_fields(line as u64, text).map_err(|r| at(line, r.kind.to_string()))?;
+    let known = |name: &str| COLUMNS.iter().find(|(_, k)| *k == name).map(|&(c, _)| c);
+    let columns = ColumnMap::of_header(line as u64, &fields, known, false).map_err(|r| {
+        at(
+            line,
+            match r.kind {
+                HeaderProblem::Token(problem) => problem.to_string(),
+                HeaderProblem::Empty => unknown_column(""),
+                HeaderProblem::Unknown(name) => unknown_column(&name),
+                HeaderProblem::Duplicate { name, .. } => {
+                    format!("column '{name}' appears twice: keep one")
+                }
+            },
+        )
+    })?;
+    let has = |column: Column| columns.has(column);
     let spectral = has(Column::Wavelength);
     if spectral && has(Column::BandRadiance) {
         return refuse(
@@ -320,14 +311,10 @@ fn parse_header(text: &str, line: usize) -> Result<Layout, Refusal> {
     } else {
         &[Column::Range, Column::Transmittance, Column::BandRadiance]
     };
-    if let Some(missing) = required.iter().find(|&&c| !has(c)) {
+    if let Some(missing) = columns.missing(required) {
         return refuse(format!("missing column '{}' ({KINDS})", missing.name()));
     }
-    Ok(Layout {
-        index,
-        width: names.len(),
-        spectral,
-    })
+    Ok(Shape { columns, spectral })
 }
 
 fn unknown_column(name: &str) -> String {
@@ -344,19 +331,19 @@ fn unknown_column(name: &str) -> String {
 }
 
 /// One data row as [wavelength (0 in a band table), range, τ, radiance].
-fn parse_row(text: &str, line: usize, layout: &Layout) -> Result<[f64; 4], Refusal> {
-    let fields: Vec<&str> = text.split(',').map(str::trim).collect();
-    if fields.len() != layout.width {
-        return Err((
-            Some(line),
+fn parse_row(text: &str, line: usize, shape: &Shape) -> Result<[f64; 4], Refusal> {
+    let fields = split_fields(line as u64, text).map_err(|r| at(line, r.kind.to_string()))?;
+    if fields.len() != shape.columns.width() {
+        return Err(at(
+            line,
             format!(
                 "the row has {} fields, the header row has {}",
                 fields.len(),
-                layout.width
+                shape.columns.width()
             ),
         ));
     }
-    let radiance = if layout.spectral {
+    let radiance = if shape.spectral {
         Column::SpectralRadiance
     } else {
         Column::BandRadiance
@@ -371,41 +358,24 @@ fn parse_row(text: &str, line: usize, layout: &Layout) -> Result<[f64; 4], Refus
     .into_iter()
     .enumerate()
     {
-        let Some(i) = layout.index[column as usize] else {
+        let Some(i) = shape.columns.field(column) else {
             continue;
         };
-        let value = parse_number(fields[i])
-            .map_err(|why| (Some(line), format!("column '{}': {why}", column.name())))?;
+        let text = fields[i].text.as_ref();
+        let value = parse_finite(text).map_err(|problem| {
+            let why = match problem {
+                NumberProblem::Empty => "empty, expected a number".to_string(),
+                NumberProblem::NotFinite => format!("'{}' is not a finite number", shown(text)),
+                NumberProblem::NotANumber => format!("'{}' is not a number", shown(text)),
+            };
+            at(line, format!("column '{}': {why}", column.name()))
+        })?;
         if let Some(why) = column.problem(value) {
-            return Err((Some(line), format!("column '{}': {why}", column.name())));
+            return Err(at(line, format!("column '{}': {why}", column.name())));
         }
         values[slot] = value;
     }
     Ok(values)
-}
-
-/// Why a field is not a finite number.
-struct NotANumber(String);
-
-impl std::fmt::Display for NotANumber {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-/// A field as a finite number, or why not.
-fn parse_number(text: &str) -> Result<f64, NotANumber> {
-    if text.is_empty() {
-        return Err(NotANumber("empty, expected a number".into()));
-    }
-    match text.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(NotANumber(format!(
-            "'{}' is not a finite number",
-            shown(text)
-        ))),
-        Err(_) => Err(NotANumber(format!("'{}' is not a number", shown(text)))),
-    }
 }
 
 /// "`r` m is not after `previous` m" for a range out of order.
@@ -420,8 +390,9 @@ fn not_increasing(r: f64, previous: f64, within: &str) -> String {
 
 /// "N data row(s)" refusal of a table too short to interpolate.
 fn too_few(count: usize, line: usize, what: &str) -> Refusal {
-    (
-        (line > 0).then_some(line),
+    // Line 0 (no data row at all) is the whole file.
+    at(
+        line,
         format!(
             "{count} range(s){what}: the table needs at least two ranges to interpolate between"
         ),
@@ -438,7 +409,7 @@ struct BandBuilder {
 impl BandBuilder {
     fn push(&mut self, line: usize, r: f64, t: f64, l: f64) -> Result<(), Refusal> {
         if let Some(&previous) = self.ranges.last().filter(|&&p| r <= p) {
-            return Err((Some(line), not_increasing(r, previous, "")));
+            return Err(at(line, not_increasing(r, previous, "")));
         }
         self.ranges.push(r);
         self.tau.push(t);
@@ -473,8 +444,8 @@ impl SpectralBuilder {
         if current != Some(w) {
             if let Some(previous) = current {
                 if w < previous {
-                    return Err((
-                        Some(line),
+                    return Err(at(
+                        line,
                         format!(
                             "column 'wavelength_um': {} µm comes after {} µm: group the rows by \
                              wavelength, wavelengths ascending (ranges ascending within each)",
@@ -495,11 +466,11 @@ impl SpectralBuilder {
         let within = format!(" within wavelength {} µm", number(w));
         if first_block {
             if let Some(&previous) = rows.ranges_m.last().filter(|&&p| r <= p) {
-                return Err((Some(line), not_increasing(r, previous, &within)));
+                return Err(at(line, not_increasing(r, previous, &within)));
             }
             rows.ranges_m.push(r);
         } else if rows.ranges_m.get(k) != Some(&r) {
-            return Err((Some(line), other_ranges(rows, k, r, &within)));
+            return Err(at(line, other_ranges(rows, k, r, &within)));
         }
         if let (Some(taus), Some(radiances)) = (
             rows.transmittance.last_mut(),
@@ -556,8 +527,8 @@ fn close_block(rows: &SpectralRows, block_line: usize, line: usize) -> Result<()
     let count = rows.transmittance.last().map_or(0, Vec::len);
     if count < rows.ranges_m.len() {
         let w = rows.wavelengths_um.last().copied().unwrap_or_default();
-        return Err((
-            Some(line),
+        return Err(at(
+            line,
             format!(
                 "wavelength {} µm (from line {block_line}) has {count} range(s), the first \
                  wavelength {}: every wavelength needs the same ranges",

@@ -2,9 +2,9 @@
 //! Required: theta_i_deg, theta_r_deg, m00. Optional: phi_i_deg, phi_r_deg, wavelength_um, any of
 //! m01…m33 and their uncertainties u_m00…u_m33. Names are case-sensitive.
 
-use super::error::{Delimiter, MeasureErrorKind, Refusal};
-use super::fields::Field;
+use super::error::{MeasureErrorKind, Refusal};
 use super::MUELLER_ELEMENT_NAMES;
+use crate::table_text::{ColumnMap, Field, HeaderProblem};
 use crate::text::shown;
 
 const THETA_I: &str = "theta_i_deg";
@@ -44,9 +44,9 @@ impl Quantity {
     }
 }
 
-/// The columns of a file, in file order, and the Mueller elements they hold.
+/// The columns of a §2.1 file, in file order, and the Mueller elements they hold.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Layout {
+pub(crate) struct NativeColumns {
     pub quantities: Vec<Quantity>,
     /// Column names as written, for messages.
     pub names: Vec<String>,
@@ -54,26 +54,23 @@ pub(crate) struct Layout {
     pub elements: Vec<usize>,
 }
 
-impl Layout {
+impl NativeColumns {
     pub(crate) fn has(&self, quantity: Quantity) -> bool {
         self.quantities.contains(&quantity)
     }
 
-    /// Position of Mueller element `index` within [`Layout::elements`].
+    /// Position of Mueller element `index` within [`NativeColumns::elements`].
     pub(crate) fn slot(&self, index: usize) -> Option<usize> {
         self.elements.iter().position(|&e| e == index)
     }
 }
 
 /// Reads the header row (1-based line `line`) from its fields.
-pub(crate) fn parse_header_row(line: u64, fields: &[Field<'_>]) -> Result<Layout, Refusal> {
-    let mut quantities = Vec::with_capacity(fields.len());
-    let mut names = Vec::with_capacity(fields.len());
-    for field in fields {
-        let quantity = column_quantity(line, field, fields, &quantities)?;
-        quantities.push(quantity);
-        names.push(field.text.to_string());
-    }
+pub(crate) fn parse_header_row(line: u64, fields: &[Field<'_>]) -> Result<NativeColumns, Refusal> {
+    let map = ColumnMap::of_header(line, fields, Quantity::from_name, false)
+        .map_err(|refusal| refusal.map(header_problem))?;
+    // Every name is known (unknown ones were refused).
+    let quantities: Vec<Quantity> = map.known().iter().flatten().copied().collect();
     check_required_columns(line, &quantities)?;
     check_uncertainty_columns(line, fields, &quantities)?;
     let mut elements: Vec<usize> = quantities
@@ -84,55 +81,26 @@ pub(crate) fn parse_header_row(line: u64, fields: &[Field<'_>]) -> Result<Layout
         })
         .collect();
     elements.sort_unstable();
-    Ok(Layout {
+    Ok(NativeColumns {
         quantities,
-        names,
+        names: map.names().to_vec(),
         elements,
     })
 }
 
-/// The quantity `field` names, refusing a wrong delimiter, an empty or unknown name, and a
-/// name already among the `earlier` columns (of `fields`).
-fn column_quantity(
-    line: u64,
-    field: &Field<'_>,
-    fields: &[Field<'_>],
-    earlier: &[Quantity],
-) -> Result<Quantity, Refusal> {
-    let name = field.text.as_ref();
-    if !field.quoted {
-        if let Some(refusal) = wrong_delimiter(line, field) {
-            return Err(refusal);
+/// A header problem in §2.1's words.
+fn header_problem(problem: HeaderProblem) -> MeasureErrorKind {
+    match problem {
+        HeaderProblem::Token(token) => MeasureErrorKind::Token(token),
+        HeaderProblem::Empty => MeasureErrorKind::EmptyColumnName,
+        HeaderProblem::Unknown(name) => MeasureErrorKind::UnknownColumn {
+            name: shown(&name),
+            hint: unknown_column_hint(&name),
+        },
+        HeaderProblem::Duplicate { name, first_column } => {
+            MeasureErrorKind::DuplicateColumn { name, first_column }
         }
     }
-    if name.is_empty() {
-        return Err(Refusal::new(
-            line,
-            field.column,
-            MeasureErrorKind::EmptyColumnName,
-        ));
-    }
-    let Some(quantity) = Quantity::from_name(name) else {
-        return Err(Refusal::new(
-            line,
-            field.column,
-            MeasureErrorKind::UnknownColumn {
-                name: shown(name),
-                hint: unknown_column_hint(name),
-            },
-        ));
-    };
-    if let Some(first) = earlier.iter().position(|&q| q == quantity) {
-        return Err(Refusal::new(
-            line,
-            field.column,
-            MeasureErrorKind::DuplicateColumn {
-                name: name.to_string(),
-                first_column: fields[first].column,
-            },
-        ));
-    }
-    Ok(quantity)
 }
 
 /// Refuses a header without theta_i_deg, theta_r_deg or m00 (pointing at its first column).
@@ -178,23 +146,6 @@ fn check_uncertainty_columns(
     Ok(())
 }
 
-/// A refusal if an unquoted field holds a ';', tab or '|': the file is separated by that
-/// character (a European spreadsheet export, a TSV), not by ','.
-pub(crate) fn wrong_delimiter(line: u64, field: &Field<'_>) -> Option<Refusal> {
-    field
-        .text
-        .chars()
-        .enumerate()
-        .find_map(|(offset, c)| Delimiter::from_char(c).map(|found| (offset, found)))
-        .map(|(offset, found)| {
-            Refusal::new(
-                line,
-                field.column + offset as u64,
-                MeasureErrorKind::WrongDelimiter { found },
-            )
-        })
-}
-
 /// A hint that turns a near miss into a one-edit fix.
 fn unknown_column_hint(name: &str) -> String {
     let geometry = [THETA_I, PHI_I, THETA_R, PHI_R, WAVELENGTH];
@@ -226,11 +177,11 @@ fn unknown_column_hint(name: &str) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::fields::split_fields;
     use super::*;
+    use crate::table_text::split_fields;
 
-    fn layout(header: &str) -> Result<Layout, Refusal> {
-        parse_header_row(4, &split_fields(header).unwrap())
+    fn layout(header: &str) -> Result<NativeColumns, Refusal> {
+        parse_header_row(4, &split_fields(4, header).unwrap())
     }
 
     #[test]

@@ -9,13 +9,17 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
-use super::columns::{parse_header_row, wrong_delimiter, Layout, Quantity};
+use super::columns::{parse_header_row, NativeColumns, Quantity};
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
-use super::fields::{split_fields, Field};
 use super::metadata::{split_metadata_line, wavelength_in_range, HeaderWavelength, Metadata};
+use super::table_file::{
+    check_width, decode_utf8, fields_of, hex, material_of, measurement_point, parse_number,
+    read_bytes, row_wavelength, table_lines, wavelength_groups, FileFacts, RowWavelengths,
+};
 use super::units::{check_degrees, converted_note, AngleReading};
 use super::{MeasurementPoint, MeasurementSet, MAX_MUELLER_SR, MIN_UNCERTAINTY_SR};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
+use crate::table_text::wrong_delimiter;
 use crate::text::shown;
 
 /// Default azimuths when the columns are absent: the plane of incidence, with the receiver on
@@ -23,31 +27,10 @@ use crate::text::shown;
 const DEFAULT_PHI_I_DEG: f64 = 0.0;
 const DEFAULT_PHI_R_DEG: f64 = 180.0;
 
-/// Two wavelengths are the same when they agree to 1 ppm: tighter than any monochromator, looser
-/// than the digits a file writer may drop between a header and a column.
-const WAVELENGTH_RELATIVE_TOLERANCE: f64 = 1e-6;
-
 /// Reads and validates one measurement CSV. `path` is quoted as given in every message.
 pub fn read_measurement_csv(path: &Path) -> Result<MeasurementSet, MeasureError> {
     let bytes = read_bytes(path)?;
     parse_measurement_csv(path, &bytes)
-}
-
-/// The bytes of a measurement file, refused with a message if it cannot be read.
-pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, MeasureError> {
-    let whole_file = |kind| Refusal::new(1, 1, kind).in_file(path);
-    match std::fs::metadata(path) {
-        Ok(meta) if meta.is_dir() => return Err(whole_file(MeasureErrorKind::IsDirectory)),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(whole_file(MeasureErrorKind::NotFound))
-        }
-        _ => {}
-    }
-    std::fs::read(path).map_err(|e| {
-        whole_file(MeasureErrorKind::Unreadable {
-            reason: e.to_string(),
-        })
-    })
 }
 
 /// Parses the bytes of a measurement CSV of one wavelength; `source` names it in messages and in
@@ -93,154 +76,42 @@ fn parse_sets(
     let sha256 = hex(&Sha256::digest(bytes));
     let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
     let radians = angles == AngleReading::Radians;
-    let mut parsed = parse_text(text, radians).map_err(|r| r.in_file(source))?;
+    let parsed = parse_text(text, radians).map_err(|r| r.in_file(source))?;
     let file = source.display().to_string();
     let angle_note = if radians {
         Some(converted_note(&file))
     } else {
         check_degrees(&file, &parsed.points, angles, PLAIN_FIX).map_err(|r| r.in_file(source))?
     };
-    let groups = wavelength_groups(&mut parsed, spectral).map_err(|r| r.in_file(source))?;
-    let material = match parsed.metadata.material {
-        Some(material) => material,
-        None => source
-            .file_stem()
-            .map(|stem| stem.to_string_lossy().into_owned())
-            .unwrap_or_default(),
+    let groups = wavelength_groups(parsed.points, parsed.wavelengths, spectral)
+        .map_err(|r| r.in_file(source))?;
+    let facts = FileFacts {
+        sha256,
+        material: material_of(parsed.metadata.material.as_ref(), source),
+        metadata: parsed.metadata.entries,
+        elements: parsed.columns.elements,
     };
     let notes: Vec<String> = angle_note
         .into_iter()
         .chain(signed_zenith_note(&file, parsed.signed_rows))
         .collect();
+    // The file's notes go with every set (a set chosen by wavelength keeps them); the fit says
+    // each note once.
     Ok(groups
         .into_iter()
-        .map(|(wavelength_um, points)| MeasurementSet {
-            source: source.to_path_buf(),
-            sha256: sha256.clone(),
-            material: material.clone(),
-            wavelength_um,
-            metadata: parsed.metadata.entries.clone(),
-            elements: parsed.layout.elements.clone(),
-            points,
-            merged: Vec::new(),
-            // The file's notes go with every set (a set chosen by wavelength keeps them); the
-            // fit says each note once.
-            notes: notes.clone(),
-        })
+        .map(|(wavelength_um, points)| facts.set(source, wavelength_um, points, notes.clone()))
         .collect())
-}
-
-/// The rows of a parsed file by wavelength, ascending: all of them at the file's wavelength, or,
-/// for a wavelength_um column without a header, one group per distinct wavelength (equal within
-/// [`WAVELENGTH_RELATIVE_TOLERANCE`], the group keeping its first row's value). Unless `spectral`,
-/// a second wavelength is refused at its first row.
-fn wavelength_groups(
-    parsed: &mut ParsedText,
-    spectral: bool,
-) -> Result<Vec<(f64, Vec<MeasurementPoint>)>, Refusal> {
-    let points = std::mem::take(&mut parsed.points);
-    let Some(rows) = parsed.row_wavelengths.take() else {
-        return Ok(vec![(parsed.wavelength_um, points)]);
-    };
-    let mut groups: Vec<(HeaderWavelength, Vec<MeasurementPoint>)> = Vec::new();
-    for (point, (row, column)) in points.into_iter().zip(rows) {
-        match groups
-            .iter()
-            .position(|(w, _)| same_wavelength(w.um, row.um))
-        {
-            Some(i) => groups[i].1.push(point),
-            None if groups.is_empty() || spectral => groups.push((row, vec![point])),
-            None => {
-                let first = &groups[0].0;
-                return Err(Refusal::new(
-                    row.line,
-                    column,
-                    MeasureErrorKind::MixedWavelengths {
-                        value: shown(&row.text),
-                        first: shown(&first.text),
-                        first_line: first.line,
-                    },
-                ));
-            }
-        }
-    }
-    groups.sort_by(|a, b| a.0.um.total_cmp(&b.0.um));
-    Ok(groups
-        .into_iter()
-        .map(|(w, points)| (w.um, points))
-        .collect())
-}
-
-pub(crate) fn same_wavelength(a: f64, b: f64) -> bool {
-    (a - b).abs() <= WAVELENGTH_RELATIVE_TOLERANCE * a.max(b)
-}
-
-pub(crate) fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// The text of the file without a leading byte-order mark (spreadsheets write one).
-pub(crate) fn decode_utf8(bytes: &[u8]) -> Result<&str, Refusal> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        // The valid prefix is UTF-8 by construction, so the lossy decode is exact.
-        let before = String::from_utf8_lossy(&bytes[..e.valid_up_to()]);
-        let (last_line, line_number) = text_lines(without_bom(&before))
-            .zip(1..)
-            .last()
-            .unwrap_or(("", 1));
-        let byte = bytes[e.valid_up_to()];
-        Refusal::new(
-            line_number,
-            last_column(last_line),
-            MeasureErrorKind::InvalidUtf8 { byte },
-        )
-    })?;
-    Ok(without_bom(text))
-}
-
-fn without_bom(text: &str) -> &str {
-    text.strip_prefix('\u{feff}').unwrap_or(text)
-}
-
-/// The column just after the end of `line`.
-pub(crate) fn last_column(line: &str) -> u64 {
-    line.chars().count() as u64 + 1
-}
-
-/// The lines of a text without their terminators: "\r\n", "\n", or a bare "\r" (old Mac
-/// spreadsheet exports) each end a line.
-fn text_lines(text: &str) -> impl Iterator<Item = &str> {
-    text.split('\n')
-        .flat_map(|line| line.strip_suffix('\r').unwrap_or(line).split('\r'))
 }
 
 struct ParsedText {
     metadata: Metadata,
-    layout: Layout,
-    /// The file's wavelength (the header's, else the first row's).
-    wavelength_um: f64,
+    columns: NativeColumns,
     points: Vec<MeasurementPoint>,
-    /// Each row's wavelength and the column it is in, for a wavelength_um column without a
+    /// The file's wavelength (the header's) or each row's, for a wavelength_um column without a
     /// header (which may hold several wavelengths).
-    row_wavelengths: Option<Vec<(HeaderWavelength, u64)>>,
+    wavelengths: RowWavelengths,
     /// Rows whose θ_r was negative.
     signed_rows: usize,
-}
-
-/// A line of the file, numbered from 1, without its terminator.
-type NumberedLine<'a> = (u64, &'a str);
-
-/// The file's non-blank lines, numbered from 1; a file without one is refused as empty.
-pub(crate) fn numbered_lines(text: &str) -> Result<Vec<NumberedLine<'_>>, Refusal> {
-    let lines: Vec<NumberedLine<'_>> = text_lines(text)
-        .zip(1..)
-        .map(|(line, number)| (number, line))
-        .filter(|(_, line)| !line.trim().is_empty())
-        .collect();
-    if lines.is_empty() {
-        return Err(Refusal::new(1, 1, MeasureErrorKind::EmptyFile));
-    }
-    Ok(lines)
 }
 
 /// How to fix a §2.1 file whose angles look like radians.
@@ -248,38 +119,28 @@ const PLAIN_FIX: &str = "convert them to degrees, or pass --angles radians to co
      the file is read (--angles degrees if they are degrees)";
 
 fn parse_text(text: &str, radians: bool) -> Result<ParsedText, Refusal> {
-    let lines = numbered_lines(text)?;
-    let is_hash_line = |line: &str| line.trim_start().starts_with('#');
-
+    let lines = table_lines(text)?;
     let mut metadata = Metadata::default();
-    for &(number, line) in lines.iter().filter(|(_, line)| is_hash_line(line)) {
+    for &(number, line) in &lines.comments {
         if let Some((key, value, column)) = split_metadata_line(line) {
             metadata.add(number, key, value, column)?;
         }
     }
-
-    let mut content = lines.iter().filter(|(_, line)| !is_hash_line(line));
-    let &(header_line, header) = content
-        .next()
-        .ok_or_else(|| Refusal::new(1, 1, MeasureErrorKind::NoHeader))?;
+    let (header_line, header) = lines.header()?;
     let header_fields = fields_of(header_line, header)?;
-    let layout = parse_header_row(header_line, &header_fields)?;
-
-    let wavelength = match (&metadata.wavelength, layout.has(Quantity::Wavelength)) {
-        (Some(header), _) => WavelengthCheck::AgainstHeader(header.clone()),
-        (None, true) => WavelengthCheck::PerRow,
-        (None, false) => return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength)),
-    };
+    let columns = parse_header_row(header_line, &header_fields)?;
+    if metadata.wavelength.is_none() && !columns.has(Quantity::Wavelength) {
+        return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength));
+    }
     let mut row_wavelengths = Vec::new();
-    let mut points = content
-        .map(|&(number, line)| parse_row(number, line, &layout, &wavelength, radians))
-        .map(|row| {
-            let (point, row_wavelength) = row?;
-            row_wavelengths.extend(row_wavelength);
-            Ok(point)
-        })
-        .collect::<Result<Vec<_>, Refusal>>()?;
-    let signed_rows = fold_signed_detector_angles(&mut points);
+    let mut signed_rows = 0;
+    let mut points = Vec::with_capacity(lines.rows().len());
+    for &(number, line) in lines.rows() {
+        let row = parse_row(number, line, &columns, &metadata, radians)?;
+        row_wavelengths.extend(row.wavelength);
+        signed_rows += usize::from(row.signed);
+        points.push(row.point);
+    }
     if points.is_empty() {
         return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
     }
@@ -288,7 +149,7 @@ fn parse_text(text: &str, radians: bool) -> Result<ParsedText, Refusal> {
     if points.iter().all(|p| p.values[0] == 0.0) {
         let m00_column = header_fields
             .iter()
-            .zip(&layout.quantities)
+            .zip(&columns.quantities)
             .find(|(_, q)| **q == Quantity::Element(0))
             .map_or(1, |(field, _)| field.column);
         return Err(Refusal::new(
@@ -297,103 +158,54 @@ fn parse_text(text: &str, radians: bool) -> Result<ParsedText, Refusal> {
             MeasureErrorKind::AllM00Zero,
         ));
     }
-    let (wavelength_um, row_wavelengths) = match wavelength {
-        WavelengthCheck::AgainstHeader(header) => (header.um, None),
-        // With a wavelength column and at least one row, the first row has one.
-        WavelengthCheck::PerRow => (
-            row_wavelengths
-                .first()
-                .map(|(w, _): &(HeaderWavelength, u64)| w.um)
-                .ok_or_else(|| Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows))?,
-            Some(row_wavelengths),
-        ),
+    let wavelengths = match &metadata.wavelength {
+        Some(header) => RowWavelengths::Header(header.um),
+        None => RowWavelengths::PerRow(row_wavelengths),
     };
     Ok(ParsedText {
         metadata,
-        layout,
-        wavelength_um,
+        columns,
         points,
-        row_wavelengths,
+        wavelengths,
         signed_rows,
     })
 }
 
-/// Reads each row's θ_r < 0 as the detector across the normal, (|θ_r|, φ_r + 180°), once all
-/// of the row's columns are known; returns how many rows were so read.
-fn fold_signed_detector_angles(points: &mut [MeasurementPoint]) -> usize {
-    let mut folded = 0;
-    for point in points.iter_mut().filter(|p| p.theta_r_deg < 0.0) {
-        (point.theta_r_deg, point.phi_r_deg) =
-            fold_signed_zenith(point.theta_r_deg, point.phi_r_deg);
-        folded += 1;
-    }
-    folded
+/// One data row read: its point (θ_r < 0 read as the detector across the normal, (|θ_r|,
+/// φ_r + 180°), once all of the row's columns are known), its own wavelength if the file has no
+/// header one, and whether θ_r was negative.
+struct Row {
+    point: MeasurementPoint,
+    wavelength: Option<(HeaderWavelength, u64)>,
+    signed: bool,
 }
 
-fn fields_of(line_number: u64, line: &str) -> Result<Vec<Field<'_>>, Refusal> {
-    split_fields(line).map_err(|(column, kind)| Refusal::new(line_number, column, kind))
-}
-
-/// How each row's wavelength_um is read: with a `# wavelength_um:` header every row must agree
-/// with it (docs/design.md §2.1); without one each row carries its own (a spectral file may hold
-/// several, docs/design.md §1.9).
-enum WavelengthCheck {
-    AgainstHeader(HeaderWavelength),
-    PerRow,
-}
-
-impl WavelengthCheck {
-    /// The row's own wavelength, for [`WavelengthCheck::PerRow`].
-    fn check(
-        &self,
-        line: u64,
-        column: u64,
-        um: f64,
-        text: &str,
-    ) -> Result<Option<(HeaderWavelength, u64)>, Refusal> {
-        match self {
-            Self::AgainstHeader(header) if !same_wavelength(header.um, um) => Err(Refusal::new(
-                line,
-                column,
-                MeasureErrorKind::WavelengthDisagrees {
-                    value: shown(text),
-                    header: shown(&header.text),
-                    header_line: header.line,
-                },
-            )),
-            Self::AgainstHeader(_) => Ok(None),
-            Self::PerRow => Ok(Some((
-                HeaderWavelength {
-                    um,
-                    text: text.to_string(),
-                    line,
-                },
-                column,
-            ))),
-        }
-    }
+/// A row's values as read, before they become a point.
+struct RowValues {
+    angles: [f64; 4],
+    values: Vec<f64>,
+    uncertainties: Vec<Option<f64>>,
 }
 
 fn parse_row(
     line_number: u64,
     line: &str,
-    layout: &Layout,
-    wavelength: &WavelengthCheck,
+    columns: &NativeColumns,
+    metadata: &Metadata,
     radians: bool,
-) -> Result<(MeasurementPoint, Option<(HeaderWavelength, u64)>), Refusal> {
+) -> Result<Row, Refusal> {
     let fields = fields_of(line_number, line)?;
-    check_row_fields(line_number, line, &fields, layout.quantities.len())?;
-    let mut point = MeasurementPoint {
-        theta_i_deg: f64::NAN,
-        phi_i_deg: DEFAULT_PHI_I_DEG,
-        theta_r_deg: f64::NAN,
-        phi_r_deg: DEFAULT_PHI_R_DEG,
-        values: vec![f64::NAN; layout.elements.len()],
-        uncertainties: vec![None; layout.elements.len()],
-        line: line_number,
+    if let Some(refusal) = wrong_delimiter(line_number, &fields) {
+        return Err(refusal.map(MeasureErrorKind::Token));
+    }
+    check_width(line_number, line, &fields, columns.quantities.len())?;
+    let mut row = RowValues {
+        angles: [f64::NAN, DEFAULT_PHI_I_DEG, f64::NAN, DEFAULT_PHI_R_DEG],
+        values: vec![f64::NAN; columns.elements.len()],
+        uncertainties: vec![None; columns.elements.len()],
     };
-    let mut row_wavelength = None;
-    for ((field, &quantity), name) in fields.iter().zip(&layout.quantities).zip(&layout.names) {
+    let mut wavelength = None;
+    for ((field, &quantity), name) in fields.iter().zip(&columns.quantities).zip(&columns.names) {
         let refuse = |kind| Refusal::new(line_number, field.column, kind);
         let text = field.text.as_ref();
         let mut value = parse_number(name, text).map_err(refuse)?;
@@ -412,52 +224,31 @@ fn parse_row(
             if let Some(kind) = wavelength_refusal(value, text) {
                 return Err(refuse(kind));
             }
-            row_wavelength = wavelength.check(line_number, field.column, value, text)?;
+            let header = metadata.wavelength.as_ref();
+            wavelength = row_wavelength(header, line_number, field.column, value, text)?;
         } else {
-            store_value(&mut point, layout, quantity, name, value, text).map_err(refuse)?;
+            store_value(&mut row, columns, quantity, name, value, text).map_err(refuse)?;
         }
     }
-    Ok((point, row_wavelength))
-}
-
-/// Refuses a row with a field separated by another delimiter than ',', or with another number
-/// of fields than the header's `expected`.
-fn check_row_fields(
-    line_number: u64,
-    line: &str,
-    fields: &[Field<'_>],
-    expected: usize,
-) -> Result<(), Refusal> {
-    if let Some(refusal) = fields
-        .iter()
-        .filter(|f| !f.quoted)
-        .find_map(|f| wrong_delimiter(line_number, f))
-    {
-        return Err(refusal);
-    }
-    if fields.len() != expected {
-        // Point at the first extra field, or at the end of a short row.
-        let column = match fields.get(expected) {
-            Some(extra) => extra.column,
-            None => last_column(line),
-        };
-        return Err(Refusal::new(
-            line_number,
-            column,
-            MeasureErrorKind::FieldCount {
-                found: fields.len(),
-                expected,
-            },
-        ));
-    }
-    Ok(())
+    let [theta_i, phi_i, theta_r, phi_r] = row.angles;
+    let signed = theta_r < 0.0;
+    let (theta_r, phi_r) = match signed {
+        true => fold_signed_zenith(theta_r, phi_r),
+        false => (theta_r, phi_r),
+    };
+    let angles = [theta_i, phi_i, theta_r, phi_r];
+    Ok(Row {
+        point: measurement_point(angles, row.values, row.uncertainties, line_number),
+        wavelength,
+        signed,
+    })
 }
 
 /// Stores `value` (written `text`) of column `name`, holding `quantity` (not the wavelength),
 /// in `point`, or says why it is refused.
 fn store_value(
-    point: &mut MeasurementPoint,
-    layout: &Layout,
+    row: &mut RowValues,
+    columns: &NativeColumns,
     quantity: Quantity,
     name: &str,
     value: f64,
@@ -466,7 +257,7 @@ fn store_value(
     match quantity {
         // Zenith angles of directions above the surface; 90° is grazing and leaves the
         // BRDF's 1/cosθ undefined (docs/design.md §1.3). The detector's may be signed (in-plane
-        // scans are written −80…80°); parse_text folds the negative ones.
+        // scans are written −80…80°); parse_row folds the negative ones.
         Quantity::ThetaI => {
             if !(0.0..90.0).contains(&value) {
                 return Err(MeasureErrorKind::ThetaOutOfRange {
@@ -474,16 +265,16 @@ fn store_value(
                     value: shown(text),
                 });
             }
-            point.theta_i_deg = value;
+            row.angles[0] = value;
         }
         Quantity::ThetaR => {
             if !(value > -90.0 && value < 90.0) {
                 return Err(MeasureErrorKind::DetectorThetaOutOfRange { value: shown(text) });
             }
-            point.theta_r_deg = value;
+            row.angles[2] = value;
         }
-        Quantity::PhiI => point.phi_i_deg = value,
-        Quantity::PhiR => point.phi_r_deg = value,
+        Quantity::PhiI => row.angles[1] = value,
+        Quantity::PhiR => row.angles[3] = value,
         // Checked against the header's or kept as the row's own by parse_row.
         Quantity::Wavelength => {}
         Quantity::Element(index) => {
@@ -493,8 +284,8 @@ fn store_value(
             if let Some(kind) = element_value_refusal(name, value, text) {
                 return Err(kind);
             }
-            if let Some(slot) = layout.slot(index) {
-                point.values[slot] = value;
+            if let Some(slot) = columns.slot(index) {
+                row.values[slot] = value;
             }
         }
         Quantity::Uncertainty(index) => {
@@ -510,8 +301,8 @@ fn store_value(
                     value: shown(text),
                 });
             }
-            if let Some(slot) = layout.slot(index) {
-                point.uncertainties[slot] = Some(value);
+            if let Some(slot) = columns.slot(index) {
+                row.uncertainties[slot] = Some(value);
             }
         }
     }
@@ -545,27 +336,6 @@ pub(crate) fn wavelength_refusal(value: f64, text: &str) -> Option<MeasureErrorK
         })
     } else {
         None
-    }
-}
-
-/// A finite number, or why the field is not one.
-pub(crate) fn parse_number(column: &str, text: &str) -> Result<f64, MeasureErrorKind> {
-    if text.is_empty() {
-        return Err(MeasureErrorKind::EmptyField {
-            column: column.to_string(),
-        });
-    }
-    match text.parse::<f64>() {
-        Ok(value) if value.is_finite() => Ok(value),
-        // Rust parses "NaN", "inf" and overflowing literals such as 1e999 as non-finite.
-        Ok(_) => Err(MeasureErrorKind::NotFinite {
-            column: column.to_string(),
-            value: shown(text),
-        }),
-        Err(_) => Err(MeasureErrorKind::NotANumber {
-            column: column.to_string(),
-            value: shown(text),
-        }),
     }
 }
 

@@ -2,26 +2,17 @@
 //! and the 1-based character column of the offending field, then says what is wrong, so that
 //! `irpol fit` can print it as one line (`file:line:column: what is wrong`).
 
-use std::fmt;
-use std::path::PathBuf;
+use crate::table_text::{TableError, TokenProblem};
 
-/// A refused measurement input. Displays exactly as `file:line:column: what is wrong`, with the
-/// file as the caller gave it. Whole-file problems point at line 1 column 1 (or at the header
-/// row when they concern the columns).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{}:{}:{}: {}", crate::text::path(file), .line, .column, .kind)]
-pub struct MeasureError {
-    /// The path as given by the caller (not canonicalized).
-    pub file: PathBuf,
-    /// 1-based line number.
-    pub line: u64,
-    /// 1-based character (not byte) column of the start of the offending field.
-    pub column: u64,
-    /// What is wrong.
-    pub kind: MeasureErrorKind,
-}
+/// A refused measurement input: the table reader's [`TableError`], displayed exactly as
+/// `file:line:column: what is wrong`, with the file as the caller gave it. Whole-file problems
+/// point at line 1 column 1 (or at the header row when they concern the columns).
+pub type MeasureError = TableError<MeasureErrorKind>;
 
-impl MeasureError {
+/// A refusal located in the file but not yet tied to a path; the reader attaches the path.
+pub(crate) type Refusal = crate::table_text::Refusal<MeasureErrorKind>;
+
+impl TableError<MeasureErrorKind> {
     /// The path could not be read at all (missing, a folder, unreadable), as opposed to a file
     /// that reads but is malformed: an I/O failure to callers that sort errors that way (the
     /// Python bindings' `OSError`). The reader keeps no `std::io::Error` source, so this is it.
@@ -66,12 +57,8 @@ pub enum MeasureErrorKind {
     NoDataRows,
 
     // --- field splitting ---
-    #[error("fields are separated by {found}, expected ','")]
-    WrongDelimiter { found: Delimiter },
-    #[error("quoted field has no closing '\"'")]
-    UnterminatedQuote,
-    #[error("unexpected text after the closing '\"' of a quoted field")]
-    TextAfterQuote,
+    #[error("{0}")]
+    Token(TokenProblem),
 
     // --- `# key: value` metadata ---
     #[error("header '{key}' given twice (first on line {first_line})")]
@@ -217,57 +204,4 @@ pub enum MeasureErrorKind {
         value: String,
         layout_value: &'static str,
     },
-}
-
-/// A field separator found where ',' was expected.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Delimiter {
-    Semicolon,
-    Tab,
-    Pipe,
-}
-
-impl Delimiter {
-    /// The separator a character would be, if it is one of the common non-comma ones.
-    pub(crate) fn from_char(c: char) -> Option<Self> {
-        match c {
-            ';' => Some(Self::Semicolon),
-            '\t' => Some(Self::Tab),
-            '|' => Some(Self::Pipe),
-            _ => None,
-        }
-    }
-}
-
-impl fmt::Display for Delimiter {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Self::Semicolon => "';'",
-            Self::Tab => "tabs",
-            Self::Pipe => "'|'",
-        })
-    }
-}
-
-/// A refusal located in the file but not yet tied to a path; the reader attaches the path.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Refusal {
-    pub line: u64,
-    pub column: u64,
-    pub kind: MeasureErrorKind,
-}
-
-impl Refusal {
-    pub(crate) fn new(line: u64, column: u64, kind: MeasureErrorKind) -> Self {
-        Self { line, column, kind }
-    }
-
-    pub(crate) fn in_file(self, file: &std::path::Path) -> MeasureError {
-        MeasureError {
-            file: file.to_path_buf(),
-            line: self.line,
-            column: self.column,
-            kind: self.kind,
-        }
-    }
 }

@@ -4,7 +4,7 @@
 //! rebuilds after such edits; a changed number changes it. Digests of groups of rows let a
 //! changed file be described ("data in rows 12–14 changed") without keeping the data.
 
-use super::csv_reader::hex;
+use super::table_file::hex;
 use super::{MeasurementPoint, MeasurementSet, MUELLER_ELEMENT_NAMES};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};

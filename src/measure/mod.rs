@@ -26,7 +26,6 @@
 mod columns;
 mod csv_reader;
 mod error;
-mod fields;
 mod files;
 mod fingerprint;
 mod layout;
@@ -36,16 +35,16 @@ mod pbsdf;
 mod reading;
 mod realizability;
 mod selection;
+mod table_file;
 mod units;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-pub(crate) use csv_reader::hex;
 pub use csv_reader::{
     parse_measurement_csv, parse_measurement_sets, read_measurement_csv, read_measurement_sets,
 };
-pub use error::{Delimiter, MeasureError, MeasureErrorKind};
+pub use error::{MeasureError, MeasureErrorKind};
 pub use files::collect_measurement_files;
 pub use fingerprint::SourceData;
 pub use layout::{
@@ -59,6 +58,7 @@ pub use reading::{
 };
 pub use realizability::{unrealizable_rows, Realizability};
 pub use selection::{RowSelection, SelectionError, THETA_I_TOLERANCE_DEG};
+pub(crate) use table_file::hex;
 pub use units::{is_angle_note, AngleReading};
 
 /// Largest |Mueller element| and uncertainty a measurement file may hold (sr⁻¹): far above the

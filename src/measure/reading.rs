@@ -4,11 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use super::csv_reader::{decode_utf8, numbered_lines, parse_sets_reading, read_bytes};
+use super::csv_reader::parse_sets_reading;
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
 use super::layout::{parse_with_layout_reading, Layout};
 use super::metadata::split_metadata_line;
 use super::selection::{RowSelection, SelectionError};
+use super::table_file::{decode_utf8, numbered_lines, read_bytes};
 use super::units::AngleReading;
 use super::MeasurementSet;
 use crate::text::shown;

@@ -19,7 +19,7 @@ pub use frame::{
 pub use fresnel::{fresnel_amplitudes, FresnelFractions, RefractiveIndex};
 pub use planck::{
     ln_spectral_radiance, spectral_radiance, valid_temperature, Band, OpticsError,
-    MAX_TEMPERATURE_K, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM,
+    MAX_TEMPERATURE_K, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM, STEFAN_BOLTZMANN,
 };
 pub use polarization::{
     fresnel_mueller, jones_to_mueller, rotate_stokes, FrameTurn, Mueller, Stokes,

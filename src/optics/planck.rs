@@ -31,6 +31,10 @@ pub const MAX_WAVELENGTH_UM: f64 = 1000.0;
 /// to NaN).
 pub const MAX_TEMPERATURE_K: f64 = 1e4;
 
+/// Stefan–Boltzmann constant σ (W m⁻² K⁻⁴), CODATA 2018: the thermal model's emission and the
+/// weather's long-wave sky formulas share it.
+pub const STEFAN_BOLTZMANN: f64 = 5.670_374_419e-8;
+
 /// Whether `t` is a temperature a scene may hold: finite, in [0, [`MAX_TEMPERATURE_K`]].
 pub fn valid_temperature(t: f64) -> bool {
     t.is_finite() && (0.0..=MAX_TEMPERATURE_K).contains(&t)

@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 pub struct ThermalConfig {
     pub weather: WeatherConfig,
     /// The weather file's format; default from the file (`.epw`, a TMY3 header, else irpol's CSV).
-    pub weather_format: Option<crate::thermal::WeatherFormat>,
+    pub weather_format: Option<crate::weather::WeatherFormat>,
     /// Read every row of an EPW or TMY3 file in this year (typical-year files mix years).
     pub weather_year: Option<i32>,
     /// RFC 3339 instant of time_s = 0 (the weather file's origin); an EPW or TMY3 file's first
@@ -93,7 +93,7 @@ pub enum WeatherConfig {
 #[serde(deny_unknown_fields)]
 pub struct GeneratedWeather {
     #[serde(deserialize_with = "table")]
-    pub clear_day: crate::thermal::ClearDay,
+    pub clear_day: crate::weather::ClearDay,
 }
 
 /// `[thermal.layers.NAME]`: one layer material.

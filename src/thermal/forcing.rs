@@ -5,8 +5,7 @@
 use super::layers::ThermalError;
 use crate::text::number;
 
-/// Stefan–Boltzmann constant σ (W m⁻² K⁻⁴), CODATA 2018.
-pub const STEFAN_BOLTZMANN: f64 = 5.670_374_419e-8;
+pub use crate::optics::STEFAN_BOLTZMANN;
 
 /// Front-surface forcing of §1.8 at one instant, with the sun and sky already reduced to numbers.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -9,8 +9,9 @@
 //!   factorization per sub-step.
 //! - [`config`], [`setup`]: a scene's `[thermal]` keys and their checked form (the run and each
 //!   part's stack); [`convection`]: the front convective coefficient.
-//! - [`weather`]: the weather the surface balance needs, from a CSV or a built-in clear day,
-//!   interpolated in time.
+//!
+//! The weather the surface balance needs (a CSV, an EPW or TMY3 file, a built-in clear day) is
+//! read by [`crate::weather`], a layer below this one.
 
 pub mod batch;
 pub mod config;
@@ -20,7 +21,6 @@ mod implicit_rows;
 pub mod layers;
 pub mod setup;
 pub mod solver;
-pub mod weather;
 
 pub use batch::{
     BatchForcing, BatchReport, BatchSolver, BatchState, Lanes, BATCH_MAX_SUBSTEP_S, LANES,
@@ -31,7 +31,3 @@ pub use layers::{
     MAX_GRID_NODES,
 };
 pub use solver::{Solver, SolverControl, StepReport, ThermalState};
-pub use weather::{
-    simplified_solis, swinbank_longwave_w_m2, ClearDay, ClearSkyIrradiance, Site, SolisAtmosphere,
-    StationFormat, StationWeather, Weather, WeatherError, WeatherFormat, WeatherSample,
-};

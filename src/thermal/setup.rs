@@ -4,10 +4,10 @@
 //! a stack, and their materials' emissivities, are the scene's to say.
 
 use super::config::{EnclosureConfig, ThermalConfig, WeatherConfig};
-use super::{Site, StationFormat, StationWeather, Weather, WeatherError, WeatherFormat};
 use crate::emitter::{parse_time_utc, SunError};
 use crate::optics::{valid_temperature, MAX_TEMPERATURE_K};
 use crate::text::{about, number};
+use crate::weather::{Site, StationFormat, StationWeather, Weather, WeatherError, WeatherFormat};
 use std::collections::BTreeMap;
 use std::path::Path;
 

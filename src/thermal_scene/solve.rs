@@ -21,10 +21,10 @@ use crate::thermal::convection::mcadams_coefficient;
 use crate::thermal::setup::{SurfaceThermal, ThermalSetup};
 use crate::thermal::{
     Forcing, FrontForcing, Resolution, Solver, SolverControl, StepReport, ThermalState,
-    WeatherSample,
 };
 use crate::transport::accel::Accelerator;
 use crate::transport::horizon::HorizonMap;
+use crate::weather::WeatherSample;
 use rayon::prelude::*;
 
 mod enclosure;

@@ -30,7 +30,7 @@ use irpol::pbrdf::{Pbrdf, Shadowing, SlopeDistribution};
 use irpol::scene::load_scene_text;
 use irpol::scene::obj::parse_obj;
 use irpol::scene::ply::parse_ply;
-use irpol::thermal::{Site, StationFormat, StationWeather, Weather};
+use irpol::weather::{Site, StationFormat, StationWeather, Weather};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use std::path::Path;

@@ -167,7 +167,7 @@ fn clear_sky_adds_the_solis_irradiance() {
     assert_eq!(rows.len(), 3);
     for row in &rows {
         let solis =
-            irpol::thermal::simplified_solis(row[0], &irpol::thermal::SolisAtmosphere::DEFAULT);
+            irpol::weather::simplified_solis(row[0], &irpol::weather::SolisAtmosphere::DEFAULT);
         assert_eq!(
             row[2..],
             [

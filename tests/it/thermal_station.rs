@@ -7,10 +7,11 @@ use crate::common;
 use common::{thermal_plate_scene, write_scene};
 use irpol::progress::Silent;
 use irpol::scene::load_scene;
-use irpol::thermal::weather::epw;
-use irpol::thermal::weather::station::{clark_allen_longwave_w_m2, Field};
-use irpol::thermal::{Site, StationFormat, StationWeather, Weather, STEFAN_BOLTZMANN};
+use irpol::thermal::STEFAN_BOLTZMANN;
 use irpol::thermal_scene::solve_scene;
+use irpol::weather::epw;
+use irpol::weather::station::{clark_allen_longwave_w_m2, Field};
+use irpol::weather::{Site, StationFormat, StationWeather, Weather};
 use std::path::{Path, PathBuf};
 
 fn sample(name: &str) -> PathBuf {
@@ -48,7 +49,7 @@ fn edited_epw(edit: impl Fn(usize, &mut Vec<String>)) -> String {
     out
 }
 
-fn parse_epw(text: &str) -> Result<StationWeather, irpol::thermal::WeatherError> {
+fn parse_epw(text: &str) -> Result<StationWeather, irpol::weather::WeatherError> {
     StationWeather::parse(
         Path::new("w.epw"),
         text.as_bytes(),
@@ -351,7 +352,7 @@ fn plate_scene(dir: &Path) -> PathBuf {
 
 /// The quasi-steady surface temperature of a thin adiabatic horizontal plate under `w`: the root
 /// of α(E_dn sin h + E_dh) + ε E_lw − εσT⁴ + h_c (T_air − T) = 0 (McAdams h_c = 5.7 + 3.8 v).
-fn steady_plate_k(w: &irpol::thermal::WeatherSample) -> (f64, f64) {
+fn steady_plate_k(w: &irpol::weather::WeatherSample) -> (f64, f64) {
     let (alpha, eps) = (0.6, 0.9);
     let absorbed =
         alpha * (w.direct_normal_w_m2 * w.sun_direction.z.max(0.0) + w.diffuse_horizontal_w_m2);

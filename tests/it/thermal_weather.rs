@@ -2,7 +2,7 @@
 //! file:line:column, interpolation in time, and the built-in clear day.
 
 use irpol::emitter::{parse_time_utc, sun_direction, sun_position};
-use irpol::thermal::{
+use irpol::weather::{
     simplified_solis, swinbank_longwave_w_m2, ClearDay, Site, SolisAtmosphere, Weather,
     WeatherError,
 };

@@ -171,7 +171,7 @@ impl Layout {
 /// ascending, converted to docs/design.md §2.1's meaning (docs/design.md §2.8). `path` is quoted
 /// as given in every message.
 pub fn read_with_layout(path: &Path, layout: &Layout) -> Result<Vec<MeasurementSet>, MeasureError> {
-    let bytes = super::csv_reader::read_bytes(path)?;
+    let bytes = super::table_file::read_bytes(path)?;
     parse_with_layout(path, &bytes, layout)
 }
 

@@ -10,17 +10,17 @@ use sha2::{Digest, Sha256};
 use super::basis::{mixed_with, xyxy_to_psps};
 use super::uncertainty::apply_uncertainty_model;
 use super::{AngleUnit, Layout, MuellerBasis, SpecularAzimuth};
-use crate::measure::columns::wrong_delimiter;
-use crate::measure::csv_reader::{
-    decode_utf8, element_value_refusal, hex, last_column, numbered_lines, parse_number,
-    same_wavelength, wavelength_refusal,
-};
+use crate::measure::csv_reader::{element_value_refusal, wavelength_refusal};
 use crate::measure::error::{MeasureError, MeasureErrorKind, Refusal};
-use crate::measure::fields::{split_fields, Field};
 use crate::measure::metadata::{split_metadata_line, HeaderWavelength, Metadata};
+use crate::measure::table_file::{
+    check_width, decode_utf8, fields_of, hex, material_of, measurement_point, parse_number,
+    row_wavelength, table_lines, wavelength_groups, FileFacts, RowWavelengths,
+};
 use crate::measure::units::{check_degrees, AngleReading};
 use crate::measure::{MeasurementPoint, MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
+use crate::table_text::{wrong_delimiter, Field};
 use crate::text::shown;
 
 /// irpol's azimuths when the layout names no column for them (docs/design.md §2.1).
@@ -40,18 +40,12 @@ struct Resolved {
     names: Vec<String>,
 }
 
-/// The rows' wavelengths: the `# wavelength_um:` line's for all, or each row's own column value.
-enum Wavelengths {
-    Header(f64),
-    PerRow(Vec<HeaderWavelength>),
-}
-
 /// Everything read from the table, before it is split by wavelength.
 struct ParsedTable {
     metadata: Metadata,
     elements: Vec<usize>,
     points: Vec<MeasurementPoint>,
-    wavelengths: Wavelengths,
+    wavelengths: RowWavelengths,
     folded_incident: usize,
     folded_detector: usize,
     unused_columns: Vec<String>,
@@ -68,7 +62,7 @@ pub(super) fn parse_table(
     let parsed = parse_text(text, layout).map_err(|r| r.in_file(source))?;
     let angle_note = check_layout_angles(source, &parsed.points, layout, angles)
         .map_err(|r| r.in_file(source))?;
-    Ok(build_sets(source, sha256, parsed, layout, angle_note))
+    build_sets(source, sha256, parsed, layout, angle_note).map_err(|r| r.in_file(source))
 }
 
 /// The table's angles against the layout's `angle_unit` and `--angles`: radians declared as
@@ -108,16 +102,12 @@ fn check_layout_angles(
 }
 
 fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
-    let lines = numbered_lines(text)?;
-    let is_hash_line = |line: &str| line.trim_start().starts_with('#');
+    let lines = table_lines(text)?;
     let mut metadata = Metadata::default();
-    for &(number, line) in lines.iter().filter(|(_, line)| is_hash_line(line)) {
+    for &(number, line) in &lines.comments {
         add_metadata(&mut metadata, number, line, layout)?;
     }
-    let mut content = lines.iter().filter(|(_, line)| !is_hash_line(line));
-    let &(header_line, header) = content
-        .next()
-        .ok_or_else(|| Refusal::new(1, 1, MeasureErrorKind::NoHeader))?;
+    let (header_line, header) = lines.header()?;
     let header_fields = fields_of(header_line, header)?;
     let resolved = resolve_header(header_line, &header_fields, layout)?;
     if resolved.wavelength.is_none() && metadata.wavelength.is_none() {
@@ -126,8 +116,14 @@ fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
     let mut points = Vec::new();
     let mut row_wavelengths = Vec::new();
     let (mut folded_incident, mut folded_detector) = (0, 0);
-    for &(number, line) in content {
-        let row = parse_row(number, line, &resolved, layout, &metadata.wavelength)?;
+    for &(number, line) in lines.rows() {
+        let row = parse_row(
+            number,
+            line,
+            &resolved,
+            layout,
+            metadata.wavelength.as_ref(),
+        )?;
         folded_incident += usize::from(row.folded.0);
         folded_detector += usize::from(row.folded.1);
         points.push(row.point);
@@ -150,8 +146,8 @@ fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
         .map(|i| resolved.names[i].clone())
         .collect();
     let wavelengths = match &metadata.wavelength {
-        Some(header) => Wavelengths::Header(header.um),
-        None => Wavelengths::PerRow(row_wavelengths),
+        Some(header) => RowWavelengths::Header(header.um),
+        None => RowWavelengths::PerRow(row_wavelengths),
     };
     Ok(ParsedTable {
         metadata,
@@ -192,10 +188,6 @@ fn add_metadata(
         return Ok(());
     }
     metadata.add(number, key, value, column)
-}
-
-fn fields_of(line_number: u64, line: &str) -> Result<Vec<Field<'_>>, Refusal> {
-    split_fields(line).map_err(|(column, kind)| Refusal::new(line_number, column, kind))
 }
 
 /// The field index of every role, refusing a named column the header lacks (or holds twice), an
@@ -251,12 +243,8 @@ fn find_column(
 ) -> Result<usize, Refusal> {
     let mut matches = fields.iter().enumerate().filter(|(_, f)| f.text == column);
     let Some((index, first)) = matches.next() else {
-        if let Some(refusal) = fields
-            .iter()
-            .filter(|f| !f.quoted)
-            .find_map(|f| wrong_delimiter(line, f))
-        {
-            return Err(refusal);
+        if let Some(refusal) = wrong_delimiter(line, fields) {
+            return Err(refusal.map(MeasureErrorKind::Token));
         }
         return Err(Refusal::new(
             line,
@@ -322,7 +310,7 @@ fn used_fields(resolved: &Resolved) -> Vec<usize> {
 /// One converted row.
 struct Row {
     point: MeasurementPoint,
-    wavelength: Option<HeaderWavelength>,
+    wavelength: Option<(HeaderWavelength, u64)>,
     /// Whether θ_i and θ_r were negative (read across the normal).
     folded: (bool, bool),
 }
@@ -332,28 +320,17 @@ fn parse_row(
     line: &str,
     resolved: &Resolved,
     layout: &Layout,
-    header_wavelength: &Option<HeaderWavelength>,
+    header_wavelength: Option<&HeaderWavelength>,
 ) -> Result<Row, Refusal> {
     let fields = fields_of(number, line)?;
-    let expected = resolved.names.len();
-    if fields.len() != expected {
-        let column = fields.get(expected).map_or(last_column(line), |f| f.column);
-        return Err(Refusal::new(
-            number,
-            column,
-            MeasureErrorKind::FieldCount {
-                found: fields.len(),
-                expected,
-            },
-        ));
-    }
+    check_width(number, line, &fields, resolved.names.len())?;
     let cells = Cells {
         number,
         fields: &fields,
         names: &resolved.names,
     };
     let wavelength = match resolved.wavelength {
-        Some(field) => row_wavelength(&cells, field, header_wavelength)?,
+        Some(field) => row_wavelength_of(&cells, field, header_wavelength)?,
         None => None,
     };
     let conventions = &layout.conventions;
@@ -374,17 +351,10 @@ fn parse_row(
     let (theta_i_deg, phi_i_deg) = fold_signed_zenith(theta_i, phi_i);
     let (theta_r_deg, phi_r_deg) = fold_signed_zenith(theta_r, phi_r);
     let values = cells.elements(resolved, layout, phi_i_deg, phi_r_deg)?;
-    let width = values.len();
+    let uncertainties = vec![None; values.len()];
+    let angles = [theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg];
     Ok(Row {
-        point: MeasurementPoint {
-            theta_i_deg,
-            phi_i_deg,
-            theta_r_deg,
-            phi_r_deg,
-            values,
-            uncertainties: vec![None; width],
-            line: number,
-        },
+        point: measurement_point(angles, values, uncertainties, number),
         wavelength,
         folded: (theta_i < 0.0, theta_r < 0.0),
     })
@@ -398,12 +368,12 @@ fn in_degrees(value: f64, unit: AngleUnit) -> f64 {
 }
 
 /// A row's wavelength: checked against the `# wavelength_um:` line if there is one (then `None`),
-/// else the row's own.
-fn row_wavelength(
+/// else the row's own, with its column.
+fn row_wavelength_of(
     cells: &Cells<'_>,
     field: usize,
-    header: &Option<HeaderWavelength>,
-) -> Result<Option<HeaderWavelength>, Refusal> {
+    header: Option<&HeaderWavelength>,
+) -> Result<Option<(HeaderWavelength, u64)>, Refusal> {
     let um = cells.number(field)?;
     let (text, column) = (
         cells.fields[field].text.as_ref(),
@@ -412,23 +382,7 @@ fn row_wavelength(
     if let Some(kind) = wavelength_refusal(um, text) {
         return Err(Refusal::new(cells.number, column, kind));
     }
-    match header {
-        Some(header) if !same_wavelength(header.um, um) => Err(Refusal::new(
-            cells.number,
-            column,
-            MeasureErrorKind::WavelengthDisagrees {
-                value: shown(text),
-                header: shown(&header.text),
-                header_line: header.line,
-            },
-        )),
-        Some(_) => Ok(None),
-        None => Ok(Some(HeaderWavelength {
-            um,
-            text: text.to_string(),
-            line: cells.number,
-        })),
-    }
+    row_wavelength(header, cells.number, column, um, text)
 }
 
 /// The fields of one data row, with what messages need to point at them.
@@ -542,44 +496,33 @@ fn build_sets(
     parsed: ParsedTable,
     layout: &Layout,
     angle_note: Option<String>,
-) -> Vec<MeasurementSet> {
+) -> Result<Vec<MeasurementSet>, Refusal> {
     let file = source.display().to_string();
-    let material = match &parsed.metadata.material {
-        Some(material) => material.clone(),
-        None => source
-            .file_stem()
-            .map(|stem| stem.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-    };
     let mut file_notes: Vec<String> = angle_note.into_iter().collect();
     file_notes.extend(file_notes_of(&file, &parsed, layout));
-    let mut metadata = parsed.metadata.entries.clone();
-    metadata.insert("layout".to_string(), layout.source.display().to_string());
-    let groups = wavelength_groups(parsed.points, parsed.wavelengths);
-    groups
-        .into_iter()
-        .map(|(wavelength_um, mut points)| {
-            let applied =
-                apply_uncertainty_model(layout.uncertainty, &mut points, &parsed.elements);
-            let mut metadata = metadata.clone();
-            metadata.insert("uncertainty_model".to_string(), applied.label.clone());
-            // The file's notes go with every set, as read_measurement_sets does (a set chosen by
-            // wavelength keeps them; the fit says each note once).
-            let mut notes = file_notes.clone();
-            notes.push(format!("{file} at {wavelength_um} µm: {}", applied.note));
-            MeasurementSet {
-                source: source.to_path_buf(),
-                sha256: sha256.clone(),
-                material: material.clone(),
-                wavelength_um,
-                metadata,
-                elements: parsed.elements.clone(),
-                points,
-                merged: Vec::new(),
-                notes,
-            }
-        })
-        .collect()
+    let mut facts = FileFacts {
+        sha256,
+        material: material_of(parsed.metadata.material.as_ref(), source),
+        metadata: parsed.metadata.entries,
+        elements: parsed.elements,
+    };
+    facts
+        .metadata
+        .insert("layout".to_string(), layout.source.display().to_string());
+    let groups = wavelength_groups(parsed.points, parsed.wavelengths, true)?;
+    let mut sets = Vec::with_capacity(groups.len());
+    for (wavelength_um, mut points) in groups {
+        let applied = apply_uncertainty_model(layout.uncertainty, &mut points, &facts.elements);
+        // The file's notes go with every set, as read_measurement_sets does (a set chosen by
+        // wavelength keeps them; the fit says each note once).
+        let mut notes = file_notes.clone();
+        notes.push(format!("{file} at {wavelength_um} µm: {}", applied.note));
+        let mut set = facts.set(source, wavelength_um, points, notes);
+        set.metadata
+            .insert("uncertainty_model".to_string(), applied.label.clone());
+        sets.push(set);
+    }
+    Ok(sets)
 }
 
 /// What the layout changed, said once per file.
@@ -623,32 +566,4 @@ fn file_notes_of(file: &str, parsed: &ParsedTable, layout: &Layout) -> Vec<Strin
         ));
     }
     notes
-}
-
-/// The points by wavelength, ascending: all at the header's, or one group per distinct row
-/// wavelength (equal within 1 ppm, the group keeping its first row's value).
-fn wavelength_groups(
-    points: Vec<MeasurementPoint>,
-    wavelengths: Wavelengths,
-) -> Vec<(f64, Vec<MeasurementPoint>)> {
-    let rows = match wavelengths {
-        Wavelengths::Header(um) => return vec![(um, points)],
-        Wavelengths::PerRow(rows) => rows,
-    };
-    let mut groups: BTreeMap<usize, (f64, Vec<MeasurementPoint>)> = BTreeMap::new();
-    let mut firsts: Vec<f64> = Vec::new();
-    for (point, row) in points.into_iter().zip(rows) {
-        let um = row.um;
-        let slot = match firsts.iter().position(|&w| same_wavelength(w, um)) {
-            Some(slot) => slot,
-            None => {
-                firsts.push(um);
-                firsts.len() - 1
-            }
-        };
-        groups.entry(slot).or_insert((um, Vec::new())).1.push(point);
-    }
-    let mut groups: Vec<_> = groups.into_values().collect();
-    groups.sort_by(|a, b| a.0.total_cmp(&b.0));
-    groups
 }

@@ -10,7 +10,8 @@
 //! normal, its F_sky and its V_sun at that time, so a block of vertices costs a few multiply–adds
 //! each.
 
-use crate::thermal::{WeatherSample, STEFAN_BOLTZMANN};
+use crate::optics::STEFAN_BOLTZMANN;
+use crate::weather::WeatherSample;
 use nalgebra::Vector3;
 
 /// What is below the horizon and in the blocked part of the sky at one sample.

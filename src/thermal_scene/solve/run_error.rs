@@ -14,7 +14,7 @@ pub enum ThermalRunError {
     NotThermal(String),
     /// The weather has no value at a time the run needs.
     #[error("{0}")]
-    Weather(crate::thermal::WeatherError),
+    Weather(crate::weather::WeatherError),
     #[error(
         "thermal time {} s is outside the run 0…{} s",
         number(*time_s), number(*duration_s)

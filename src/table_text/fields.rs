@@ -1,20 +1,62 @@
-//! Splitting one CSV line into trimmed fields that remember their character column, so every
-//! refusal can point at `line:column` (docs/design.md §2.1).
+//! The tokenizer of every text table: one line split into trimmed fields that remember their
+//! character column, so every refusal can point at `line:column` (docs/design.md §2.1).
 //!
 //! Written by hand rather than with the `csv` crate because the crate reports positions per
-//! record, not per field. Fields are separated by ','; surrounding whitespace is trimmed; a field
-//! may be wrapped in double quotes (with `""` for a literal quote), as R's `write.csv` and
-//! spreadsheets write column names. A quoted field cannot span lines.
+//! record, not per field (the weather reader once re-scanned each line to find its columns).
+//! Fields are separated by ','; surrounding whitespace is trimmed; a field may be wrapped in
+//! double quotes (with `""` for a literal quote), as R's `write.csv` and spreadsheets write
+//! column names. A quoted field cannot span lines.
 
 use std::borrow::Cow;
 use std::iter::Peekable;
 use std::str::CharIndices;
 
-use super::error::MeasureErrorKind;
+use super::Refusal;
+
+/// Why a line cannot be split into fields.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum TokenProblem {
+    #[error("fields are separated by {0}, expected ','")]
+    WrongDelimiter(Delimiter),
+    #[error("quoted field has no closing '\"'")]
+    UnterminatedQuote,
+    #[error("unexpected text after the closing '\"' of a quoted field")]
+    TextAfterQuote,
+}
+
+/// A field separator found where ',' was expected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Delimiter {
+    Semicolon,
+    Tab,
+    Pipe,
+}
+
+impl Delimiter {
+    /// The separator a character would be, if it is one of the common non-comma ones.
+    fn from_char(c: char) -> Option<Self> {
+        match c {
+            ';' => Some(Self::Semicolon),
+            '\t' => Some(Self::Tab),
+            '|' => Some(Self::Pipe),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for Delimiter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Semicolon => "';'",
+            Self::Tab => "tabs",
+            Self::Pipe => "'|'",
+        })
+    }
+}
 
 /// One field of a line: its trimmed (and unquoted) text and where it starts.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Field<'a> {
+pub struct Field<'a> {
     pub text: Cow<'a, str>,
     /// 1-based character column of the first non-blank character of the field (the opening
     /// quote of a quoted field); for a blank field, the column just after the preceding ','.
@@ -22,9 +64,39 @@ pub(crate) struct Field<'a> {
     pub quoted: bool,
 }
 
-/// Splits `line` (without its line terminator) at ','. On a malformed quote returns the column
-/// and the reason.
-pub(crate) fn split_fields(line: &str) -> Result<Vec<Field<'_>>, (u64, MeasureErrorKind)> {
+/// Splits line `number` (its text `line`, without its terminator) at ','; a malformed quote is
+/// refused at its column.
+pub fn split_fields(number: u64, line: &str) -> Result<Vec<Field<'_>>, Refusal<TokenProblem>> {
+    split_line(line).map_err(|(column, problem)| Refusal::new(number, column, problem))
+}
+
+/// A refusal if an unquoted field of `fields` holds a ';', tab or '|': the file is separated by
+/// that character (a European spreadsheet export, a TSV), not by ','.
+pub fn wrong_delimiter(line: u64, fields: &[Field<'_>]) -> Option<Refusal<TokenProblem>> {
+    fields.iter().find_map(|field| field_delimiter(line, field))
+}
+
+/// [`wrong_delimiter`] of one field.
+pub fn field_delimiter(line: u64, field: &Field<'_>) -> Option<Refusal<TokenProblem>> {
+    if field.quoted {
+        return None;
+    }
+    field
+        .text
+        .chars()
+        .enumerate()
+        .find_map(|(offset, c)| Delimiter::from_char(c).map(|found| (offset, found)))
+        .map(|(offset, found)| {
+            Refusal::new(
+                line,
+                field.column + offset as u64,
+                TokenProblem::WrongDelimiter(found),
+            )
+        })
+}
+
+/// [`split_fields`] without the line number.
+fn split_line(line: &str) -> Result<Vec<Field<'_>>, (u64, TokenProblem)> {
     let mut fields = Vec::new();
     let mut cursor = Cursor {
         line,
@@ -87,7 +159,7 @@ impl<'a> Cursor<'a> {
 
     /// The field whose opening quote is next (at `field_column`): its text up to the closing
     /// quote with `""` read as '"'; only blanks may follow before the next ','.
-    fn quoted_field(&mut self, field_column: u64) -> Result<Field<'a>, (u64, MeasureErrorKind)> {
+    fn quoted_field(&mut self, field_column: u64) -> Result<Field<'a>, (u64, TokenProblem)> {
         self.advance();
         let mut text = String::new();
         let mut closed = false;
@@ -103,14 +175,14 @@ impl<'a> Cursor<'a> {
             }
         }
         if !closed {
-            return Err((field_column, MeasureErrorKind::UnterminatedQuote));
+            return Err((field_column, TokenProblem::UnterminatedQuote));
         }
         while let Some((_, c)) = self.peek() {
             if c == ',' {
                 break;
             }
             if !c.is_whitespace() {
-                return Err((self.column, MeasureErrorKind::TextAfterQuote));
+                return Err((self.column, TokenProblem::TextAfterQuote));
             }
             self.advance();
         }
@@ -146,7 +218,7 @@ mod tests {
     use super::*;
 
     fn texts_and_columns(line: &str) -> Vec<(String, u64)> {
-        split_fields(line)
+        split_line(line)
             .unwrap()
             .into_iter()
             .map(|f| (f.text.into_owned(), f.column))
@@ -194,7 +266,7 @@ mod tests {
 
     #[test]
     fn quoted_fields_are_unquoted() {
-        let fields = split_fields(r#""theta_i_deg", "a,""b""" ,c"#).unwrap();
+        let fields = split_line(r#""theta_i_deg", "a,""b""" ,c"#).unwrap();
         assert_eq!(fields[0].text, "theta_i_deg");
         assert!(fields[0].quoted);
         assert_eq!(fields[1].text, r#"a,"b""#);
@@ -207,12 +279,26 @@ mod tests {
     #[test]
     fn malformed_quotes_are_refused_with_their_column() {
         assert_eq!(
-            split_fields(r#"a, "b"#).unwrap_err(),
-            (4, MeasureErrorKind::UnterminatedQuote)
+            split_line(r#"a, "b"#).unwrap_err(),
+            (4, TokenProblem::UnterminatedQuote)
         );
         assert_eq!(
-            split_fields(r#""b"x,c"#).unwrap_err(),
-            (4, MeasureErrorKind::TextAfterQuote)
+            split_line(r#""b"x,c"#).unwrap_err(),
+            (4, TokenProblem::TextAfterQuote)
         );
+    }
+
+    #[test]
+    fn another_delimiter_is_named_at_its_column() {
+        let fields = split_line("a;b,\"c;d\"").unwrap();
+        assert_eq!(
+            wrong_delimiter(4, &fields),
+            Some(Refusal::new(
+                4,
+                2,
+                TokenProblem::WrongDelimiter(Delimiter::Semicolon)
+            ))
+        );
+        assert_eq!(wrong_delimiter(4, &split_line("a,\"c;d\"").unwrap()), None);
     }
 }

@@ -34,29 +34,6 @@ pub mod solis;
 pub mod station;
 mod tmy3;
 
-/// What is wrong with one field or line of a weather file: the message of a refusal at its line
-/// (and column), said once by the reader that knows where it is.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FieldProblem(pub String);
-
-impl From<String> for FieldProblem {
-    fn from(message: String) -> Self {
-        FieldProblem(message)
-    }
-}
-
-impl From<&str> for FieldProblem {
-    fn from(message: &str) -> Self {
-        FieldProblem(message.to_owned())
-    }
-}
-
-impl std::fmt::Display for FieldProblem {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
 pub use solis::{simplified_solis, ClearSkyIrradiance, SolisAtmosphere};
 pub use station::{
     clark_allen_longwave_w_m2, kasten_czeplak, Field, HourRecord, Station, StationFormat,
@@ -64,6 +41,7 @@ pub use station::{
 };
 
 use crate::emitter::{format_time_utc, SunError};
+use crate::table_text::{Problem, TableError};
 use crate::text::number;
 use chrono::{DateTime, TimeDelta, Utc};
 use nalgebra::Vector3;
@@ -165,19 +143,11 @@ pub enum WeatherError {
     #[error("{}: cannot read the weather file: {reason}", crate::text::path(file))]
     Read { file: PathBuf, reason: String },
     /// An EPW or TMY3 file refused at a line; the message names the field.
-    #[error("{}:{line}: {message}", crate::text::path(file))]
-    Station {
-        file: PathBuf,
-        line: u64,
-        message: String,
-    },
-    #[error("{}:{line}:{column}: {message}", crate::text::path(file))]
-    Csv {
-        file: PathBuf,
-        line: u64,
-        column: u64,
-        message: String,
-    },
+    #[error(transparent)]
+    Station(TableError<Problem>),
+    /// A weather CSV refused at a line and column.
+    #[error(transparent)]
+    Csv(TableError<Problem>),
     #[error(
         "weather site latitude {}°, longitude {}° is invalid: latitude must be within \
          [-90°, 90°] and longitude within [-180°, 180°]",

@@ -30,11 +30,11 @@
 //! the run needs (a knot of a row the run uses, of a quantity with no fallback, or of a fallback's
 //! inputs) is refused, naming file, line and field; missing values outside the run are ignored.
 
-use super::FieldProblem;
 use super::{
     simplified_solis, Site, SolisAtmosphere, Weather, WeatherError, WeatherSample, MAX_WEATHER_ROWS,
 };
 use crate::emitter::sun_position;
+use crate::table_text::Problem;
 use crate::text::number;
 use chrono::{DateTime, NaiveDateTime, TimeDelta, Utc};
 use std::path::PathBuf;
@@ -44,7 +44,7 @@ use std::path::PathBuf;
 pub const STATION_STEP_S: i64 = 300;
 
 /// Stefan–Boltzmann constant (W m⁻² K⁻⁴).
-const SIGMA: f64 = super::super::STEFAN_BOLTZMANN;
+const SIGMA: f64 = crate::optics::STEFAN_BOLTZMANN;
 
 /// The quantities irpol reads from a station file, in this order in [`HourRecord::values`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -162,7 +162,7 @@ pub struct StationWeather {
 }
 
 /// A refusal at a line (before the path is attached).
-pub(super) type LineRefusal = (u64, String);
+pub(super) type Refusal = crate::table_text::Refusal<Problem>;
 
 impl StationWeather {
     /// The first instant covered (the first label, UTC).
@@ -184,11 +184,7 @@ impl StationWeather {
         duration_s: Option<f64>,
     ) -> Result<Weather, WeatherError> {
         site.validate()?;
-        let refuse = |(line, message): LineRefusal| WeatherError::Station {
-            file: self.source.clone(),
-            line,
-            message,
-        };
+        let refuse = |refusal: Refusal| WeatherError::Station(refusal.in_file(&self.source));
         let first = self.first_utc().timestamp();
         let last = self.last_utc().timestamp();
         let start = site.start_utc.timestamp();
@@ -207,7 +203,7 @@ impl StationWeather {
                 crate::emitter::format_time_utc(&self.first_utc()),
                 crate::emitter::format_time_utc(&self.last_utc())
             );
-            return Err(refuse((line, message)));
+            return Err(refuse(Refusal::at_line(line, message.into())));
         }
         let to = (end.clamp(first, last) - first + STATION_STEP_S - 1).div_euclid(STATION_STEP_S);
         let to = to.min((last - first) / STATION_STEP_S).max(from + 1);
@@ -228,9 +224,9 @@ impl StationWeather {
         site: &Site,
         since_first_s: i64,
         at: &DateTime<Utc>,
-    ) -> Result<WeatherSample, LineRefusal> {
+    ) -> Result<WeatherSample, Refusal> {
         let sun = sun_position(site.latitude_deg, site.longitude_deg, at)
-            .map_err(|e| (self.records[0].line, e.to_string()))?;
+            .map_err(|e| Refusal::at_line(self.records[0].line, e.to_string().into()))?;
         let value = |field| self.interpolate(field, since_first_s);
         let air_c = value(Field::DryBulb)?;
         let air_k = air_c + 273.15;
@@ -266,22 +262,20 @@ impl StationWeather {
 
     /// `field` at `since_first_s` after the first label, linear between its knots; a missing
     /// knot that is needed is refused at its line.
-    fn interpolate(&self, field: Field, since_first_s: i64) -> Result<f64, LineRefusal> {
+    fn interpolate(&self, field: Field, since_first_s: i64) -> Result<f64, Refusal> {
         // Hour means sit half an hour before their label: shift time by +30 min onto their knots.
         let t = since_first_s + if field.is_hour_mean() { 1800 } else { 0 };
         let (i, rest) = (t.div_euclid(3600) as usize, t.rem_euclid(3600));
-        let knot = |i: usize| -> Result<f64, LineRefusal> {
+        let knot = |i: usize| -> Result<f64, Refusal> {
             let record = &self.records[i.min(self.records.len() - 1)];
             record.values[field as usize].ok_or_else(|| {
                 let name = &self.field_names[field as usize];
-                (
-                    record.line,
-                    format!(
-                        "{name} is missing at {} local standard time and the run needs it: fill \
-                         it in (e.g. from the neighbouring hours) or move the run off it",
-                        record.end_local.format("%Y-%m-%d %H:%M")
-                    ),
-                )
+                let message = format!(
+                    "{name} is missing at {} local standard time and the run needs it: fill it in \
+                     (e.g. from the neighbouring hours) or move the run off it",
+                    record.end_local.format("%Y-%m-%d %H:%M")
+                );
+                Refusal::at_line(record.line, message.into())
             })
         };
         let a = knot(i)?;
@@ -334,16 +328,14 @@ pub(super) fn field_value(
     text: &str,
     missing: Missing,
     scale: f64,
-) -> Result<Option<f64>, FieldProblem> {
+) -> Result<Option<f64>, Problem> {
     let text = text.trim();
     let shown = crate::text::shown(text);
     let v: f64 = text
         .parse()
-        .map_err(|_| FieldProblem(format!("{name}: '{shown}' is not a number")))?;
+        .map_err(|_| Problem(format!("{name}: '{shown}' is not a number")))?;
     if !v.is_finite() {
-        return Err(FieldProblem(format!(
-            "{name}: '{shown}' is not a finite number"
-        )));
+        return Err(Problem(format!("{name}: '{shown}' is not a finite number")));
     }
     let (is_missing, marker) = match missing {
         Missing::AtOrAbove(m) => (v >= m, m),
@@ -354,7 +346,7 @@ pub(super) fn field_value(
     }
     let (low, high) = field.range();
     if !(low..=high).contains(&(v * scale)) {
-        return Err(FieldProblem(format!(
+        return Err(Problem(format!(
             "{name}: {} is outside {}…{} (mark a missing value with {})",
             number(v),
             number(low / scale),
@@ -373,11 +365,11 @@ pub(super) fn label(
     day: u32,
     hour: u32,
     time_zone_h: f64,
-) -> Result<(NaiveDateTime, DateTime<Utc>), FieldProblem> {
+) -> Result<(NaiveDateTime, DateTime<Utc>), Problem> {
     let date = chrono::NaiveDate::from_ymd_opt(year, month, day)
-        .ok_or_else(|| FieldProblem(format!("{year:04}-{month:02}-{day:02} is not a date")))?;
+        .ok_or_else(|| Problem(format!("{year:04}-{month:02}-{day:02} is not a date")))?;
     if hour > 24 {
-        return Err(FieldProblem(format!(
+        return Err(Problem(format!(
             "hour {hour} is outside 1…24 (hour-ending labels)"
         )));
     }
@@ -385,13 +377,13 @@ pub(super) fn label(
         .and_hms_opt(0, 0, 0)
         .and_then(|midnight| midnight.checked_add_signed(TimeDelta::hours(hour as i64)))
         .ok_or_else(|| {
-            FieldProblem(format!(
+            Problem(format!(
                 "{year:04}-{month:02}-{day:02} is beyond the calendar"
             ))
         })?;
     let zone = TimeDelta::seconds((time_zone_h * 3600.0).round() as i64);
     let utc = local.checked_sub_signed(zone).ok_or_else(|| {
-        FieldProblem(format!(
+        Problem(format!(
             "{year:04}-{month:02}-{day:02} is beyond the calendar"
         ))
     })?;
@@ -404,15 +396,15 @@ pub(super) fn header_station<S: AsRef<str>>(
     fields: &[S],
     columns: [usize; 4],
     line: &str,
-) -> Result<Station, FieldProblem> {
-    let number = |index: usize, what: &str| -> Result<f64, FieldProblem> {
+) -> Result<Station, Problem> {
+    let number = |index: usize, what: &str| -> Result<f64, Problem> {
         let field = fields[index].as_ref();
         field
             .parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
             .ok_or_else(|| {
-                FieldProblem(format!(
+                Problem(format!(
                     "{line} field {} ({what}): '{}' is not a number",
                     index + 1,
                     crate::text::shown(field)
@@ -434,13 +426,13 @@ pub(super) fn header_station<S: AsRef<str>>(
         time_zone_h,
         elevation_m,
     };
-    check_station(&station).map_err(|e| FieldProblem(format!("{line}: {e}")))?;
+    check_station(&station).map_err(|e| Problem(format!("{line}: {e}")))?;
     Ok(station)
 }
 
 /// Checks the header's site: latitude within ±90°, longitude within ±180°, time zone within
 /// −12…+14 h, elevation within −1000…9000 m.
-pub(super) fn check_station(station: &Station) -> Result<(), FieldProblem> {
+pub(super) fn check_station(station: &Station) -> Result<(), Problem> {
     let checks = [
         ("latitude", station.latitude_deg, -90.0, 90.0, "°"),
         ("longitude", station.longitude_deg, -180.0, 180.0, "°"),
@@ -449,7 +441,7 @@ pub(super) fn check_station(station: &Station) -> Result<(), FieldProblem> {
     ];
     for (name, v, low, high, unit) in checks {
         if !(v.is_finite() && (low..=high).contains(&v)) {
-            return Err(FieldProblem(format!(
+            return Err(Problem(format!(
                 "the {name} {}{unit} is outside {}…{}{unit}",
                 number(v),
                 number(low),
@@ -466,8 +458,8 @@ pub(super) fn check_station(station: &Station) -> Result<(), FieldProblem> {
 pub(super) fn read_records<'a>(
     lines: impl Iterator<Item = (u64, &'a str)>,
     header_end: u64,
-    mut parse: impl FnMut(&str) -> Result<HourRecord, FieldProblem>,
-) -> Result<Vec<HourRecord>, LineRefusal> {
+    mut parse: impl FnMut(&str) -> Result<HourRecord, Problem>,
+) -> Result<Vec<HourRecord>, Refusal> {
     let mut records = Vec::new();
     let mut last_line = header_end;
     for (line, row) in lines {
@@ -477,9 +469,9 @@ pub(super) fn read_records<'a>(
         if records.len() == MAX_WEATHER_ROWS {
             let message =
                 format!("more than {MAX_WEATHER_ROWS} rows: split the weather or thin it out");
-            return Err((line, message));
+            return Err(Refusal::at_line(line, message.into()));
         }
-        let mut record = parse(row).map_err(|problem| (line, problem.0))?;
+        let mut record = parse(row).map_err(|problem| Refusal::at_line(line, problem))?;
         record.line = line;
         records.push(record);
         last_line = line;
@@ -490,27 +482,27 @@ pub(super) fn read_records<'a>(
 
 /// Rows must follow each other by exactly one hour (a typical-year file mixes years: then give
 /// the year to read it in), and there must be at least two.
-pub(super) fn check_sequence(records: &[HourRecord], last_line: u64) -> Result<(), LineRefusal> {
+pub(super) fn check_sequence(records: &[HourRecord], last_line: u64) -> Result<(), Refusal> {
     if records.len() < 2 {
         let message = format!(
             "{} hourly row(s): the weather needs at least two to interpolate between",
             records.len()
         );
-        return Err((last_line, message));
+        return Err(Refusal::at_line(last_line, message.into()));
     }
     for pair in records.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);
         if b.end_utc - a.end_utc != TimeDelta::hours(1) {
-            return Err((
+            return Err(Refusal::at_line(
                 b.line,
-                format!(
+                Problem(format!(
                     "the row for {} does not follow the row for {} on line {} by one hour: rows \
                      must be hourly and in order (a typical-year file mixes years: set \
                      thermal.weather_year = YEAR to read every row in one year)",
                     b.end_local.format("%Y-%m-%d %H:%M"),
                     a.end_local.format("%Y-%m-%d %H:%M"),
                     a.line
-                ),
+                )),
             ));
         }
     }

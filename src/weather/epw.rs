@@ -6,11 +6,12 @@
 //! marker is missing. Fields beyond 24 (visibility, precipitation, …) are not read.
 
 use super::station::{
-    field_value, header_station, label, read_records, Field, HourRecord, LineRefusal, Missing,
-    Station, StationFormat, StationWeather, FIELDS,
+    field_value, header_station, label, read_records, Field, HourRecord, Missing, Refusal, Station,
+    StationFormat, StationWeather, FIELDS,
 };
-use super::FieldProblem;
 use super::WeatherError;
+use crate::table_text::split_fields;
+use crate::table_text::Problem;
 use crate::text::shown;
 use std::path::Path;
 
@@ -70,10 +71,15 @@ const HEADER_KEYWORDS: [&str; 6] = [
 /// Whether `line` is one of the EPW header lines after LOCATION (its first field one of
 /// [`HEADER_KEYWORDS`], `COMMENTS 1` and `COMMENTS 2` alike).
 fn is_header_line(line: &str) -> bool {
-    let first = line.split(',').next().unwrap_or("").trim();
-    HEADER_KEYWORDS
-        .iter()
-        .any(|k| first.to_ascii_uppercase().starts_with(k))
+    // No keyword holds a ',', so the line starts with one exactly when its first field does.
+    let line = line.trim_start().to_ascii_uppercase();
+    HEADER_KEYWORDS.iter().any(|k| line.starts_with(k))
+}
+
+/// The fields of a line, trimmed and unquoted.
+fn split(line: &str) -> Result<Vec<String>, Problem> {
+    let fields = split_fields(0, line).map_err(|r| Problem(r.kind.to_string()))?;
+    Ok(fields.into_iter().map(|f| f.text.into_owned()).collect())
 }
 
 /// Reads an EPW file's bytes; `year` replaces every row's year (a typical-year file).
@@ -85,11 +91,7 @@ pub(super) fn parse(
     let text = String::from_utf8_lossy(bytes);
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let (station, records) =
-        parse_text(text, year).map_err(|(line, message)| WeatherError::Station {
-            file: path.to_path_buf(),
-            line,
-            message,
-        })?;
+        parse_text(text, year).map_err(|refusal| WeatherError::Station(refusal.in_file(path)))?;
     let field_names = LAYOUT.map(|(_, position, name, _)| format!("field {position} ({name})"));
     Ok(StationWeather {
         source: path.to_path_buf(),
@@ -100,15 +102,15 @@ pub(super) fn parse(
     })
 }
 
-fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), LineRefusal> {
+fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), Refusal> {
     let mut lines = text.lines().enumerate().map(|(i, l)| (i as u64 + 1, l));
     let Some((_, first)) = lines.next() else {
-        return Err((
+        return Err(Refusal::at_line(
             1,
             "empty file: an EPW file starts with a LOCATION line".into(),
         ));
     };
-    let station = location(first).map_err(|problem| (1, problem.0))?;
+    let station = location(first).map_err(|problem| Refusal::at_line(1, problem))?;
     let mut lines = lines.peekable();
     let mut header_end = 1;
     while let Some(&(number, _)) = lines.peek().filter(|(_, line)| is_header_line(line)) {
@@ -120,10 +122,10 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
 }
 
 /// The LOCATION line's site.
-fn location(line: &str) -> Result<Station, FieldProblem> {
-    let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+fn location(line: &str) -> Result<Station, Problem> {
+    let fields = split(line)?;
     if !fields[0].eq_ignore_ascii_case("LOCATION") || fields.len() < 10 {
-        return Err(FieldProblem(format!(
+        return Err(Problem(format!(
             "the first line must be LOCATION,city,state,country,source,WMO,latitude,longitude,\
              time zone,elevation; got '{}'",
             crate::text::shown_at_most(line, 80)
@@ -134,20 +136,20 @@ fn location(line: &str) -> Result<Station, FieldProblem> {
 }
 
 /// One data row.
-fn record(row: &str, year: Option<i32>, station: &Station) -> Result<HourRecord, FieldProblem> {
-    let fields: Vec<&str> = row.split(',').collect();
+fn record(row: &str, year: Option<i32>, station: &Station) -> Result<HourRecord, Problem> {
+    let fields = split(row)?;
     let needed = LAYOUT.iter().map(|l| l.1).max().unwrap_or(0);
     if fields.len() < needed {
-        return Err(FieldProblem(format!(
+        return Err(Problem(format!(
             "{} fields, an EPW data row has at least {needed} (year, month, day, hour, minute, \
              flags, dry bulb, …, opaque sky cover)",
             fields.len()
         )));
     }
-    let integer = |index: usize, what: &str| -> Result<i64, FieldProblem> {
-        let text = fields[index].trim();
+    let integer = |index: usize, what: &str| -> Result<i64, Problem> {
+        let text = fields[index].as_str();
         text.parse::<i64>().map_err(|_| {
-            FieldProblem(format!(
+            Problem(format!(
                 "field {} ({what}): '{}' is not a whole number",
                 index + 1,
                 shown(text)
@@ -159,14 +161,12 @@ fn record(row: &str, year: Option<i32>, station: &Station) -> Result<HourRecord,
     let day = integer(2, "day")?;
     let hour = integer(3, "hour")?;
     if !(1..=24).contains(&hour) {
-        return Err(FieldProblem(format!(
-            "field 4 (hour): {hour} is outside 1…24"
-        )));
+        return Err(Problem(format!("field 4 (hour): {hour} is outside 1…24")));
     }
     let year = year.map_or(file_year, i64::from);
     let fits = |v: i64, low: i64, high: i64| (low..=high).contains(&v);
     if !(fits(year, 1, 9999) && fits(month, 1, 12) && fits(day, 1, 31)) {
-        return Err(FieldProblem(format!(
+        return Err(Problem(format!(
             "{year}-{month}-{day} is not a date (fields 1-3)"
         )));
     }
@@ -183,7 +183,7 @@ fn record(row: &str, year: Option<i32>, station: &Station) -> Result<HourRecord,
         values[field as usize] = field_value(
             field,
             &name,
-            fields[position - 1],
+            &fields[position - 1],
             Missing::AtOrAbove(marker),
             1.0,
         )?;

@@ -6,11 +6,12 @@
 //! no infrared column: the sky's long-wave is always Clark & Allen's. −9900 (NSRDB) is missing.
 
 use super::station::{
-    field_value, header_station, label, read_records, Field, HourRecord, LineRefusal, Missing,
-    Station, StationFormat, StationWeather, FIELDS,
+    field_value, header_station, label, read_records, Field, HourRecord, Missing, Refusal, Station,
+    StationFormat, StationWeather, FIELDS,
 };
-use super::FieldProblem;
 use super::WeatherError;
+use crate::table_text::split_fields;
+use crate::table_text::Problem;
 use crate::text::shown;
 use std::path::Path;
 
@@ -52,11 +53,7 @@ pub(super) fn parse(
     let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
     let text = String::from_utf8_lossy(bytes);
     let (station, records) =
-        parse_text(&text, year).map_err(|(line, message)| WeatherError::Station {
-            file: path.to_path_buf(),
-            line,
-            message,
-        })?;
+        parse_text(&text, year).map_err(|refusal| WeatherError::Station(refusal.in_file(path)))?;
     let mut field_names: [String; FIELDS] = Default::default();
     field_names[Field::Infrared as usize] = "horizontal infrared (not in TMY3)".into();
     for (field, name, _) in COLUMNS {
@@ -71,39 +68,37 @@ pub(super) fn parse(
     })
 }
 
-/// Splits a line into fields with the csv crate (a station name may be quoted).
+/// Splits a line into trimmed fields (a station name may be quoted); a line the tokenizer
+/// refuses is one field, refused as such by what reads it.
 fn split(line: &str) -> Vec<String> {
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .from_reader(line.as_bytes());
-    match reader.records().next() {
-        Some(Ok(record)) => record.iter().map(|f| f.trim().to_owned()).collect(),
-        _ => vec![line.to_owned()],
+    match split_fields(0, line) {
+        Ok(fields) => fields.into_iter().map(|f| f.text.into_owned()).collect(),
+        Err(_) => vec![line.to_owned()],
     }
 }
 
-fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), LineRefusal> {
+fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>), Refusal> {
     let mut lines = text.lines().enumerate().map(|(i, l)| (i as u64 + 1, l));
     let station = match lines.next() {
-        Some((_, first)) => site(&split(first)).map_err(|problem| (1, problem.0))?,
+        Some((_, first)) => site(&split(first)).map_err(|problem| Refusal::at_line(1, problem))?,
         None => {
-            return Err((
+            return Err(Refusal::at_line(
                 1,
                 "empty file: a TMY3 file starts with its site line".into(),
             ))
         }
     };
     let Some((_, header)) = lines.next() else {
-        return Err((1, "no column header line after the site line".into()));
+        return Err(Refusal::at_line(
+            1,
+            "no column header line after the site line".into(),
+        ));
     };
     let header = split(header);
-    let find = |name: &str| -> Result<usize, LineRefusal> {
+    let find = |name: &str| -> Result<usize, Refusal> {
         header.iter().position(|h| h == name).ok_or_else(|| {
-            (
-                2,
-                format!("missing column '{name}' in the column header line"),
-            )
+            let message = format!("missing column '{name}' in the column header line");
+            Refusal::at_line(2, message.into())
         })
     };
     let (date, time) = (find(DATE)?, find(TIME)?);
@@ -118,9 +113,9 @@ fn parse_text(text: &str, year: Option<i32>) -> Result<(Station, Vec<HourRecord>
 }
 
 /// The site line: USAF, name, state, time zone, latitude, longitude, elevation.
-fn site(fields: &[String]) -> Result<Station, FieldProblem> {
+fn site(fields: &[String]) -> Result<Station, Problem> {
     if fields.len() < 7 {
-        return Err(FieldProblem(format!(
+        return Err(Problem(format!(
             "the first line must be USAF,name,state,time zone,latitude,longitude,elevation; got \
              {} field(s)",
             fields.len()
@@ -137,10 +132,10 @@ fn record(
     index: &[usize; FIELDS - 1],
     year: Option<i32>,
     station: &Station,
-) -> Result<HourRecord, FieldProblem> {
+) -> Result<HourRecord, Problem> {
     let get = |i: usize| fields.get(i).map(String::as_str).unwrap_or("");
     let bad_date = || {
-        FieldProblem(format!(
+        Problem(format!(
             "column '{DATE}': '{}' is not MM/DD/YYYY",
             shown(get(date))
         ))
@@ -158,14 +153,14 @@ fn record(
         _ => None,
     }
     .ok_or_else(|| {
-        FieldProblem(format!(
+        Problem(format!(
             "column '{TIME}': '{}' is not HH:00",
             shown(get(time))
         ))
     })?;
     let year = year.unwrap_or(file_year);
     let (end_local, end_utc) = label(year, month, day, hour, station.time_zone_h)
-        .map_err(|e| FieldProblem(format!("columns '{DATE}', '{TIME}': {e}")))?;
+        .map_err(|e| Problem(format!("columns '{DATE}', '{TIME}': {e}")))?;
     let mut values = [None; FIELDS];
     for (i, (field, name, scale)) in COLUMNS.iter().enumerate() {
         let name = format!("column '{name}'");
