@@ -1,9 +1,8 @@
 //! Rayon pools of a chosen size for the calls that take `threads`. A sweep's worker processes
-//! share the machine's cores: each of them running rayon's global pool (one thread per core)
-//! oversubscribes it, and rayon's idle threads spin before they sleep, so the renders then cost
-//! more CPU time, not only more wall time. A call given `threads` runs on a pool of that many
-//! threads instead, kept for the process's later calls of the same size. The results do not
-//! depend on the thread count (renders seed their samples per pixel).
+//! share the machine's cores: each running rayon's global pool (one thread per core) puts
+//! workers × cores threads on the cores, which then preempt one another mid-render. A call given
+//! `threads` runs on a pool of that many threads instead, kept for the process's later calls of
+//! the same size. A render's images do not depend on its thread count (python/tests).
 
 use crate::errors::bad_argument;
 use pyo3::prelude::*;
