@@ -140,6 +140,8 @@ pub(crate) fn apply(
 /// `thermal_solution` (by `solve_thermal`) when given. Returns channel name → float32 image
 /// (rows from the top), plus "summary" (JSON text) when `out` is given. `threads`: render on a
 /// pool of that many threads instead of rayon's global pool (the same images).
+// The arguments are the keywords of `irpol.render` (python/irpol/_render.py).
+#[allow(clippy::too_many_arguments)]
 #[pyfunction]
 #[pyo3(signature = (scene, patch = None, overrides = None, time_s = None, out = None,
                     thermal_solution = None, threads = None))]
