@@ -23,6 +23,7 @@ def render(
     patch: Optional[Mapping[str, Any]] = None,
     out: Optional[Union[str, "os.PathLike[str]"]] = None,
     thermal_solution: Optional[Union[str, "os.PathLike[str]"]] = None,
+    threads: Optional[int] = None,
 ) -> Dict[str, Any]:
     """Renders a scene TOML as ``irpol render`` does and returns its images.
 
@@ -40,6 +41,8 @@ def render(
     :func:`solve_thermal` to take the temperatures at `time_s` from instead of solving the run
     again: the same images bit for bit; a file made for other thermal inputs (its key is not the
     scene's, :func:`thermal_keys`), damaged or missing raises ValueError or OSError naming it.
+    `threads` renders on that many threads instead of one per core (the same images bit for bit):
+    processes rendering side by side each take their share of the cores.
     Raises OSError or ValueError.
     """
     if thermal_solution is not None and time_s is None:
@@ -58,6 +61,7 @@ def render(
         time_s=None if time_s is None else float(time_s),
         out=None if out is None else os.fspath(out),
         thermal_solution=None if thermal_solution is None else os.fspath(thermal_solution),
+        threads=None if threads is None else int(threads),
     )
     if "summary" in images:
         images["summary"] = json.loads(images["summary"])
@@ -87,10 +91,13 @@ def solve_thermal(
     out: Union[str, "os.PathLike[str]"],
     *,
     patch: Optional[Mapping[str, Any]] = None,
+    threads: Optional[int] = None,
 ) -> str:
     """Solves the scene's thermal run (with `patch`) recording `times_s`, which must share one
     key (:func:`thermal_keys`), and saves it to the file `out` (atomically; kept as it is when it
     already holds that run with those instants). Returns the key. ``render(…, time_s=t,
-    thermal_solution=out)`` then renders any of `times_s` without solving again."""
+    thermal_solution=out)`` then renders any of `times_s` without solving again. `threads` solves
+    on that many threads instead of one per core."""
     return _irpol.solve_thermal(os.fspath(scene), [float(t) for t in times_s], os.fspath(out),
-                                patch=list((patch or {}).items()))
+                                patch=list((patch or {}).items()),
+                                threads=None if threads is None else int(threads))

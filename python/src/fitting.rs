@@ -89,12 +89,7 @@ fn outcome_dict<'py>(py: Python<'py>, outcome: &MaterialFit) -> PyResult<Bound<'
     let d = PyDict::new(py);
     let material = outcome.material();
     d.set_item("name", &material.name)?;
-    d.set_item(
-        "material",
-        PyMaterial {
-            inner: material.clone(),
-        },
-    )?;
+    d.set_item("material", PyMaterial::wrapping(material.clone()))?;
     let entry = PathBuf::from(format!("{}.toml", material.name));
     let toml = material.to_toml(&entry).map_err(raised)?;
     d.set_item("toml", toml)?;

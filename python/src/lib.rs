@@ -9,6 +9,7 @@ mod interop;
 mod material;
 mod measurements;
 mod model;
+mod pools;
 mod radiometry;
 mod rendering;
 mod scene_patch;

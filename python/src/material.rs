@@ -2,18 +2,30 @@
 //! built from parameters or written exactly as the library does it.
 
 use crate::errors::{bad_argument, raised};
+use irpol::app::material_pbrdf;
 use irpol::material::{Material, MaterialModel};
+use irpol::pbrdf::Pbrdf;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
 
 /// A pBRDF material: slope distribution and σ, q (shared across wavelengths), shadowing, and
 /// N = n + ik and ρ_d, one value (grey) or one per table wavelength (spectral, µm, ascending).
 #[pyclass(name = "Material", module = "irpol", frozen)]
-#[derive(Clone)]
 pub struct PyMaterial {
     pub inner: Material,
+    /// The pBRDF last evaluated, by wavelength (its bits; `None` for a grey material's own), kept
+    /// with the tables it builds on its first evaluation (the Cauchy Smith factor's), so that a
+    /// second `mueller` or `emissivity` call does not build them again.
+    model: Mutex<Option<(Option<u64>, Arc<Pbrdf>)>>,
+}
+
+impl Clone for PyMaterial {
+    fn clone(&self) -> Self {
+        PyMaterial::wrapping(self.inner.clone())
+    }
 }
 
 /// A number or a list of numbers as a TOML value of `[model]`.
@@ -84,21 +96,19 @@ impl PyMaterial {
         model
             .validate()
             .map_err(|e| bad_argument(format!("the model is invalid: {e}")))?;
-        Ok(PyMaterial {
-            inner: Material {
-                name: name.to_owned(),
-                tool_version: format!("irpol {}", irpol::VERSION),
-                model,
-                fit: None,
-            },
-        })
+        Ok(PyMaterial::wrapping(Material {
+            name: name.to_owned(),
+            tool_version: format!("irpol {}", irpol::VERSION),
+            model,
+            fit: None,
+        }))
     }
 
     /// Reads a material TOML (as `irpol fit` writes them). Raises OSError or ValueError.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<PyMaterial> {
         Material::load(&path)
-            .map(|inner| PyMaterial { inner })
+            .map(PyMaterial::wrapping)
             .map_err(raised)
     }
 
@@ -106,7 +116,7 @@ impl PyMaterial {
     #[staticmethod]
     fn from_toml(text: &str) -> PyResult<PyMaterial> {
         Material::from_toml(text, std::path::Path::new("<text>"))
-            .map(|inner| PyMaterial { inner })
+            .map(PyMaterial::wrapping)
             .map_err(raised)
     }
 
@@ -125,13 +135,11 @@ impl PyMaterial {
     /// material itself. Raises ValueError outside a spectral table.
     fn at(&self, wavelength_um: f64) -> PyResult<PyMaterial> {
         let spec = self.inner.at(wavelength_um).map_err(raised)?;
-        Ok(PyMaterial {
-            inner: Material {
-                model: MaterialModel::Grey(spec),
-                fit: None,
-                ..self.inner.clone()
-            },
-        })
+        Ok(PyMaterial::wrapping(Material {
+            model: MaterialModel::Grey(spec),
+            fit: None,
+            ..self.inner.clone()
+        }))
     }
 
     #[getter]
@@ -331,6 +339,28 @@ fn span(values: &[f64]) -> String {
 const DEFAULT_GREY_WAVELENGTH_UM: f64 = 10.0;
 
 impl PyMaterial {
+    pub(crate) fn wrapping(inner: Material) -> Self {
+        PyMaterial {
+            inner,
+            model: Mutex::new(None),
+        }
+    }
+
+    /// The material's pBRDF as `irpol eval --material` builds it (at `wavelength_um` for a
+    /// spectral material), built once per wavelength in a row of calls.
+    pub(crate) fn pbrdf(&self, wavelength_um: Option<f64>) -> PyResult<Arc<Pbrdf>> {
+        let key = wavelength_um.map(f64::to_bits);
+        let mut kept = self.model.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some((k, model)) = kept.as_ref() {
+            if *k == key {
+                return Ok(Arc::clone(model));
+            }
+        }
+        let model = Arc::new(material_pbrdf(&self.inner, wavelength_um, None).map_err(raised)?);
+        *kept = Some((key, Arc::clone(&model)));
+        Ok(model)
+    }
+
     fn per_wavelength<'py>(
         &self,
         py: Python<'py>,

@@ -2,23 +2,16 @@
 //! `emissivity` (§1.4). The Python side broadcasts the angle arrays and hands over flat,
 //! contiguous float64 arrays of one length; results come back flat (16 or 4 values per entry).
 
-use crate::errors::{bad_argument, raised};
+use crate::errors::bad_argument;
 use crate::material::PyMaterial;
-use irpol::app::material_pbrdf;
 use irpol::optics::Direction;
-use irpol::pbrdf::{GeometryColumns, HemisphereQuadrature, ModelError, Pbrdf};
+use irpol::pbrdf::{GeometryColumns, HemisphereQuadrature, ModelError};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
 /// Geometries per parallel work unit (small enough to balance, large enough to amortize).
 const CHUNK: usize = 4096;
-
-/// The material's pBRDF as `irpol eval --material` builds it (at `wavelength_um` for a spectral
-/// material).
-fn pbrdf(material: &PyMaterial, wavelength_um: Option<f64>) -> PyResult<Pbrdf> {
-    material_pbrdf(&material.inner, wavelength_um, None).map_err(raised)
-}
 
 /// Mueller BRDF elements (sr⁻¹, psps frames, row-major m00…m33) at each geometry (degrees).
 #[pyfunction]
@@ -31,7 +24,7 @@ pub fn mueller_flat<'py>(
     theta_r: PyReadonlyArray1<'py, f64>,
     phi_r: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let model = pbrdf(material, wavelength_um)?;
+    let model = material.pbrdf(wavelength_um)?;
     let (ti, pi, tr, pr) = (
         theta_i.as_slice()?,
         phi_i.as_slice()?,
@@ -79,7 +72,7 @@ pub fn emissivity_flat<'py>(
     wavelength_um: Option<f64>,
     theta: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let model = pbrdf(material, wavelength_um)?;
+    let model = material.pbrdf(wavelength_um)?;
     let thetas = theta.as_slice()?;
     for &t in thetas {
         Direction::from_degrees_checked("theta", t, 0.0)

@@ -139,6 +139,47 @@ def test_external_scheduler_gives_the_same_manifest(sweep_folder, tmp_path_facto
     assert _comparable(_rows(sweep_folder / "dataset")) == _comparable(local)
 
 
+# An item rendered alone, in a fresh process (nothing loaded or built before it).
+RENDER_ALONE = """import json, sys
+import irpol
+irpol.render(sys.argv[1], patch=json.loads(sys.argv[2]), resolution=(16, 12), samples=1,
+             out=sys.argv[3])
+"""
+
+
+def test_a_sweep_renders_its_items_bit_for_bit_as_one_process_does(sweep_folder):
+    """The workers of a LocalCluster render on their share of the cores (two workers on two
+    cores: one thread each) and reuse the tables of their last render where only the camera
+    changed (a worker gets every other item: both build the tables of 295 K, one reuses them,
+    both build those of 305 K, the other reuses them); each item rendered alone in a fresh
+    process on a thread per core writes the same files but the timings, and so does each
+    rendered here on one thread."""
+    import os
+
+    import irpol
+    from irpol.dataset.runner import render_threads
+
+    cores = len(os.sched_getaffinity(0))
+    assert render_threads(None, 2) == max(1, cores // 2)
+    assert render_threads("tcp://127.0.0.1:8786", 2) is None
+    grid = '"objects.0.temperature_k" = [295.0, 305.0]\n"camera.fov_deg" = [25.0, 30.0, 35.0]\n'
+    summary = run(_write_spec(sweep_folder, grid), workers=2, progress=False)
+    assert (summary.ok, summary.failed) == (6, 0)
+    scene = sweep_folder / "scene.toml"
+    for row in _rows(sweep_folder / "dataset"):
+        alone = sweep_folder / "alone" / str(row["item"])
+        subprocess.run([sys.executable, "-c", RENDER_ALONE, str(scene), json.dumps(row["params"]),
+                        str(alone)], check=True)
+        expected = {k: v for k, v in hashes(alone).items() if k not in VOLATILE}
+        assert {k: v for k, v in row["outputs"].items() if k not in VOLATILE} == expected
+        one_thread = sweep_folder / "one_thread" / str(row["item"])
+        irpol.render(scene, patch=row["params"], resolution=(16, 12), samples=1, threads=1,
+                     out=one_thread)
+        assert {k: v for k, v in hashes(one_thread).items() if k not in VOLATILE} == expected
+    with pytest.raises(ValueError, match="threads must be at least 1"):
+        irpol.render(scene, resolution=(16, 12), samples=1, threads=0)
+
+
 def test_bad_specs_are_refused_before_any_work(sweep_folder):
     out = sweep_folder / "dataset"
     spec = sweep_folder / "unknown.toml"

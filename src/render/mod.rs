@@ -79,20 +79,88 @@ pub struct Rendered {
     pub table_resolutions: Vec<TableResolution>,
 }
 
-/// Renders a loaded scene in memory, reporting progress (raster tiles, then image rows) to
-/// `progress`.
-pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, RenderError> {
-    let mut timings = Timings::default();
-    let start = Instant::now();
-    let mesh = &scene.mesh;
-    let (t_lo, t_hi) = mesh
+/// The reflection tables of a scene's materials: built from its materials, environment, sensor
+/// band and surface temperature range, not from its camera, so that renders of one scene from
+/// several viewpoints can share them ([`render_with_tables`]; the Python sweeps do).
+pub struct SceneTables {
+    /// What the tables were built from, [`table_inputs`].
+    inputs: String,
+    tables: Vec<MaterialTables>,
+    resolutions: Vec<TableResolution>,
+}
+
+impl SceneTables {
+    pub fn build(scene: &Scene) -> Result<SceneTables, RenderError> {
+        // Read before the build, which may fill a model's lazily built tables (part of its Debug).
+        let inputs = table_inputs(scene);
+        let (tables, resolutions) = material_tables(scene, surface_temperature_range(scene))?;
+        Ok(SceneTables {
+            inputs,
+            tables,
+            resolutions,
+        })
+    }
+
+    /// Whether these are the tables of `scene` (freshly loaded, as the one they were built for):
+    /// built from equal inputs, every number compared exactly.
+    pub fn built_for(&self, scene: &Scene) -> bool {
+        self.inputs == table_inputs(scene)
+    }
+}
+
+/// Everything [`material_tables`] reads of a scene, as text: the derived `Debug` of each value,
+/// which prints every field and every float exactly (shortest round-trip form).
+fn table_inputs(scene: &Scene) -> String {
+    let optics: Vec<_> = scene.materials.iter().map(|m| &m.optics).collect();
+    let (t_lo, t_hi) = surface_temperature_range(scene);
+    format!(
+        "{optics:?}\n{:?}\n{:?}\n{:?}",
+        scene.environment,
+        scene.sensor.band,
+        (t_lo.to_bits(), t_hi.to_bits())
+    )
+}
+
+/// The lowest and highest vertex temperature (K).
+fn surface_temperature_range(scene: &Scene) -> (f64, f64) {
+    let (t_lo, t_hi) = scene
+        .mesh
         .temperatures
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
             (lo.min(t), hi.max(t))
         });
-    let temperatures = (t_lo.min(t_hi), t_hi.max(t_lo));
-    let (tables, resolutions) = material_tables(scene, temperatures)?;
+    (t_lo.min(t_hi), t_hi.max(t_lo))
+}
+
+/// Renders a loaded scene in memory, reporting progress (raster tiles, then image rows) to
+/// `progress`.
+pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, RenderError> {
+    let start = Instant::now();
+    let tables = SceneTables::build(scene)?;
+    render_from(scene, &tables, start, progress)
+}
+
+/// [`render`] with `tables` built by [`SceneTables::build`] for this scene or one that differs
+/// from it only in its camera: the same images bit for bit, without building the tables again.
+pub fn render_with_tables(
+    scene: &Scene,
+    tables: &SceneTables,
+    progress: &dyn Progress,
+) -> Result<Rendered, RenderError> {
+    render_from(scene, tables, Instant::now(), progress)
+}
+
+/// [`render`] with its tables, its timings counted from `start`.
+fn render_from(
+    scene: &Scene,
+    tables: &SceneTables,
+    start: Instant,
+    progress: &dyn Progress,
+) -> Result<Rendered, RenderError> {
+    let mut timings = Timings::default();
+    let mesh = &scene.mesh;
+    let temperatures = surface_temperature_range(scene);
     let radiance = RadianceTable::new(&scene.sensor.band, temperatures.0, temperatures.1);
     timings.tables = start.elapsed().as_secs_f64();
 
@@ -108,7 +176,7 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
 
     let shade_start = Instant::now();
     let open_world = OpenWorld {
-        tables: &tables,
+        tables: &tables.tables,
         radiance: &radiance,
     };
     let accel;
@@ -132,7 +200,7 @@ pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, Render
         dofp: recording.dofp,
         camera_metrics: recording.metrics,
         timings,
-        table_resolutions: resolutions,
+        table_resolutions: tables.resolutions.clone(),
     })
 }
 

@@ -61,7 +61,7 @@ def _render(job: Dict[str, Any], params: Dict[str, Any], folder: Path,
             thermal: Optional[str]) -> None:
     solution = None if thermal is None else thermal_path(Path(job["out"]), thermal)
     irpol.render(job["scene"], patch=scene_patch(params), time_s=params.get(TIME_KEY), out=folder,
-                 thermal_solution=solution, **job["render"])
+                 thermal_solution=solution, threads=job.get("threads"), **job["render"])
 
 
 def _fit(job: Dict[str, Any], params: Dict[str, Any], folder: Path,

@@ -4,6 +4,7 @@ the renders that need it depend on that task instead of each solving the run aga
 
 from __future__ import annotations
 
+import os
 import shutil
 import uuid
 import time
@@ -49,12 +50,30 @@ def dask_client(scheduler: Optional[str], workers: Optional[int]) -> Iterator[ob
         yield client
 
 
-def _job(spec: Spec) -> dict:
+def _cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def render_threads(scheduler: Optional[str], workers: Optional[int]) -> Optional[int]:
+    """Threads per render on a LocalCluster of `workers` processes: its share of the cores, so
+    that workers × threads ≤ cores (each render otherwise starts a thread per core, and the
+    workers' threads oversubscribe the machine). None (one per core) on an external scheduler,
+    whose workers' machines this process does not know."""
+    if scheduler is not None:
+        return None
+    return max(1, _cores() // (workers or 2))
+
+
+def _job(spec: Spec, threads: Optional[int]) -> dict:
     """What a task needs of the spec, as plain data (sent to every worker)."""
     return {"kind": spec.kind, "out": str(spec.out.resolve()),
             "scene": None if spec.scene is None else str(spec.scene.resolve()),
             "render": spec.render, "options": spec.options,
-            "spec_dir": str(spec.path.parent.resolve())}
+            "spec_dir": str(spec.path.parent.resolve()), "threads": threads}
 
 
 def _failed_row(index: int, params: dict, error: BaseException, thermal: Optional[str]) -> dict:
@@ -138,7 +157,7 @@ def run(spec_path, scheduler: Optional[str] = None, workers: Optional[int] = Non
     todo = [item for item in items if item.index not in done]
     ok = failed = 0
     if todo:
-        job, run_id = _job(spec), uuid.uuid4().hex[:12]
+        job, run_id = _job(spec, render_threads(scheduler, workers)), uuid.uuid4().hex[:12]
         plan = _thermal_plan(spec, todo)
         with dask_client(scheduler, workers) as client:
             # A render's argument is its run's future: Dask starts it once the run is saved.
@@ -146,9 +165,12 @@ def run(spec_path, scheduler: Optional[str] = None, workers: Optional[int] = Non
                                          retries=RETRIES, pure=False,
                                          key=f"irpol-thermal-{key[:16]}-{run_id}")
                       for key, (patch, times) in plan.runs.items()}
+            # In grid order (the last key varies fastest): a worker's next item then mostly
+            # differs from its last in a camera key only and reuses its tables.
             futures = {client.submit(run_item, job, it.index, it.params,
                                      solves.get(plan.key_of.get(it.index)), retries=RETRIES,
-                                     pure=False, key=f"irpol-item-{it.index}-{run_id}"): it
+                                     pure=False, priority=-it.index,
+                                     key=f"irpol-item-{it.index}-{run_id}"): it
                        for it in todo}
             bar = _progress(len(todo), progress)
             for future in as_completed(futures):
