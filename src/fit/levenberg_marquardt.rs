@@ -9,7 +9,6 @@
 use super::objective::Objective;
 use super::stages::{Stage, StageHistory};
 use nalgebra::{DMatrix, DVector};
-use rayon::prelude::*;
 
 /// Settings of the Levenberg–Marquardt stage.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,40 +71,13 @@ impl LeastSquares for Objective<'_> {
         self.residuals_at(&self.space().values(s), r.as_mut_slice())
             .then_some(r)
     }
-    /// From the columns without assembling J (a measurement's J is tens of thousands of rows):
-    /// JᵀJ is symmetric, so each pair of columns is multiplied once.
+    /// Block by block of points, never holding J ([`super::normal_equations`]).
     fn normal_equations(
         &self,
         s: &[f64],
         r: &DVector<f64>,
     ) -> Option<(DMatrix<f64>, DVector<f64>)> {
-        let columns = self.jacobian_columns(s, r)?;
-        let n = columns.len();
-        let mut a = DMatrix::zeros(n, n);
-        for p in 0..n {
-            for q in p..n {
-                let product = columns[p].dot(&columns[q]);
-                a[(p, q)] = product;
-                a[(q, p)] = product;
-            }
-        }
-        let g = DVector::from_fn(n, |p, _| columns[p].dot(r));
-        Some((a, g))
-    }
-}
-
-impl Objective<'_> {
-    /// ∂r/∂s_j by forward differences, one column per thread task.
-    fn jacobian_columns(&self, s: &[f64], r: &DVector<f64>) -> Option<Vec<DVector<f64>>> {
-        (0..s.len())
-            .into_par_iter()
-            .map(|j| {
-                let mut shifted = s.to_vec();
-                let h = forward_step(s, j, self.upper());
-                shifted[j] += h;
-                self.residuals(&shifted).map(|rh| (rh - r) / h)
-            })
-            .collect()
+        super::normal_equations::normal_equations(self, s, r)
     }
 }
 

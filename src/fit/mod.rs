@@ -26,6 +26,7 @@ mod global;
 mod levenberg_marquardt;
 mod model_fit;
 mod nelder_mead;
+mod normal_equations;
 mod objective;
 mod optimize;
 mod option_error;

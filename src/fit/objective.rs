@@ -17,7 +17,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// Points per block of an evaluation run in parallel: more than the shipped measurements hold
 /// (≤ 4000 rows), so their costs are summed exactly as serially, and enough work per block
 /// (≈ 0.4 ms) that the threads' overhead does not show.
-const CHUNK_POINTS: usize = 4096;
+/// A multiple of 8, so a block's observations start on a lane of the normal equations' sums
+/// ([`super::normal_equations`]).
+pub(crate) const CHUNK_POINTS: usize = 4096;
 
 /// The objective of one model family on one measurement, as a function of search coordinates
 /// ([`ModelSpace`]). Thread-safe: the genetic stage evaluates it in parallel.
@@ -112,10 +114,7 @@ impl<'a> Objective<'a> {
         let masking = self.masking(pbrdf);
         let width = self.data.elements.len();
         let fill = |(chunk, block): (usize, &mut [f64])| {
-            let first = chunk * CHUNK_POINTS;
-            for (p, values) in block.chunks_mut(width).enumerate() {
-                self.point_residuals(pbrdf, &masking, first + p, |e, r| values[e] = map(r));
-            }
+            self.fill_block(pbrdf, &masking, chunk * CHUNK_POINTS, block, &map);
         };
         // One block (every shipped file) runs on the calling thread: no task to hand out.
         if self.data.points() <= CHUNK_POINTS {
@@ -124,6 +123,43 @@ impl<'a> Objective<'a> {
             out.par_chunks_mut(CHUNK_POINTS * width)
                 .enumerate()
                 .for_each(fill);
+        }
+    }
+
+    /// Writes `map(r)` of the points from `first` on into `block` (whole points).
+    #[inline]
+    fn fill_block(
+        &self,
+        pbrdf: &Pbrdf,
+        masking: &[f64],
+        first: usize,
+        block: &mut [f64],
+        map: &impl Fn(f64) -> f64,
+    ) {
+        let width = self.data.elements.len();
+        for (p, values) in block.chunks_mut(width).enumerate() {
+            self.point_residuals(pbrdf, masking, first + p, |e, r| values[e] = map(r));
+        }
+    }
+
+    /// The model at search coordinates `s` and its shadowing factors, counting one evaluation;
+    /// `None` for an invalid model. What [`Objective::block_residuals`] evaluates.
+    pub(crate) fn prepared_model(&self, s: &[f64]) -> Option<PreparedModel> {
+        let pbrdf = self.model(&self.space.values(s))?;
+        let masking = self.masking(&pbrdf);
+        Some(PreparedModel { pbrdf, masking })
+    }
+
+    /// The residuals of [`LeastSquares::residuals`](super::levenberg_marquardt::LeastSquares)
+    /// of the points from `first` on, written into `block` (whole points): the same values as
+    /// the whole vector's, a block at a time.
+    pub(crate) fn block_residuals(&self, model: &PreparedModel, first: usize, block: &mut [f64]) {
+        let (pbrdf, masking) = (&model.pbrdf, model.masking.as_slice());
+        match self.robust {
+            None => self.fill_block(pbrdf, masking, first, block, &|r| r),
+            Some(loss) => {
+                self.fill_block(pbrdf, masking, first, block, &|r| loss.pseudo_residual(r))
+            }
         }
     }
 
@@ -194,6 +230,16 @@ impl<'a> Objective<'a> {
         Some(out)
     }
 
+    /// [`Objective::normalized_residuals`] written into `out` (length
+    /// [`Objective::observations`]); false for an invalid model.
+    pub fn normalized_residuals_into(&self, values: &ParameterValues, out: &mut [f64]) -> bool {
+        let Some(pbrdf) = self.model(values) else {
+            return false;
+        };
+        self.fill_residuals(&pbrdf, out, |r| r);
+        true
+    }
+
     /// The model's full Mueller matrix (sr⁻¹) at every point.
     pub fn model_muellers(&self, values: &ParameterValues) -> Option<Vec<Mueller>> {
         let pbrdf = self.model(values)?;
@@ -212,6 +258,13 @@ impl<'a> Objective<'a> {
                 .collect(),
         )
     }
+}
+
+/// A model and its shadowing factor per distinct zenith angle, ready to evaluate blocks of
+/// points.
+pub(crate) struct PreparedModel {
+    pbrdf: Pbrdf,
+    masking: Vec<f64>,
 }
 
 /// The objective as an argmin cost function of search coordinates (the genetic stage's box).

@@ -13,7 +13,7 @@
 use super::objective::Objective;
 use super::parameters::{value_per_coordinate, Parameter, ParameterValues};
 use crate::material::ConfidenceBound;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 /// Correlation beyond which two parameters count as not separately determined.
@@ -44,30 +44,38 @@ pub struct Uncertainty {
 }
 
 /// Jacobian of the plain normalized residuals with respect to the physical free parameters, by
-/// central differences in search coordinates (one-sided at a bound) and the chain rule.
+/// central differences in search coordinates (one-sided at a bound) and the chain rule. Each
+/// column is written in place: J is observations × parameters, the largest array of a fit.
 fn physical_jacobian(objective: &Objective, search: &[f64]) -> Option<DMatrix<f64>> {
     let space = objective.space();
-    let columns: Option<Vec<DVector<f64>>> = space
-        .free()
-        .par_iter()
+    let rows = objective.observations();
+    let mut jacobian = DMatrix::zeros(rows, space.free().len());
+    let complete = jacobian
+        .as_mut_slice()
+        .par_chunks_mut(rows)
+        .zip(space.free().par_iter())
         .enumerate()
-        .map(|(j, &parameter)| {
+        .all(|(j, (column, &parameter))| {
             let h = 1e-5 * search[j].abs().max(1.0);
             let lo = (search[j] - h).max(space.lower()[j]);
             let hi = (search[j] + h).min(space.upper()[j]);
-            let residuals_at = |coordinate: f64| {
+            let residuals_at = |coordinate: f64, out: &mut [f64]| {
                 let mut shifted = search.to_vec();
                 shifted[j] = coordinate;
-                objective
-                    .normalized_residuals(&space.values(&shifted))
-                    .map(DVector::from_vec)
+                objective.normalized_residuals_into(&space.values(&shifted), out)
             };
-            let derivative = (residuals_at(hi)? - residuals_at(lo)?) / (hi - lo);
+            let mut below = vec![0.0; rows];
+            if !(residuals_at(hi, column) && residuals_at(lo, &mut below)) {
+                return false;
+            }
             // d r/d value = (d r/d coordinate) / (d value/d coordinate), at the central point.
-            Some(derivative / value_per_coordinate(parameter, search[j]))
-        })
-        .collect();
-    Some(DMatrix::from_columns(&columns?))
+            let per_coordinate = value_per_coordinate(parameter, search[j]);
+            for (c, b) in column.iter_mut().zip(&below) {
+                *c = ((*c - b) / (hi - lo)) / per_coordinate;
+            }
+            true
+        });
+    complete.then_some(jacobian)
 }
 
 /// Uncertainties of the free parameters at the optimum `search` (search coordinates), with
