@@ -9,13 +9,13 @@ mod fit_support;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fit_support::{goniometer_geometry, model, synthetic_set, LINEAR_ELEMENTS};
 use irpol::fit::{
-    fit_grey, fit_measurement, fit_spectral, subset, validate_model, Dispersion, DistributionKind,
-    FitOptions, MeasurementData, ModelSpace, Objective, Parameter, ParameterBounds,
-    ParameterValues,
+    fit_grey, fit_measurement, fit_spectral, subset, validate_model, Dispersion, FitOptions,
+    MeasurementData, ModelSpace, Objective, ParameterBounds, ParameterValues,
 };
 use irpol::measure::{
     read_measurement_csv, read_measurement_sets, read_with_layout, Layout, MeasurementSet,
 };
+use irpol::pbrdf::{DistributionKind, Parameter};
 use irpol::pbrdf::{ModelTerms, Shadowing, SlopeDistribution};
 use std::path::Path;
 use std::time::Duration;

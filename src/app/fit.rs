@@ -6,11 +6,12 @@
 use super::AppError;
 use crate::atomic::OutputSet;
 use crate::fit::{
-    fit_read_inputs, parse_parameter_list, parse_parameter_values, Dispersion, DistributionKind,
-    FitInputs, FitOptions, MaterialFit, Optimizer, RobustLoss,
+    fit_read_inputs, parse_parameter_list, parse_parameter_values, Dispersion, FitInputs,
+    FitOptions, MaterialFit, Optimizer, RobustLoss,
 };
 use crate::material::{list_library, Library, Material};
 use crate::measure::{is_angle_note, ReadOptions};
+use crate::pbrdf::DistributionKind;
 use crate::pbrdf::{ModelTerms, Shadowing};
 use crate::report::fit_report::encode_fit_report;
 use crate::report::index::library_index_html;

@@ -100,7 +100,7 @@ fn spectral_summary_line(outcome: &irpol::fit::SpectralFitOutcome, entry: &Path)
 fn fit_summary_line(outcome: &irpol::fit::FitOutcome, entry: &Path) -> String {
     let chosen = &outcome.chosen;
     let record = outcome.material.fit.as_ref();
-    let bound = |p: &irpol::fit::Parameter| record.and_then(|r| r.profile_bounds.get(p.name()));
+    let bound = |p: &irpol::pbrdf::Parameter| record.and_then(|r| r.profile_bounds.get(p.name()));
     let parameters: Vec<String> = chosen
         .free
         .iter()

@@ -4,7 +4,7 @@
 //! lowest AIC is preferred; on a tie the one with fewer parameters, then the one fitted first.
 //! The χ² is the plain one even when the fit used a robust loss.
 
-use super::parameters::DistributionKind;
+use crate::pbrdf::DistributionKind;
 use serde::{Deserialize, Serialize};
 use std::cmp::Ordering;
 

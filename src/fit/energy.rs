@@ -6,8 +6,9 @@
 //! and the other parameters refitted (an active set). A model whose facets alone reflect more
 //! than 1 (shadowing `none` at grazing angles) cannot be repaired this way and is refused.
 
-use super::parameters::{Parameter, ParameterValues};
+use super::parameters::ParameterValues;
 use super::space::ModelSpace;
+use crate::pbrdf::Parameter;
 use crate::pbrdf::{HemisphereQuadrature, Pbrdf};
 use rayon::prelude::*;
 

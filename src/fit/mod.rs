@@ -63,10 +63,7 @@ pub use optimize::{coarse_stride, OptimizerSettings, COARSE_POINTS};
 pub use option_error::OptionError;
 pub use options::{parse_parameter_list, parse_parameter_values, FitOptions};
 pub use outcome::{fit_measurement, FitOutcome};
-pub use parameters::{
-    DistributionKind, Interval, InvalidBounds, Parameter, ParameterBounds, ParameterValues,
-    SMITH_MIN_Q,
-};
+pub use parameters::{Interval, InvalidBounds, ParameterBounds, ParameterValues, SMITH_MIN_Q};
 pub use profile::{CONFIDENCE, ONE_SIDED_95_DELTA_CHI2};
 pub use robust::RobustLoss;
 pub use space::ModelSpace;

@@ -6,7 +6,7 @@ use super::energy::{check_energy, EnergyCheck, ENERGY_TOLERANCE};
 use super::objective::Objective;
 use super::optimize::minimize;
 use super::options::FitOptions;
-use super::parameters::{DistributionKind, Parameter, ParameterValues};
+use super::parameters::ParameterValues;
 use super::profile::{parameters_to_profile, profile_bounds};
 use super::space::ModelSpace;
 use super::stages::ConvergenceHistory;
@@ -17,6 +17,7 @@ use crate::material::ModelSpec;
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::optics::Mueller;
 use crate::pbrdf::ModelTerms;
+use crate::pbrdf::{DistributionKind, Parameter};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 

@@ -4,8 +4,8 @@ use super::global::{genetic, GeneticSettings};
 use super::levenberg_marquardt::{levenberg_marquardt, LevenbergMarquardtSettings};
 use super::nelder_mead::{nelder_mead, NelderMeadSettings};
 use super::objective::Objective;
-use super::parameters::Parameter;
 use super::stages::{ConvergenceHistory, Optimizer, Stage};
+use crate::pbrdf::Parameter;
 use rayon::prelude::*;
 
 /// Settings of every stage (the defaults suit fits of 3–5 parameters).

@@ -2,10 +2,11 @@
 
 use super::optimize::OptimizerSettings;
 use super::option_error::OptionError;
-use super::parameters::{DistributionKind, Parameter, ParameterBounds, ParameterValues};
+use super::parameters::{ParameterBounds, ParameterValues};
 use super::robust::RobustLoss;
 use super::stages::Optimizer;
 use super::FitError;
+use crate::pbrdf::{DistributionKind, Parameter};
 use crate::pbrdf::{ModelTerms, Shadowing, SpectralRole};
 use std::collections::BTreeMap;
 

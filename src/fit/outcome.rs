@@ -5,11 +5,11 @@ use super::comparison::ModelComparison;
 use super::data::{ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR};
 use super::model_fit::{fit_model, ModelFit};
 use super::options::FitOptions;
-use super::parameters::{DistributionKind, Parameter};
 use super::stages::Stage;
 use super::FitError;
 use crate::material::{pinned_at_bound, AlternativeFit, FitRecord, Material, MergedSource};
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
+use crate::pbrdf::{DistributionKind, Parameter};
 use std::collections::BTreeMap;
 
 /// Everything a fit report needs about one measurement.

@@ -15,7 +15,7 @@
 //! §1.3), hence the raised lower bound of q with Smith shadowing.
 
 use crate::pbrdf::Shadowing;
-pub use crate::pbrdf::{DistributionKind, OutsideDomain, Parameter};
+use crate::pbrdf::Parameter;
 use serde::{Deserialize, Serialize};
 
 impl Parameter {
@@ -149,6 +149,7 @@ pub fn value_per_coordinate(parameter: Parameter, coordinate: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::pbrdf::DistributionKind;
 
     #[test]
     fn search_coordinates_round_trip_and_have_the_right_slope() {

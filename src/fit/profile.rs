@@ -16,10 +16,11 @@
 
 use super::levenberg_marquardt::{levenberg_marquardt, LevenbergMarquardtSettings};
 use super::objective::Objective;
-use super::parameters::{from_search, value_per_coordinate, Parameter, ParameterValues};
+use super::parameters::{from_search, value_per_coordinate, ParameterValues};
 use super::space::ModelSpace;
 use super::uncertainty::Uncertainty;
 use crate::material::ConfidenceBound;
+use crate::pbrdf::Parameter;
 
 /// z² of the one-sided 95 % quantile of the standard normal: 1.6448536269514722².
 pub const ONE_SIDED_95_DELTA_CHI2: f64 = 2.705_543_454_095_404;

@@ -1,13 +1,12 @@
 //! The model being fitted: a distribution family and shadowing, which parameters are free, the
 //! values of the others, and the box of search coordinates the free ones live in.
 
-use super::parameters::{
-    from_search, to_search, DistributionKind, Interval, Parameter, ParameterBounds, ParameterValues,
-};
+use super::parameters::{from_search, to_search, Interval, ParameterBounds, ParameterValues};
 use super::FitError;
 use crate::material::ModelSpec;
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{Body, ModelError, ModelTerms, Pbrdf, Shadowing, Subsurface};
+use crate::pbrdf::{DistributionKind, Parameter};
 
 /// Lowest n searched with the volume terms (see [`ModelSpace::new`]).
 pub const VOLUME_MIN_N: f64 = 1.0;

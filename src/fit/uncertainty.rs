@@ -11,8 +11,9 @@
 //! is consistent with zero but tightly bounded (ρ_d = 0.00001 ± 0.00002) determined.
 
 use super::objective::Objective;
-use super::parameters::{value_per_coordinate, Parameter, ParameterValues};
+use super::parameters::{value_per_coordinate, ParameterValues};
 use crate::material::ConfidenceBound;
+use crate::pbrdf::Parameter;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 

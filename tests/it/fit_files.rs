@@ -4,8 +4,9 @@
 use crate::fit_support;
 
 use fit_support::{goniometer_geometry, model, synthetic_set, to_csv, LINEAR_ELEMENTS};
-use irpol::fit::{fit_files, DistributionKind, FitError, FitOptions};
+use irpol::fit::{fit_files, FitError, FitOptions};
 use irpol::material::Material;
+use irpol::pbrdf::DistributionKind;
 use irpol::pbrdf::{Shadowing, SlopeDistribution};
 use std::path::{Path, PathBuf};
 
@@ -122,7 +123,7 @@ fn a_bad_input_fails_the_run_before_anything_is_written() {
     let mut invalid = options();
     invalid.shadowing = Shadowing::Smith;
     invalid.distribution = Some(DistributionKind::Cauchy);
-    invalid.fixed.insert(irpol::fit::Parameter::Q, 1.2);
+    invalid.fixed.insert(irpol::pbrdf::Parameter::Q, 1.2);
     let good = inputs.path().join("good.csv");
     let error = fit_files(&[good], &invalid, &fits, &irpol::progress::Silent).unwrap_err();
     assert!(matches!(error, FitError::Options(_)), "{error}");

@@ -4,9 +4,10 @@
 //! the generating distribution is the one the model comparison prefers; every seed and every
 //! start of the local stage reaches the same minimum.
 
-use irpol::fit::{fit_measurement, DistributionKind, FitOptions, Optimizer, Parameter};
+use irpol::fit::{fit_measurement, FitOptions, Optimizer};
 use irpol::measure::{read_measurement_csv, MeasurementSet};
 use irpol::pbrdf::Shadowing;
+use irpol::pbrdf::{DistributionKind, Parameter};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;

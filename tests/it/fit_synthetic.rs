@@ -6,10 +6,10 @@ use crate::fit_support;
 
 use fit_support::{goniometer_geometry, model, synthetic_set, LINEAR_ELEMENTS};
 use irpol::fit::{
-    fit_measurement, DistributionKind, ErrorSource, FitError, FitOptions, MeasurementData,
-    Optimizer, Parameter, RobustLoss,
+    fit_measurement, ErrorSource, FitError, FitOptions, MeasurementData, Optimizer, RobustLoss,
 };
 use irpol::measure::MeasurementSet;
+use irpol::pbrdf::{DistributionKind, Parameter};
 use irpol::pbrdf::{Shadowing, SlopeDistribution};
 use rayon::prelude::*;
 use std::collections::BTreeMap;

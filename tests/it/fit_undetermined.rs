@@ -8,10 +8,9 @@ use crate::fit_support;
 
 use common::fit_into;
 use fit_support::{goniometer_geometry, model, synthetic_set, to_csv, LINEAR_ELEMENTS};
-use irpol::fit::{
-    fit_measurement, DistributionKind, FitOptions, Parameter, ONE_SIDED_95_DELTA_CHI2,
-};
+use irpol::fit::{fit_measurement, FitOptions, ONE_SIDED_95_DELTA_CHI2};
 use irpol::measure::MeasurementSet;
+use irpol::pbrdf::{DistributionKind, Parameter};
 use irpol::pbrdf::{Shadowing, SlopeDistribution};
 use std::collections::BTreeMap;
 

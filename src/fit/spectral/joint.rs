@@ -12,9 +12,10 @@
 
 use super::super::levenberg_marquardt::{forward_step, LeastSquares};
 use super::super::objective::Objective;
-use super::super::parameters::{Parameter, ParameterValues};
+use super::super::parameters::ParameterValues;
 use super::lorentz_start::{law_of, LAW_PER_OSCILLATOR};
 use crate::optics::LorentzDispersion;
+use crate::pbrdf::Parameter;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::ops::Range;

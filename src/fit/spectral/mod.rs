@@ -25,9 +25,7 @@ use super::levenberg_marquardt::{levenberg_marquardt, LeastSquares};
 use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
 use super::options::FitOptions;
-use super::parameters::{
-    from_search, to_search, value_per_coordinate, DistributionKind, Parameter,
-};
+use super::parameters::{from_search, to_search, value_per_coordinate};
 use super::space::ModelSpace;
 use super::space::VOLUME_MIN_N;
 use super::stages::StageHistory;
@@ -36,6 +34,7 @@ use super::FitError;
 use crate::material::{Material, SpectralModel};
 use crate::measure::MeasurementSet;
 use crate::optics::{LorentzDispersion, Mueller};
+use crate::pbrdf::{DistributionKind, Parameter};
 use joint::{Block, IndexModel, JointProblem};
 use lorentz_start::{law_bounds, lorentz_start};
 use num_complex::Complex64;
