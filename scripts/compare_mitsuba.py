@@ -105,6 +105,8 @@ SCENE = {
                "material": {"sigma": 0.15, "n": 3.0, "k": 20.0}},
     "plane": {"size": [12.0, 12.0],
               "material": {"sigma": 0.2, "n": 1.5, "k": 0.1}},
+    # irpol's lobe samples per path at the visible point (`[render] first_bounce_samples`).
+    "first_bounce_samples": 4,
 }
 
 SKY_SAMPLES = 1025  # irpol's u grid (src/scene/environment.rs)
@@ -164,6 +166,7 @@ ground = {{ temperature_k = {SCENE["ground_temperature_k"]!r}, emissivity = {SCE
 shading = "pixel"
 bounces = {bounces}
 samples = {samples}
+first_bounce_samples = {SCENE["first_bounce_samples"]}
 seed = {seed}
 
 [materials.metal]
@@ -750,6 +753,9 @@ def main():
     parser.add_argument("--passes", type=int, default=8, help="independent passes per renderer")
     parser.add_argument("--irpol-samples", type=int, default=1024, help="irpol samples per pass")
     parser.add_argument("--mitsuba-spp", type=int, default=2048, help="Mitsuba spp per pass")
+    parser.add_argument("--irpol-first-bounce-samples", type=int,
+                        default=SCENE["first_bounce_samples"],
+                        help="irpol's lobe samples per path at the visible point (1: no split)")
     parser.add_argument("--mitsuba-sampler", default="independent",
                         help="Mitsuba sampler plugin: independent (its default), stratified, "
                              "multijitter, orthogonal or ldsampler")
@@ -768,6 +774,7 @@ def main():
 
     if args.sphere_only:
         SCENE["plane"]["size"] = [0.0, 0.0]
+    SCENE["first_bounce_samples"] = args.irpol_first_bounce_samples
     irpol = args.irpol
     if not os.access(irpol, os.X_OK):
         print(f"irpol binary not found at {irpol}", file=sys.stderr)

@@ -34,6 +34,7 @@
 //! aop_mask_dolp = 0.002               # AoP preview masked where DoLP is below this
 //! bounces = 3                         # surface hits followed (occlusion, inter-reflection)
 //! samples = 16                        # paths per pixel for the occluded correction
+//! first_bounce_samples = 1            # lobe samples per path at the visible point
 //! seed = 1
 //! open_world = false                  # true: the paper's model (no occlusion, no sun)
 //!
@@ -359,6 +360,9 @@ pub struct RenderConfig {
     /// Paths per pixel for the occluded correction.
     #[serde(default = "default_samples")]
     pub samples: u32,
+    /// Lobe samples per path at the visible point (1: no split; docs/design.md §1.7).
+    #[serde(default = "default_first_bounce_samples")]
+    pub first_bounce_samples: u32,
     #[serde(default = "default_render_seed")]
     pub seed: u64,
     /// The paper's model (no occlusion, no sun): today's images exactly.
@@ -430,6 +434,10 @@ fn default_samples() -> u32 {
     16
 }
 
+fn default_first_bounce_samples() -> u32 {
+    1
+}
+
 fn default_render_seed() -> u64 {
     1
 }
@@ -445,6 +453,7 @@ impl Default for RenderConfig {
             aop_mask_dolp: default_aop_mask(),
             bounces: default_bounces(),
             samples: default_samples(),
+            first_bounce_samples: default_first_bounce_samples(),
             seed: default_render_seed(),
             open_world: false,
             preview: PreviewConfig::default(),

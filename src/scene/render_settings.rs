@@ -15,6 +15,9 @@ pub struct PathSettings {
     pub bounces: u32,
     /// Paths per pixel.
     pub samples: u32,
+    /// Lobe samples per path at the visible point: the path's own continues, the others take
+    /// their hit's open-world value (1: no split; [`crate::transport`]'s path integrator).
+    pub first_bounce_samples: u32,
     pub seed: u64,
 }
 
@@ -30,6 +33,10 @@ pub enum Transport {
 /// Deeper chains change nothing measurable in thermal scenes (each bounce multiplies by a
 /// reflectance well below 1) and only cost time.
 const MAX_BOUNCES: u32 = 64;
+
+/// A split beyond this costs more first-bounce rays than the deeper paths it shares them with
+/// can use.
+const MAX_FIRST_BOUNCE_SAMPLES: u32 = 64;
 
 /// The `[render]` transport keys, checked.
 pub(super) fn transport_settings(
@@ -54,9 +61,19 @@ pub(super) fn transport_settings(
             ),
         ));
     }
+    if !(1..=MAX_FIRST_BOUNCE_SAMPLES).contains(&render.first_bounce_samples) {
+        return Err(SceneError::new(
+            path,
+            format!(
+                "render.first_bounce_samples = {} must lie within 1..={MAX_FIRST_BOUNCE_SAMPLES}",
+                render.first_bounce_samples
+            ),
+        ));
+    }
     Ok(Transport::Path(PathSettings {
         bounces: render.bounces,
         samples: render.samples,
+        first_bounce_samples: render.first_bounce_samples,
         seed: render.seed,
     }))
 }

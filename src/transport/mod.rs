@@ -8,6 +8,7 @@
 
 pub mod accel;
 pub mod band_environment;
+mod band_scattering;
 pub mod horizon;
 pub mod kernel;
 pub mod open_world;

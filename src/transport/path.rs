@@ -30,16 +30,17 @@
 //! rendering"). A ray that escapes still adds exactly zero (no hit, no correction).
 
 use super::accel::Accelerator;
+use super::band_scattering::{band_scattering, BandScattering, BandSources, EmittedLight};
 use super::open_world::OpenWorld;
 use super::sampler::PixelSampler;
 use super::tables::THETA_MAX;
-use crate::emitter::{DiscQuadrature, Sun, SUN_TEMPERATURE_K};
-use crate::optics::band_nodes::{BrightnessGrid, FractionsByRadiance};
+use crate::emitter::{DiscQuadrature, Sun};
+use crate::optics::band_nodes::BrightnessGrid;
 use crate::optics::{
     camera_frame_turn, rotation_between_frames, Direction, FrameTurn, Mueller, OutgoingFrame,
     SpectralMix, Stokes,
 };
-use crate::pbrdf::{BandPbrdf, MaterialOptics, Pbrdf, ScatteredView};
+use crate::pbrdf::{MaterialOptics, Pbrdf, ScatteredView};
 use crate::scene::mesh::SurfaceHit;
 use crate::scene::{PathSettings, Scene};
 use nalgebra::Vector3;
@@ -97,6 +98,18 @@ struct Outgoing {
     to_frame: FrameTurn,
 }
 
+/// A direction drawn from a shading point's pBRDF and the surface it hits.
+struct Bounce {
+    /// ω_i in the point's local frame and its density (sr⁻¹).
+    w_i: Vector3<f64>,
+    pdf: f64,
+    /// ω_i in the world, and −ω_i (from the hit back toward the point).
+    direction: Vector3<f64>,
+    toward_x: Vector3<f64>,
+    /// The hit, seen from the point.
+    next: Vertex,
+}
+
 impl PathTracer<'_> {
     fn shading_point<'v>(&self, vertex: &'v Vertex, omega: &Vector3<f64>) -> ShadingPoint<'v> {
         let frame = OutgoingFrame::new(&vertex.normal, omega);
@@ -140,105 +153,6 @@ pub struct PathTracer<'a> {
     pub sun: Option<(Sun, Vec<DiscQuadrature>)>,
     /// Per material, the source spectra a band material weights its models with (`None`: grey).
     band_sources: Vec<Option<BandSources>>,
-}
-
-/// The spectral shares of the sources a band material scatters (docs/design.md §1.9, module docs).
-struct BandSources {
-    /// Planck fractions of a grey source by its band radiance (a surface hit, the environment).
-    by_radiance: FractionsByRadiance,
-    /// Planck fractions of the sun: a 5772 K blackbody through the band.
-    sun: Vec<f64>,
-}
-
-/// Light emitted by a surface hit, in the receiver's incident frame ([`PathTracer::emitted_toward`]).
-struct EmittedLight {
-    /// L_bb(T) of the hit.
-    radiance: f64,
-    /// Its (ε0, ε1) toward the receiver (band-integrated for a band material).
-    emissivity: [f64; 2],
-    /// (ε0, ε1) of a band material at each wavelength node; `None` for a grey one.
-    per_node: Option<Vec<[f64; 2]>>,
-    /// The unit linear polarization (0, 1, 0, 0) of the hit's outgoing frame, rotated into the
-    /// receiver's incident frame: the hit emits L (ε0 e₀ + ε1 u).
-    polarization: Stokes,
-}
-
-/// Where a band material scatters: the incident and scattered directions (local frame) and the
-/// shadowing factors of both.
-struct BandScattering<'a> {
-    incident: &'a Direction,
-    scattered: &'a Direction,
-    masking: [f64; 2],
-}
-
-/// One sample of F (S_in − L_env e₀) at a band material (docs/design.md §1.9), S_in the light from a
-/// surface hit, each part with its own spectrum over the wavelength nodes m:
-/// - what the hit emits, L_bb(T) (ε0 e₀ + ε1 u) with u its polarization: node by node
-///   p_m(T) (ε0_m e₀ + ε1_m u), p the Planck shares at the hit's temperature and ε_m its
-///   emissivity at λ_m (constant for a grey hit);
-/// - what it reflects, S_in less its emission, taken as a uniform grey source at the
-///   brightness temperature T_s of (that light / the hit's mean reflectance) reflected by the
-///   hit (Kirchhoff: a uniform source L_s is reflected as L_s ((1 − ε0_m) e₀ − ε1_m u)), with
-///   L_s such that its S0 is exact; the polarization the model misses keeps the shares f(T_s);
-/// - the environment it replaces, grey at its brightness temperature.
-fn band_scattering(
-    band: &BandPbrdf,
-    sources: &BandSources,
-    at: &BandScattering,
-    s_in: &Stokes,
-    emitted: &EmittedLight,
-    environment: f64,
-) -> Stokes {
-    let nodes = band.nodes().len();
-    let per_node = emitted.per_node.as_ref().filter(|e| e.len() == nodes);
-    let emissivity = |m: usize| per_node.map_or(emitted.emissivity, |e| e[m]);
-    let [e0, e1] = emitted.emissivity;
-    let hit = emitted.radiance;
-    let unpolarized = Stokes::new(1.0, 0.0, 0.0, 0.0);
-    let reflected = s_in - (unpolarized * e0 + emitted.polarization * e1) * hit;
-    let source = sources.by_radiance.at(reflected[0] / (1.0 - e0).max(1e-9));
-    let reflectance: f64 = (0..nodes)
-        .map(|m| source.weight(m) * (1.0 - emissivity(m)[0]))
-        .sum();
-    let source_radiance = if reflectance > 1e-12 {
-        reflected[0] / reflectance
-    } else {
-        0.0
-    };
-    let planck = sources.by_radiance.at(hit);
-    let (mut along_e0, mut along_u) = (vec![0.0; nodes], vec![0.0; nodes]);
-    let mut modelled_u = 0.0;
-    for m in 0..nodes {
-        let [em0, em1] = emissivity(m);
-        let (p, f) = (planck.weight(m), source.weight(m));
-        along_e0[m] = p * em0 * hit + f * (1.0 - em0) * source_radiance;
-        along_u[m] = p * em1 * hit - f * em1 * source_radiance;
-        modelled_u -= f * em1 * source_radiance;
-    }
-    // What the uniform-source model leaves out of the reflected light (its S0 is exact).
-    let unmodelled = reflected - unpolarized * reflected[0] - emitted.polarization * modelled_u;
-    let [mueller_e0, mueller_u, mueller_rest, mueller_environment] = band.mueller_mixtures(
-        at.incident,
-        at.scattered,
-        at.masking,
-        [
-            SpectralMix::fixed(&along_e0),
-            SpectralMix::fixed(&along_u),
-            source,
-            sources.by_radiance.at(environment),
-        ],
-    );
-    mueller_e0.column(0).into_owned() + mueller_u * emitted.polarization + mueller_rest * unmodelled
-        - mueller_environment.column(0) * environment
-}
-
-impl BandSources {
-    fn new(band: &BandPbrdf, grid: &BrightnessGrid) -> BandSources {
-        BandSources {
-            by_radiance: FractionsByRadiance::new(band.nodes(), grid),
-            sun: band.nodes().planck_fractions(SUN_TEMPERATURE_K),
-        }
-    }
 }
 
 impl PathTracer<'_> {
@@ -306,10 +220,15 @@ impl PathTracer<'_> {
                 *v = self.sun_visibility(vertex, [stratum, rng.random::<f64>()]);
             }
         }
-        let mut sampler = PixelSampler::new(n as usize, rng);
+        let split = self.settings.first_bounce_samples.max(1) as usize;
+        let mut sampler = PixelSampler::new(n as usize, split, rng);
         for s in 0..sampler.paths() {
             sampler.start_path(s);
-            let mut x = self.correction(&point, 0, &mut sampler);
+            let mut x = if split > 1 {
+                self.split_first_bounce(&point, split, &mut sampler)
+            } else {
+                self.correction(&point, 0, &mut sampler)
+            };
             if let Some(integral) = sun {
                 x += integral * visibility[s % shadow_rays];
             }
@@ -343,24 +262,132 @@ impl PathTracer<'_> {
         sampler: &mut Sampler,
     ) -> (Stokes, Vector3<f64>) {
         let point = self.shading_point(vertex, omega);
-        let mut s = self
-            .open_world
-            .leaving(point.material, &point.frame, vertex.hit.temperature);
-        if let Some(integral) = self.sun_integral(&point) {
+        let open = self.open_leaving(&point);
+        (
+            self.leaving_beyond_open(&point, open, depth, sampler),
+            point.frame.s_axis,
+        )
+    }
+
+    /// The open-world value leaving `point` (its outgoing frame).
+    fn open_leaving(&self, point: &ShadingPoint) -> Stokes {
+        self.open_world
+            .leaving(point.material, &point.frame, point.vertex.hit.temperature)
+    }
+
+    /// [`PathTracer::leaving`] at a prepared `point` whose open-world value is `open`: that
+    /// value plus the sun and, while `depth` ≤ `bounces`, the correction.
+    fn leaving_beyond_open(
+        &self,
+        point: &ShadingPoint,
+        open: Stokes,
+        depth: u32,
+        sampler: &mut Sampler,
+    ) -> Stokes {
+        let mut s = open;
+        if let Some(integral) = self.sun_integral(point) {
             let disc_point = [sampler.uniform(), sampler.uniform()];
-            s += integral * self.sun_visibility(vertex, disc_point);
+            s += integral * self.sun_visibility(point.vertex, disc_point);
         }
         if depth <= self.settings.bounces {
-            s += self.correction(&point, depth, sampler);
+            s += self.correction(point, depth, sampler);
         }
-        (s, point.frame.s_axis)
+        s
     }
 
     /// One sample of ∫ F (S_in − L_env e₀) cosθ_i dΩ_i at `point` (depth `depth`), in the psps
     /// frame of its outgoing frame, the pBRDF sampled at the path's point for this depth
     /// ([`PixelSampler::bounce_point`], stratified over the pixel's paths).
     fn correction(&self, point: &ShadingPoint, depth: u32, sampler: &mut Sampler) -> Stokes {
-        let (vertex, frame, material) = (point.vertex, &point.frame, point.material);
+        if point.outgoing.is_none() {
+            return Stokes::zeros();
+        }
+        let Some(bounce) = self.bounce(point, sampler.bounce_point(depth)) else {
+            return Stokes::zeros();
+        };
+        let (leaving, s_from) = self.leaving(&bounce.next, &bounce.toward_x, depth + 1, sampler);
+        let [scattered] = self.scatter(point, &bounce, [&leaving], &s_from);
+        scattered
+    }
+
+    /// The visible point's correction with its first bounce split into `split` lobe samples
+    /// (`[render] first_bounce_samples`): the path's own sample ω₀ continues, the others end at
+    /// their hit's open-world value. With f(ω, S) one sample's F (S − L_env e₀) cosθ_i / pdf,
+    /// S_open the hit's open-world value and S its full one (open world, sun, deeper
+    /// correction),
+    ///
+    ///   C = f(ω₀, S) − f(ω₀, S_open) + (1/split) Σ_i f(ω_i, S_open(ω_i)),  i = 0 … split − 1,
+    ///
+    /// whose expectation is E f(ω, S): the two terms at ω₀ estimate E[f(ω, S) − f(ω, S_open)],
+    /// the mean over the split estimates E f(ω, S_open) (weights 1, −1 and split × 1/split: the
+    /// open part counted exactly once; no linearity of f needed, so band materials keep
+    /// theirs). The first bounce's integrand has the edges of what it hits (a silhouette, the
+    /// far edge of a ground), where the stratified points converge faster than 1/N: split × N
+    /// first-bounce points for the cost of N deeper paths.
+    fn split_first_bounce(
+        &self,
+        point: &ShadingPoint,
+        split: usize,
+        sampler: &mut Sampler,
+    ) -> Stokes {
+        let mut open_sum = Stokes::zeros();
+        let mut beyond_open = Stokes::zeros();
+        if let Some(bounce) = self.bounce(point, sampler.bounce_point(0)) {
+            let hit = self.shading_point(&bounce.next, &bounce.toward_x);
+            let open = self.open_leaving(&hit);
+            let full = self.leaving_beyond_open(&hit, open, 1, sampler);
+            let [full, open] = self.scatter(point, &bounce, [&full, &open], &hit.frame.s_axis);
+            beyond_open = full - open;
+            open_sum = open;
+        }
+        for index in 1..split {
+            let u = sampler.extra_first_bounce_point(index);
+            if let Some(bounce) = self.bounce(point, u) {
+                let hit = self.shading_point(&bounce.next, &bounce.toward_x);
+                let open = self.open_leaving(&hit);
+                let [open] = self.scatter(point, &bounce, [&open], &hit.frame.s_axis);
+                open_sum += open;
+            }
+        }
+        beyond_open + open_sum / split as f64
+    }
+
+    /// Draws an incident direction at `point` from the pBRDF with the uniforms `u` and traces
+    /// it; `None` below the surface or when the ray escapes (the correction's integrand is zero
+    /// there).
+    fn bounce(&self, point: &ShadingPoint, u: [f64; 2]) -> Option<Bounce> {
+        let (vertex, frame) = (point.vertex, &point.frame);
+        let pbrdf = self.scene.materials[point.material].optics.sampling_pbrdf();
+        let (w_i, pdf) = pbrdf.sample_incident(&point.outgoing.as_ref()?.view, u)?;
+        let direction = frame.to_world(&w_i);
+        // Below the true (geometric) surface: an artefact of interpolated normals, not light.
+        if direction.dot(&vertex.geometric_normal) <= 0.0 {
+            return None;
+        }
+        let origin = vertex.hit.point + vertex.geometric_normal * self.accel.offset;
+        let hit = self.accel.closest_hit(&origin, &direction)?;
+        let toward_x = -direction;
+        Some(Bounce {
+            w_i,
+            pdf,
+            direction,
+            toward_x,
+            next: Vertex::seen_from(hit, &toward_x),
+        })
+    }
+
+    /// F (S_in − L_env e₀) cosθ_i / pdf at `point` for each Stokes vector in `leaving` (the
+    /// light leaving the bounce's hit toward the point, in the psps frame with s axis `s_from`),
+    /// in the psps frame of the point's outgoing frame. A grey material's Mueller matrix is
+    /// evaluated once for all of them.
+    fn scatter<const N: usize>(
+        &self,
+        point: &ShadingPoint,
+        bounce: &Bounce,
+        leaving: [&Stokes; N],
+        s_from: &Vector3<f64>,
+    ) -> [Stokes; N] {
+        let (frame, material) = (&point.frame, point.material);
         let optics = &self.scene.materials[material].optics;
         let pbrdf = optics.sampling_pbrdf();
         let Some(Outgoing {
@@ -369,49 +396,41 @@ impl PathTracer<'_> {
             to_frame,
         }) = &point.outgoing
         else {
-            return Stokes::zeros();
+            return [Stokes::zeros(); N];
         };
-        let Some((w_i, pdf)) = pbrdf.sample_incident(view, sampler.bounce_point(depth)) else {
-            return Stokes::zeros();
-        };
-        let direction = frame.to_world(&w_i);
-        // Below the true (geometric) surface: an artefact of interpolated normals, not light.
-        if direction.dot(&vertex.geometric_normal) <= 0.0 {
-            return Stokes::zeros();
-        }
-        let origin = vertex.hit.point + vertex.geometric_normal * self.accel.offset;
-        let Some(hit) = self.accel.closest_hit(&origin, &direction) else {
-            return Stokes::zeros();
-        };
-        let toward_x = -direction;
-        let next = Vertex::seen_from(hit, &toward_x);
-        let (leaving, s_from) = self.leaving(&next, &toward_x, depth + 1, sampler);
+        let w_i = bounce.w_i;
         // Incident frame at x: k = −ω_i, s = −ê_φ(ω_i) in the local frame (docs/design.md §1.3).
         let incident = Direction::from_unit_vector(w_i);
         let s_incident = -frame.to_world(&incident.azimuthal_axis);
-        let eta = rotation_between_frames(&s_from, &s_incident, &toward_x);
-        let mut s_in = eta.apply(&leaving);
-        let environment = self.scene.environment.radiance(&direction);
+        let eta = rotation_between_frames(s_from, &s_incident, &bounce.toward_x);
+        let environment = self.scene.environment.radiance(&bounce.direction);
         let masking = [pbrdf.masking(w_i.z), view.masking];
-        let local = match (optics, &self.band_sources[material]) {
+        let weight = w_i.z / bounce.pdf;
+        match (optics, &self.band_sources[material]) {
             (MaterialOptics::Band(band), Some(sources)) => {
-                let emitted = self.emitted_toward(&next, &toward_x, eta);
+                let emitted = self.emitted_toward(&bounce.next, &bounce.toward_x, eta);
                 let geometry = BandScattering {
                     incident: &incident,
                     scattered,
                     masking,
                 };
-                band_scattering(band, sources, &geometry, &s_in, &emitted, environment)
-                    * (w_i.z / pdf)
+                leaving.map(|s| {
+                    let s_in = eta.apply(s);
+                    let local =
+                        band_scattering(band, sources, &geometry, &s_in, &emitted, environment);
+                    to_frame.apply(&(local * weight))
+                })
             }
             _ => {
-                s_in[0] -= environment;
                 let mueller =
                     pbrdf.mueller_with_masking(&incident, scattered, masking[0], masking[1]);
-                mueller * s_in * (w_i.z / pdf)
+                leaving.map(|s| {
+                    let mut s_in = eta.apply(s);
+                    s_in[0] -= environment;
+                    to_frame.apply(&(mueller * s_in * weight))
+                })
             }
-        };
-        to_frame.apply(&local)
+        }
     }
 
     /// What the hit `vertex` emits toward the receiver along `toward_x` (its open-world emission,

@@ -32,6 +32,7 @@ mod render_errors;
 mod render_outputs;
 mod render_physics;
 mod render_spectral;
+mod render_split;
 mod render_tables;
 mod render_transport;
 mod report_fit;

@@ -273,6 +273,10 @@ fn bad_transport_and_sun_settings() {
     for (extra, pieces) in [
         ("[render]\nsamples = 0\n", &["render.samples = 0"][..]),
         ("[render]\nbounces = 1000\n", &["render.bounces = 1000"][..]),
+        (
+            "[render]\nfirst_bounce_samples = 0\n",
+            &["render.first_bounce_samples = 0", "1..=64"][..],
+        ),
         ("[render]\nbounce = 2\n", &["unknown field `bounce`"][..]),
         (
             "[sun]\nelevation_deg = 30.0\nazimuth_deg = 10.0\nirradiance_w_m2 = -1.0\n",

@@ -59,11 +59,17 @@ pub struct PixelSampler<'a, R: Rng> {
     paths: usize,
     path: usize,
     points: Points,
+    /// First-bounce points per path ([`PixelSampler::extra_first_bounce_point`]).
+    first_bounce: usize,
+    /// Other counts: the extra first-bounce points, one multi-jittered pattern of
+    /// (`first_bounce` − 1) × `paths` points, made when first asked for.
+    extra_pattern: Vec<[f64; 2]>,
 }
 
 impl<'a, R: Rng> PixelSampler<'a, R> {
-    /// A sampler for `paths` paths drawing from `rng`.
-    pub fn new(paths: usize, rng: &'a mut R) -> Self {
+    /// A sampler for `paths` paths with `first_bounce` (≥ 1) first-bounce points each, drawing
+    /// from `rng`.
+    pub fn new(paths: usize, first_bounce: usize, rng: &'a mut R) -> Self {
         let paths = paths.max(1);
         let points = if paths.is_power_of_two() {
             Points::Sobol(Randomization::new(rng))
@@ -75,6 +81,8 @@ impl<'a, R: Rng> PixelSampler<'a, R> {
             paths,
             path: 0,
             points,
+            first_bounce: first_bounce.max(1),
+            extra_pattern: Vec::new(),
         }
     }
 
@@ -111,6 +119,28 @@ impl<'a, R: Rng> PixelSampler<'a, R> {
         }
     }
 
+    /// The current path's first-bounce point `index` (1 ≤ index < `first_bounce`) beyond its
+    /// own ([`PixelSampler::bounce_point`] at depth 0), for a first bounce split into
+    /// `first_bounce` lobe samples. 2^m paths: point `path + index × paths` of the pixel's
+    /// Sobol' sequence, so that with a power-of-two split the pixel's first-bounce points are
+    /// the sequence's first split × 2^m, again a (0, m', 2)-net. Other counts: a multi-jittered
+    /// pattern of their own over all the pixel's extra points.
+    pub fn extra_first_bounce_point(&mut self, index: usize) -> [f64; 2] {
+        let index = index.clamp(1, self.first_bounce.max(2) - 1);
+        match &self.points {
+            Points::Sobol(randomization) => {
+                randomization.pair(self.path + index * self.paths, 0, self.rng)
+            }
+            Points::Jittered(_) => {
+                if self.extra_pattern.is_empty() {
+                    let count = (self.first_bounce.max(2) - 1) * self.paths;
+                    self.extra_pattern = multi_jittered(count, self.rng);
+                }
+                self.extra_pattern[(index - 1) * self.paths + self.path]
+            }
+        }
+    }
+
     /// An independent uniform number in [0, 1).
     pub fn uniform(&mut self) -> f64 {
         self.rng.random()
@@ -132,7 +162,7 @@ mod tests {
     /// Every path's points of one pixel: `[depth 0 u₀, u₁, depth 1 u₀, u₁]`.
     fn pixel_points(paths: usize, seed: u64) -> Vec<[f64; DIMENSIONS]> {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let mut sampler = PixelSampler::new(paths, &mut rng);
+        let mut sampler = PixelSampler::new(paths, 1, &mut rng);
         (0..paths)
             .map(|path| {
                 sampler.start_path(path);
@@ -198,7 +228,7 @@ mod tests {
     #[test]
     fn a_path_gets_its_point_again_and_deeper_bounces_are_independent() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let mut sampler = PixelSampler::new(16, &mut rng);
+        let mut sampler = PixelSampler::new(16, 1, &mut rng);
         sampler.start_path(3);
         let first = [sampler.bounce_point(0), sampler.bounce_point(1)];
         sampler.start_path(4);
@@ -246,10 +276,49 @@ mod tests {
             assert!(var_s < var_i / 3.0, "{var_s} vs {var_i}");
         }
     }
+    /// A split first bounce: with 2^m paths and a split of 2^a the pixel's first-bounce points
+    /// (each path's own and its extra ones) are the sequence's first 2^(m+a), again a
+    /// (0, m + a, 2)-net; with other counts the extra points hold one of their own (k − 1) n
+    /// strata of either coordinate each.
+    #[test]
+    fn split_first_bounce_points_keep_the_net() {
+        let (paths, split) = (64, 4);
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let mut sampler = PixelSampler::new(paths, split, &mut rng);
+        let mut points = Vec::new();
+        for path in 0..paths {
+            sampler.start_path(path);
+            points.push(sampler.bounce_point(0));
+            points.extend((1..split).map(|i| sampler.extra_first_bounce_point(i)));
+        }
+        let n = paths * split;
+        for j in 0..=8 {
+            let (columns, rows) = (1usize << j, n >> j);
+            let mut boxes = vec![0; n];
+            for p in &points {
+                boxes[stratum(p[0], columns) * rows + stratum(p[1], rows)] += 1;
+            }
+            assert!(boxes.iter().all(|&c| c == 1), "{columns} × {rows}");
+        }
+        let (paths, split) = (12, 3);
+        let mut sampler = PixelSampler::new(paths, split, &mut rng);
+        let mut extra = Vec::new();
+        for path in 0..paths {
+            sampler.start_path(path);
+            extra.extend((1..split).map(|i| sampler.extra_first_bounce_point(i)));
+        }
+        let n = paths * (split - 1);
+        for k in 0..2 {
+            let mut strata: Vec<usize> = extra.iter().map(|q| stratum(q[k], n)).collect();
+            strata.sort_unstable();
+            assert_eq!(strata, (0..n).collect::<Vec<_>>());
+        }
+    }
+
     #[test]
     fn other_counts_take_a_jittered_pattern_per_depth_dealt_in_its_own_order() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let mut sampler = PixelSampler::new(12, &mut rng);
+        let mut sampler = PixelSampler::new(12, 1, &mut rng);
         let mut points = vec![Vec::new(); STRATIFIED_DEPTHS];
         for path in 0..sampler.paths() {
             sampler.start_path(path);
