@@ -14,8 +14,8 @@
 //! on a bound. The Smith Λ of the Cauchy distribution diverges for q ≤ 3/2 (docs/design.md
 //! §1.3), hence the raised lower bound of q with Smith shadowing.
 
-use crate::pbrdf::Shadowing;
 use crate::pbrdf::Parameter;
+use crate::pbrdf::Shadowing;
 use serde::{Deserialize, Serialize};
 
 impl Parameter {
