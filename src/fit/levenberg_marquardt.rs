@@ -6,7 +6,6 @@
 //! ratio (Nielsen's rule). Parameters resting on a bound whose gradient points outward are held
 //! for that step (a simple active set), so the others keep converging.
 
-use super::objective::Objective;
 use super::stages::{Stage, StageHistory};
 use nalgebra::{DMatrix, DVector};
 
@@ -28,8 +27,9 @@ impl Default for LevenbergMarquardtSettings {
 }
 
 /// A box-constrained nonlinear least-squares problem in search coordinates: what
-/// Levenberg–Marquardt needs. One measurement's [`Objective`] is one; the joint fit of a spectral
-/// set ([`super::spectral`]) is another, whose Jacobian uses its block structure.
+/// Levenberg–Marquardt needs. One measurement's [`super::Objective`] is one (its impl is in
+/// `super::normal_equations`); the joint fit of a spectral set ([`super::spectral`]) is another,
+/// whose Jacobian uses its block structure.
 pub(crate) trait LeastSquares: Sync {
     /// Lower corner of the search box.
     fn lower(&self) -> &[f64];
@@ -56,28 +56,6 @@ pub(crate) fn forward_step(s: &[f64], j: usize, upper: &[f64]) -> f64 {
         -h
     } else {
         h
-    }
-}
-
-impl LeastSquares for Objective<'_> {
-    fn lower(&self) -> &[f64] {
-        self.space().lower()
-    }
-    fn upper(&self) -> &[f64] {
-        self.space().upper()
-    }
-    fn residuals(&self, s: &[f64]) -> Option<DVector<f64>> {
-        let mut r = DVector::zeros(self.observations());
-        self.residuals_at(&self.space().values(s), r.as_mut_slice())
-            .then_some(r)
-    }
-    /// Block by block of points, never holding J ([`super::normal_equations`]).
-    fn normal_equations(
-        &self,
-        s: &[f64],
-        r: &DVector<f64>,
-    ) -> Option<(DMatrix<f64>, DVector<f64>)> {
-        super::normal_equations::normal_equations(self, s, r)
     }
 }
 

@@ -8,7 +8,7 @@
 //! last len mod 8 products one by one), which is what the fit used when it held the columns, so
 //! the fitted parameters are bit-identical to those of that implementation.
 
-use super::levenberg_marquardt::forward_step;
+use super::levenberg_marquardt::{forward_step, LeastSquares};
 use super::objective::{Objective, PreparedModel, CHUNK_POINTS};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -18,6 +18,30 @@ const LANES: usize = 8;
 /// Blocks of points whose Jacobian columns are evaluated in one parallel pass before they are
 /// summed, in order: enough tasks for the threads, a few MB of columns.
 const BLOCKS_PER_PASS: usize = 4;
+
+/// A measurement's objective as the Levenberg–Marquardt stage sees it: its residuals, and its
+/// normal equations summed block by block.
+impl LeastSquares for Objective<'_> {
+    fn lower(&self) -> &[f64] {
+        self.space().lower()
+    }
+    fn upper(&self) -> &[f64] {
+        self.space().upper()
+    }
+    fn residuals(&self, s: &[f64]) -> Option<DVector<f64>> {
+        let mut r = DVector::zeros(self.observations());
+        self.residuals_at(&self.space().values(s), r.as_mut_slice())
+            .then_some(r)
+    }
+    /// Block by block of points, never holding J ([`normal_equations`]).
+    fn normal_equations(
+        &self,
+        s: &[f64],
+        r: &DVector<f64>,
+    ) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        normal_equations(self, s, r)
+    }
+}
 
 /// (JᵀJ, Jᵀr) at search coordinates `s` of `objective`, whose residuals there are `r`, J by
 /// forward differences (one model evaluation per coordinate); `None` when a shifted model is
