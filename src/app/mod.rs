@@ -321,9 +321,9 @@ pub fn model_header(model: &Pbrdf) -> String {
         model.shadowing().name()
     );
     // Only models with the volume terms say so, so that other tables read as before.
-    if model.facet_side() != FacetSide::External || model.subsurface().is_some() {
+    if model.facet_side() != FacetSide::External || model.subsurface_lobes().next().is_some() {
         header.push_str(&format!("# facet = {}", model.facet_side().name()));
-        if let Some(s) = model.subsurface() {
+        for s in model.subsurface_lobes() {
             header.push_str(&format!("; rho_s = {}, d = {}", s.rho_s, s.d));
             if let Some(n_sub) = s.n_sub {
                 header.push_str(&format!(", n_sub = {n_sub}"));

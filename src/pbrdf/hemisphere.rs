@@ -192,7 +192,7 @@ impl Pbrdf {
             return;
         }
         self.visit_specular_nodes(scattered, quadrature, &mut visit);
-        if self.subsurface().is_some() {
+        if self.has_subsurface() {
             self.visit_subsurface_nodes(scattered, quadrature, self.rho_d(), &mut visit);
         } else if self.rho_d() > 0.0 {
             for (w_i, weight) in quadrature.cosine_weighted_nodes() {
@@ -214,7 +214,7 @@ impl Pbrdf {
         rho_d: f64,
         mut visit: impl FnMut(&Vector3<f64>, Stokes),
     ) {
-        if self.subsurface().is_none() || scattered.cos_theta() <= 0.0 {
+        if !self.has_subsurface() || scattered.cos_theta() <= 0.0 {
             return;
         }
         let depolarized = Stokes::new(rho_d * FRAC_1_PI, 0.0, 0.0, 0.0);

@@ -26,8 +26,9 @@ pub struct Pbrdf {
     index: RefractiveIndex,
     rho_d: f64,
     facet_side: FacetSide,
-    /// The polarized subsurface term (docs/design.md §1.10), if the model has one.
-    subsurface: Option<PreparedSubsurface>,
+    /// The polarized subsurface lobes (docs/design.md §1.10), in the order they were given;
+    /// empty for a model without the term. Each lobe adds its own Mueller matrix and albedo.
+    subsurface_lobes: Vec<PreparedSubsurface>,
     prepared: PreparedDistribution,
     /// The permittivity the facets see: N², or 1/N² for internal facets.
     permittivity: Complex64,
@@ -225,7 +226,7 @@ impl Pbrdf {
             index,
             rho_d,
             facet_side: FacetSide::External,
-            subsurface: None,
+            subsurface_lobes: Vec::new(),
             prepared: distribution.prepare(),
             permittivity: index.permittivity(),
             lambda_table: OnceLock::new(),
@@ -248,20 +249,21 @@ impl Pbrdf {
     pub fn facet_side(&self) -> FacetSide {
         self.facet_side
     }
-    /// The subsurface term's parameters, if the model has one.
-    pub fn subsurface(&self) -> Option<Subsurface> {
-        self.subsurface.map(|s| s.terms)
+    /// The parameters of each subsurface lobe (none for a model without the term).
+    pub fn subsurface_lobes(&self) -> impl Iterator<Item = Subsurface> + '_ {
+        self.subsurface_lobes.iter().map(|s| s.terms)
     }
 
     /// The model with the volume-scattering terms of docs/design.md §1.10: the facets reflecting
-    /// from `facet_side`, and a polarized subsurface term. ρ_s and d are checked against their
-    /// domains ([`Parameter::check`]).
+    /// from `facet_side`, and polarized subsurface lobes (an `Option` gives none or one). Each
+    /// lobe's ρ_s, d, … are checked against their domains ([`Parameter::check`]).
     pub fn with_volume(
         mut self,
         facet_side: FacetSide,
-        subsurface: Option<Subsurface>,
+        subsurface: impl IntoIterator<Item = Subsurface>,
     ) -> Result<Pbrdf, ModelError> {
-        if let Some(terms) = subsurface {
+        let lobes: Vec<Subsurface> = subsurface.into_iter().collect();
+        for &terms in &lobes {
             Parameter::RhoS.check(terms.rho_s)?;
             Parameter::D.check(terms.d)?;
             if let Some(n_sub) = terms.n_sub {
@@ -288,28 +290,40 @@ impl Pbrdf {
         }
         self.facet_side = facet_side;
         self.permittivity = facet_side.facet_permittivity(self.index);
-        self.subsurface = subsurface.map(|terms| PreparedSubsurface::new(terms, self.index));
+        self.subsurface_lobes = lobes
+            .into_iter()
+            .map(|terms| PreparedSubsurface::new(terms, self.index))
+            .collect();
         Ok(self)
     }
 
-    /// The reflectance of the terms without a lobe, ρ_d + ρ_s: what the renderer's cosine lobe
-    /// samples.
+    /// The reflectance of the terms without a facet lobe, ρ_d + Σ ρ_s: what the renderer's
+    /// cosine lobe samples.
     pub fn body_albedo(&self) -> f64 {
-        self.rho_d + self.subsurface.map_or(0.0, |s| s.terms.rho_s)
+        self.subsurface_lobes
+            .iter()
+            .fold(self.rho_d, |albedo, s| albedo + s.terms.rho_s)
     }
 
-    /// The subsurface term's Mueller matrix at cos θ_i, cos θ_r, if the model has one.
+    /// The subsurface lobes' summed Mueller matrix at cos θ_i, cos θ_r, `None` without one (a
+    /// single lobe's matrix is its own, not added to a zero matrix: −0 elements stay −0).
     #[inline]
     fn subsurface_mueller(&self, geometry: &ScatteringGeometry) -> Option<Mueller> {
-        let s = self.subsurface.as_ref()?;
         let facet = &geometry.facet;
-        Some(s.mueller(
-            s.transmission(facet.cos_i),
-            s.transmission(facet.cos_r),
-            geometry.scattering_plane_turn(),
-            // cos Θ = −ω_i·ω_r = −cos 2β (docs/design.md §1.1).
-            1.0 - 2.0 * facet.cos2_beta,
-        ))
+        // cos Θ = −ω_i·ω_r = −cos 2β (docs/design.md §1.1).
+        let cos_scattering = 1.0 - 2.0 * facet.cos2_beta;
+        let turn = geometry.scattering_plane_turn();
+        self.subsurface_lobes
+            .iter()
+            .map(|s| {
+                s.mueller(
+                    s.transmission(facet.cos_i),
+                    s.transmission(facet.cos_r),
+                    turn,
+                    cos_scattering,
+                )
+            })
+            .reduce(|sum, lobe| sum + lobe)
     }
 
     /// (m00, m10, m20) of the subsurface term from ω_i onto ω_r, zero without one: its Stokes
@@ -520,7 +534,7 @@ impl Pbrdf {
 
     /// Whether the model has the subsurface term of docs/design.md §1.10.
     pub(super) fn has_subsurface(&self) -> bool {
-        self.subsurface.is_some()
+        !self.subsurface_lobes.is_empty()
     }
 
     /// First column F_j0 (sr⁻¹): the Stokes BRDF for unpolarized illumination, the only part that
@@ -534,7 +548,7 @@ impl Pbrdf {
         let (cr, sr) = double_angle(facet_axis_in_scattered_frame(&incident.vector, scattered));
         let (a, b) = facet.scaled_a_and_b();
         let facets_and_depolarizer = Stokes::new(a + self.rho_d * FRAC_1_PI, cr * b, sr * b, 0.0);
-        if self.subsurface.is_none() {
+        if self.subsurface_lobes.is_empty() {
             return facets_and_depolarizer;
         }
         // The subsurface term turns with the scattering plane: it needs the incident rotation too.

@@ -558,7 +558,11 @@ fn the_default_on_measured_ptfe_is_physical_and_keeps_its_terms() {
     assert!(n_uv >= n_ir - 0.02, "{n_uv} {n_ir}");
     for node in model.nodes() {
         let pbrdf = node.pbrdf().unwrap();
-        assert!(pbrdf.subsurface().is_some(), "the term survives the file");
+        assert_eq!(
+            pbrdf.subsurface_lobes().count(),
+            1,
+            "the term survives the file"
+        );
         let (reflectance, _) = largest_reflectance(&pbrdf);
         assert!(reflectance <= 1.0 + ENERGY_TOLERANCE, "{reflectance}");
     }
@@ -605,4 +609,53 @@ fn parameters_the_data_do_not_determine_are_named_not_refused() {
         }
         Material::load(&dir.path().join("paper_paint.toml")).unwrap();
     }
+}
+
+/// Subsurface lobes add: the term is linear in ρ_s (F_ss = ρ_s/(πZ) · …, Z independent of ρ_s),
+/// so two lobes of ρ_s = 0.3 and 0.2 with the same d, n_sub, d_c, d1 are one lobe of ρ_s = 0.5 —
+/// in every Mueller element and in the albedo the renderer samples.
+#[test]
+fn subsurface_lobes_add_as_one_lobe_of_their_summed_reflectance() {
+    let lobe = |rho_s| Subsurface {
+        rho_s,
+        d: 0.3,
+        n_sub: Some(1.3),
+        d_c: Some(0.1),
+        d1: Some(0.2),
+    };
+    let model = |lobes: Vec<Subsurface>| {
+        Pbrdf::new(
+            SlopeDistribution::Cauchy { sigma: 0.4, q: 2.2 },
+            Shadowing::Smith,
+            RefractiveIndex::new(1.4, 0.01),
+            0.05,
+        )
+        .unwrap()
+        .with_volume(FacetSide::Internal, lobes)
+        .unwrap()
+    };
+    let (two, one) = (model(vec![lobe(0.3), lobe(0.2)]), model(vec![lobe(0.5)]));
+    assert_eq!(two.subsurface_lobes().count(), 2);
+    assert!((two.body_albedo() - one.body_albedo()).abs() < 1e-15);
+    for (ti, tr, phi) in [(0.0, 30.0, 180.0), (45.0, 60.0, 90.0), (75.0, 10.0, 20.0)] {
+        let (wi, wr) = (
+            Direction::from_degrees(ti, 0.0),
+            Direction::from_degrees(tr, phi),
+        );
+        let (a, b) = (two.mueller(&wi, &wr), one.mueller(&wi, &wr));
+        assert!(
+            (a - b).abs().max() <= 1e-14 * b[(0, 0)],
+            "{ti} {tr} {phi}: {a} {b}"
+        );
+    }
+    // A lobe outside its domain is refused whichever lobe it is.
+    let bad = Pbrdf::new(
+        SlopeDistribution::Gaussian { sigma: 0.2 },
+        Shadowing::Smith,
+        RefractiveIndex::new(1.4, 0.0),
+        0.0,
+    )
+    .unwrap()
+    .with_volume(FacetSide::External, vec![lobe(0.3), lobe(1.5)]);
+    assert!(bad.is_err());
 }
