@@ -26,8 +26,7 @@ pub struct Pbrdf {
     index: RefractiveIndex,
     rho_d: f64,
     facet_side: FacetSide,
-    /// The polarized subsurface lobes (docs/design.md §1.10), in the order they were given;
-    /// empty for a model without the term. Each lobe adds its own Mueller matrix and albedo.
+    /// The polarized subsurface lobes (docs/design.md §1.10), each adding its Mueller matrix.
     subsurface_lobes: Vec<PreparedSubsurface>,
     prepared: PreparedDistribution,
     /// The permittivity the facets see: N², or 1/N² for internal facets.
@@ -305,25 +304,19 @@ impl Pbrdf {
             .fold(self.rho_d, |albedo, s| albedo + s.terms.rho_s)
     }
 
-    /// The subsurface lobes' summed Mueller matrix at cos θ_i, cos θ_r, `None` without one (a
-    /// single lobe's matrix is its own, not added to a zero matrix: −0 elements stay −0).
+    /// The subsurface lobes' summed Mueller matrix, `None` without one (not added to zeros).
     #[inline]
     fn subsurface_mueller(&self, geometry: &ScatteringGeometry) -> Option<Mueller> {
-        let facet = &geometry.facet;
-        // cos Θ = −ω_i·ω_r = −cos 2β (docs/design.md §1.1).
-        let cos_scattering = 1.0 - 2.0 * facet.cos2_beta;
-        let turn = geometry.scattering_plane_turn();
+        let (facet, turn) = (&geometry.facet, geometry.scattering_plane_turn());
+        let cos_scattering = 1.0 - 2.0 * facet.cos2_beta; // cos Θ = −ω_i·ω_r (design.md §1.1)
+        let lobe = |s: &PreparedSubsurface| {
+            let (t_i, t_r) = (s.transmission(facet.cos_i), s.transmission(facet.cos_r));
+            s.mueller(t_i, t_r, turn, cos_scattering)
+        };
         self.subsurface_lobes
             .iter()
-            .map(|s| {
-                s.mueller(
-                    s.transmission(facet.cos_i),
-                    s.transmission(facet.cos_r),
-                    turn,
-                    cos_scattering,
-                )
-            })
-            .reduce(|sum, lobe| sum + lobe)
+            .map(lobe)
+            .reduce(|sum, m| sum + m)
     }
 
     /// (m00, m10, m20) of the subsurface term from ω_i onto ω_r, zero without one: its Stokes
