@@ -164,6 +164,42 @@ pub fn write_scene(dir: &Path, text: &str) -> std::path::PathBuf {
     path
 }
 
+/// Writes `text` as `dir/scene.toml`, loads and renders it in memory.
+pub fn render_scene_text(
+    dir: &Path,
+    text: &str,
+) -> (irpol::scene::Scene, irpol::render::StokesImage) {
+    let scene = irpol::scene::load_scene(&write_scene(dir, text)).unwrap();
+    let image = irpol::render::render(&scene, &irpol::progress::Silent)
+        .unwrap()
+        .image;
+    (scene, image)
+}
+
+/// The pixels of `image` that see a surface.
+pub fn object_pixels(image: &irpol::render::StokesImage) -> Vec<usize> {
+    (0..image.stokes.len())
+        .filter(|&i| image.surface[i] != irpol::render::BACKGROUND)
+        .collect()
+}
+
+/// A closed isothermal cavity: the camera inside a sphere of paper_paint's generating parameters
+/// (`shipped_truths`) at 350 K, a 283 K environment outside, 24 × 24 pixels; `render` is the
+/// `[render]` table's keys.
+pub fn closed_cavity_toml(render: &str) -> String {
+    format!(
+        "[camera]\nposition = [0.0, 0.0, 0.0]\nlook_at = [0.0, 1.0, 0.2]\nup = [0.0, 0.0, 1.0]\n\
+         fov_deg = 50.0\nresolution = [24, 24]\n\
+         [environment]\nair_temperature_k = 283.0\n\
+         sky = {{ model = \"table\", elevation_deg = [0.0, 90.0], brightness_temperature_k = [283.0, 283.0] }}\n\
+         ground = {{ temperature_k = 283.0, emissivity = 1.0 }}\n\
+         {}\n[render]\n{render}\n\
+         [[objects]]\nname = \"cavity\"\nshape = {{ kind = \"sphere\", radius = 2.0, subdivisions = 5 }}\n\
+         material = \"m\"\ntemperature_k = 350.0\n",
+        material_toml(0.10, 1.8, 1.2, 0.2, 0.0)
+    )
+}
+
 /// A camera 4 m from the origin along −y looking at it, square image.
 pub fn camera_toml(size: u32) -> String {
     format!(

@@ -6,16 +6,7 @@
 use crate::common;
 
 use common::*;
-use irpol::progress::Silent;
-use irpol::render::{render, StokesImage, BACKGROUND};
-use irpol::scene::{load_scene, Scene};
-use std::path::Path;
-
-fn render_text(dir: &Path, text: &str) -> (Scene, StokesImage) {
-    let scene = load_scene(&write_scene(dir, text)).unwrap();
-    let image = render(&scene, &Silent).unwrap().image;
-    (scene, image)
-}
+use irpol::render::StokesImage;
 
 /// Mean and standard error (from the pixels' own errors) of Stokes component `j` over `pixels`.
 fn mean_and_error(image: &StokesImage, pixels: &[usize], j: usize) -> (f64, f64) {
@@ -37,18 +28,10 @@ fn mean_and_error(image: &StokesImage, pixels: &[usize], j: usize) -> (f64, f64)
 fn a_split_first_bounce_keeps_a_closed_cavity_at_its_blackbody_radiance() {
     let dir = tempfile::tempdir().unwrap();
     for (samples, split) in [(64, 4), (12, 3)] {
-        let text = format!(
-            "[camera]\nposition = [0.0, 0.0, 0.0]\nlook_at = [0.0, 1.0, 0.2]\nup = [0.0, 0.0, 1.0]\n\
-             fov_deg = 50.0\nresolution = [24, 24]\n\
-             [environment]\nair_temperature_k = 283.0\n\
-             sky = {{ model = \"table\", elevation_deg = [0.0, 90.0], brightness_temperature_k = [283.0, 283.0] }}\n\
-             ground = {{ temperature_k = 283.0, emissivity = 1.0 }}\n\
-             {}\n[render]\nbounces = 8\nsamples = {samples}\nfirst_bounce_samples = {split}\n\
-             [[objects]]\nname = \"cavity\"\nshape = {{ kind = \"sphere\", radius = 2.0, subdivisions = 5 }}\n\
-             material = \"m\"\ntemperature_k = 350.0\n",
-            material_toml(0.10, 1.8, 1.2, 0.2, 0.0)
-        );
-        let (scene, image) = render_text(dir.path(), &text);
+        let text = closed_cavity_toml(&format!(
+            "bounces = 8\nsamples = {samples}\nfirst_bounce_samples = {split}"
+        ));
+        let (scene, image) = render_scene_text(dir.path(), &text);
         let l350 = scene.sensor.band.radiance(350.0);
         let pixels: Vec<usize> = (0..image.stokes.len()).collect();
         let (s0, _) = mean_and_error(&image, &pixels, 0);
@@ -91,12 +74,10 @@ fn a_split_first_bounce_has_the_unsplit_mean_and_less_noise() {
              material = \"ground\"\ntemperature_k = 1.0\n"
         )
     };
-    let (scene, plain) = render_text(dir.path(), &text(1, 1));
-    let (_, split) = render_text(dir.path(), &text(4, 2));
+    let (scene, plain) = render_scene_text(dir.path(), &text(1, 1));
+    let (_, split) = render_scene_text(dir.path(), &text(4, 2));
     let object_of = |i: usize| scene.surfaces[plain.surface[i] as usize].object;
-    let visible: Vec<usize> = (0..plain.stokes.len())
-        .filter(|&i| plain.surface[i] != BACKGROUND)
-        .collect();
+    let visible = object_pixels(&plain);
     let sphere: Vec<usize> = visible
         .iter()
         .copied()

@@ -8,16 +8,10 @@ use irpol::optics::{fresnel_amplitudes, fresnel_mueller, rotate_stokes, Refracti
 use irpol::optics::{Direction, Stokes};
 use irpol::pbrdf::{Pbrdf, Shadowing, SlopeDistribution};
 use irpol::progress::Silent;
-use irpol::render::{render, StokesImage, BACKGROUND};
-use irpol::scene::{load_scene, Scene};
+use irpol::render::{render, BACKGROUND};
+use irpol::scene::load_scene;
 use nalgebra::Vector3;
 use std::path::Path;
-
-fn render_text(dir: &Path, text: &str) -> (Scene, StokesImage) {
-    let scene = load_scene(&write_scene(dir, text)).unwrap();
-    let image = render(&scene, &Silent).unwrap().image;
-    (scene, image)
-}
 
 /// Sky and ground of (almost) zero radiance: only what the scene itself emits or reflects.
 const BLACK_ENVIRONMENT: &str = "[environment]\nair_temperature_k = 1.0\n\
@@ -32,12 +26,6 @@ fn lambertian_toml(name: &str, rho_d: f64) -> String {
     )
 }
 
-fn object_pixels(image: &StokesImage) -> Vec<usize> {
-    (0..image.stokes.len())
-        .filter(|&i| image.surface[i] != BACKGROUND)
-        .collect()
-}
-
 /// Acceptance 2: a lone convex object sees nothing but the environment, so the path integrator
 /// reproduces the open-world image (to rounding) and reports zero standard error.
 #[test]
@@ -50,8 +38,8 @@ fn a_convex_object_alone_renders_as_in_the_open_world_with_no_noise() {
         material_toml(0.15, 2.0, 1.5, 0.1, 0.05),
         sphere_toml(3, 300.0),
     );
-    let (_, open) = render_text(dir.path(), &format!("{base}[render]\nopen_world = true\n"));
-    let (_, path) = render_text(
+    let (_, open) = render_scene_text(dir.path(), &format!("{base}[render]\nopen_world = true\n"));
+    let (_, path) = render_scene_text(
         dir.path(),
         &format!("{base}[render]\nbounces = 3\nsamples = 8\n"),
     );
@@ -77,19 +65,8 @@ fn a_convex_object_alone_renders_as_in_the_open_world_with_no_noise() {
 #[test]
 fn a_closed_isothermal_cavity_reads_its_blackbody_radiance() {
     let dir = tempfile::tempdir().unwrap();
-    let text = format!(
-        "[camera]\nposition = [0.0, 0.0, 0.0]\nlook_at = [0.0, 1.0, 0.2]\nup = [0.0, 0.0, 1.0]\n\
-         fov_deg = 50.0\nresolution = [24, 24]\n\
-         [environment]\nair_temperature_k = 283.0\n\
-         sky = {{ model = \"table\", elevation_deg = [0.0, 90.0], brightness_temperature_k = [283.0, 283.0] }}\n\
-         ground = {{ temperature_k = 283.0, emissivity = 1.0 }}\n\
-         {}\n[render]\nbounces = 8\nsamples = 64\n\
-         [[objects]]\nname = \"cavity\"\nshape = {{ kind = \"sphere\", radius = 2.0, subdivisions = 5 }}\n\
-         material = \"m\"\ntemperature_k = 350.0\n",
-        // paper_paint's generating parameters (tests/common::shipped_truths).
-        material_toml(0.10, 1.8, 1.2, 0.2, 0.0)
-    );
-    let (scene, image) = render_text(dir.path(), &text);
+    let text = closed_cavity_toml("bounces = 8\nsamples = 64");
+    let (scene, image) = render_scene_text(dir.path(), &text);
     let l350 = scene.sensor.band.radiance(350.0);
     let pixels = object_pixels(&image);
     assert_eq!(pixels.len(), 24 * 24);
@@ -114,7 +91,7 @@ fn a_closed_isothermal_cavity_reads_its_blackbody_radiance() {
         }
     }
     // The open-world model, for contrast, sees the cold outside through the wall (349.2 K).
-    let (_, open) = render_text(
+    let (_, open) = render_scene_text(
         dir.path(),
         &text.replace("bounces = 8", "open_world = true"),
     );
@@ -159,7 +136,7 @@ fn a_lambertian_patch_reflects_a_disc_by_its_view_factor() {
             lambertian_toml("patch", rho_d),
             lambertian_toml("black", 0.0),
         );
-        let (scene, image) = render_text(dir.path(), &text);
+        let (scene, image) = render_scene_text(dir.path(), &text);
         let patch: Vec<usize> = object_pixels(&image)
             .into_iter()
             .filter(|&i| scene.surfaces[image.surface[i] as usize].object == 0)
@@ -199,7 +176,7 @@ fn a_corner_reflector_applies_two_fresnel_matrices_and_creates_circular_polariza
          [render]\nbounces = 3\nsamples = 256\n{plates}",
         camera.x, camera.y, camera.z, target.x, target.y, target.z
     );
-    let (scene, image) = render_text(dir.path(), &text);
+    let (scene, image) = render_scene_text(dir.path(), &text);
     assert!(scene.mesh.triangles.len() == 4);
     // The centre pixel's ray, reflected by the floor (normal +z), then by the wall (normal +x,
     // the plane rotated about y by 90° faces +x) to the sky.
@@ -238,7 +215,7 @@ fn a_corner_reflector_applies_two_fresnel_matrices_and_creates_circular_polariza
     let expected = rotate_stokes(&leaving, -psi);
     let got = image.stokes[i];
     // The open-world model sees only the floor's reflection of the sky.
-    let (_, open) = render_text(
+    let (_, open) = render_scene_text(
         dir.path(),
         &text.replace("samples = 256", "open_world = true"),
     );
@@ -271,7 +248,7 @@ fn sunlight_on_a_rough_plate_is_the_brdf_times_the_irradiance() {
          material = \"m\"\ntemperature_k = 1.0\n",
         material_toml(0.3, 2.0, 1.5, 0.1, 0.1)
     );
-    let (scene, image) = render_text(dir.path(), &text);
+    let (scene, image) = render_scene_text(dir.path(), &text);
     let pbrdf = Pbrdf::new(
         SlopeDistribution::Cauchy { sigma: 0.3, q: 2.0 },
         Shadowing::Smith,
@@ -317,7 +294,7 @@ fn a_spheres_shadow_matches_the_analytic_one() {
         lambertian_toml("ground", 0.8),
         lambertian_toml("black", 0.0),
     );
-    let (scene, image) = render_text(dir.path(), &text);
+    let (scene, image) = render_scene_text(dir.path(), &text);
     let sun = irpol::emitter::sun_direction(elevation, azimuth);
     let centre = Vector3::new(0.0, 0.0, centre_z);
     let lit = 0.8 / std::f64::consts::PI * 1000.0 * sun.z;
@@ -457,7 +434,7 @@ fn a_grazing_glossy_plate_reflects_half_its_lobe_from_a_wall() {
         )
     };
     let values: Vec<f64> = (1..=6)
-        .map(|seed| render_text(dir.path(), &scene_text(seed)).1.stokes[0][0])
+        .map(|seed| render_scene_text(dir.path(), &scene_text(seed)).1.stokes[0][0])
         .collect();
     let scene = load_scene(&write_scene(dir.path(), &scene_text(1))).unwrap();
     let pbrdf = Pbrdf::new(
