@@ -85,19 +85,32 @@ pub struct Rendered {
 pub struct SceneTables {
     /// What the tables were built from, [`table_inputs`].
     inputs: String,
+    tables: MaterialTableSet,
+}
+
+/// The tables themselves, as one render builds and uses them.
+struct MaterialTableSet {
     tables: Vec<MaterialTables>,
     resolutions: Vec<TableResolution>,
+}
+
+impl MaterialTableSet {
+    fn build(scene: &Scene) -> Result<MaterialTableSet, RenderError> {
+        let (tables, resolutions) = material_tables(scene, surface_temperature_range(scene))?;
+        Ok(MaterialTableSet {
+            tables,
+            resolutions,
+        })
+    }
 }
 
 impl SceneTables {
     pub fn build(scene: &Scene) -> Result<SceneTables, RenderError> {
         // Read before the build, which may fill a model's lazily built tables (part of its Debug).
         let inputs = table_inputs(scene);
-        let (tables, resolutions) = material_tables(scene, surface_temperature_range(scene))?;
         Ok(SceneTables {
             inputs,
-            tables,
-            resolutions,
+            tables: MaterialTableSet::build(scene)?,
         })
     }
 
@@ -137,7 +150,8 @@ fn surface_temperature_range(scene: &Scene) -> (f64, f64) {
 /// `progress`.
 pub fn render(scene: &Scene, progress: &dyn Progress) -> Result<Rendered, RenderError> {
     let start = Instant::now();
-    let tables = SceneTables::build(scene)?;
+    // No sharing key here: a render that builds its own tables never compares them.
+    let tables = MaterialTableSet::build(scene)?;
     render_from(scene, &tables, start, progress)
 }
 
@@ -148,13 +162,13 @@ pub fn render_with_tables(
     tables: &SceneTables,
     progress: &dyn Progress,
 ) -> Result<Rendered, RenderError> {
-    render_from(scene, tables, Instant::now(), progress)
+    render_from(scene, &tables.tables, Instant::now(), progress)
 }
 
 /// [`render`] with its tables, its timings counted from `start`.
 fn render_from(
     scene: &Scene,
-    tables: &SceneTables,
+    tables: &MaterialTableSet,
     start: Instant,
     progress: &dyn Progress,
 ) -> Result<Rendered, RenderError> {
