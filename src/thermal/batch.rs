@@ -30,13 +30,14 @@
 // turns into one vector operation per statement.
 #![allow(clippy::needless_range_loop)]
 
-use super::forcing::{Back, Forcing, FrontForcing, STEFAN_BOLTZMANN};
+use super::forcing::{Back, Forcing, FrontForcing};
 use super::implicit_rows::{
     back_row, crossed, front_row, surface_newton_step, BackRow, NEWTON_ITERATIONS,
 };
 use super::layers::{Grid, ThermalError};
 use super::solver::{check_step_s, MAX_SUBSTEPS_PER_STEP};
 use crate::optics::MAX_TEMPERATURE_K;
+use crate::optics::STEFAN_BOLTZMANN;
 use crate::text::number;
 
 /// Vertices marched together: eight f64 fill one AVX-512 register (or two AVX2 ones). Sixteen

@@ -5,7 +5,7 @@
 use super::layers::ThermalError;
 use crate::text::number;
 
-pub use crate::optics::STEFAN_BOLTZMANN;
+use crate::optics::STEFAN_BOLTZMANN;
 
 /// Front-surface forcing of §1.8 at one instant, with the sun and sky already reduced to numbers.
 #[derive(Debug, Clone, Copy, PartialEq)]

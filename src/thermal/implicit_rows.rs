@@ -3,8 +3,9 @@
 //! the front, the scalar Newton solve of the non-linear surface balance, and back substitution.
 //! See the solver's module docs for why the elimination runs toward the front.
 
-use super::forcing::{Back, Forcing, FrontForcing, STEFAN_BOLTZMANN};
+use super::forcing::{Back, Forcing, FrontForcing};
 use super::layers::{Grid, ThermalError};
+use crate::optics::STEFAN_BOLTZMANN;
 
 /// Energies (J m⁻²) that crossed the boundaries in one implicit Euler step.
 #[derive(Debug, Clone, Copy, Default)]

@@ -25,7 +25,7 @@ pub mod solver;
 pub use batch::{
     BatchForcing, BatchReport, BatchSolver, BatchState, Lanes, BATCH_MAX_SUBSTEP_S, LANES,
 };
-pub use forcing::{Back, Forcing, FrontForcing, STEFAN_BOLTZMANN};
+pub use forcing::{Back, Forcing, FrontForcing};
 pub use layers::{
     Grid, Layer, LayerLimit, LayerMaterial, LayerStack, Resolution, ThermalError, LAYER_LIMITS,
     MAX_GRID_NODES,

@@ -2,9 +2,10 @@
 //! closure, convergence in time and space, and physical sanity. Run with `--nocapture` to see the
 //! measured errors and the solver speed.
 
+use irpol::optics::STEFAN_BOLTZMANN;
 use irpol::thermal::{
     Back, Forcing, FrontForcing, Layer, LayerMaterial, LayerStack, Resolution, Solver,
-    SolverControl, ThermalState, STEFAN_BOLTZMANN,
+    SolverControl, ThermalState,
 };
 use std::f64::consts::PI;
 use std::time::Instant;

@@ -5,9 +5,9 @@
 use crate::common;
 
 use common::{thermal_plate_scene, write_scene};
+use irpol::optics::STEFAN_BOLTZMANN;
 use irpol::progress::Silent;
 use irpol::scene::load_scene;
-use irpol::thermal::STEFAN_BOLTZMANN;
 use irpol::thermal_scene::solve_scene;
 use irpol::weather::epw;
 use irpol::weather::station::{clark_allen_longwave_w_m2, Field};
