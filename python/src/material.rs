@@ -268,21 +268,8 @@ fn volume_terms(model: &irpol::material::ModelSpec) -> String {
     if !model.facet.is_external() {
         text.push_str(&format!(", facet={}", py_str(model.facet.name())));
     }
-    if let Some(s) = model.subsurface() {
-        text.push_str(&format!(
-            ", rho_s={}, d={}",
-            py_float(s.rho_s),
-            py_float(s.d)
-        ));
-        if let Some(n_sub) = s.n_sub {
-            text.push_str(&format!(", n_sub={}", py_float(n_sub)));
-        }
-        if let Some(d_c) = s.d_c {
-            text.push_str(&format!(", d_c={}", py_float(d_c)));
-        }
-        if let Some(d1) = s.d1 {
-            text.push_str(&format!(", d1={}", py_float(d1)));
-        }
+    for (parameter, value) in model.subsurface_lobes().iter().flat_map(|s| s.keys()) {
+        text.push_str(&format!(", {parameter}={}", py_float(value)));
     }
     text
 }

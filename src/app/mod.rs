@@ -22,7 +22,8 @@ pub use selection::{MeasurementArgs, SelectionArgs};
 use crate::material::{Material, MaterialError};
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{
-    DistributionError, DistributionKind, FacetSide, ModelError, Pbrdf, Shadowing, Subsurface,
+    DistributionError, DistributionKind, FacetSide, LobeKeys, LobeKeysWithoutReflectance,
+    ModelError, Pbrdf, Shadowing,
 };
 use crate::text::shown;
 use std::path::{Path, PathBuf};
@@ -57,22 +58,10 @@ pub struct ModelArgs {
     /// (1/N, inside grains; docs/design.md §1.10).
     #[cfg_attr(feature = "cli", arg(long))]
     pub facet: Option<String>,
-    /// Subsurface reflectance ρ_s: adds the polarized subsurface term (docs/design.md §1.10).
-    #[cfg_attr(feature = "cli", arg(long = "rho-s", allow_negative_numbers = true))]
-    pub rho_s: Option<f64>,
-    /// Residual polarization d of the subsurface term (needs --rho-s; default 0).
-    #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
-    pub d: Option<f64>,
-    /// Real index of the subsurface term's interface (needs --rho-s; default --n).
-    #[cfg_attr(feature = "cli", arg(long = "n-sub", allow_negative_numbers = true))]
-    pub n_sub: Option<f64>,
-    /// Residual circular polarization d_c of the subsurface term (needs --rho-s; default --d).
-    #[cfg_attr(feature = "cli", arg(long = "d-c", allow_negative_numbers = true))]
-    pub d_c: Option<f64>,
-    /// Change of the subsurface term's residual polarization with the scattering angle Θ,
-    /// d(Θ) = d + d1 cos Θ (needs --rho-s; default 0).
-    #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
-    pub d1: Option<f64>,
+    /// The subsurface lobes' parameters (`--rho-s`, `--d`, `--n-sub`, `--d-c`, `--d1`: one flag
+    /// per lobe parameter of the registry, docs/design.md §1.10).
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub lobes: LobeFlags,
     /// Shadowing: none, torrance-sparrow or smith (default smith, as `fit`; with --material,
     /// the material's own).
     #[cfg_attr(feature = "cli", arg(long))]
@@ -81,6 +70,59 @@ pub struct ModelArgs {
     /// table; outside it is refused). A grey material is the same at every wavelength.
     #[cfg_attr(feature = "cli", arg(long = "wavelength", value_name = "UM"))]
     pub wavelength_um: Option<f64>,
+}
+
+/// The subsurface lobes' flags of [`ModelArgs`]: one `--flag` per lobe parameter of the
+/// registry ([`crate::pbrdf::ParameterInfo::flag`]), so that a new lobe term brings its flags.
+#[derive(Clone, Debug, Default)]
+pub struct LobeFlags(pub LobeKeys<f64>);
+
+#[cfg(feature = "cli")]
+impl clap::FromArgMatches for LobeFlags {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> Result<LobeFlags, clap::Error> {
+        let mut keys = LobeKeys::default();
+        for parameter in crate::pbrdf::lobe_parameters() {
+            keys.set(parameter, matches.get_one::<f64>(parameter.name()).copied());
+        }
+        Ok(LobeFlags(keys))
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = LobeFlags::from_arg_matches(matches)?;
+        Ok(())
+    }
+}
+
+#[cfg(feature = "cli")]
+impl clap::Args for LobeFlags {
+    fn augment_args(command: clap::Command) -> clap::Command {
+        crate::pbrdf::lobe_parameters().fold(command, |command, parameter| {
+            let info = parameter.info();
+            let lobe = info.term.lobe().expect("a lobe parameter");
+            let mut comment = info.comment.chars();
+            let mut help: String = comment
+                .next()
+                .into_iter()
+                .flat_map(char::to_uppercase)
+                .collect();
+            help.extend(comment);
+            if parameter != lobe.reflectance {
+                help.push_str(&format!("; needs --{}", lobe.reflectance.info().flag));
+            }
+            command.arg(
+                clap::Arg::new(parameter.name())
+                    .long(info.flag)
+                    .value_name("VALUE")
+                    .value_parser(clap::value_parser!(f64))
+                    .allow_negative_numbers(true)
+                    .help(help),
+            )
+        })
+    }
+
+    fn augment_args_for_update(command: clap::Command) -> clap::Command {
+        LobeFlags::augment_args(command)
+    }
 }
 
 /// Why the model of [`ModelArgs`] or of a material cannot be built.
@@ -93,8 +135,8 @@ pub enum ModelArgsError {
     UnknownShadowing(String),
     #[error("unknown facet side '{}': use external or internal", crate::text::shown(.0))]
     UnknownFacet(String),
-    #[error("--d, --n-sub, --d-c and --d1 belong to the subsurface term: give --rho-s too")]
-    PolarizationWithoutSubsurface,
+    #[error("{}", .0.message(|p| format!("--{}", p.info().flag)))]
+    PolarizationWithoutSubsurface(LobeKeysWithoutReflectance),
     #[error(
         "give either --material or model parameters (--distribution --sigma --q --n --k \
          --rho), not both (got {0} with --material)"
@@ -205,12 +247,11 @@ impl ModelArgs {
         self.with_volume_terms(model)
     }
 
-    /// `--facet`, `--rho-s`, `--d`, `--n-sub` and `--d-c` applied to `model` (docs/design.md
-    /// §1.10).
+    /// `--facet` and the lobes' flags applied to `model` (docs/design.md §1.10).
     fn with_volume_terms(&self, model: Pbrdf) -> Result<Pbrdf, ModelArgsError> {
-        let subsurface = Subsurface::from_keys(self.rho_s, self.d, self.n_sub, self.d_c, self.d1)
-            .map_err(|_| ModelArgsError::PolarizationWithoutSubsurface)?;
-        if self.facet.is_none() && subsurface.is_none() {
+        let subsurface =
+            (self.lobes.0.lobes()).map_err(ModelArgsError::PolarizationWithoutSubsurface)?;
+        if self.facet.is_none() && subsurface.is_empty() {
             return Ok(model);
         }
         let facet = match &self.facet {
@@ -225,22 +266,19 @@ impl ModelArgs {
     /// The material defines every model parameter: a flag beside it would be silently ignored
     /// (only --shadowing overrides the material's, by design).
     fn refuse_parameters(&self) -> Result<(), ModelArgsError> {
-        let given: Vec<&str> = [
-            ("--distribution", self.distribution.is_some()),
-            ("--sigma", self.sigma.is_some()),
-            ("--q", self.q.is_some()),
-            ("--n", self.n.is_some()),
-            ("--k", self.k.is_some()),
-            ("--rho", self.rho.is_some()),
-            ("--facet", self.facet.is_some()),
-            ("--rho-s", self.rho_s.is_some()),
-            ("--d", self.d.is_some()),
-            ("--n-sub", self.n_sub.is_some()),
-            ("--d-c", self.d_c.is_some()),
-            ("--d1", self.d1.is_some()),
+        let given: Vec<String> = [
+            ("distribution", self.distribution.is_some()),
+            ("sigma", self.sigma.is_some()),
+            ("q", self.q.is_some()),
+            ("n", self.n.is_some()),
+            ("k", self.k.is_some()),
+            ("rho", self.rho.is_some()),
+            ("facet", self.facet.is_some()),
         ]
         .into_iter()
         .filter_map(|(flag, set)| set.then_some(flag))
+        .chain(self.lobes.0.iter().map(|(p, _)| p.info().flag))
+        .map(|flag| format!("--{flag}"))
         .collect();
         if given.is_empty() {
             Ok(())
@@ -323,17 +361,9 @@ pub fn model_header(model: &Pbrdf) -> String {
     // Only models with the volume terms say so, so that other tables read as before.
     if model.facet_side() != FacetSide::External || model.subsurface_lobes().next().is_some() {
         header.push_str(&format!("# facet = {}", model.facet_side().name()));
-        for s in model.subsurface_lobes() {
-            header.push_str(&format!("; rho_s = {}, d = {}", s.rho_s, s.d));
-            if let Some(n_sub) = s.n_sub {
-                header.push_str(&format!(", n_sub = {n_sub}"));
-            }
-            if let Some(d_c) = s.d_c {
-                header.push_str(&format!(", d_c = {d_c}"));
-            }
-            if let Some(d1) = s.d1 {
-                header.push_str(&format!(", d1 = {d1}"));
-            }
+        for lobe in model.subsurface_lobes() {
+            let keys: Vec<String> = lobe.keys().map(|(p, v)| format!("{p} = {v}")).collect();
+            header.push_str(&format!("; {}", keys.join(", ")));
         }
         header.push('\n');
     }

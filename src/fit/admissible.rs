@@ -84,11 +84,7 @@ mod tests {
             k,
             rho_d,
             facet: FacetSide::External,
-            rho_s: None,
-            d: None,
-            n_sub: None,
-            d_c: None,
-            d1: None,
+            lobe_keys: Default::default(),
             wavelength_um: 1.064,
         }
     }

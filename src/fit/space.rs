@@ -5,8 +5,8 @@ use super::parameters::{from_search, to_search, Interval, ParameterBounds, Param
 use super::FitError;
 use crate::material::ModelSpec;
 use crate::optics::RefractiveIndex;
-use crate::pbrdf::{Body, ModelError, ModelTerms, Pbrdf, Shadowing, Subsurface};
 use crate::pbrdf::{DistributionKind, Parameter};
+use crate::pbrdf::{LobeKeys, ModelError, ModelTerms, Pbrdf, Shadowing, Subsurface};
 
 /// Lowest n searched with the volume terms (see [`ModelSpace::new`]).
 pub const VOLUME_MIN_N: f64 = 1.0;
@@ -152,9 +152,11 @@ impl ModelSpace {
             RefractiveIndex::new(values.get(Parameter::N), values.get(Parameter::K)),
             self.body_value(values, Parameter::RhoD),
         )?;
-        match self.subsurface(values) {
-            None if self.terms == ModelTerms::default() => Ok(model),
-            subsurface => model.with_volume(self.terms.facet_side, subsurface),
+        let lobes = self.lobes(values);
+        if lobes.is_empty() && self.terms == ModelTerms::default() {
+            Ok(model)
+        } else {
+            model.with_volume(self.terms.facet_side, lobes)
         }
     }
 
@@ -167,17 +169,22 @@ impl ModelSpace {
         }
     }
 
-    fn subsurface(&self, values: &ParameterValues) -> Option<Subsurface> {
-        (self.terms.body == Body::Subsurface).then(|| Subsurface {
-            rho_s: values.get(Parameter::RhoS),
-            d: values.get(Parameter::D),
-            n_sub: Some(values.get(Parameter::NSub)),
-            d_c: Some(values.get(Parameter::DC)),
-            d1: Some(values.get(Parameter::D1)),
-        })
+    /// The family's subsurface lobes at `values`, every key of each one given.
+    fn lobes(&self, values: &ParameterValues) -> Vec<Subsurface> {
+        self.terms
+            .body
+            .lobe_terms()
+            .filter_map(|term| {
+                Subsurface::from_keys(term, |p| Some(values.get(p))).expect("ρ_s is given")
+            })
+            .collect()
     }
 
     pub fn model_spec(&self, values: &ParameterValues, wavelength_um: f64) -> ModelSpec {
+        let mut lobe_keys = LobeKeys::default();
+        for (parameter, value) in self.lobes(values).iter().flat_map(Subsurface::keys) {
+            lobe_keys.set(parameter, Some(value));
+        }
         ModelSpec {
             distribution: self.kind.with_parameters(|p| values.get(p)),
             shadowing: self.shadowing,
@@ -185,11 +192,7 @@ impl ModelSpace {
             k: values.get(Parameter::K),
             rho_d: self.body_value(values, Parameter::RhoD),
             facet: self.terms.facet_side,
-            rho_s: self.subsurface(values).map(|s| s.rho_s),
-            d: self.subsurface(values).map(|s| s.d),
-            n_sub: self.subsurface(values).and_then(|s| s.n_sub),
-            d_c: self.subsurface(values).and_then(|s| s.d_c),
-            d1: self.subsurface(values).and_then(|s| s.d1),
+            lobe_keys,
             wavelength_um,
         }
     }

@@ -28,8 +28,8 @@ pub use spectral::{
 use crate::atomic::write_atomically;
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{
-    Body, FacetSide, ModelError, ModelTerms, Parameter, Pbrdf, Shadowing, SlopeDistribution,
-    Subsurface,
+    FacetSide, LobeKeys, ModelError, ModelTerms, Parameter, Pbrdf, Shadowing, SlopeDistribution,
+    Subsurface, Term,
 };
 use crate::text::{number, shown, shown_at_most};
 use serde::{Deserialize, Serialize};
@@ -89,59 +89,42 @@ pub struct ModelSpec {
     /// `external`, so that models without the volume terms are written as before.
     #[serde(default, skip_serializing_if = "FacetSide::is_external")]
     pub facet: FacetSide,
-    /// The subsurface term's ρ_s and d, both present or both absent.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub rho_s: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub d: Option<f64>,
-    /// The subsurface interface's own index (absent: n).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub n_sub: Option<f64>,
-    /// The subsurface term's circular residual polarization (absent: d).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub d_c: Option<f64>,
-    /// The change of its residual polarization with the scattering angle (absent: 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub d1: Option<f64>,
+    /// The subsurface lobes' keys (ρ_s, d, n_sub, d_c, d1 of docs/design.md §1.10), where
+    /// written: ρ_s and d both present or both absent; n_sub absent is n, d_c absent d, d1 0.
+    #[serde(flatten)]
+    pub lobe_keys: LobeKeys<f64>,
     pub wavelength_um: f64,
 }
 
 impl ModelSpec {
     /// The value of a model parameter; `None` for a slope parameter the distribution does not
-    /// have (q of the Gaussian).
+    /// have (q of the Gaussian) and a lobe's parameter of a model without that lobe.
     pub fn parameter(&self, parameter: Parameter) -> Option<f64> {
         match parameter {
             Parameter::N => Some(self.n),
             Parameter::K => Some(self.k),
             Parameter::RhoD => Some(self.rho_d),
-            Parameter::RhoS => self.rho_s,
-            Parameter::D => self.d,
-            Parameter::NSub => self.rho_s.map(|_| self.n_sub.unwrap_or(self.n)),
-            Parameter::DC => self.subsurface().map(|s| s.circular()),
-            Parameter::D1 => self.subsurface().map(|s| s.d1.unwrap_or(0.0)),
+            lobe if lobe.info().term.lobe().is_some() => self
+                .subsurface_lobes()
+                .iter()
+                .find_map(|s| s.value(lobe, self.n)),
             slope => self.distribution.parameter(slope),
         }
     }
 
     /// The model's terms (docs/design.md §1.10).
     pub fn terms(&self) -> ModelTerms {
-        let body = if self.rho_s.is_some() {
-            Body::Subsurface
-        } else {
-            Body::Depolarizer
-        };
-        ModelTerms::new(self.facet, body)
+        ModelTerms::new(self.facet, self.lobe_keys.body())
     }
 
-    /// The subsurface term, if the model has one.
-    pub fn subsurface(&self) -> Option<Subsurface> {
-        self.rho_s.map(|rho_s| Subsurface {
-            rho_s,
-            d: self.d.unwrap_or(0.0),
-            n_sub: self.n_sub,
-            d_c: self.d_c,
-            d1: self.d1,
-        })
+    /// The subsurface lobes the model has (keys of a lobe without its ρ_s, refused by every
+    /// reader, describe none).
+    pub fn subsurface_lobes(&self) -> Vec<Subsurface> {
+        Term::ALL
+            .into_iter()
+            .filter_map(|t| Subsurface::from_keys(t, |p| self.lobe_keys.get(p).copied()).ok())
+            .flatten()
+            .collect()
     }
 
     pub fn pbrdf(&self) -> Result<Pbrdf, ModelError> {
@@ -151,7 +134,7 @@ impl ModelSpec {
             RefractiveIndex::new(self.n, self.k),
             self.rho_d,
         )?
-        .with_volume(self.facet, self.subsurface())
+        .with_volume(self.facet, self.subsurface_lobes())
     }
 }
 
@@ -313,11 +296,7 @@ mod tests {
                 k: 0.2,
                 rho_d: 0.0,
                 facet: Default::default(),
-                rho_s: None,
-                d: None,
-                n_sub: None,
-                d_c: None,
-                d1: None,
+                lobe_keys: Default::default(),
                 wavelength_um: 9.925,
             }),
             fit: None,

@@ -9,16 +9,18 @@ use super::{MaterialModel, ModelSpec, SpectralModel};
 use crate::measure::SAME_WAVELENGTH_UM;
 use crate::optics::{LorentzDispersion, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
 use crate::pbrdf::{
-    DistributionError, DistributionKind, FacetSide, Shadowing, Subsurface,
-    SubsurfaceKeysWithoutRhoS,
+    table_fields, DistributionError, DistributionKind, FacetSide, LobeKeys,
+    LobeKeysWithoutReflectance, Shadowing,
 };
 use crate::text::number;
+use serde::de::{Deserializer, Error as _, MapAccess, Visitor};
 use serde::Deserialize;
+use std::marker::PhantomData;
+use std::sync::LazyLock;
 
 /// `[model]` as written: `V` is `f64` where only a grey model is allowed, [`PerWavelength`] where
-/// a spectral table is too.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+/// a spectral table is too. Read key by key ([`RawModel::deserialize`]): the lobe terms' keys
+/// come from the registry, and every other key is refused by name.
 pub(super) struct RawModel<V> {
     distribution: DistributionKind,
     sigma: f64,
@@ -27,15 +29,81 @@ pub(super) struct RawModel<V> {
     n: V,
     k: V,
     rho_d: Option<V>,
-    #[serde(default)]
     facet: FacetSide,
-    rho_s: Option<V>,
-    d: Option<V>,
-    n_sub: Option<V>,
-    d_c: Option<V>,
-    d1: Option<V>,
+    lobe_keys: LobeKeys<V>,
     wavelength_um: V,
     dispersion: Option<LorentzDispersion>,
+}
+
+/// The keys of [`RawModel`] besides the lobes'.
+const MODEL_KEYS: [&str; 10] = [
+    "distribution",
+    "sigma",
+    "q",
+    "shadowing",
+    "n",
+    "k",
+    "rho_d",
+    "facet",
+    "wavelength_um",
+    "dispersion",
+];
+
+impl<'de, V: Deserialize<'de>> Deserialize<'de> for RawModel<V> {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<RawModel<V>, D::Error> {
+        deserializer.deserialize_map(RawModelVisitor(PhantomData))
+    }
+}
+
+struct RawModelVisitor<V>(PhantomData<V>);
+
+impl<'de, V: Deserialize<'de>> Visitor<'de> for RawModelVisitor<V> {
+    type Value = RawModel<V>;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a [model] table")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawModel<V>, A::Error> {
+        static FIELDS: LazyLock<Vec<&'static str>> = LazyLock::new(|| table_fields(&MODEL_KEYS));
+        let (mut distribution, mut sigma, mut q, mut shadowing) = (None, None, None, None);
+        let (mut n, mut k, mut rho_d, mut facet) = (None, None, None, None);
+        let (mut wavelength_um, mut dispersion) = (None, None);
+        let mut lobe_keys = LobeKeys::default();
+        while let Some(key) = map.next_key::<String>()? {
+            match key.as_str() {
+                "distribution" => distribution = Some(map.next_value()?),
+                "sigma" => sigma = Some(map.next_value()?),
+                "q" => q = map.next_value()?,
+                "shadowing" => shadowing = Some(map.next_value()?),
+                "n" => n = Some(map.next_value()?),
+                "k" => k = Some(map.next_value()?),
+                "rho_d" => rho_d = map.next_value()?,
+                "facet" => facet = Some(map.next_value()?),
+                "wavelength_um" => wavelength_um = Some(map.next_value()?),
+                "dispersion" => dispersion = map.next_value()?,
+                other => {
+                    if !lobe_keys.read_key(other, &mut map)? {
+                        return Err(A::Error::unknown_field(other, &FIELDS));
+                    }
+                }
+            }
+        }
+        let missing = A::Error::missing_field;
+        Ok(RawModel {
+            distribution: distribution.ok_or_else(|| missing("distribution"))?,
+            sigma: sigma.ok_or_else(|| missing("sigma"))?,
+            q,
+            shadowing: shadowing.ok_or_else(|| missing("shadowing"))?,
+            n: n.ok_or_else(|| missing("n"))?,
+            k: k.ok_or_else(|| missing("k"))?,
+            rho_d,
+            facet: facet.unwrap_or_default(),
+            lobe_keys,
+            wavelength_um: wavelength_um.ok_or_else(|| missing("wavelength_um"))?,
+            dispersion,
+        })
+    }
 }
 
 /// Why a `[model]` table is refused (the message follows the file's path and line).
@@ -87,7 +155,7 @@ pub enum ModelTableError {
     #[error("dispersion: {0}")]
     Dispersion(#[source] crate::optics::LorentzError),
     #[error("{0}")]
-    PolarizationWithoutSubsurface(#[from] SubsurfaceKeysWithoutRhoS),
+    PolarizationWithoutSubsurface(#[from] LobeKeysWithoutReflectance),
 }
 
 /// Refuses a wavelength irpol does not model.
@@ -107,8 +175,9 @@ impl TryFrom<RawModel<f64>> for ModelSpec {
         if raw.dispersion.is_some() {
             return Err(ModelTableError::GreyDispersion);
         }
-        // Refuses d, n_sub, d_c without rho_s; the spec keeps the keys as written.
-        Subsurface::from_keys(raw.rho_s, raw.d, raw.n_sub, raw.d_c, raw.d1)?;
+        // Refuses d, n_sub, d_c without rho_s; the spec keeps the keys as written, with each
+        // lobe's d (0 where absent).
+        let lobe_keys = raw.lobe_keys.with_residuals()?;
         Ok(ModelSpec {
             distribution,
             shadowing: raw.shadowing,
@@ -116,11 +185,7 @@ impl TryFrom<RawModel<f64>> for ModelSpec {
             k: raw.k,
             rho_d: raw.rho_d.unwrap_or(0.0),
             facet: raw.facet,
-            rho_s: raw.rho_s,
-            d: raw.rho_s.map(|_| raw.d.unwrap_or(0.0)),
-            n_sub: raw.n_sub,
-            d_c: raw.d_c,
-            d1: raw.d1,
+            lobe_keys,
             wavelength_um: check_wavelength(raw.wavelength_um)?,
         })
     }
@@ -139,14 +204,7 @@ impl TryFrom<RawModel<PerWavelength>> for MaterialModel {
             return Err(ModelTableError::MixedShapes);
         };
         // One check of the subsurface keys for grey and spectral files alike.
-        let present = |key: &Option<PerWavelength>| key.as_ref().map(|_| 0.0);
-        Subsurface::from_keys(
-            present(&raw.rho_s),
-            present(&raw.d),
-            present(&raw.n_sub),
-            present(&raw.d_c),
-            present(&raw.d1),
-        )?;
+        raw.lobe_keys.map(|_, _| 0.0).lobes()?;
         let rho_d = match raw.rho_d.unwrap_or(Shared(0.0)) {
             Shared(r) => vec![r; wavelength_um.len()],
             Each(r) => r,
@@ -160,11 +218,7 @@ impl TryFrom<RawModel<PerWavelength>> for MaterialModel {
             rho_d,
             volume: SpectralVolume {
                 facet: raw.facet,
-                rho_s: raw.rho_s,
-                d: raw.d,
-                n_sub: raw.n_sub,
-                d_c: raw.d_c,
-                d1: raw.d1,
+                lobe_keys: raw.lobe_keys,
             },
             dispersion: raw.dispersion,
         };
@@ -184,6 +238,10 @@ impl RawModel<PerWavelength> {
             None => Some(None),
             Some(v) => one(v).map(Some),
         };
+        let mut lobe_keys = LobeKeys::default();
+        for (parameter, value) in self.lobe_keys.iter() {
+            lobe_keys.set(parameter, Some(one(value)?));
+        }
         Some(RawModel {
             distribution: self.distribution,
             sigma: self.sigma,
@@ -193,11 +251,7 @@ impl RawModel<PerWavelength> {
             k: one(&self.k)?,
             rho_d: optional(&self.rho_d)?,
             facet: self.facet,
-            rho_s: optional(&self.rho_s)?,
-            d: optional(&self.d)?,
-            n_sub: optional(&self.n_sub)?,
-            d_c: optional(&self.d_c)?,
-            d1: optional(&self.d1)?,
+            lobe_keys,
             wavelength_um: one(&self.wavelength_um)?,
             dispersion: self.dispersion.clone(),
         })
@@ -213,9 +267,9 @@ fn check_table(model: &SpectralModel) -> Result<(), ModelTableError> {
     }
     let volume = model
         .volume
-        .keys()
-        .into_iter()
-        .filter_map(|(name, value)| Some((name, value?.table_len()?)));
+        .lobe_keys
+        .iter()
+        .filter_map(|(parameter, value)| Some((parameter.name(), value.table_len()?)));
     for (name, len) in [
         ("n", model.n.len()),
         ("k", model.k.len()),

@@ -4,39 +4,96 @@
 use super::{find_material, BandModelError, Material, MaterialError, MaterialModel, SpectralModel};
 use crate::optics::{Band, RefractiveIndex, TableMissesBand};
 use crate::pbrdf::{
-    slope_distribution, DistributionError, FacetSide, MaterialOptics, ModelError, Pbrdf,
-    Subsurface, SubsurfaceKeysWithoutRhoS,
+    slope_distribution, table_fields, DistributionError, FacetSide, LobeKeys,
+    LobeKeysWithoutReflectance, MaterialOptics, ModelError, Pbrdf,
 };
+use serde::de::{Deserializer, Error as _, MapAccess, Visitor};
 use serde::Deserialize;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
 
 /// pBRDF parameters given directly in the scene (docs/design.md §1.3); wavelength is not needed to render.
-#[derive(Debug, Deserialize, Clone)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone)]
 pub struct InlineMaterialConfig {
     pub distribution: String,
     pub sigma: f64,
     pub q: Option<f64>,
     pub n: f64,
     pub k: f64,
-    #[serde(default)]
     pub rho_d: f64,
     /// Default Smith, as everywhere in irpol.
-    #[serde(default = "smith")]
     pub shadowing: crate::pbrdf::Shadowing,
-    /// The volume-scattering terms of docs/design.md §1.10, as in a material file.
-    #[serde(default)]
+    /// The volume-scattering terms of docs/design.md §1.10, as in a material file: the facet
+    /// side and the subsurface lobes' keys.
     pub facet: FacetSide,
-    pub rho_s: Option<f64>,
-    pub d: Option<f64>,
-    pub n_sub: Option<f64>,
-    pub d_c: Option<f64>,
-    pub d1: Option<f64>,
+    pub lobe_keys: LobeKeys<f64>,
 }
 
-fn smith() -> crate::pbrdf::Shadowing {
-    crate::pbrdf::Shadowing::Smith
+/// The keys of [`InlineMaterialConfig`] besides the lobes'.
+const INLINE_KEYS: [&str; 8] = [
+    "distribution",
+    "sigma",
+    "q",
+    "n",
+    "k",
+    "rho_d",
+    "shadowing",
+    "facet",
+];
+
+/// Read key by key, as a material file's `[model]` (`material::raw`): the lobe terms' keys come
+/// from the registry, every other key is refused by name.
+impl<'de> Deserialize<'de> for InlineMaterialConfig {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_map(InlineMaterialVisitor)
+    }
+}
+
+struct InlineMaterialVisitor;
+
+impl<'de> Visitor<'de> for InlineMaterialVisitor {
+    type Value = InlineMaterialConfig;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("an inline material table")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<InlineMaterialConfig, A::Error> {
+        static FIELDS: LazyLock<Vec<&'static str>> = LazyLock::new(|| table_fields(&INLINE_KEYS));
+        let (mut distribution, mut sigma, mut q, mut n, mut k) = (None, None, None, None, None);
+        let (mut rho_d, mut shadowing, mut facet) = (None, None, None);
+        let mut lobe_keys = LobeKeys::default();
+        while let Some(key) = map.next_key::<String>()? {
+            match key.as_str() {
+                "distribution" => distribution = Some(map.next_value()?),
+                "sigma" => sigma = Some(map.next_value()?),
+                "q" => q = map.next_value()?,
+                "n" => n = Some(map.next_value()?),
+                "k" => k = Some(map.next_value()?),
+                "rho_d" => rho_d = Some(map.next_value()?),
+                "shadowing" => shadowing = Some(map.next_value()?),
+                "facet" => facet = Some(map.next_value()?),
+                other => {
+                    if !lobe_keys.read_key(other, &mut map)? {
+                        return Err(A::Error::unknown_field(other, &FIELDS));
+                    }
+                }
+            }
+        }
+        let missing = A::Error::missing_field;
+        Ok(InlineMaterialConfig {
+            distribution: distribution.ok_or_else(|| missing("distribution"))?,
+            sigma: sigma.ok_or_else(|| missing("sigma"))?,
+            q,
+            n: n.ok_or_else(|| missing("n"))?,
+            k: k.ok_or_else(|| missing("k"))?,
+            rho_d: rho_d.unwrap_or(0.0),
+            shadowing: shadowing.unwrap_or(crate::pbrdf::Shadowing::Smith),
+            facet: facet.unwrap_or_default(),
+            lobe_keys,
+        })
+    }
 }
 
 /// A material used by the scene, with its validated pBRDF over the sensor band.
@@ -65,7 +122,7 @@ pub enum InlineMaterialError {
     #[error("{0}")]
     Model(ModelError),
     #[error("{0}")]
-    PolarizationWithoutSubsurface(#[from] SubsurfaceKeysWithoutRhoS),
+    PolarizationWithoutSubsurface(#[from] LobeKeysWithoutReflectance),
 }
 
 /// A material of a scene cannot be used. The inner errors are part of the message (not a
@@ -292,7 +349,7 @@ pub fn share_wavelength_nodes(
 
 pub fn inline_pbrdf(m: &InlineMaterialConfig) -> Result<Pbrdf, InlineMaterialError> {
     let distribution = slope_distribution(&m.distribution, m.sigma, m.q)?;
-    let subsurface = Subsurface::from_keys(m.rho_s, m.d, m.n_sub, m.d_c, m.d1)?;
+    let subsurface = m.lobe_keys.lobes()?;
     Pbrdf::new(
         distribution,
         m.shadowing,

@@ -6,7 +6,7 @@
 
 use super::ModelSpec;
 use crate::optics::{Band, LorentzDispersion, TableMissesBand, WavelengthNodes};
-use crate::pbrdf::{BandPbrdf, FacetSide, ModelError, Shadowing, SlopeDistribution};
+use crate::pbrdf::{BandPbrdf, FacetSide, LobeKeys, ModelError, Shadowing, SlopeDistribution};
 use crate::text::number;
 use serde::{Deserialize, Serialize};
 
@@ -20,7 +20,7 @@ pub enum MaterialModel {
 }
 
 /// n, k and ρ_d tabulated over wavelength with shared σ, q and shadowing.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SpectralModel {
     #[serde(flatten)]
     pub distribution: SlopeDistribution,
@@ -44,20 +44,12 @@ pub struct SpectralModel {
 /// and the subsurface term's parameters, each shared by every wavelength (one number: the fit
 /// shared it) or one per table wavelength. Absent keys mean what they mean in a grey model: no
 /// subsurface term without ρ_s, d = 0, n_sub = n, d_c = d, d1 = 0.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct SpectralVolume {
     #[serde(default, skip_serializing_if = "FacetSide::is_external")]
     pub facet: FacetSide,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub rho_s: Option<PerWavelength>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub d: Option<PerWavelength>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub n_sub: Option<PerWavelength>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub d_c: Option<PerWavelength>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub d1: Option<PerWavelength>,
+    #[serde(flatten)]
+    pub lobe_keys: LobeKeys<PerWavelength>,
 }
 
 /// A model parameter over a spectral table: one number for every wavelength, or one per
@@ -92,19 +84,6 @@ impl PerWavelength {
             PerWavelength::Shared(_) => None,
             PerWavelength::Each(values) => Some(values.len()),
         }
-    }
-}
-
-impl SpectralVolume {
-    /// The subsurface keys by name, as a material file writes them.
-    pub fn keys(&self) -> [(&'static str, Option<&PerWavelength>); 5] {
-        [
-            ("rho_s", self.rho_s.as_ref()),
-            ("d", self.d.as_ref()),
-            ("n_sub", self.n_sub.as_ref()),
-            ("d_c", self.d_c.as_ref()),
-            ("d1", self.d1.as_ref()),
-        ]
     }
 }
 
@@ -200,8 +179,9 @@ impl SpectralModel {
                 values[a] + f * (values[b] - values[a])
             }
         };
-        let volume = |key: &Option<PerWavelength>| key.as_ref().map(|v| v.at(&interpolate));
-        let rho_s = volume(&self.volume.rho_s);
+        // As a grey file reads (material::raw): each lobe's d is written, 0 where absent.
+        let lobe_keys = self.volume.lobe_keys.map(|_, v| v.at(&interpolate));
+        let lobe_keys = lobe_keys.clone().with_residuals().unwrap_or(lobe_keys);
         Ok(ModelSpec {
             distribution: self.distribution,
             shadowing: self.shadowing,
@@ -209,12 +189,7 @@ impl SpectralModel {
             k: interpolate(&self.k),
             rho_d: interpolate(&self.rho_d),
             facet: self.volume.facet,
-            rho_s,
-            // As a grey file reads (material::raw): d is 0 where the subsurface term has none.
-            d: rho_s.map(|_| volume(&self.volume.d).unwrap_or(0.0)),
-            n_sub: volume(&self.volume.n_sub),
-            d_c: volume(&self.volume.d_c),
-            d1: volume(&self.volume.d1),
+            lobe_keys,
             wavelength_um,
         })
     }
@@ -224,10 +199,15 @@ impl SpectralModel {
     /// [`SpectralModel::nodes`]. A subsurface parameter equal at every node is written once.
     pub fn from_nodes(nodes: &[ModelSpec], dispersion: Option<LorentzDispersion>) -> SpectralModel {
         let column = |value: fn(&ModelSpec) -> f64| nodes.iter().map(value).collect::<Vec<_>>();
-        let volume = |value: fn(&ModelSpec) -> Option<f64>| {
-            let values: Option<Vec<f64>> = nodes.iter().map(value).collect();
-            values.map(PerWavelength::from_values)
-        };
+        // A lobe key written at every node, as one number or a table.
+        let mut lobe_keys = LobeKeys::default();
+        for (parameter, _) in nodes[0].lobe_keys.iter() {
+            let values: Option<Vec<f64>> = nodes
+                .iter()
+                .map(|m| m.lobe_keys.get(parameter).copied())
+                .collect();
+            lobe_keys.set(parameter, values.map(PerWavelength::from_values));
+        }
         SpectralModel {
             distribution: nodes[0].distribution,
             shadowing: nodes[0].shadowing,
@@ -237,11 +217,7 @@ impl SpectralModel {
             rho_d: column(|m| m.rho_d),
             volume: SpectralVolume {
                 facet: nodes[0].facet,
-                rho_s: volume(|m| m.rho_s),
-                d: volume(|m| m.d),
-                n_sub: volume(|m| m.n_sub),
-                d_c: volume(|m| m.d_c),
-                d1: volume(|m| m.d1),
+                lobe_keys,
             },
             dispersion,
         }
@@ -249,12 +225,7 @@ impl SpectralModel {
 
     /// The model's terms (docs/design.md §1.10), as [`ModelSpec::terms`] says them.
     pub fn terms(&self) -> crate::pbrdf::ModelTerms {
-        let body = if self.volume.rho_s.is_some() {
-            crate::pbrdf::Body::Subsurface
-        } else {
-            crate::pbrdf::Body::Depolarizer
-        };
-        crate::pbrdf::ModelTerms::new(self.volume.facet, body)
+        crate::pbrdf::ModelTerms::new(self.volume.facet, self.volume.lobe_keys.body())
     }
 
     /// The first and last table wavelengths, µm.
@@ -405,8 +376,17 @@ mod tests {
     mod grey_twins {
         use super::super::super::{Material, ModelSpec};
         use super::*;
-        use crate::pbrdf::{Body, FacetSide, ModelTerms};
+        use crate::pbrdf::{Body, FacetSide, LobeKeys, ModelTerms, Parameter};
         use std::path::Path;
+
+        /// The lobe keys `values` where `present`, else none.
+        fn lobe_keys(present: bool, values: [(Parameter, f64); 5]) -> LobeKeys<f64> {
+            let mut keys = LobeKeys::default();
+            for (parameter, value) in values {
+                keys.set(parameter, present.then_some(value));
+            }
+            keys
+        }
 
         /// A grey model of each term set at `wavelength_um`, with per-wavelength n, k and
         /// reflectances and the subsurface's d, n_sub, d_c shared (`per_wavelength_d` makes d
@@ -424,11 +404,19 @@ mod tests {
                 k: 0.04 + 0.01 * j,
                 rho_d: if subsurface { 0.0 } else { 0.7 + 0.05 * j },
                 facet: terms.facet_side,
-                rho_s: subsurface.then_some(0.96 - 0.01 * j),
-                d: subsurface.then_some(0.02 + if per_wavelength_d { 0.01 * j } else { 0.0 }),
-                n_sub: subsurface.then_some(1.05),
-                d_c: subsurface.then_some(-0.015),
-                d1: subsurface.then_some(0.004),
+                lobe_keys: lobe_keys(
+                    subsurface,
+                    [
+                        (Parameter::RhoS, 0.96 - 0.01 * j),
+                        (
+                            Parameter::D,
+                            0.02 + if per_wavelength_d { 0.01 * j } else { 0.0 },
+                        ),
+                        (Parameter::NSub, 1.05),
+                        (Parameter::DC, -0.015),
+                        (Parameter::D1, 0.004),
+                    ],
+                ),
                 wavelength_um,
             }
         }

@@ -330,6 +330,7 @@ mod tests {
         let internal = model(Shadowing::Smith).with_volume(FacetSide::Internal, None);
         models.push(internal.unwrap());
         let subsurface = Subsurface {
+            term: crate::pbrdf::Term::Subsurface,
             rho_s: 0.3,
             d: 0.2,
             n_sub: None,

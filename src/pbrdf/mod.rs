@@ -10,6 +10,7 @@ mod error;
 mod geometry;
 mod hemisphere;
 pub mod limits;
+mod lobe_keys;
 mod model;
 mod sample;
 mod shadowing;
@@ -26,8 +27,12 @@ pub use distribution::{
 pub use error::ModelError;
 pub use geometry::{fold_signed_zenith, signed_zenith_note};
 pub use hemisphere::{cosine_hemisphere_rule, HemisphereQuadrature};
+pub(crate) use lobe_keys::table_fields;
+pub use lobe_keys::{lobe_parameters, LobeKeys};
 pub use model::{Pbrdf, ScatteringGeometry};
 pub use sample::ScatteredView;
 pub use shadowing::Shadowing;
-pub use subsurface::{FacetSide, Subsurface, SubsurfaceKeysWithoutRhoS, Transmission};
+pub use subsurface::{
+    FacetSide, LobeKeysWithoutReflectance, LobeParameters, Subsurface, Transmission,
+};
 pub use terms::{Body, ModelTerms, OutsideDomain, Parameter, ParameterInfo, SpectralRole, Term};

@@ -5,7 +5,6 @@
 use super::distribution::{CauchySmithTable, PreparedDistribution};
 use super::limits::{within, MAX_K, MAX_N, MIN_N};
 use super::subsurface::{FacetSide, PreparedSubsurface, Subsurface};
-use super::terms::Parameter;
 use super::visible_slopes::VisibleSlopes;
 use super::{ModelError, Shadowing, SlopeDistribution};
 use crate::elementary::{exp_within_range, inline_exp};
@@ -255,7 +254,7 @@ impl Pbrdf {
 
     /// The model with the volume-scattering terms of docs/design.md §1.10: the facets reflecting
     /// from `facet_side`, and polarized subsurface lobes (an `Option` gives none or one). Each
-    /// lobe's ρ_s, d, … are checked against their domains ([`Parameter::check`]).
+    /// lobe's ρ_s, d, … are checked against their domains ([`super::Parameter::check`]).
     pub fn with_volume(
         mut self,
         facet_side: FacetSide,
@@ -263,16 +262,8 @@ impl Pbrdf {
     ) -> Result<Pbrdf, ModelError> {
         let lobes: Vec<Subsurface> = subsurface.into_iter().collect();
         for &terms in &lobes {
-            Parameter::RhoS.check(terms.rho_s)?;
-            Parameter::D.check(terms.d)?;
-            if let Some(n_sub) = terms.n_sub {
-                Parameter::NSub.check(n_sub)?;
-            }
-            if let Some(d_c) = terms.d_c {
-                Parameter::DC.check(d_c)?;
-            }
-            if let Some(d1) = terms.d1 {
-                Parameter::D1.check(d1)?;
+            for (parameter, value) in terms.keys() {
+                parameter.check(value)?;
             }
             if terms.largest_residual() > 1.0 {
                 return Err(ModelError::ResidualAboveOne {

@@ -38,6 +38,7 @@
 //! F(ω_r→ω_i) = Q F(ω_i→ω_r)ᵀ Q. With N = 1 and d = 0 every R is exactly 0, Z exactly 1 and the
 //! term is (ρ_s/π) diag(1,0,0,0) bit for bit: today's ideal depolarizer (§1.3's ρ_d).
 
+use super::{Parameter, Term};
 use crate::optics::{FresnelFractions, Mueller, RefractiveIndex};
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
@@ -89,7 +90,7 @@ impl FacetSide {
     }
 }
 
-/// The parameters of the subsurface term: ρ_s ∈ [0, 1], the fraction of the transmitted light
+/// The parameters of a subsurface lobe: ρ_s ∈ [0, 1], the fraction of the transmitted light
 /// that comes back out, d ∈ [0, 1], its residual polarization, and the real index n_sub of the
 /// interface it crosses (`None`: the material's n). The subsurface light meets the interface
 /// everywhere, not only on the facets that make the lobe; where that interface is rougher or
@@ -97,6 +98,8 @@ impl FacetSide {
 /// index describes (docs/design.md §1.10).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Subsurface {
+    /// The model's term this lobe is ([`Term::lobe`] names its parameters).
+    pub term: Term,
     pub rho_s: f64,
     pub d: f64,
     pub n_sub: Option<f64>,
@@ -107,34 +110,119 @@ pub struct Subsurface {
     pub d1: Option<f64>,
 }
 
-/// d, n_sub or d_c given without ρ_s (in a material file, a scene's inline material or on the
-/// command line): they describe a subsurface term that is not there.
+/// Which parameter of a lobe term ([`Term::lobe`]) is which field of [`Subsurface`]; a lobe
+/// without an `interface_index`, `circular` or `residual_slope` parameter takes that field's
+/// default (n, d, 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LobeParameters {
+    pub reflectance: Parameter,
+    pub residual: Parameter,
+    pub interface_index: Option<Parameter>,
+    pub circular: Option<Parameter>,
+    pub residual_slope: Option<Parameter>,
+}
+
+impl LobeParameters {
+    /// The parameters other than the reflectance, in [`Parameter::ALL`] order.
+    fn dependents(&self) -> impl Iterator<Item = Parameter> {
+        [
+            Some(self.residual),
+            self.interface_index,
+            self.circular,
+            self.residual_slope,
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
+/// A lobe's d, n_sub, d_c or d1 given without its ρ_s (in a material file, a scene's inline
+/// material or on the command line): they describe a lobe that is not there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("d, n_sub, d_c and d1 need rho_s: they belong to the subsurface term")]
-pub struct SubsurfaceKeysWithoutRhoS;
+#[error("{}", self.message(|p| p.name().to_owned()))]
+pub struct LobeKeysWithoutReflectance {
+    pub term: Term,
+}
+
+impl LobeKeysWithoutReflectance {
+    /// "d, n_sub, d_c and d1 need rho_s: they belong to the subsurface term", with each
+    /// parameter written by `name` (a key, or a flag).
+    pub fn message(&self, name: impl Fn(Parameter) -> String) -> String {
+        let lobe = self.term.lobe().expect("a lobe term");
+        let names: Vec<String> = lobe.dependents().map(&name).collect();
+        let listed = match names.split_last() {
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+            None => String::new(),
+        };
+        format!(
+            "{listed} need {}: they belong to the {} term",
+            name(lobe.reflectance),
+            self.term.name()
+        )
+    }
+}
 
 impl Subsurface {
-    /// The subsurface term its keys describe, wherever they are written: none without ρ_s, d
-    /// absent is 0, n_sub, d_c and d1 absent take their defaults (n, d, 0).
+    /// The lobe `term` that its keys describe (`key` gives a parameter's value where written),
+    /// wherever they are written: none without ρ_s, d absent is 0, n_sub, d_c and d1 absent take
+    /// their defaults (n, d, 0).
     pub fn from_keys(
-        rho_s: Option<f64>,
-        d: Option<f64>,
-        n_sub: Option<f64>,
-        d_c: Option<f64>,
-        d1: Option<f64>,
-    ) -> Result<Option<Subsurface>, SubsurfaceKeysWithoutRhoS> {
-        match rho_s {
+        term: Term,
+        key: impl Fn(Parameter) -> Option<f64>,
+    ) -> Result<Option<Subsurface>, LobeKeysWithoutReflectance> {
+        let Some(lobe) = term.lobe() else {
+            return Ok(None);
+        };
+        let optional = |p: Option<Parameter>| p.and_then(&key);
+        match key(lobe.reflectance) {
             Some(rho_s) => Ok(Some(Subsurface {
+                term,
                 rho_s,
-                d: d.unwrap_or(0.0),
-                n_sub,
-                d_c,
-                d1,
+                d: key(lobe.residual).unwrap_or(0.0),
+                n_sub: optional(lobe.interface_index),
+                d_c: optional(lobe.circular),
+                d1: optional(lobe.residual_slope),
             })),
-            None if d.is_some() || n_sub.is_some() || d_c.is_some() || d1.is_some() => {
-                Err(SubsurfaceKeysWithoutRhoS)
+            None if lobe.dependents().any(|p| key(p).is_some()) => {
+                Err(LobeKeysWithoutReflectance { term })
             }
             None => Ok(None),
+        }
+    }
+
+    /// The lobe's values as its keys are written, in [`Parameter::ALL`] order: ρ_s and d always,
+    /// n_sub, d_c and d1 where given.
+    pub fn keys(&self) -> impl Iterator<Item = (Parameter, f64)> {
+        let lobe = self.term.lobe().expect("a lobe term");
+        [
+            Some((lobe.reflectance, self.rho_s)),
+            Some((lobe.residual, self.d)),
+            lobe.interface_index.zip(self.n_sub),
+            lobe.circular.zip(self.d_c),
+            lobe.residual_slope.zip(self.d1),
+        ]
+        .into_iter()
+        .flatten()
+    }
+
+    /// The value of `parameter`, one of the lobe's, with the defaults of absent keys filled in
+    /// (n_sub = `n`, d_c = d, d1 = 0); `None` for a parameter of another term.
+    pub fn value(&self, parameter: Parameter, n: f64) -> Option<f64> {
+        let lobe = self.term.lobe()?;
+        let p = Some(parameter);
+        if parameter == lobe.reflectance {
+            Some(self.rho_s)
+        } else if parameter == lobe.residual {
+            Some(self.d)
+        } else if p == lobe.interface_index {
+            Some(self.n_sub.unwrap_or(n))
+        } else if p == lobe.circular {
+            Some(self.circular())
+        } else if p == lobe.residual_slope {
+            Some(self.d1.unwrap_or(0.0))
+        } else {
+            None
         }
     }
 

@@ -9,13 +9,14 @@
 //!   with the parameters each one owns, and the combinations a fit chooses among
 //!   ([`ModelTerms`]).
 //!
-//! The fit, the material files and the reports read this table instead of repeating it: the
-//! fit's bounds, starts, search coordinates and traps are entries here. The material schema
-//! (`material::ModelSpec`, `material::raw`) and `irpol eval`'s flags still name the subsurface
-//! term's parameters one by one.
+//! The fit, the material files, the command line's flags and the reports read this table
+//! instead of repeating it: the fit's bounds, starts, search coordinates and traps are entries
+//! here, and a subsurface lobe's keys are stored by parameter ([`super::LobeKeys`]). A new lobe
+//! term is a [`Term`] with its [`LobeParameters`], its parameters' entries and a [`Body`] that
+//! holds it.
 
 use super::limits;
-use super::subsurface::FacetSide;
+use super::subsurface::{FacetSide, LobeParameters};
 use crate::text::number;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -70,12 +71,22 @@ pub enum Body {
 }
 
 impl Body {
-    pub fn term(self) -> Term {
+    pub const ALL: [Body; 2] = [Body::Depolarizer, Body::Subsurface];
+
+    /// The terms beside the facet term, in the order the model adds them.
+    pub fn terms(self) -> &'static [Term] {
         match self {
-            Body::Depolarizer => Term::IdealDepolarizer,
-            Body::Subsurface => Term::Subsurface,
+            Body::Depolarizer => &[Term::IdealDepolarizer],
+            Body::Subsurface => &[Term::Subsurface],
         }
     }
+
+    /// The subsurface lobes among [`Body::terms`] (docs/design.md §1.10): none for the ideal
+    /// depolarizer. A body with lobes lets light into the material.
+    pub fn lobe_terms(self) -> impl Iterator<Item = Term> {
+        self.terms().iter().copied().filter(|t| t.lobe().is_some())
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Body::Depolarizer => "depolarizer",
@@ -112,7 +123,7 @@ impl ModelTerms {
     /// the distribution: [`super::DistributionKind::has`]).
     pub fn has(&self, parameter: Parameter) -> bool {
         let term = parameter.info().term;
-        term == Term::Facet || term == self.body.term()
+        term == Term::Facet || self.body.terms().contains(&term)
     }
 
     /// Whether a fit frees `parameter` unless told otherwise (`--free`, `--fix`): every parameter
@@ -159,6 +170,8 @@ pub struct ParameterInfo {
     pub key: &'static str,
     /// Further names the command line accepts (`rho` for ρ_d, docs/design.md §4).
     pub aliases: &'static [&'static str],
+    /// The flag of `irpol eval` and `emissivity` that gives its value (`--rho-s`).
+    pub flag: &'static str,
     /// The symbol in report tables.
     pub label: &'static str,
     pub unit: &'static str,
@@ -264,6 +277,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "sigma",
         aliases: &[],
+        flag: "sigma",
         label: "σ",
         unit: "dimensionless",
         term: Term::Facet,
@@ -279,6 +293,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "q",
         aliases: &[],
+        flag: "q",
         label: "q",
         unit: "dimensionless",
         term: Term::Facet,
@@ -295,6 +310,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "n",
         aliases: &[],
+        flag: "n",
         label: "n",
         unit: "dimensionless",
         term: Term::Facet,
@@ -310,6 +326,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "k",
         aliases: &[],
+        flag: "k",
         label: "k",
         unit: "dimensionless",
         term: Term::Facet,
@@ -325,6 +342,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "rho_d",
         aliases: &["rho"],
+        flag: "rho",
         label: "ρd",
         unit: "dimensionless",
         term: Term::IdealDepolarizer,
@@ -340,6 +358,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "rho_s",
         aliases: &[],
+        flag: "rho-s",
         label: "ρs",
         unit: "dimensionless",
         term: Term::Subsurface,
@@ -355,6 +374,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "d",
         aliases: &[],
+        flag: "d",
         label: "d",
         unit: "dimensionless",
         term: Term::Subsurface,
@@ -370,6 +390,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "n_sub",
         aliases: &[],
+        flag: "n-sub",
         label: "n_sub",
         unit: "dimensionless",
         term: Term::Subsurface,
@@ -385,6 +406,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "d_c",
         aliases: &[],
+        flag: "d-c",
         label: "d_c",
         unit: "dimensionless",
         term: Term::Subsurface,
@@ -400,6 +422,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
     ParameterInfo {
         key: "d1",
         aliases: &[],
+        flag: "d1",
         label: "d1",
         unit: "dimensionless",
         term: Term::Subsurface,
@@ -505,6 +528,30 @@ impl fmt::Display for Parameter {
 
 impl Term {
     pub const ALL: [Term; 3] = [Term::Facet, Term::IdealDepolarizer, Term::Subsurface];
+
+    /// The term's name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Term::Facet => "facet",
+            Term::IdealDepolarizer => "depolarizer",
+            Term::Subsurface => "subsurface",
+        }
+    }
+
+    /// Which of the term's parameters plays which part of a subsurface lobe
+    /// ([`super::Subsurface`]); `None` for a term that is not a lobe.
+    pub const fn lobe(self) -> Option<LobeParameters> {
+        match self {
+            Term::Subsurface => Some(LobeParameters {
+                reflectance: Parameter::RhoS,
+                residual: Parameter::D,
+                interface_index: Some(Parameter::NSub),
+                circular: Some(Parameter::DC),
+                residual_slope: Some(Parameter::D1),
+            }),
+            Term::Facet | Term::IdealDepolarizer => None,
+        }
+    }
 
     /// The parameters of the term, in canonical order (the facet term's slope parameters are
     /// those of every distribution: [`super::DistributionKind::parameters`] says which one has

@@ -343,7 +343,7 @@ fn critical_angle_note(spec: &crate::material::ModelSpec) -> Option<String> {
     let internal = terms.facet_side == crate::pbrdf::FacetSide::Internal;
     let indices: Vec<(&str, f64)> = [("n", Some(spec.n))]
         .into_iter()
-        .filter(|_| internal || spec.rho_s.is_some())
+        .filter(|_| internal || !spec.subsurface_lobes().is_empty())
         .chain(std::iter::once((
             "n_sub",
             spec.parameter(crate::pbrdf::Parameter::NSub),

@@ -12,6 +12,7 @@ use crate::common;
 use irpol::optics::{Band, RefractiveIndex};
 use irpol::pbrdf::{
     Direction, FacetSide, HemisphereQuadrature, Pbrdf, Shadowing, SlopeDistribution, Subsurface,
+    Term,
 };
 use irpol::scene::config::{EnvironmentConfig, GroundConfig, SkyConfig};
 use irpol::scene::environment::Environment;
@@ -141,6 +142,7 @@ fn materials() -> Vec<(String, Pbrdf)> {
             .with_volume(
                 side,
                 Some(Subsurface {
+                    term: Term::Subsurface,
                     rho_s,
                     d: sub_d,
                     n_sub: None,

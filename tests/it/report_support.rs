@@ -19,11 +19,7 @@ pub fn truth() -> ModelSpec {
         k: 0.1,
         rho_d: 0.02,
         facet: Default::default(),
-        rho_s: None,
-        d: None,
-        n_sub: None,
-        d_c: None,
-        d1: None,
+        lobe_keys: Default::default(),
         wavelength_um: 9.925,
     }
 }

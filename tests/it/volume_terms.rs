@@ -10,7 +10,7 @@ use irpol::measure::read_measurement_csv;
 use irpol::optics::{Mueller, RefractiveIndex};
 use irpol::pbrdf::{
     Body, Direction, FacetSide, HemisphereQuadrature, ModelTerms, Parameter, Pbrdf, Shadowing,
-    SlopeDistribution, Subsurface, Transmission,
+    SlopeDistribution, Subsurface, Term, Transmission,
 };
 use std::path::Path;
 use std::process::Command;
@@ -33,6 +33,7 @@ fn model(n: f64, k: f64, rho_d: f64, side: FacetSide, subsurface: Option<Subsurf
 
 fn subsurface(rho_s: f64, d: f64) -> Option<Subsurface> {
     Some(Subsurface {
+        term: Term::Subsurface,
         rho_s,
         d,
         n_sub: None,
@@ -84,6 +85,7 @@ fn every_term_is_reciprocal_with_the_facet_terms_q() {
             0.0,
             FacetSide::External,
             Some(Subsurface {
+                term: Term::Subsurface,
                 rho_s: 0.9,
                 d: 0.3,
                 n_sub: Some(1.1),
@@ -135,6 +137,7 @@ fn subsurface_term_conserves_energy_and_stays_realizable() {
             .with_volume(
                 FacetSide::External,
                 Some(Subsurface {
+                    term: Term::Subsurface,
                     rho_s: 1.0,
                     d,
                     n_sub: Some(n),
@@ -178,6 +181,7 @@ fn an_unrealizable_subsurface_depolarizer_is_refused() {
         base.clone().with_volume(
             FacetSide::Internal,
             Some(Subsurface {
+                term: Term::Subsurface,
                 rho_s: 0.5,
                 d,
                 n_sub: None,
@@ -199,6 +203,7 @@ fn an_unrealizable_subsurface_depolarizer_is_refused() {
         base.clone().with_volume(
             FacetSide::Internal,
             Some(Subsurface {
+                term: Term::Subsurface,
                 rho_s: 0.5,
                 d: 0.4,
                 n_sub: None,
@@ -272,10 +277,13 @@ fn synthetic_volume_scatterers_are_recovered_and_their_terms_chosen() {
             assert!(within(value, truth, tolerance), "{file}: {p} = {value}");
         }
         assert!(
-            within(model.rho_s.unwrap(), rho_s, 0.02),
+            within(model.parameter(Parameter::RhoS).unwrap(), rho_s, 0.02),
             "{file}: {model:?}"
         );
-        assert!((model.d.unwrap() - d).abs() <= 0.02, "{file}: {model:?}");
+        assert!(
+            (model.parameter(Parameter::D).unwrap() - d).abs() <= 0.02,
+            "{file}: {model:?}"
+        );
         // The data were made with D's circular part equal to d (d_c absent): the free d_c finds it.
         let d_c = model.parameter(Parameter::DC).unwrap();
         assert!((d_c - d).abs() <= 0.02, "{file}: d_c = {d_c}");
@@ -293,8 +301,8 @@ fn material_files_carry_the_volume_terms() {
     let spec = material.grey_model().unwrap();
     assert_eq!(spec.facet, FacetSide::Internal);
     assert_eq!(
-        (spec.rho_s, spec.d, spec.n_sub),
-        (Some(0.9), Some(0.1), Some(1.2))
+        [Parameter::RhoS, Parameter::D, Parameter::NSub].map(|p| spec.lobe_keys.get(p).copied()),
+        [Some(0.9), Some(0.1), Some(1.2)]
     );
     let pbrdf = spec.pbrdf().unwrap();
     assert_eq!(pbrdf.facet_side(), FacetSide::Internal);
@@ -311,9 +319,10 @@ fn material_files_carry_the_volume_terms() {
     let at = read.at(1.0).unwrap();
     assert_eq!(at.facet, FacetSide::Internal);
     assert_eq!(
-        (at.n, at.rho_s, at.d, at.n_sub),
-        (1.35, Some(0.9), Some(0.1), Some(1.2))
+        [Parameter::RhoS, Parameter::D, Parameter::NSub].map(|p| at.lobe_keys.get(p).copied()),
+        [Some(0.9), Some(0.1), Some(1.2)]
     );
+    assert_eq!(at.n, 1.35);
 }
 
 /// NIST's PTFE through its layout (1.064 µm): today's model fits it only by creating energy
@@ -617,6 +626,7 @@ fn parameters_the_data_do_not_determine_are_named_not_refused() {
 #[test]
 fn subsurface_lobes_add_as_one_lobe_of_their_summed_reflectance() {
     let lobe = |rho_s| Subsurface {
+        term: Term::Subsurface,
         rho_s,
         d: 0.3,
         n_sub: Some(1.3),
@@ -658,4 +668,73 @@ fn subsurface_lobes_add_as_one_lobe_of_their_summed_reflectance() {
     .unwrap()
     .with_volume(FacetSide::External, vec![lobe(0.3), lobe(1.5)]);
     assert!(bad.is_err());
+}
+
+/// The subsurface lobe's flags of `irpol eval` come from the parameter registry: the model they
+/// give is the one the same keys give in a material file (every key, d_c and d1 included), a
+/// lobe's key without its ρ_s is refused in the flags' own words, and a flag beside --material
+/// is named.
+#[test]
+fn eval_flags_of_the_subsurface_lobe_match_the_material_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let lobe = [
+        ("rho_s", "0.8"),
+        ("d", "0.2"),
+        ("n_sub", "1.3"),
+        ("d_c", "0.1"),
+        ("d1", "-0.3"),
+    ];
+    let mut file = "name = \"m\"\ntool_version = \"irpol\"\n[model]\ndistribution = \"cauchy\"\n\
+                    sigma = 0.2\nq = 2.5\nshadowing = \"smith\"\nn = 1.5\nk = 0.01\n\
+                    facet = \"internal\"\nwavelength_um = 10.0\n"
+        .to_owned();
+    let mut flags = vec!["--sigma", "0.2", "--q", "2.5", "--n", "1.5", "--k", "0.01"];
+    flags.extend(["--facet", "internal"]);
+    let names: Vec<String> = lobe
+        .iter()
+        .map(|(key, _)| format!("--{}", key.replace('_', "-")))
+        .collect();
+    for ((key, value), flag) in lobe.iter().zip(&names) {
+        file.push_str(&format!("{key} = {value}\n"));
+        flags.extend([flag.as_str(), value]);
+    }
+    let path = dir.path().join("m.toml");
+    std::fs::write(&path, &file).unwrap();
+    let geometry = ["--theta-i", "50", "--theta-r", "0:80:20", "--phi-r", "60"];
+    let run = |model: &[&str]| {
+        let args: Vec<&str> = ["eval"]
+            .iter()
+            .chain(model)
+            .chain(&geometry)
+            .copied()
+            .collect();
+        let (ok, stdout, stderr) = super::common::irpol(&args);
+        assert!(ok, "{stderr}");
+        stdout
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(str::to_owned)
+            .collect::<Vec<_>>()
+    };
+    let from_flags = run(&flags);
+    let from_file = run(&["--material", path.to_str().unwrap()]);
+    assert_eq!(from_flags, from_file);
+    // d1 and d_c change the table: the flags are read, not ignored.
+    let without_d1 = run(&flags[..flags.len() - 2]);
+    assert_ne!(from_flags, without_d1);
+
+    let orphan = [
+        "eval", "--sigma", "0.2", "--q", "2.5", "--n", "1.5", "--k", "0", "--d-c", "0.1",
+    ];
+    let (ok, _, stderr) =
+        super::common::irpol(&orphan.iter().chain(&geometry).copied().collect::<Vec<_>>());
+    assert!(!ok);
+    assert!(
+        stderr.contains("--d, --n-sub, --d-c and --d1 need --rho-s"),
+        "{stderr}"
+    );
+    let beside = ["eval", "--material", path.to_str().unwrap(), "--d1", "0.1"];
+    let (ok, _, stderr) =
+        super::common::irpol(&beside.iter().chain(&geometry).copied().collect::<Vec<_>>());
+    assert!(!ok && stderr.contains("--d1 with --material"), "{stderr}");
 }

@@ -679,11 +679,7 @@ mod tests {
             k: 0.1,
             rho_d: 0.01,
             facet: Default::default(),
-            rho_s: None,
-            d: None,
-            n_sub: None,
-            d_c: None,
-            d1: None,
+            lobe_keys: Default::default(),
             wavelength_um: 10.0,
         }
     }

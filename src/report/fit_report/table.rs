@@ -475,11 +475,7 @@ mod tests {
             k: 0.2,
             rho_d: 0.0,
             facet: Default::default(),
-            rho_s: None,
-            d: None,
-            n_sub: None,
-            d_c: None,
-            d1: None,
+            lobe_keys: Default::default(),
             wavelength_um: 9.925,
         };
         Material {

@@ -57,9 +57,9 @@ fn shared_lines(model: &SpectralModel, fit: Option<&FitRecord>) -> Vec<Line> {
     }
     // The subsurface parameters the fit shared (one number); per-wavelength ones are in the
     // table below.
-    for (name, value) in model.volume.keys() {
-        if let Some(crate::material::PerWavelength::Shared(v)) = value {
-            lines.push(row(name.to_owned(), *v, name));
+    for (parameter, value) in model.volume.lobe_keys.iter() {
+        if let crate::material::PerWavelength::Shared(v) = value {
+            lines.push(row(parameter.name().to_owned(), *v, parameter.name()));
         }
     }
 
@@ -131,7 +131,7 @@ fn quality_lines(outcome: &SpectralFitOutcome, fit: Option<&FitRecord>) -> Vec<L
 /// n, k, ρd ± 1σ, χ²/obs and points at each wavelength.
 fn wavelength_lines(outcome: &SpectralFitOutcome, model: &SpectralModel) -> Vec<Line> {
     let fit = &outcome.chosen;
-    let rho_s = match &model.volume.rho_s {
+    let rho_s = match model.volume.lobe_keys.get(Parameter::RhoS) {
         Some(crate::material::PerWavelength::Each(values)) => Some(values),
         _ => None,
     };
