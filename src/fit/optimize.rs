@@ -5,6 +5,7 @@ use super::levenberg_marquardt::{levenberg_marquardt, LevenbergMarquardtSettings
 use super::nelder_mead::{nelder_mead, NelderMeadSettings};
 use super::objective::Objective;
 use super::stages::{ConvergenceHistory, Optimizer, Stage};
+use crate::pbrdf::terms::RESTART_COUNT;
 use crate::pbrdf::Parameter;
 use rayon::prelude::*;
 
@@ -121,16 +122,6 @@ fn local_stages(optimizer: &Optimizer) -> Vec<Stage> {
         .collect()
 }
 
-/// Restart points of the local stages (physical σ, q, n, k, ρ_d, ρ_s, d, n_sub, d_c, d1 in [`Parameter::ALL`]
-/// order; only the free parameters are taken from them): smooth, medium and rough surfaces with
-/// low and high index, each with some absorption so that no restart sits on the k = 0
-/// stationary boundary.
-const RESTARTS: [[f64; Parameter::ALL.len()]; 4] = [
-    [0.03, 3.0, 2.0, 0.1, 0.01, 0.5, 0.1, 2.0, 0.1, 0.0],
-    [0.1, 2.0, 1.5, 0.3, 0.01, 0.8, 0.3, 1.5, -0.1, 0.0],
-    [0.3, 3.0, 1.5, 0.05, 0.03, 0.3, 0.05, 1.3, 0.0, 0.0],
-    [0.1, 8.0, 3.0, 1.0, 0.01, 0.9, 0.5, 2.5, 0.5, 0.0],
-];
 /// Values of k tried from a result in the k = 0 trap.
 const EXTINCTION_RESTARTS: [f64; 2] = [0.1, 1.0];
 /// A result with k below this (and k free) may sit in the k = 0 trap.
@@ -174,7 +165,7 @@ fn trap_at(objective: &Objective, point: &[f64]) -> Option<Trap> {
 
 /// When the local stages end in a [`Trap`], runs them again from other starts and keeps the
 /// best result: from the same point with k moved to each of [`EXTINCTION_RESTARTS`] for the
-/// k = 0 trap, from each of the [`RESTARTS`] for a pinned shape. Each remedy is tried at most
+/// k = 0 trap, from each of the registry's restarts ([`crate::pbrdf::ParameterInfo::restarts`]) for a pinned shape. Each remedy is tried at most
 /// once (escaping one trap can land in the other), `tried` holding those already tried (on a
 /// subsample, [`minimize`]); returns them with the new ones. Deterministic.
 fn escape_traps(
@@ -216,12 +207,11 @@ fn escape(
                 space.search(&values)
             })
             .collect(),
-        Trap::PinnedShape => RESTARTS
-            .iter()
+        Trap::PinnedShape => (0..RESTART_COUNT)
             .map(|restart| {
                 let mut values = space.values(point);
                 for &p in space.free() {
-                    values.set(p, restart[p.index()]);
+                    values.set(p, p.info().restarts[restart]);
                 }
                 space.search(&values)
             })

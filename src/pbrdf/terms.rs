@@ -196,7 +196,14 @@ pub struct ParameterInfo {
     pub search: SearchMap,
     /// Which end of its search interval makes a local fit's end point suspect ([`TrapRule`]).
     pub trap: TrapRule,
+    /// Where the local stages restart from a trapped end point (`fit::optimize`): smooth,
+    /// medium and rough surfaces with low and high index, each with some absorption so that no
+    /// restart sits on the k = 0 stationary boundary (only the free parameters are taken).
+    pub restarts: [f64; RESTART_COUNT],
 }
+
+/// The number of restart points of a trapped local fit ([`ParameterInfo::restarts`]).
+pub const RESTART_COUNT: usize = 4;
 
 /// The smooth, monotone map from a parameter's value to the *search coordinate* a fit's
 /// optimizers work in, chosen so that the parameter's plausible range spreads evenly over the
@@ -289,6 +296,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 0.2,
         search: SearchMap::Log,
         trap: TrapRule::EitherBound,
+        restarts: [0.03, 0.1, 0.3, 0.1],
     },
     ParameterInfo {
         key: "q",
@@ -306,6 +314,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 3.0,
         search: SearchMap::LogAboveOne,
         trap: TrapRule::LowerBound,
+        restarts: [3.0, 2.0, 3.0, 8.0],
     },
     ParameterInfo {
         key: "n",
@@ -322,6 +331,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 1.8,
         search: SearchMap::Linear,
         trap: TrapRule::Never,
+        restarts: [2.0, 1.5, 1.5, 3.0],
     },
     ParameterInfo {
         key: "k",
@@ -338,6 +348,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 0.1,
         search: SearchMap::Asinh { scale: K_SEARCH_SCALE },
         trap: TrapRule::Never,
+        restarts: [0.1, 0.3, 0.05, 1.0],
     },
     ParameterInfo {
         key: "rho_d",
@@ -354,6 +365,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 0.02,
         search: SearchMap::Linear,
         trap: TrapRule::Never,
+        restarts: [0.01, 0.01, 0.03, 0.01],
     },
     ParameterInfo {
         key: "rho_s",
@@ -370,6 +382,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 0.5,
         search: SearchMap::Linear,
         trap: TrapRule::Never,
+        restarts: [0.5, 0.8, 0.3, 0.9],
     },
     ParameterInfo {
         key: "d",
@@ -386,6 +399,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 0.1,
         search: SearchMap::Linear,
         trap: TrapRule::Never,
+        restarts: [0.1, 0.3, 0.05, 0.5],
     },
     ParameterInfo {
         key: "n_sub",
@@ -402,6 +416,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 1.4,
         search: SearchMap::Linear,
         trap: TrapRule::Never,
+        restarts: [2.0, 1.5, 1.3, 2.5],
     },
     ParameterInfo {
         key: "d_c",
@@ -418,6 +433,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 0.0,
         search: SearchMap::Linear,
         trap: TrapRule::Never,
+        restarts: [0.1, -0.1, 0.0, 0.5],
     },
     ParameterInfo {
         key: "d1",
@@ -434,6 +450,7 @@ const REGISTRY: [ParameterInfo; Parameter::COUNT] = [
         start: 0.0,
         search: SearchMap::Linear,
         trap: TrapRule::Never,
+        restarts: [0.0, 0.0, 0.0, 0.0],
     },
 ];
 
