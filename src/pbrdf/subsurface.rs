@@ -155,8 +155,13 @@ impl LobeKeysWithoutReflectance {
             Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
             None => String::new(),
         };
+        let (verb, pronoun) = if names.len() == 1 {
+            ("needs", "it belongs")
+        } else {
+            ("need", "they belong")
+        };
         format!(
-            "{listed} need {}: they belong to the {} term",
+            "{listed} {verb} {}: {pronoun} to the {} term",
             name(lobe.reflectance),
             self.term.name()
         )

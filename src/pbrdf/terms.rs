@@ -10,10 +10,11 @@
 //!   ([`ModelTerms`]).
 //!
 //! The fit, the material files, the command line's flags and the reports read this table
-//! instead of repeating it: the fit's bounds, starts, search coordinates and traps are entries
-//! here, and a subsurface lobe's keys are stored by parameter ([`super::LobeKeys`]). A new lobe
-//! term is a [`Term`] with its [`LobeParameters`], its parameters' entries and a [`Body`] that
-//! holds it.
+//! instead of repeating it: the fit's bounds, starts, search coordinates, traps and restarts are
+//! entries here, and a subsurface lobe's keys are stored by parameter ([`super::LobeKeys`]). A
+//! new lobe term is a [`Term`] with its [`LobeParameters`], its parameters' entries, a [`Body`]
+//! that holds it and, for the default fit to try it, a [`ModelTerms::ALL`] entry: nothing
+//! outside this file.
 
 use super::limits;
 use super::subsurface::{FacetSide, LobeParameters};
