@@ -7,12 +7,14 @@ mod band;
 mod batch;
 mod distribution;
 mod error;
+mod facet_side;
 mod geometry;
 mod hemisphere;
 pub mod limits;
 mod lobe_keys;
 mod model;
 mod sample;
+mod search_rules;
 mod shadowing;
 mod subsurface;
 pub mod terms;
@@ -32,7 +34,8 @@ pub use lobe_keys::{lobe_parameters, LobeKeys};
 pub use model::{Pbrdf, ScatteringGeometry};
 pub use sample::ScatteredView;
 pub use shadowing::Shadowing;
-pub use subsurface::{
-    FacetSide, LobeKeysWithoutReflectance, LobeParameters, Subsurface, Transmission,
+pub use facet_side::FacetSide;
+pub use subsurface::{LobeKeysWithoutReflectance, Subsurface, Transmission};
+pub use terms::{
+    Body, LobeParameters, ModelTerms, OutsideDomain, Parameter, ParameterInfo, SpectralRole, Term,
 };
-pub use terms::{Body, ModelTerms, OutsideDomain, Parameter, ParameterInfo, SpectralRole, Term};

@@ -4,7 +4,8 @@
 
 use super::distribution::{CauchySmithTable, PreparedDistribution};
 use super::limits::{within, MAX_K, MAX_N, MIN_N};
-use super::subsurface::{FacetSide, PreparedSubsurface, Subsurface};
+use super::facet_side::FacetSide;
+use super::subsurface::{PreparedSubsurface, Subsurface};
 use super::visible_slopes::VisibleSlopes;
 use super::{ModelError, Shadowing, SlopeDistribution};
 use crate::elementary::{exp_within_range, inline_exp};

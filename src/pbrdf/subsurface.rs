@@ -38,57 +38,10 @@
 //! F(ω_r→ω_i) = Q F(ω_i→ω_r)ᵀ Q. With N = 1 and d = 0 every R is exactly 0, Z exactly 1 and the
 //! term is (ρ_s/π) diag(1,0,0,0) bit for bit: today's ideal depolarizer (§1.3's ρ_d).
 
-use super::{Parameter, Term};
+use super::terms::{Parameter, Term};
 use crate::optics::{FresnelFractions, Mueller, RefractiveIndex};
 use num_complex::Complex64;
-use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_1_PI, PI};
-
-/// Which side of the surface's facets reflects the facet term (docs/design.md §1.10).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FacetSide {
-    /// Reflection off the outside of the surface: relative index N (docs/design.md §1.3).
-    #[default]
-    External,
-    /// Reflection inside grains at grain/air facets: relative index 1/N, total internal
-    /// reflection included (sintered PTFE, powders, pigments).
-    Internal,
-}
-
-impl FacetSide {
-    pub const ALL: [FacetSide; 2] = [FacetSide::External, FacetSide::Internal];
-
-    pub fn name(&self) -> &'static str {
-        match self {
-            FacetSide::External => "external",
-            FacetSide::Internal => "internal",
-        }
-    }
-
-    /// Whether this is the default side (a material file then leaves the key out).
-    pub fn is_external(&self) -> bool {
-        *self == FacetSide::External
-    }
-
-    pub fn parse(text: &str) -> Option<FacetSide> {
-        FacetSide::ALL.into_iter().find(|s| s.name() == text.trim())
-    }
-
-    /// The permittivity the facets' Fresnel coefficients see: N² outside; inside, the relative
-    /// permittivity of air to the grain, 1/N², taken as N²/|N|⁴ = conj(1/N²). Why the
-    /// conjugate: 1/N² has Im < 0 for k > 0, and under total internal reflection the principal
-    /// root w = √(ε − sin²β) then jumps from +i√a (k = 0, the evanescent wave decaying into the
-    /// air) to −i√a for any k > 0, flipping the sign of the retardance m23, m32; with Im ε ≥ 0
-    /// the coefficients are continuous in k, |r| ≤ 1, and k = 0 is unchanged. (conj also turns
-    /// the −0 imaginary part of 1/n² into +0, which keeps k = 0 itself on the physical branch.)
-    pub(super) fn facet_permittivity(&self, index: RefractiveIndex) -> Complex64 {
-        match self {
-            FacetSide::External => index.permittivity(),
-            FacetSide::Internal => index.permittivity().inv().conj(),
-        }
-    }
-}
 
 /// The parameters of a subsurface lobe: ρ_s ∈ [0, 1], the fraction of the transmitted light
 /// that comes back out, d ∈ [0, 1], its residual polarization, and the real index n_sub of the
@@ -108,32 +61,6 @@ pub struct Subsurface {
     /// The residual polarization's change with the scattering angle Θ, d(Θ) = d + d1 cos Θ;
     /// absent: 0.
     pub d1: Option<f64>,
-}
-
-/// Which parameter of a lobe term ([`Term::lobe`]) is which field of [`Subsurface`]; a lobe
-/// without an `interface_index`, `circular` or `residual_slope` parameter takes that field's
-/// default (n, d, 0).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct LobeParameters {
-    pub reflectance: Parameter,
-    pub residual: Parameter,
-    pub interface_index: Option<Parameter>,
-    pub circular: Option<Parameter>,
-    pub residual_slope: Option<Parameter>,
-}
-
-impl LobeParameters {
-    /// The parameters other than the reflectance, in [`Parameter::ALL`] order.
-    fn dependents(&self) -> impl Iterator<Item = Parameter> {
-        [
-            Some(self.residual),
-            self.interface_index,
-            self.circular,
-            self.residual_slope,
-        ]
-        .into_iter()
-        .flatten()
-    }
 }
 
 /// A lobe's d, n_sub, d_c or d1 given without its ρ_s (in a material file, a scene's inline

@@ -17,7 +17,8 @@
 //! outside this file.
 
 use super::limits;
-use super::subsurface::{FacetSide, LobeParameters};
+use super::facet_side::FacetSide;
+pub use super::search_rules::{SearchMap, TrapRule};
 use crate::text::number;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -153,6 +154,32 @@ impl fmt::Display for ModelTerms {
     }
 }
 
+/// Which parameter of a lobe term ([`Term::lobe`]) is which field of [`super::Subsurface`]; a lobe
+/// without an `interface_index`, `circular` or `residual_slope` parameter takes that field's
+/// default (n, d, 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LobeParameters {
+    pub reflectance: Parameter,
+    pub residual: Parameter,
+    pub interface_index: Option<Parameter>,
+    pub circular: Option<Parameter>,
+    pub residual_slope: Option<Parameter>,
+}
+
+impl LobeParameters {
+    /// The parameters other than the reflectance, in [`Parameter::ALL`] order.
+    pub(super) fn dependents(&self) -> impl Iterator<Item = Parameter> {
+        [
+            Some(self.residual),
+            self.interface_index,
+            self.circular,
+            self.residual_slope,
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
 /// How a parameter varies over the wavelengths of a spectral fit (docs/design.md §1.9–1.10).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SpectralRole {
@@ -205,76 +232,6 @@ pub struct ParameterInfo {
 
 /// The number of restart points of a trapped local fit ([`ParameterInfo::restarts`]).
 pub const RESTART_COUNT: usize = 4;
-
-/// The smooth, monotone map from a parameter's value to the *search coordinate* a fit's
-/// optimizers work in, chosen so that the parameter's plausible range spreads evenly over the
-/// search box.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum SearchMap {
-    /// The value itself: parameters that enter the Mueller elements (nearly) linearly.
-    Linear,
-    /// ln v: a parameter that spans decades (roughness).
-    Log,
-    /// ln(v − 1): a tail exponent whose tail weight goes as 1/(v − 1).
-    LogAboveOne,
-    /// asinh(v / scale): linear below ~scale (0 is an ordinary point), logarithmic above.
-    Asinh { scale: f64 },
-}
-
-impl SearchMap {
-    /// The search coordinate of `value`.
-    pub fn to_search(self, value: f64) -> f64 {
-        match self {
-            SearchMap::Linear => value,
-            SearchMap::Log => value.ln(),
-            SearchMap::LogAboveOne => (value - 1.0).ln(),
-            SearchMap::Asinh { scale } => (value / scale).asinh(),
-        }
-    }
-
-    /// Inverse of [`SearchMap::to_search`].
-    pub fn from_search(self, coordinate: f64) -> f64 {
-        match self {
-            SearchMap::Linear => coordinate,
-            SearchMap::Log => coordinate.exp(),
-            SearchMap::LogAboveOne => 1.0 + coordinate.exp(),
-            SearchMap::Asinh { scale } => scale * coordinate.sinh(),
-        }
-    }
-
-    /// d(value)/d(coordinate) of [`SearchMap::from_search`], to carry Jacobians to values.
-    pub fn value_per_coordinate(self, coordinate: f64) -> f64 {
-        match self {
-            SearchMap::Linear => 1.0,
-            SearchMap::Log | SearchMap::LogAboveOne => coordinate.exp(),
-            SearchMap::Asinh { scale } => scale * coordinate.cosh(),
-        }
-    }
-}
-
-/// Which bound of its search interval, reached by a local fit, marks the fit as trapped in a
-/// degenerate shape (a surface of no slope or all slope, a tail that holds every facet) and
-/// sends the local stages to restart elsewhere (`fit::optimize`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TrapRule {
-    /// Either bound is an ordinary answer (an index, a reflectance).
-    Never,
-    /// Both bounds are degenerate (σ).
-    EitherBound,
-    /// The lower bound is degenerate (q → 1: all facets in the tail).
-    LowerBound,
-}
-
-impl TrapRule {
-    /// Whether a point at the lower (`at_lower`) or the upper (`at_upper`) bound is a trap.
-    pub fn traps(self, at_lower: bool, at_upper: bool) -> bool {
-        match self {
-            TrapRule::Never => false,
-            TrapRule::EitherBound => at_lower || at_upper,
-            TrapRule::LowerBound => at_lower,
-        }
-    }
-}
 
 /// Scale of the asinh search map of k: below ~0.1 the search coordinate is linear in k (k = 0 is
 /// an ordinary point), above it logarithmic (metals reach k ≈ 50 in the LWIR).
