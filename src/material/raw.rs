@@ -9,7 +9,7 @@ use super::{MaterialModel, ModelSpec, SpectralModel};
 use crate::measure::SAME_WAVELENGTH_UM;
 use crate::optics::{LorentzDispersion, MAX_WAVELENGTH_UM, MIN_WAVELENGTH_UM};
 use crate::pbrdf::{
-    table_fields, DistributionError, DistributionKind, FacetSide, LobeKeys,
+    read_table, table_fields, DistributionError, DistributionKind, FacetSide, LobeKeys,
     LobeKeysWithoutReflectance, Shadowing,
 };
 use crate::text::number;
@@ -64,14 +64,13 @@ impl<'de, V: Deserialize<'de>> Visitor<'de> for RawModelVisitor<V> {
         f.write_str("a [model] table")
     }
 
-    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawModel<V>, A::Error> {
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<RawModel<V>, A::Error> {
         static FIELDS: LazyLock<Vec<&'static str>> = LazyLock::new(|| table_fields(&MODEL_KEYS));
         let (mut distribution, mut sigma, mut q, mut shadowing) = (None, None, None, None);
         let (mut n, mut k, mut rho_d, mut facet) = (None, None, None, None);
         let (mut wavelength_um, mut dispersion) = (None, None);
-        let mut lobe_keys = LobeKeys::default();
-        while let Some(key) = map.next_key::<String>()? {
-            match key.as_str() {
+        let lobe_keys = read_table(map, &FIELDS, |key, map| {
+            match key {
                 "distribution" => distribution = Some(map.next_value()?),
                 "sigma" => sigma = Some(map.next_value()?),
                 "q" => q = map.next_value()?,
@@ -82,13 +81,10 @@ impl<'de, V: Deserialize<'de>> Visitor<'de> for RawModelVisitor<V> {
                 "facet" => facet = Some(map.next_value()?),
                 "wavelength_um" => wavelength_um = Some(map.next_value()?),
                 "dispersion" => dispersion = map.next_value()?,
-                other => {
-                    if !lobe_keys.read_key(other, &mut map)? {
-                        return Err(A::Error::unknown_field(other, &FIELDS));
-                    }
-                }
+                _ => return Ok(false),
             }
-        }
+            Ok(true)
+        })?;
         let missing = A::Error::missing_field;
         Ok(RawModel {
             distribution: distribution.ok_or_else(|| missing("distribution"))?,

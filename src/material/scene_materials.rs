@@ -4,7 +4,7 @@
 use super::{find_material, BandModelError, Material, MaterialError, MaterialModel, SpectralModel};
 use crate::optics::{Band, RefractiveIndex, TableMissesBand};
 use crate::pbrdf::{
-    slope_distribution, table_fields, DistributionError, FacetSide, LobeKeys,
+    read_table, slope_distribution, table_fields, DistributionError, FacetSide, LobeKeys,
     LobeKeysWithoutReflectance, MaterialOptics, ModelError, Pbrdf,
 };
 use serde::de::{Deserializer, Error as _, MapAccess, Visitor};
@@ -59,13 +59,12 @@ impl<'de> Visitor<'de> for InlineMaterialVisitor {
         f.write_str("an inline material table")
     }
 
-    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<InlineMaterialConfig, A::Error> {
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<InlineMaterialConfig, A::Error> {
         static FIELDS: LazyLock<Vec<&'static str>> = LazyLock::new(|| table_fields(&INLINE_KEYS));
         let (mut distribution, mut sigma, mut q, mut n, mut k) = (None, None, None, None, None);
         let (mut rho_d, mut shadowing, mut facet) = (None, None, None);
-        let mut lobe_keys = LobeKeys::default();
-        while let Some(key) = map.next_key::<String>()? {
-            match key.as_str() {
+        let lobe_keys = read_table(map, &FIELDS, |key, map| {
+            match key {
                 "distribution" => distribution = Some(map.next_value()?),
                 "sigma" => sigma = Some(map.next_value()?),
                 "q" => q = map.next_value()?,
@@ -74,13 +73,10 @@ impl<'de> Visitor<'de> for InlineMaterialVisitor {
                 "rho_d" => rho_d = Some(map.next_value()?),
                 "shadowing" => shadowing = Some(map.next_value()?),
                 "facet" => facet = Some(map.next_value()?),
-                other => {
-                    if !lobe_keys.read_key(other, &mut map)? {
-                        return Err(A::Error::unknown_field(other, &FIELDS));
-                    }
-                }
+                _ => return Ok(false),
             }
-        }
+            Ok(true)
+        })?;
         let missing = A::Error::missing_field;
         Ok(InlineMaterialConfig {
             distribution: distribution.ok_or_else(|| missing("distribution"))?,

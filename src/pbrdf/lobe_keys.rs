@@ -5,7 +5,7 @@
 
 use super::subsurface::{LobeKeysWithoutReflectance, Subsurface};
 use super::terms::{Body, Parameter, Term};
-use serde::de::MapAccess;
+use serde::de::{Error as _, MapAccess};
 use serde::ser::{Serialize, SerializeMap, Serializer};
 
 /// The values of the lobe terms' parameters that are written, `V` a number (a grey model) or a
@@ -77,22 +77,6 @@ impl<V> LobeKeys<V> {
             .find(|b| b.lobe_terms().eq(self.present_terms()))
             .unwrap_or_default()
     }
-
-    /// Reads the value of `key` from a table being deserialized when `key` is a lobe
-    /// parameter's, and says whether it was (the table's other keys are its reader's).
-    pub fn read_key<'de, A>(&mut self, key: &str, map: &mut A) -> Result<bool, A::Error>
-    where
-        A: MapAccess<'de>,
-        V: serde::Deserialize<'de>,
-    {
-        match lobe_parameters().find(|p| p.name() == key) {
-            Some(parameter) => {
-                self.set(parameter, Some(map.next_value()?));
-                Ok(true)
-            }
-            None => Ok(false),
-        }
-    }
 }
 
 impl LobeKeys<f64> {
@@ -138,4 +122,30 @@ pub fn table_fields(fixed: &[&'static str]) -> Vec<&'static str> {
         .copied()
         .chain(lobe_parameters().map(|p| p.name()))
         .collect()
+}
+
+/// Reads every entry of a table being deserialized that holds lobe keys beside its own (a
+/// material's `[model]`, a scene's inline material): `own` takes a key of the table's own and
+/// says whether it was one, the lobes' keys are returned, and any other key is refused by name
+/// with `fields`, the whole list ([`table_fields`]).
+pub fn read_table<'de, A, V>(
+    mut map: A,
+    fields: &'static [&'static str],
+    mut own: impl FnMut(&str, &mut A) -> Result<bool, A::Error>,
+) -> Result<LobeKeys<V>, A::Error>
+where
+    A: MapAccess<'de>,
+    V: serde::Deserialize<'de>,
+{
+    let mut keys = LobeKeys::default();
+    while let Some(key) = map.next_key::<String>()? {
+        if own(&key, &mut map)? {
+            continue;
+        }
+        match lobe_parameters().find(|p| p.name() == key) {
+            Some(parameter) => keys.set(parameter, Some(map.next_value()?)),
+            None => return Err(A::Error::unknown_field(&key, fields)),
+        }
+    }
+    Ok(keys)
 }

@@ -27,14 +27,14 @@ pub use distribution::{
     parse_distribution, slope_distribution, DistributionError, DistributionKind, SlopeDistribution,
 };
 pub use error::ModelError;
+pub use facet_side::FacetSide;
 pub use geometry::{fold_signed_zenith, signed_zenith_note};
 pub use hemisphere::{cosine_hemisphere_rule, HemisphereQuadrature};
-pub(crate) use lobe_keys::table_fields;
 pub use lobe_keys::{lobe_parameters, LobeKeys};
+pub(crate) use lobe_keys::{read_table, table_fields};
 pub use model::{Pbrdf, ScatteringGeometry};
 pub use sample::ScatteredView;
 pub use shadowing::Shadowing;
-pub use facet_side::FacetSide;
 pub use subsurface::{LobeKeysWithoutReflectance, Subsurface, Transmission};
 pub use terms::{
     Body, LobeParameters, ModelTerms, OutsideDomain, Parameter, ParameterInfo, SpectralRole, Term,

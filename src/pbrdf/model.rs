@@ -3,8 +3,8 @@
 //! M = L(−η_r) F_fres(β) L(η_i).
 
 use super::distribution::{CauchySmithTable, PreparedDistribution};
-use super::limits::{within, MAX_K, MAX_N, MIN_N};
 use super::facet_side::FacetSide;
+use super::limits::{within, MAX_K, MAX_N, MIN_N};
 use super::subsurface::{PreparedSubsurface, Subsurface};
 use super::visible_slopes::VisibleSlopes;
 use super::{ModelError, Shadowing, SlopeDistribution};

@@ -16,8 +16,8 @@
 //! that holds it and, for the default fit to try it, a [`ModelTerms::ALL`] entry: nothing
 //! outside this file.
 
-use super::limits;
 use super::facet_side::FacetSide;
+use super::limits;
 pub use super::search_rules::{SearchMap, TrapRule};
 use crate::text::number;
 use serde::{Deserialize, Serialize};
