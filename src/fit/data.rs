@@ -57,7 +57,7 @@ impl MeasurementData {
         check_elements(set)?;
         let width = set.elements.len();
         let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
-        let floor = DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE);
+        let floor = default_floor(m00_max);
 
         let mut zeniths = DistinctCosines::default();
         let mut geometry = Vec::with_capacity(set.points.len());
@@ -76,11 +76,7 @@ impl MeasurementData {
             for (column, (&value, uncertainty)) in
                 point.values.iter().zip(&point.uncertainties).enumerate()
             {
-                let sigma = match uncertainty {
-                    Some(u) => *u,
-                    None if column == 0 => (DEFAULT_M00_RELATIVE_ERROR * m00).max(floor),
-                    None => (DEFAULT_OTHER_ERROR_PER_M00 * m00).max(floor),
-                };
+                let sigma = uncertainty.unwrap_or_else(|| default_sigma(column, m00, floor));
                 if !(value.is_finite() && sigma.is_finite() && sigma > 0.0) {
                     return Err(at_line(format!(
                         "{} = {value} ± {sigma} is not a usable observation",
@@ -131,16 +127,46 @@ impl MeasurementData {
         (self.values[index], 1.0 / self.inverse_sigma[index])
     }
 
+    /// The points `rows` (ascending), exactly as [`MeasurementData::new`] prepares a set of
+    /// those rows alone (a cross-validation fold): the default noise model's floor is the
+    /// subset's, the zenith list that of its points. No copy of the set's rows is made.
+    pub(crate) fn rows(&self, rows: &[usize]) -> MeasurementData {
+        let width = self.elements.len();
+        let m00_max = rows
+            .iter()
+            .map(|&p| self.values[p * width])
+            .fold(0.0, f64::max);
+        let floor = default_floor(m00_max);
+        let mut subset = self.with_points(rows.iter().copied(), rows.len());
+        for (point, chunk) in subset.inverse_sigma.chunks_mut(width).enumerate() {
+            let m00 = subset.values[point * width];
+            for (column, inverse) in chunk.iter_mut().enumerate() {
+                if self.error_sources[column] == ErrorSource::DefaultModel {
+                    *inverse = 1.0 / default_sigma(column, m00, floor);
+                }
+            }
+        }
+        subset
+    }
+
     /// Every `stride`-th point, from the first, with the same standard deviations (the default
     /// noise model's floor stays the whole file's) and the zenith list of those points only, so
     /// that an evaluation costs what the subsample holds.
     pub(crate) fn every_nth(&self, stride: usize) -> MeasurementData {
+        let count = self.points().div_ceil(stride);
+        self.with_points((0..self.points()).step_by(stride), count)
+    }
+
+    /// The points `points` (`count` of them, ascending) with their standard deviations as they
+    /// are, and the zenith list of those points only.
+    fn with_points(&self, points: impl Iterator<Item = usize>, count: usize) -> MeasurementData {
         let width = self.elements.len();
         let mut zeniths = DistinctCosines::default();
-        let mut geometry = Vec::with_capacity(self.points().div_ceil(stride));
-        let mut values = Vec::with_capacity(geometry.capacity() * width);
-        let mut inverse_sigma = Vec::with_capacity(values.capacity());
-        for (point, g) in self.geometry.iter().enumerate().step_by(stride) {
+        let mut geometry = Vec::with_capacity(count);
+        let mut values = Vec::with_capacity(count * width);
+        let mut inverse_sigma = Vec::with_capacity(count * width);
+        for point in points {
+            let g = &self.geometry[point];
             geometry.push(PreparedGeometry {
                 scattering: g.scattering,
                 incident_zenith: zeniths.index(self.zenith_cosines[g.incident_zenith]),
@@ -159,6 +185,22 @@ impl MeasurementData {
             error_sources: self.error_sources.clone(),
         }
     }
+}
+
+/// The default noise model's standard deviation of element `column` (0: m00) of a point whose
+/// m00 is `m00`, at least `floor`.
+fn default_sigma(column: usize, m00: f64, floor: f64) -> f64 {
+    let relative = if column == 0 {
+        DEFAULT_M00_RELATIVE_ERROR
+    } else {
+        DEFAULT_OTHER_ERROR_PER_M00
+    };
+    (relative * m00).max(floor)
+}
+
+/// The default noise model's floor for a set whose largest m00 is `m00_max`.
+fn default_floor(m00_max: f64) -> f64 {
+    DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE)
 }
 
 /// The refusal of `set` for `message`.
