@@ -54,39 +54,18 @@ pub struct MeasurementData {
 
 impl MeasurementData {
     pub fn new(set: &MeasurementSet) -> Result<MeasurementData, FitError> {
-        check_elements(set)?;
         let width = set.elements.len();
-        let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
-        let floor = default_floor(m00_max);
-
-        let mut zeniths = DistinctCosines::default();
         let mut geometry = Vec::with_capacity(set.points.len());
         let mut values = Vec::with_capacity(set.points.len() * width);
         let mut inverse_sigma = Vec::with_capacity(set.points.len() * width);
-        for point in &set.points {
-            let at_line = |what: String| refusal(set, format!("line {}: {what}", point.line));
-            if point.values.len() != width || point.uncertainties.len() != width {
-                return Err(at_line(format!(
-                    "{} values for {width} elements",
-                    point.values.len()
-                )));
-            }
-            geometry.push(prepare_geometry(point, &mut zeniths, &at_line)?);
-            let m00 = point.values[0];
-            for (column, (&value, uncertainty)) in
-                point.values.iter().zip(&point.uncertainties).enumerate()
-            {
-                let sigma = uncertainty.unwrap_or_else(|| default_sigma(column, m00, floor));
-                if !(value.is_finite() && sigma.is_finite() && sigma > 0.0) {
-                    return Err(at_line(format!(
-                        "{} = {value} ± {sigma} is not a usable observation",
-                        MUELLER_ELEMENT_NAMES[set.elements[column]]
-                    )));
-                }
+        let zeniths = visit_observations(
+            set,
+            |g| geometry.push(g),
+            |value, sigma| {
                 values.push(value);
                 inverse_sigma.push(1.0 / sigma);
-            }
-        }
+            },
+        )?;
         Ok(MeasurementData {
             geometry,
             zenith_cosines: zeniths.cosines,
@@ -185,6 +164,55 @@ impl MeasurementData {
             error_sources: self.error_sources.clone(),
         }
     }
+}
+
+/// The standard deviation of every observation of `set`, point-major, as the fit weighs it
+/// (exactly what [`MeasurementData::observation`] returns, 1/(1/σ)), after the same checks as
+/// [`MeasurementData::new`]; without the prepared geometry, for a caller that needs only the
+/// weights (the fit report: a third of the memory of the prepared data).
+pub fn observation_sigmas(set: &MeasurementSet) -> Result<Vec<f64>, FitError> {
+    let mut sigmas = Vec::with_capacity(set.points.len() * set.elements.len());
+    visit_observations(set, |_| {}, |_, sigma| sigmas.push(1.0 / (1.0 / sigma)))?;
+    Ok(sigmas)
+}
+
+/// Checks every point of `set` and hands its prepared geometry to `geometry` and each of its
+/// observations, value and standard deviation, to `observation`; returns the distinct zenith
+/// cosines the geometries index.
+fn visit_observations(
+    set: &MeasurementSet,
+    mut geometry: impl FnMut(PreparedGeometry),
+    mut observation: impl FnMut(f64, f64),
+) -> Result<DistinctCosines, FitError> {
+    check_elements(set)?;
+    let width = set.elements.len();
+    let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
+    let floor = default_floor(m00_max);
+    let mut zeniths = DistinctCosines::default();
+    for point in &set.points {
+        let at_line = |what: String| refusal(set, format!("line {}: {what}", point.line));
+        if point.values.len() != width || point.uncertainties.len() != width {
+            return Err(at_line(format!(
+                "{} values for {width} elements",
+                point.values.len()
+            )));
+        }
+        geometry(prepare_geometry(point, &mut zeniths, &at_line)?);
+        let m00 = point.values[0];
+        for (column, (&value, uncertainty)) in
+            point.values.iter().zip(&point.uncertainties).enumerate()
+        {
+            let sigma = uncertainty.unwrap_or_else(|| default_sigma(column, m00, floor));
+            if !(value.is_finite() && sigma.is_finite() && sigma > 0.0) {
+                return Err(at_line(format!(
+                    "{} = {value} ± {sigma} is not a usable observation",
+                    MUELLER_ELEMENT_NAMES[set.elements[column]]
+                )));
+            }
+            observation(value, sigma);
+        }
+    }
+    Ok(zeniths)
 }
 
 /// The default noise model's standard deviation of element `column` (0: m00) of a point whose

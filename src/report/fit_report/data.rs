@@ -3,7 +3,7 @@
 //! deviation and normalized residual, and the chosen and competing models evaluated along each
 //! plane and ring and as polarized emissivity (docs/design.md §1.3–1.4).
 
-use crate::fit::MeasurementData;
+use crate::fit::observation_sigmas;
 use crate::material::Material;
 use crate::measure::MeasurementSet;
 use crate::optics::{rotation_between_frames, FrameTurn, Mueller, Stokes};
@@ -190,7 +190,7 @@ fn point_views(
 ) -> Result<(Vec<PointView>, Vec<Residual>), ReportError> {
     // The standard deviations the fit weighted by (the file's u_ columns or the fit's default
     // noise model), so that report residuals are the ones the optimizer minimized.
-    let weights = MeasurementData::new(set)?;
+    let sigmas = observation_sigmas(set)?;
     let elements_per_point = set.elements.len();
     let mut points = Vec::with_capacity(set.points.len());
     let mut residuals = Vec::with_capacity(set.points.len() * elements_per_point);
@@ -209,7 +209,7 @@ fn point_views(
         let mut readings = [None; 16];
         for (column, &element) in set.elements.iter().enumerate() {
             let value = p.values[column];
-            let (_, sigma) = weights.observation(point * elements_per_point + column);
+            let sigma = sigmas[point * elements_per_point + column];
             readings[element] = Some(Reading { value, sigma });
         }
         let model = chosen.pbrdf.mueller(&incident, &scattered);
