@@ -313,3 +313,58 @@ fn error_sources(set: &MeasurementSet) -> Vec<ErrorSource> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::MeasurementPoint;
+
+    /// A fold prepared from the whole set's data is what preparing the fold's rows alone gives:
+    /// the default noise model's floor follows the fold's largest m00 (here a row with m00 = 0
+    /// sits on it), the file's uncertainties stay, the zenith list is the fold's own.
+    #[test]
+    fn rows_of_the_prepared_data_are_the_rows_prepared_alone() {
+        let point = |theta_i: f64, theta_r: f64, m00: f64| MeasurementPoint {
+            theta_i_deg: theta_i,
+            phi_i_deg: 0.0,
+            theta_r_deg: theta_r,
+            phi_r_deg: 180.0,
+            values: vec![m00, 0.1 * m00],
+            uncertainties: vec![None, Some(2e-3)],
+            line: 0,
+        };
+        let set = MeasurementSet {
+            source: "fold.csv".into(),
+            sha256: String::new(),
+            material: "fold".into(),
+            wavelength_um: 10.0,
+            metadata: Default::default(),
+            elements: vec![0, 4],
+            points: vec![
+                point(10.0, 20.0, 4.0),
+                point(30.0, 20.0, 0.0),
+                point(50.0, 40.0, 0.5),
+                point(10.0, 60.0, 0.25),
+            ],
+            merged: Vec::new(),
+            notes: Vec::new(),
+        };
+        let whole = MeasurementData::new(&set).unwrap();
+        let rows = [1, 2, 3];
+        let fold = whole.rows(&rows);
+        let alone = MeasurementData::new(&super::super::subset(&set, &rows)).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&fold.values), bits(&alone.values));
+        assert_eq!(bits(&fold.inverse_sigma), bits(&alone.inverse_sigma));
+        assert_eq!(bits(&fold.zenith_cosines), bits(&alone.zenith_cosines));
+        let zeniths = |d: &MeasurementData| {
+            d.geometry
+                .iter()
+                .map(|g| (g.incident_zenith, g.scattered_zenith))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(zeniths(&fold), zeniths(&alone));
+        // The whole file's floor (1e-6 × 4) is not the fold's (1e-6 × 0.5).
+        assert_ne!(whole.inverse_sigma[2], fold.inverse_sigma[0]);
+    }
+}

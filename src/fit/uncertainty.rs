@@ -99,10 +99,15 @@ fn information_matrix(objective: &Objective, search: &[f64]) -> Option<DMatrix<f
             })
             .collect();
         let block = DMatrix::from_iterator(rows, n, columns.into_iter().flatten());
-        let beta = if pass == 0 { 0.0 } else { 1.0 };
-        information.gemm(1.0, &block.transpose(), &block, beta);
+        add_information(&mut information, &block, pass == 0);
     }
     Some(information)
+}
+
+/// Adds JᵀJ of a block of J's rows to `information` (overwritten by the `first` block's).
+fn add_information(information: &mut DMatrix<f64>, block: &DMatrix<f64>, first: bool) {
+    let beta = if first { 0.0 } else { 1.0 };
+    information.gemm(1.0, &block.transpose(), block, beta);
 }
 
 /// The point ranges of [`information_matrix`]'s blocks: [`CHUNK_POINTS`] points each (a
@@ -236,4 +241,38 @@ fn identity(n: usize) -> Vec<Vec<f64>> {
     (0..n)
         .map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The blocked sum is `Jᵀ * J` of the whole J to the last bit, through matrixmultiply (more
+    /// than 5 parameters) and through nalgebra's own product (5 or fewer), with a thin tail of
+    /// 3 observations folded into the last block.
+    #[test]
+    fn blocked_information_is_the_whole_product_bit_for_bit() {
+        let width = 3;
+        let points = 3 * CHUNK_POINTS + 1;
+        let blocks = jacobian_blocks(points, width);
+        assert_eq!(blocks.len(), 3);
+        assert_eq!(blocks[2], 2 * CHUNK_POINTS..points);
+        for parameters in [7, 4] {
+            let rows = points * width;
+            // Entries of mixed sign and magnitude, so that the summation order shows.
+            let jacobian = DMatrix::from_fn(rows, parameters, |i, j| {
+                ((i * 31 + j * 17) as f64 * 0.37).sin() * 10f64.powi((i % 7) as i32 - 3)
+            });
+            let whole = jacobian.transpose() * &jacobian;
+            let mut blocked = DMatrix::zeros(parameters, parameters);
+            for (pass, range) in blocks.iter().enumerate() {
+                let block = jacobian
+                    .rows(range.start * width, range.len() * width)
+                    .into_owned();
+                add_information(&mut blocked, &block, pass == 0);
+            }
+            let bits = |m: &DMatrix<f64>| m.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&blocked), bits(&whole), "{parameters} parameters");
+        }
+    }
 }
