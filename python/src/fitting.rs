@@ -101,17 +101,12 @@ fn outcome_dict<'py>(py: Python<'py>, outcome: &MaterialFit) -> PyResult<Bound<'
             d.set_item("chi2", fit.chi2)?;
             d.set_item("observations", fit.observations)?;
             d.set_item("measurements", vec![set_dict(py, &o.measurement)?])?;
-            d.set_item(
-                "model_mueller",
-                vec![mueller_rows(py, &fit.model_muellers)?],
-            )?;
+            let muellers = o.model_muellers().map_err(raised)?;
+            d.set_item("model_mueller", vec![mueller_rows(py, &muellers)?])?;
+            let residuals = o.normalized_residuals().map_err(raised)?;
             d.set_item(
                 "normalized_residuals",
-                vec![residual_rows(
-                    py,
-                    &fit.normalized_residuals,
-                    &o.measurement,
-                )?],
+                vec![residual_rows(py, &residuals, &o.measurement)?],
             )?;
         }
         MaterialFit::Spectral(o) => {

@@ -131,9 +131,10 @@ pub(super) fn score_terms(
     let fitted = fit_distributions(set, data, options)?;
     let fit = &fitted.chosen;
     let folds = match folds {
-        Some(k) => cross_validate(set, options, fit, k)?,
+        Some(k) => cross_validate(set, data, options, fit, k)?,
         None => Vec::new(),
     };
+    let muellers = fit.model_muellers(set, data, options)?;
     let score = TermsScore {
         terms: options.terms,
         distribution: fit.distribution,
@@ -141,7 +142,7 @@ pub(super) fn score_terms(
         reduced_chi2: fit.reduced_chi2,
         aic: fit.aic,
         folds,
-        inadmissible: why_inadmissible(&[&fit.model], &[&fit.model_muellers]),
+        inadmissible: why_inadmissible(&[&fit.model], &[&muellers]),
     };
     Ok((fitted, score))
 }
@@ -175,10 +176,12 @@ pub(super) fn choose_spectral_terms(
             .map(|(set, data)| score_terms(set, data, &options, folds))
             .collect::<Result<Vec<_>, _>>()?;
         let models: Vec<_> = parts.iter().map(|p| &p.0.chosen.model).collect();
-        let muellers: Vec<_> = parts
+        let muellers = parts
             .iter()
-            .map(|p| p.0.chosen.model_muellers.as_slice())
-            .collect();
+            .zip(sets.iter().zip(&data))
+            .map(|(p, (set, data))| p.0.chosen.model_muellers(set, data, &options))
+            .collect::<Result<Vec<_>, _>>()?;
+        let muellers: Vec<_> = muellers.iter().map(Vec::as_slice).collect();
         let inadmissible = why_inadmissible(&models, &muellers);
         let (fitted, part_scores): (Vec<Fitted>, Vec<TermsScore>) = parts.into_iter().unzip();
         scores.push(TermsScore::combined(&part_scores, inadmissible));
@@ -233,6 +236,7 @@ pub fn subset(set: &MeasurementSet, rows: &[usize]) -> MeasurementSet {
 /// [`super::energy`]).
 fn cross_validate(
     set: &MeasurementSet,
+    data: &MeasurementData,
     options: &FitOptions,
     fit: &ModelFit,
     k: usize,
@@ -249,17 +253,11 @@ fn cross_validate(
         let training: Vec<usize> = (0..set.points.len())
             .filter(|r| held_out.binary_search(r).is_err())
             .collect();
-        let train = subset(set, &training);
-        let refit = fit_model(
-            &train,
-            &MeasurementData::new(&train)?,
-            fit.distribution,
-            &options,
-        )?;
+        // The fold's rows as prepared data (no copy of the set's rows); errors name the file.
+        let refit = fit_model(set, &data.rows(&training), fit.distribution, &options)?;
         let effective = refit.effective_options(&options);
         let space = model_space(fit.distribution, &effective)?;
-        let test = subset(set, &held_out);
-        let test_data = MeasurementData::new(&test)?;
+        let test_data = data.rows(&held_out);
         let residuals = Objective::new(&test_data, &space, None)
             .normalized_residuals(&refit.parameter_values(&effective))
             .unwrap_or_default();

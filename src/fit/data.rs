@@ -54,43 +54,18 @@ pub struct MeasurementData {
 
 impl MeasurementData {
     pub fn new(set: &MeasurementSet) -> Result<MeasurementData, FitError> {
-        check_elements(set)?;
         let width = set.elements.len();
-        let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
-        let floor = DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE);
-
-        let mut zeniths = DistinctCosines::default();
         let mut geometry = Vec::with_capacity(set.points.len());
         let mut values = Vec::with_capacity(set.points.len() * width);
         let mut inverse_sigma = Vec::with_capacity(set.points.len() * width);
-        for point in &set.points {
-            let at_line = |what: String| refusal(set, format!("line {}: {what}", point.line));
-            if point.values.len() != width || point.uncertainties.len() != width {
-                return Err(at_line(format!(
-                    "{} values for {width} elements",
-                    point.values.len()
-                )));
-            }
-            geometry.push(prepare_geometry(point, &mut zeniths, &at_line)?);
-            let m00 = point.values[0];
-            for (column, (&value, uncertainty)) in
-                point.values.iter().zip(&point.uncertainties).enumerate()
-            {
-                let sigma = match uncertainty {
-                    Some(u) => *u,
-                    None if column == 0 => (DEFAULT_M00_RELATIVE_ERROR * m00).max(floor),
-                    None => (DEFAULT_OTHER_ERROR_PER_M00 * m00).max(floor),
-                };
-                if !(value.is_finite() && sigma.is_finite() && sigma > 0.0) {
-                    return Err(at_line(format!(
-                        "{} = {value} ± {sigma} is not a usable observation",
-                        MUELLER_ELEMENT_NAMES[set.elements[column]]
-                    )));
-                }
+        let zeniths = visit_observations(
+            set,
+            |g| geometry.push(g),
+            |value, sigma| {
                 values.push(value);
                 inverse_sigma.push(1.0 / sigma);
-            }
-        }
+            },
+        )?;
         Ok(MeasurementData {
             geometry,
             zenith_cosines: zeniths.cosines,
@@ -131,16 +106,46 @@ impl MeasurementData {
         (self.values[index], 1.0 / self.inverse_sigma[index])
     }
 
+    /// The points `rows` (ascending), exactly as [`MeasurementData::new`] prepares a set of
+    /// those rows alone (a cross-validation fold): the default noise model's floor is the
+    /// subset's, the zenith list that of its points. No copy of the set's rows is made.
+    pub(crate) fn rows(&self, rows: &[usize]) -> MeasurementData {
+        let width = self.elements.len();
+        let m00_max = rows
+            .iter()
+            .map(|&p| self.values[p * width])
+            .fold(0.0, f64::max);
+        let floor = default_floor(m00_max);
+        let mut subset = self.with_points(rows.iter().copied(), rows.len());
+        for (point, chunk) in subset.inverse_sigma.chunks_mut(width).enumerate() {
+            let m00 = subset.values[point * width];
+            for (column, inverse) in chunk.iter_mut().enumerate() {
+                if self.error_sources[column] == ErrorSource::DefaultModel {
+                    *inverse = 1.0 / default_sigma(column, m00, floor);
+                }
+            }
+        }
+        subset
+    }
+
     /// Every `stride`-th point, from the first, with the same standard deviations (the default
     /// noise model's floor stays the whole file's) and the zenith list of those points only, so
     /// that an evaluation costs what the subsample holds.
     pub(crate) fn every_nth(&self, stride: usize) -> MeasurementData {
+        let count = self.points().div_ceil(stride);
+        self.with_points((0..self.points()).step_by(stride), count)
+    }
+
+    /// The points `points` (`count` of them, ascending) with their standard deviations as they
+    /// are, and the zenith list of those points only.
+    fn with_points(&self, points: impl Iterator<Item = usize>, count: usize) -> MeasurementData {
         let width = self.elements.len();
         let mut zeniths = DistinctCosines::default();
-        let mut geometry = Vec::with_capacity(self.points().div_ceil(stride));
-        let mut values = Vec::with_capacity(geometry.capacity() * width);
-        let mut inverse_sigma = Vec::with_capacity(values.capacity());
-        for (point, g) in self.geometry.iter().enumerate().step_by(stride) {
+        let mut geometry = Vec::with_capacity(count);
+        let mut values = Vec::with_capacity(count * width);
+        let mut inverse_sigma = Vec::with_capacity(count * width);
+        for point in points {
+            let g = &self.geometry[point];
             geometry.push(PreparedGeometry {
                 scattering: g.scattering,
                 incident_zenith: zeniths.index(self.zenith_cosines[g.incident_zenith]),
@@ -159,6 +164,71 @@ impl MeasurementData {
             error_sources: self.error_sources.clone(),
         }
     }
+}
+
+/// The standard deviation of every observation of `set`, point-major, as the fit weighs it
+/// (exactly what [`MeasurementData::observation`] returns, 1/(1/σ)), after the same checks as
+/// [`MeasurementData::new`]; without the prepared geometry, for a caller that needs only the
+/// weights (the fit report: a third of the memory of the prepared data).
+pub fn observation_sigmas(set: &MeasurementSet) -> Result<Vec<f64>, FitError> {
+    let mut sigmas = Vec::with_capacity(set.points.len() * set.elements.len());
+    visit_observations(set, |_| {}, |_, sigma| sigmas.push(1.0 / (1.0 / sigma)))?;
+    Ok(sigmas)
+}
+
+/// Checks every point of `set` and hands its prepared geometry to `geometry` and each of its
+/// observations, value and standard deviation, to `observation`; returns the distinct zenith
+/// cosines the geometries index.
+fn visit_observations(
+    set: &MeasurementSet,
+    mut geometry: impl FnMut(PreparedGeometry),
+    mut observation: impl FnMut(f64, f64),
+) -> Result<DistinctCosines, FitError> {
+    check_elements(set)?;
+    let width = set.elements.len();
+    let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
+    let floor = default_floor(m00_max);
+    let mut zeniths = DistinctCosines::default();
+    for point in &set.points {
+        let at_line = |what: String| refusal(set, format!("line {}: {what}", point.line));
+        if point.values.len() != width || point.uncertainties.len() != width {
+            return Err(at_line(format!(
+                "{} values for {width} elements",
+                point.values.len()
+            )));
+        }
+        geometry(prepare_geometry(point, &mut zeniths, &at_line)?);
+        let m00 = point.values[0];
+        for (column, (&value, uncertainty)) in
+            point.values.iter().zip(&point.uncertainties).enumerate()
+        {
+            let sigma = uncertainty.unwrap_or_else(|| default_sigma(column, m00, floor));
+            if !(value.is_finite() && sigma.is_finite() && sigma > 0.0) {
+                return Err(at_line(format!(
+                    "{} = {value} ± {sigma} is not a usable observation",
+                    MUELLER_ELEMENT_NAMES[set.elements[column]]
+                )));
+            }
+            observation(value, sigma);
+        }
+    }
+    Ok(zeniths)
+}
+
+/// The default noise model's standard deviation of element `column` (0: m00) of a point whose
+/// m00 is `m00`, at least `floor`.
+fn default_sigma(column: usize, m00: f64, floor: f64) -> f64 {
+    let relative = if column == 0 {
+        DEFAULT_M00_RELATIVE_ERROR
+    } else {
+        DEFAULT_OTHER_ERROR_PER_M00
+    };
+    (relative * m00).max(floor)
+}
+
+/// The default noise model's floor for a set whose largest m00 is `m00_max`.
+fn default_floor(m00_max: f64) -> f64 {
+    DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE)
 }
 
 /// The refusal of `set` for `message`.
@@ -242,4 +312,59 @@ fn error_sources(set: &MeasurementSet) -> Vec<ErrorSource> {
             None => ErrorSource::DefaultModel,
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::MeasurementPoint;
+
+    /// A fold prepared from the whole set's data is what preparing the fold's rows alone gives:
+    /// the default noise model's floor follows the fold's largest m00 (here a row with m00 = 0
+    /// sits on it), the file's uncertainties stay, the zenith list is the fold's own.
+    #[test]
+    fn rows_of_the_prepared_data_are_the_rows_prepared_alone() {
+        let point = |theta_i: f64, theta_r: f64, m00: f64| MeasurementPoint {
+            theta_i_deg: theta_i,
+            phi_i_deg: 0.0,
+            theta_r_deg: theta_r,
+            phi_r_deg: 180.0,
+            values: vec![m00, 0.1 * m00],
+            uncertainties: vec![None, Some(2e-3)],
+            line: 0,
+        };
+        let set = MeasurementSet {
+            source: "fold.csv".into(),
+            sha256: String::new(),
+            material: "fold".into(),
+            wavelength_um: 10.0,
+            metadata: Default::default(),
+            elements: vec![0, 4],
+            points: vec![
+                point(10.0, 20.0, 4.0),
+                point(30.0, 20.0, 0.0),
+                point(50.0, 40.0, 0.5),
+                point(10.0, 60.0, 0.25),
+            ],
+            merged: Vec::new(),
+            notes: Vec::new(),
+        };
+        let whole = MeasurementData::new(&set).unwrap();
+        let rows = [1, 2, 3];
+        let fold = whole.rows(&rows);
+        let alone = MeasurementData::new(&super::super::subset(&set, &rows)).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&fold.values), bits(&alone.values));
+        assert_eq!(bits(&fold.inverse_sigma), bits(&alone.inverse_sigma));
+        assert_eq!(bits(&fold.zenith_cosines), bits(&alone.zenith_cosines));
+        let zeniths = |d: &MeasurementData| {
+            d.geometry
+                .iter()
+                .map(|g| (g.incident_zenith, g.scattered_zenith))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(zeniths(&fold), zeniths(&alone));
+        // The whole file's floor (1e-6 × 4) is not the fold's (1e-6 × 0.5).
+        assert_ne!(whole.inverse_sigma[2], fold.inverse_sigma[0]);
+    }
 }

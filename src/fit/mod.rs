@@ -49,7 +49,8 @@ pub use cross_validation::{
     MAX_FOLDS,
 };
 pub use data::{
-    ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR, DEFAULT_OTHER_ERROR_PER_M00,
+    observation_sigmas, ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR,
+    DEFAULT_OTHER_ERROR_PER_M00,
 };
 pub use energy::{largest_reflectance, ENERGY_TOLERANCE};
 pub use error::FitError;

@@ -47,10 +47,6 @@ pub struct ModelFit {
     pub history: ConvergenceHistory,
     /// Model evaluations, all stages and the uncertainty estimate included.
     pub evaluations: u64,
-    /// The model's full Mueller matrix (sr⁻¹) at every measured point, in file order.
-    pub model_muellers: Vec<Mueller>,
-    /// Normalized residuals (model − data)/σ, point-major, aligned with the set's elements.
-    pub normalized_residuals: Vec<f64>,
     /// The body parameter the energy constraint held, and its value ([`fit_model`]).
     pub held_by_energy: Option<(Parameter, f64)>,
     /// What the energy constraint did, for the record (`None`: nothing to say).
@@ -84,7 +80,6 @@ impl ModelFit {
         Some(self.uncertainty.errors[i])
     }
 
-    /// The model value of element `element` (a position in the set's `elements`) at `point`.
     /// Every parameter's value: the fitted free ones over `options`' base values.
     pub(crate) fn parameter_values(&self, options: &FitOptions) -> ParameterValues {
         let mut values = options.base_values();
@@ -105,10 +100,49 @@ impl ModelFit {
         }
         options
     }
+}
 
-    pub fn model_value(&self, set: &MeasurementSet, point: usize, element: usize) -> f64 {
-        let index = set.elements[element];
-        self.model_muellers[point][(index / 4, index % 4)]
+/// The fitted model at every point of a measurement, recomputed on demand: a fit keeps
+/// neither its model matrices nor its residuals (200 B a row of a 9-element file, and up to six
+/// fits are kept while sets of terms are scored).
+impl ModelFit {
+    /// The model's full Mueller matrix (sr⁻¹) at every point of `data`, in its order;
+    /// `options` are those the fit was given.
+    pub fn model_muellers(
+        &self,
+        set: &MeasurementSet,
+        data: &MeasurementData,
+        options: &FitOptions,
+    ) -> Result<Vec<Mueller>, FitError> {
+        let options = &self.effective_options(options);
+        let space = model_space(self.distribution, options)?;
+        Objective::new(data, &space, None)
+            .model_muellers(&self.parameter_values(options))
+            .ok_or_else(|| unevaluable(set, self.distribution, "Mueller matrices"))
+    }
+
+    /// Normalized residuals (model − data)/σ at every observation of `data`, point-major,
+    /// aligned with the set's elements; `options` are those the fit was given.
+    pub fn normalized_residuals(
+        &self,
+        set: &MeasurementSet,
+        data: &MeasurementData,
+        options: &FitOptions,
+    ) -> Result<Vec<f64>, FitError> {
+        let options = &self.effective_options(options);
+        let space = model_space(self.distribution, options)?;
+        Objective::new(data, &space, None)
+            .normalized_residuals(&self.parameter_values(options))
+            .ok_or_else(|| unevaluable(set, self.distribution, "residuals"))
+    }
+}
+
+/// The refusal of a fitted `kind` model of `set` that cannot be evaluated (`what`).
+fn unevaluable(set: &MeasurementSet, kind: DistributionKind, what: &str) -> FitError {
+    FitError::Optimizer {
+        file: set.source.clone(),
+        stage: "final".into(),
+        message: format!("the best {kind} model could not be evaluated ({what})"),
     }
 }
 
@@ -281,17 +315,9 @@ fn fit_model_unconstrained(
         message: error.to_string(),
     })?;
     let values = space.values(&best);
-    let invalid = |what: &str| FitError::Optimizer {
-        file: set.source.clone(),
-        stage: "final".into(),
-        message: format!("the best {kind} model could not be evaluated ({what})"),
-    };
     let residuals = objective
         .normalized_residuals(&values)
-        .ok_or_else(|| invalid("residuals"))?;
-    let model_muellers = objective
-        .model_muellers(&values)
-        .ok_or_else(|| invalid("Mueller matrices"))?;
+        .ok_or_else(|| unevaluable(set, kind, "residuals"))?;
     let chi2: f64 = residuals.iter().map(|r| r * r).sum();
     let free_count = space.dimension();
     let degrees_of_freedom = observations - free_count;
@@ -314,8 +340,6 @@ fn fit_model_unconstrained(
         uncertainty,
         history,
         evaluations: objective.evaluations(),
-        model_muellers,
-        normalized_residuals: residuals,
         held_by_energy: None,
         energy: None,
     })

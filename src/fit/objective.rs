@@ -163,6 +163,18 @@ impl<'a> Objective<'a> {
         }
     }
 
+    /// The plain normalized residuals of the points from `first` on, written into `block` (whole
+    /// points), whatever the loss: the values of [`Objective::normalized_residuals`], a block
+    /// at a time.
+    pub(crate) fn block_normalized_residuals(
+        &self,
+        model: &PreparedModel,
+        first: usize,
+        block: &mut [f64],
+    ) {
+        self.fill_block(&model.pbrdf, &model.masking, first, block, &|r| r);
+    }
+
     /// Σ map(r) over every normalized residual of the model `pbrdf`: partial sums over blocks of
     /// [`CHUNK_POINTS`] points in parallel, added in block order, so that the sum does not depend
     /// on the thread count (and is the serial sum for a set of one block).
@@ -228,16 +240,6 @@ impl<'a> Objective<'a> {
         let mut out = vec![0.0; self.observations()];
         self.fill_residuals(&pbrdf, &mut out, |r| r);
         Some(out)
-    }
-
-    /// [`Objective::normalized_residuals`] written into `out` (length
-    /// [`Objective::observations`]); false for an invalid model.
-    pub fn normalized_residuals_into(&self, values: &ParameterValues, out: &mut [f64]) -> bool {
-        let Some(pbrdf) = self.model(values) else {
-            return false;
-        };
-        self.fill_residuals(&pbrdf, out, |r| r);
-        true
     }
 
     /// The model's full Mueller matrix (sr⁻¹) at every point.

@@ -9,6 +9,7 @@ use super::stages::Stage;
 use super::FitError;
 use crate::material::{pinned_at_bound, AlternativeFit, FitRecord, Material, MergedSource};
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
+use crate::optics::Mueller;
 use crate::pbrdf::{DistributionKind, Parameter};
 use std::collections::BTreeMap;
 
@@ -25,6 +26,26 @@ pub struct FitOutcome {
     pub comparison: Option<ModelComparison>,
     /// How the model's terms were chosen, when there was a choice (`--terms a,b`, `--cv K`).
     pub terms_choice: Option<super::terms_choice::TermsChoice>,
+    /// The options the chosen fit was given (its terms among them), from which its model is
+    /// evaluated again on demand ([`FitOutcome::model_muellers`]).
+    pub options: FitOptions,
+}
+
+impl FitOutcome {
+    /// The chosen model's full Mueller matrix (sr⁻¹) at every measured point, in file order.
+    pub fn model_muellers(&self) -> Result<Vec<Mueller>, FitError> {
+        let data = MeasurementData::new(&self.measurement)?;
+        self.chosen
+            .model_muellers(&self.measurement, &data, &self.options)
+    }
+
+    /// The chosen model's normalized residuals (model − data)/σ, point-major, aligned with the
+    /// set's elements.
+    pub fn normalized_residuals(&self) -> Result<Vec<f64>, FitError> {
+        let data = MeasurementData::new(&self.measurement)?;
+        self.chosen
+            .normalized_residuals(&self.measurement, &data, &self.options)
+    }
 }
 
 /// Fits one measurement: each requested distribution (both in parallel when
@@ -97,6 +118,7 @@ pub(super) fn finish(
         comparison,
     } = fitted;
     chosen.add_profile_bounds(data, options)?;
+    let given = options.clone();
     let options = &chosen.effective_options(options);
     let material = Material {
         name: set.material.clone(),
@@ -118,6 +140,7 @@ pub(super) fn finish(
         alternative,
         comparison,
         terms_choice: None,
+        options: given,
     })
 }
 

@@ -10,12 +10,13 @@
 //! both half its value and 1 % of its search interval. The second condition keeps a value that
 //! is consistent with zero but tightly bounded (ρ_d = 0.00001 ± 0.00002) determined.
 
-use super::objective::Objective;
+use super::objective::{Objective, CHUNK_POINTS};
 use super::parameters::{value_per_coordinate, ParameterValues};
 use crate::material::ConfidenceBound;
 use crate::pbrdf::Parameter;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Correlation beyond which two parameters count as not separately determined.
 pub const DEGENERATE_CORRELATION: f64 = 0.999;
@@ -29,6 +30,9 @@ pub const UNDETERMINED_RANGE_FRACTION: f64 = 0.01;
 const AT_BOUND: f64 = 1e-6;
 /// Relative eigenvalue of the scaled JᵀJ below which a direction counts as unconstrained.
 const SINGULAR: f64 = 1e-12;
+/// Inner dimension up to which nalgebra multiplies matrices itself instead of through
+/// matrixmultiply (its `SMALL_DIM`).
+const THIN_PRODUCT: usize = 5;
 
 /// 1-σ errors and correlations of the free parameters, in [`Uncertainty::parameters`] order.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,39 +48,82 @@ pub struct Uncertainty {
     pub profile_bounds: Vec<(Parameter, ConfidenceBound)>,
 }
 
-/// Jacobian of the plain normalized residuals with respect to the physical free parameters, by
-/// central differences in search coordinates (one-sided at a bound) and the chain rule. Each
-/// column is written in place: J is observations × parameters, the largest array of a fit.
-fn physical_jacobian(objective: &Objective, search: &[f64]) -> Option<DMatrix<f64>> {
+/// The information matrix JᵀJ of the plain normalized residuals with respect to the physical
+/// free parameters, J by central differences in search coordinates (one-sided at a bound) and the
+/// chain rule; `None` when a shifted model is invalid.
+///
+/// J (observations × parameters, 8 B each) is never held whole: it is built a block of
+/// [`CHUNK_POINTS`] points at a time and each block's JᵀJ added with nalgebra's `gemm`. Every
+/// block but the last starts on a multiple of 256 observations, the depth by which
+/// matrixmultiply (behind nalgebra's product of large matrices) splits the inner dimension and
+/// accumulates into the result, so the sum is bit-identical to `Jᵀ * J` of the whole J.
+fn information_matrix(objective: &Objective, search: &[f64]) -> Option<DMatrix<f64>> {
     let space = objective.space();
-    let rows = objective.observations();
-    let mut jacobian = DMatrix::zeros(rows, space.free().len());
-    let complete = jacobian
-        .as_mut_slice()
-        .par_chunks_mut(rows)
-        .zip(space.free().par_iter())
-        .enumerate()
-        .all(|(j, (column, &parameter))| {
+    let n = search.len();
+    let shifted_models = (0..n)
+        .into_par_iter()
+        .map(|j| {
             let h = 1e-5 * search[j].abs().max(1.0);
             let lo = (search[j] - h).max(space.lower()[j]);
             let hi = (search[j] + h).min(space.upper()[j]);
-            let residuals_at = |coordinate: f64, out: &mut [f64]| {
+            let at = |coordinate: f64| {
                 let mut shifted = search.to_vec();
                 shifted[j] = coordinate;
-                objective.normalized_residuals_into(&space.values(&shifted), out)
+                objective.prepared_model(&shifted)
             };
-            let mut below = vec![0.0; rows];
-            if !(residuals_at(hi, column) && residuals_at(lo, &mut below)) {
-                return false;
-            }
+            let above = at(hi)?;
+            let below = at(lo)?;
             // d r/d value = (d r/d coordinate) / (d value/d coordinate), at the central point.
-            let per_coordinate = value_per_coordinate(parameter, search[j]);
-            for (c, b) in column.iter_mut().zip(&below) {
-                *c = ((*c - b) / (hi - lo)) / per_coordinate;
-            }
-            true
-        });
-    complete.then_some(jacobian)
+            let per_coordinate = value_per_coordinate(space.free()[j], search[j]);
+            Some((above, below, hi - lo, per_coordinate))
+        })
+        .collect::<Option<Vec<_>>>()?;
+    let width = objective.data().element_count();
+    let mut information = DMatrix::zeros(n, n);
+    for (pass, points) in jacobian_blocks(objective.data().points(), width)
+        .into_iter()
+        .enumerate()
+    {
+        let rows = points.len() * width;
+        let columns: Vec<Vec<f64>> = shifted_models
+            .par_iter()
+            .map(|(above, below, step, per_coordinate)| {
+                let mut column = vec![0.0; rows];
+                let mut lower = vec![0.0; rows];
+                objective.block_normalized_residuals(above, points.start, &mut column);
+                objective.block_normalized_residuals(below, points.start, &mut lower);
+                for (c, b) in column.iter_mut().zip(&lower) {
+                    *c = ((*c - b) / step) / per_coordinate;
+                }
+                column
+            })
+            .collect();
+        let block = DMatrix::from_iterator(rows, n, columns.into_iter().flatten());
+        add_information(&mut information, &block, pass == 0);
+    }
+    Some(information)
+}
+
+/// Adds JᵀJ of a block of J's rows to `information` (overwritten by the `first` block's).
+fn add_information(information: &mut DMatrix<f64>, block: &DMatrix<f64>, first: bool) {
+    let beta = if first { 0.0 } else { 1.0 };
+    information.gemm(1.0, &block.transpose(), block, beta);
+}
+
+/// The point ranges of [`information_matrix`]'s blocks: [`CHUNK_POINTS`] points each (a
+/// multiple of 256 observations), the last one longer when the rest would hold 5 observations
+/// or fewer: nalgebra multiplies such a thin block by another rule (column by column), which
+/// would change the sum's last bits.
+fn jacobian_blocks(points: usize, width: usize) -> Vec<Range<usize>> {
+    let mut blocks: Vec<Range<usize>> = (0..points)
+        .step_by(CHUNK_POINTS)
+        .map(|first| first..(first + CHUNK_POINTS).min(points))
+        .collect();
+    if blocks.len() > 1 && blocks.last().map_or(0, |b| b.len() * width) <= THIN_PRODUCT {
+        let last = blocks.pop().expect("more than one block");
+        blocks.last_mut().expect("more than one block").end = last.end;
+    }
+    blocks
 }
 
 /// Uncertainties of the free parameters at the optimum `search` (search coordinates), with
@@ -103,12 +150,12 @@ pub(crate) fn estimate(objective: &Objective, search: &[f64], reduced_chi2: f64)
         at_bound,
         profile_bounds: Vec::new(),
     };
-    let Some(jacobian) = physical_jacobian(objective, search) else {
+    let Some(information) = information_matrix(objective, search) else {
         uncertainty.undetermined = parameters;
         return uncertainty;
     };
     (uncertainty.errors, uncertainty.correlation, _) =
-        linearized_errors(&(jacobian.transpose() * &jacobian), reduced_chi2);
+        linearized_errors(&information, reduced_chi2);
     for (i, &parameter) in parameters.iter().enumerate() {
         let degenerate = uncertainty.correlation[i]
             .iter()
@@ -194,4 +241,38 @@ fn identity(n: usize) -> Vec<Vec<f64>> {
     (0..n)
         .map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The blocked sum is `Jᵀ * J` of the whole J to the last bit, through matrixmultiply (more
+    /// than 5 parameters) and through nalgebra's own product (5 or fewer), with a thin tail of
+    /// 3 observations folded into the last block.
+    #[test]
+    fn blocked_information_is_the_whole_product_bit_for_bit() {
+        let width = 3;
+        let points = 3 * CHUNK_POINTS + 1;
+        let blocks = jacobian_blocks(points, width);
+        assert_eq!(blocks.len(), 3);
+        assert_eq!(blocks[2], 2 * CHUNK_POINTS..points);
+        for parameters in [7, 4] {
+            let rows = points * width;
+            // Entries of mixed sign and magnitude, so that the summation order shows.
+            let jacobian = DMatrix::from_fn(rows, parameters, |i, j| {
+                ((i * 31 + j * 17) as f64 * 0.37).sin() * 10f64.powi((i % 7) as i32 - 3)
+            });
+            let whole = jacobian.transpose() * &jacobian;
+            let mut blocked = DMatrix::zeros(parameters, parameters);
+            for (pass, range) in blocks.iter().enumerate() {
+                let block = jacobian
+                    .rows(range.start * width, range.len() * width)
+                    .into_owned();
+                add_information(&mut blocked, &block, pass == 0);
+            }
+            let bits = |m: &DMatrix<f64>| m.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&blocked), bits(&whole), "{parameters} parameters");
+        }
+    }
 }

@@ -3,13 +3,16 @@
 //! deviation and normalized residual, and the chosen and competing models evaluated along each
 //! plane and ring and as polarized emissivity (docs/design.md §1.3–1.4).
 
-use crate::fit::MeasurementData;
+use crate::fit::observation_sigmas;
 use crate::material::Material;
 use crate::measure::MeasurementSet;
-use crate::optics::{rotation_between_frames, FrameTurn, Mueller, Stokes};
+use crate::optics::{Mueller, Stokes};
 use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
 
 use super::super::ReportError;
+
+mod points;
+use points::{add_drawn, point_views};
 
 /// Two angles are the same goniometer setting when they agree to a microdegree.
 const SAME_ANGLE_DEG: f64 = 1e-6;
@@ -39,9 +42,19 @@ pub struct PointView {
     pub ring: Option<usize>,
     /// φ_r − φ_i in [0°, 360°).
     pub relative_azimuth: f64,
+    /// What the profile panels draw of a point they show (in the plane of incidence at an angle
+    /// with curves, or on a drawn ring); `None` for the others, which appear only among the
+    /// residuals: a dense scan's rows are mostly such, and these are 0.5 KB a row.
+    pub drawn: Option<Box<DrawnPoint>>,
+}
+
+/// The measured elements and the model of a point the profile panels show.
+#[derive(Clone, Debug)]
+pub struct DrawnPoint {
     /// The measured elements by Mueller index r*4 + c, in the psps frame the point is drawn in: its
     /// own, except at the normal (θ_r = 0), where they are turned into the in-plane profile's
-    /// frame ([`in_plane_frame_at_normal`]); elements that cannot be turned are `None` there.
+    /// frame (`points::in_plane_frame_at_normal`); elements that cannot be turned are `None`
+    /// there.
     /// [`ReportData::residuals`] are taken before, in the row's own frame.
     pub readings: [Option<Reading>; 16],
     /// The chosen model at this geometry, in the same frame as `readings`.
@@ -118,7 +131,10 @@ impl ReportData {
     pub fn new(material: &Material, set: &MeasurementSet) -> Result<ReportData, ReportError> {
         let (chosen, alternative) = curve_sources(material)?;
         let incidences = distinct_sorted(set.points.iter().map(|p| p.theta_i_deg));
-        let (mut points, residuals) = point_views(set, &incidences, &chosen)?;
+        // The standard deviations the fit weighted by (the file's u_ columns or the fit's
+        // default noise model), so that report residuals are the ones the optimizer minimized.
+        let sigmas = observation_sigmas(set)?;
+        let (mut points, residuals) = point_views(set, &sigmas, &incidences, &chosen)?;
         let shown = representatives(&incidences, MAX_CURVE_INCIDENCES);
         let mut slot = vec![None; incidences.len()];
         for (position, &incidence) in shown.iter().enumerate() {
@@ -133,6 +149,7 @@ impl ReportData {
             alternative.as_ref(),
         );
         let in_plane = in_plane_sweeps(&points, &incidences, &shown, &chosen, alternative.as_ref());
+        add_drawn(&mut points, set, &sigmas, &slot, &chosen)?;
         let emissivity = emissivity_curves(&chosen, alternative.as_ref());
 
         Ok(ReportData {
@@ -179,58 +196,6 @@ fn curve_sources(
         None => None,
     };
     Ok((chosen, alternative))
-}
-
-/// Every measured point as the report sees it (not yet on a ring), and the normalized residuals
-/// of all of them, in the order of the file.
-fn point_views(
-    set: &MeasurementSet,
-    incidences: &[f64],
-    chosen: &ModelCurveSource,
-) -> Result<(Vec<PointView>, Vec<Residual>), ReportError> {
-    // The standard deviations the fit weighted by (the file's u_ columns or the fit's default
-    // noise model), so that report residuals are the ones the optimizer minimized.
-    let weights = MeasurementData::new(set)?;
-    let elements_per_point = set.elements.len();
-    let mut points = Vec::with_capacity(set.points.len());
-    let mut residuals = Vec::with_capacity(set.points.len() * elements_per_point);
-    for (point, p) in set.points.iter().enumerate() {
-        let incident = checked_direction("theta_i_deg", p.theta_i_deg, p.phi_i_deg)?;
-        let scattered = checked_direction("theta_r_deg", p.theta_r_deg, p.phi_r_deg)?;
-        let relative_azimuth = (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0);
-        let signed_zenith = in_plane_zenith(p.theta_r_deg, relative_azimuth);
-        let forward_zenith = signed_zenith.unwrap_or({
-            if (90.0..=270.0).contains(&relative_azimuth) {
-                p.theta_r_deg
-            } else {
-                -p.theta_r_deg
-            }
-        });
-        let mut readings = [None; 16];
-        for (column, &element) in set.elements.iter().enumerate() {
-            let value = p.values[column];
-            let (_, sigma) = weights.observation(point * elements_per_point + column);
-            readings[element] = Some(Reading { value, sigma });
-        }
-        let model = chosen.pbrdf.mueller(&incident, &scattered);
-        // Residuals in the row's own frame: the model is evaluated at the row's own φ_r, as
-        // the fit compared them.
-        residuals.extend(normalized_residuals(&readings, &model, forward_zenith));
-        let (readings, model) = if at_normal(p.theta_r_deg) {
-            in_plane_frame_at_normal(&readings, &model, p.phi_i_deg, p.phi_r_deg)
-        } else {
-            (readings, model)
-        };
-        points.push(PointView {
-            incidence: position_of(incidences, p.theta_i_deg),
-            signed_zenith,
-            ring: None,
-            relative_azimuth,
-            readings,
-            model,
-        });
-    }
-    Ok((points, residuals))
 }
 
 /// The in-plane model sweeps of the `shown` incidence angles: `None` for an angle without a
@@ -299,25 +264,6 @@ fn evenly(count: usize, limit: usize) -> Vec<usize> {
     picked
 }
 
-fn checked_direction(name: &'static str, theta: f64, phi: f64) -> Result<Direction, ReportError> {
-    Ok(Direction::from_degrees_checked(name, theta, phi)?)
-}
-
-/// (data − model)/σ for each measured element, in the frame both are given in.
-fn normalized_residuals<'a>(
-    readings: &'a [Option<Reading>; 16],
-    model: &'a Mueller,
-    forward_zenith: f64,
-) -> impl Iterator<Item = Residual> + 'a {
-    readings.iter().enumerate().filter_map(move |(element, r)| {
-        r.map(|r| Residual {
-            forward_zenith,
-            element,
-            value: (r.value - model[(element / 4, element % 4)]) / r.sigma,
-        })
-    })
-}
-
 /// A detector at the normal (θ_r = 0 to a microdegree): its φ_r is arbitrary, so it lies in
 /// every plane, the plane of incidence included.
 fn at_normal(theta_r_deg: f64) -> bool {
@@ -346,73 +292,6 @@ fn in_plane_relative_azimuth(zenith: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// Largest |mixing weight| of the frame turn of [`in_plane_frame_at_normal`] treated as zero:
-/// the sin 2η or cos 2η of a turn within [`SAME_ANGLE_DEG`] of a multiple of 90° (sin 2e-6° ≈
-/// 3.49e-8), where rounding of 90° in radians leaves ~1e-16 instead of 0.
-const NEGLIGIBLE_MIXING: f64 = 3.5e-8;
-
-/// The turn η of the outgoing psps frame of a detector at the normal from its own azimuth φ_r
-/// to the in-plane profile's (φ_i + 180°, [`in_plane_relative_azimuth`]). At θ_r = 0 light leaves
-/// along k = ẑ and each frame is the limit θ_r → 0⁺ along its azimuth φ (docs/design.md §1.3), with
-/// s = lim unit(ẑ × k) = ê_φ = (−sin φ, cos φ, 0) ([`Direction::azimuthal_axis`]); η is the angle
-/// from the row's s toward its p = k × s at which the in-plane s lies (optics::frame).
-fn normal_detector_turn(phi_i_deg: f64, phi_r_deg: f64) -> FrameTurn {
-    let own = Direction::from_angles(0.0, phi_r_deg.to_radians());
-    let in_plane_phi = phi_i_deg + in_plane_relative_azimuth(0.0);
-    let in_plane = Direction::from_angles(0.0, in_plane_phi.to_radians());
-    rotation_between_frames(&own.azimuthal_axis, &in_plane.azimuthal_axis, &own.vector)
-}
-
-/// A row measured with the detector at the normal, re-expressed in the psps frame of the
-/// in-plane profile (the frame the in-plane model curves are drawn in at θ_r = 0), so that it
-/// can be drawn there whatever its φ_r: M' = L(η) M with L = [`FrameTurn::mueller`] and η from
-/// [`normal_detector_turn`]. Only the outgoing (row) side turns; the incident side is the scan's.
-///
-/// L(η) mixes rows 1 and 2 of each column (m1c' = cos2η m1c + sin2η m2c, m2c' = −sin2η m1c +
-/// cos2η m2c); rows 0 and 3 stay as they are. A turned element is formed only when every
-/// element it mixes in with a non-negligible weight was measured (a row with m10 but not m20
-/// at φ_r − φ_i = 135° has no in-plane m10, and it is left out of the in-plane polarization
-/// panels rather than drawn from half its partners); at a turn of a multiple of 90° each element
-/// is its own partner (m10' = ±m10). m00 never turns. The 1-σ of a turned element is that of
-/// independent errors, √(Σ (L_rj σ_jc)²). Points at the normal are never on a ring
-/// ([`find_rings`] skips groups without an off-plane point), so only the in-plane panels see
-/// the turned values; the residual panels use the row's own frame.
-fn in_plane_frame_at_normal(
-    readings: &[Option<Reading>; 16],
-    model: &Mueller,
-    phi_i_deg: f64,
-    phi_r_deg: f64,
-) -> ([Option<Reading>; 16], Mueller) {
-    let turn = normal_detector_turn(phi_i_deg, phi_r_deg).mueller();
-    let mut turned = [None; 16];
-    for (element, slot) in turned.iter_mut().enumerate() {
-        let (row, column) = (element / 4, element % 4);
-        let mut value = 0.0;
-        let mut variance = 0.0;
-        let mut complete = true;
-        for partner in 0..4 {
-            let weight = turn[(row, partner)];
-            if weight.abs() <= NEGLIGIBLE_MIXING {
-                continue;
-            }
-            match readings[partner * 4 + column] {
-                Some(r) => {
-                    value += weight * r.value;
-                    variance += (weight * r.sigma).powi(2);
-                }
-                None => complete = false,
-            }
-        }
-        if complete && readings[element].is_some() {
-            *slot = Some(Reading {
-                value,
-                sigma: variance.sqrt(),
-            });
-        }
-    }
-    (turned, turn * model)
 }
 
 fn distinct_sorted(values: impl Iterator<Item = f64>) -> Vec<f64> {
@@ -663,6 +542,7 @@ fn emissivity_curves(
 
 #[cfg(test)]
 mod tests {
+    use super::points::normal_detector_turn;
     use super::*;
     use crate::material::{AlternativeFit, ModelSpec};
     use crate::measure::MeasurementPoint;
@@ -952,8 +832,9 @@ mod tests {
         let curve = in_plane_curve_at_normal(&data);
         let m00 = curve[(0, 0)];
         assert!(curve[(1, 0)].abs() > 0.05 * m00, "a polarizing model");
-        for (p, row) in data.points.iter().zip(&set.points) {
-            assert_eq!(p.signed_zenith, Some(0.0));
+        for (view, row) in data.points.iter().zip(&set.points) {
+            assert_eq!(view.signed_zenith, Some(0.0));
+            let p = view.drawn.as_deref().expect("an in-plane point is drawn");
             let measured = p.readings[0].unwrap().value;
             assert_eq!(measured, row.values[0], "m00 does not turn");
             for &e in &linear {
@@ -994,7 +875,7 @@ mod tests {
         let set = model_set(&[(40.0, 0.0, 0.0, 90.0), (40.0, 0.0, 0.0, 135.0)], &[0, 4]);
         let data = ReportData::new(&material(false), &set).unwrap();
         let curve = in_plane_curve_at_normal(&data);
-        let quarter = &data.points[0];
+        let quarter = data.points[0].drawn.as_deref().unwrap();
         let m10 = quarter.readings[4].unwrap();
         assert_eq!(m10.value, -set.points[0].values[1]);
         assert!(
@@ -1002,7 +883,7 @@ mod tests {
                 < 1e-12
         );
         assert!((m10.sigma - 1e-4).abs() < 1e-18);
-        let eighth = &data.points[1];
+        let eighth = data.points[1].drawn.as_deref().unwrap();
         assert_eq!(eighth.readings[4], None);
         assert_eq!(
             eighth.readings[0].map(|r| r.value),
@@ -1018,6 +899,20 @@ mod tests {
         assert_eq!(series[0].points.len(), 2);
         // Both rows keep their residuals in their own frames.
         assert_eq!(data.residuals.len(), 4);
+    }
+
+    #[test]
+    fn only_points_the_profiles_show_keep_their_readings() {
+        // In the plane (specular side), and off it beside specular (a raster, on no ring).
+        let set = model_set(
+            &[(40.0, 0.0, 30.0, 180.0), (40.0, 0.0, 30.0, 170.0)],
+            &[0, 4],
+        );
+        let data = ReportData::new(&material(false), &set).unwrap();
+        assert!(data.points[0].drawn.is_some());
+        assert!(data.points[1].drawn.is_none());
+        assert_eq!(data.off_ring_points(), 1);
+        assert_eq!(data.residuals.len(), 4, "every row keeps its residuals");
     }
 
     #[test]

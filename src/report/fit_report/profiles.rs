@@ -6,7 +6,7 @@ mod axes;
 
 pub use axes::{flat_floor, linear_axis, log_axis, DegreeAxis, Domain, FLOOR_LABEL};
 
-use super::data::{ModelSweep, PointView, ReportData};
+use super::data::{DrawnPoint, ModelSweep, PointView, ReportData};
 use super::style::{
     incidence_color, log_tick, report_mesh_style, DrawResult, Marker, YAxis, AXIS_DESC_SIZE,
     CAPTION_SIZE, GREY, LEGEND_SIZE, SMALL_CAPTION_SIZE, SMALL_TICK_SIZE, TICK_SIZE,
@@ -48,7 +48,7 @@ impl Quantity {
     }
 
     /// The measured value and, where it propagates simply, its 1-σ.
-    pub fn of_point(&self, p: &PointView) -> Option<(f64, Option<f64>)> {
+    pub fn of_point(&self, p: &DrawnPoint) -> Option<(f64, Option<f64>)> {
         let m00 = p.readings[0]?;
         match *self {
             Quantity::M00 => Some((m00.value, Some(m00.sigma))),
@@ -175,6 +175,7 @@ pub fn profile_series(
 /// groups as points).
 fn profile_points(data: &ReportData, quantity: Quantity, domain: Domain) -> Vec<Vec<ProfilePoint>> {
     let measured = |p: &PointView, x: f64| {
+        let p = p.drawn.as_deref()?;
         quantity.of_point(p).map(|(value, sigma)| ProfilePoint {
             x,
             value,
@@ -366,16 +367,12 @@ mod tests {
     use super::*;
     use crate::report::fit_report::data::Reading;
 
-    fn point(readings: &[(usize, f64, f64)]) -> PointView {
+    fn point(readings: &[(usize, f64, f64)]) -> DrawnPoint {
         let mut all = [None; 16];
         for &(e, value, sigma) in readings {
             all[e] = Some(Reading { value, sigma });
         }
-        PointView {
-            incidence: 0,
-            signed_zenith: Some(10.0),
-            ring: None,
-            relative_azimuth: 180.0,
+        DrawnPoint {
             readings: all,
             model: Mueller::zeros(),
         }
