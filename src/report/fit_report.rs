@@ -22,7 +22,7 @@ mod test_records;
 mod validation;
 
 pub use source::rebuild_report;
-pub(crate) use source::{verified_source, verified_spectral_source};
+pub(crate) use source::source_unchanged;
 use table::format_angle;
 pub(crate) use table::{
     fitted_cells, format_plain, format_with_uncertainty, is_free, parameters, preference,

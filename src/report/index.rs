@@ -4,8 +4,8 @@
 //! links only, so the page works from a file browser and when the folder is copied elsewhere.
 
 use super::fit_report::{
-    fitted_cells, format_plain, is_free, parameters, preference, sha_prefix, verified_source,
-    verified_spectral_source, FOOTNOTE_BOUND, FOOTNOTE_PROFILE,
+    fitted_cells, format_plain, is_free, parameters, preference, sha_prefix, source_unchanged,
+    FOOTNOTE_BOUND, FOOTNOTE_PROFILE,
 };
 use super::ReportError;
 use crate::atomic::write_atomically;
@@ -169,11 +169,8 @@ fn provenance(material_path: &Path, material: &Material) -> (String, &'static st
     let Some(fit) = material.fit.as_ref() else {
         return ("not fitted by irpol".into(), "warn");
     };
-    let verified = match material.model {
-        MaterialModel::Grey(_) => verified_source(material_path, fit),
-        MaterialModel::Spectral(_) => verified_spectral_source(material_path, fit),
-    };
-    match verified {
+    let spectral = matches!(material.model, MaterialModel::Spectral(_));
+    match source_unchanged(material_path, fit, spectral) {
         Ok(_) => ("source unchanged".into(), "ok"),
         Err(ReportError::SourceChanged { .. } | ReportError::SourceDataChanged { .. }) => {
             ("source CSV changed since the fit".into(), "warn")
