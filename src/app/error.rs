@@ -110,14 +110,9 @@ pub enum AppError {
     /// A command-line argument (or the Python argument of the same name) that makes no sense.
     #[error("{0}")]
     Invalid(String),
-    /// A geometry CSV of `irpol eval`; `at` is the `:line` or `:line:column` after the path, or
-    /// nothing for the whole file.
-    #[error("{}{at}: {message}", crate::text::path(path))]
-    Geometry {
-        path: PathBuf,
-        at: String,
-        message: String,
-    },
+    /// A geometry CSV of `irpol eval`, refused at its line and column.
+    #[error(transparent)]
+    Geometry(crate::table_text::TableError<crate::table_text::Problem>),
     /// A bad line of a `--times-file`.
     #[error("{}:{line}", crate::text::path(path))]
     TimesLine {

@@ -6,14 +6,19 @@
 //! as given, and the table carries one note saying how many rows were so read.
 //!
 //! Rows are produced one at a time, never held all at once: a geometry file is read into memory
-//! as bytes and parsed twice (once to validate every row, so that a bad row refuses the file
-//! before anything is printed, once to evaluate), and a sweep generates its rows from its angle
-//! lists. Output goes through the csv crate's writer, so a passed-through field such as "a,b"
-//! stays quoted and the CSV stays rectangular.
+//! as text and parsed twice by the text tables' reader (`table_text`: once to validate every
+//! row, so that a bad row refuses the file at its line and column before anything is printed,
+//! once to evaluate), and a sweep generates its rows from its angle lists. Output goes through
+//! the csv crate's writer, so a passed-through field such as "a,b" stays quoted and the CSV
+//! stays rectangular.
 
 use super::AppError;
 use crate::measure::MUELLER_ELEMENT_NAMES;
 use crate::pbrdf::{signed_zenith_note, Direction, HemisphereQuadrature, Pbrdf};
+use crate::table_text::{
+    self, decode_utf8, is_comment, parse_finite, split_fields, wrong_delimiter, Field, InvalidUtf8,
+    Problem, Refusal,
+};
 use crate::text::{shown, shown_at_most};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -60,7 +65,7 @@ pub struct GeometryTable {
 enum Rows {
     File {
         path: PathBuf,
-        bytes: Vec<u8>,
+        text: String,
         columns: GeometryColumns,
     },
     /// Every θ_i, then every θ_r, then every φ_r (innermost: a ring of the detector per θ_r).
@@ -81,11 +86,15 @@ struct GeometryColumns {
     phi_r: Option<usize>,
 }
 
-fn geometry_reader(bytes: &[u8]) -> csv::Reader<&[u8]> {
-    csv::ReaderBuilder::new()
-        .comment(Some(b'#'))
-        .trim(csv::Trim::All)
-        .from_reader(bytes)
+/// The lines of a geometry CSV that hold a header or a row: not blank, not a `#` comment.
+fn table_lines(text: &str) -> impl Iterator<Item = (u64, &str)> {
+    table_text::lines(text).filter(|(_, line)| !line.trim().is_empty() && !is_comment(line))
+}
+
+/// The fields of line `number`, refused at the column of a malformed quote.
+fn fields_of<'a>(path: &Path, number: u64, line: &'a str) -> Result<Vec<Field<'a>>, AppError> {
+    split_fields(number, line)
+        .map_err(|refusal| geometry_error(path, refusal.map(|k| k.to_string())))
 }
 
 /// Reads and validates a geometry CSV: every row must hold valid angles.
@@ -97,38 +106,37 @@ pub fn read_geometry_csv(path: &Path) -> Result<GeometryTable, AppError> {
     parse_geometry_csv(path, bytes)
 }
 
-/// A refused geometry CSV: `path` then `at` (`:line`, `:line:column` or nothing), the message.
-fn geometry_error(path: &Path, at: impl Into<String>, message: impl Into<String>) -> AppError {
-    AppError::Geometry {
-        path: path.to_owned(),
-        at: at.into(),
-        message: message.into(),
-    }
+/// A refused geometry CSV: the text tables' one refusal (`path:line:column: message`; line 0
+/// is the whole file, column 0 the whole line).
+fn geometry_error(path: &Path, refusal: Refusal<String>) -> AppError {
+    AppError::Geometry(refusal.map(Problem).in_file(path))
 }
 
 /// [`read_geometry_csv`] of a file's bytes; `path` names it in messages.
 pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> Result<GeometryTable, AppError> {
-    let headers: Vec<String> = geometry_reader(&bytes)
-        .headers()
-        .map_err(|e| {
-            geometry_error(
-                path,
-                ":1:1",
-                format!(
-                    "cannot read the header: {}",
-                    shown_at_most(&e.to_string(), HEADER_EXCERPT_CHARS)
-                ),
-            )
+    let text = decode_utf8(&bytes)
+        .map_err(|refusal| {
+            let problem = |k: InvalidUtf8| format!("byte 0x{:02X} is not UTF-8 text", k.byte);
+            geometry_error(path, refusal.map(problem))
         })?
-        .iter()
-        .map(str::to_owned)
-        .collect();
-    let columns = geometry_columns(path, &headers)?;
+        .to_owned();
+    drop(bytes);
+    let (header_line, header) = match table_lines(&text).next() {
+        Some((number, line)) => (number, fields_of(path, number, line)?),
+        None => (1, Vec::new()),
+    };
+    // A header of one field holding ';' or tabs is a file separated by them (rows may pass
+    // such characters through in their own columns).
+    if let (Some(refusal), 1) = (wrong_delimiter(header_line, &header), header.len()) {
+        return Err(geometry_error(path, refusal.map(|k| k.to_string())));
+    }
+    let columns = geometry_columns(path, header_line, &header)?;
+    let headers: Vec<String> = header.into_iter().map(|f| f.text.into_owned()).collect();
     let mut table = GeometryTable {
         headers,
         rows: Rows::File {
             path: path.to_owned(),
-            bytes,
+            text,
             columns,
         },
         notes: Vec::new(),
@@ -140,7 +148,10 @@ pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> Result<GeometryTable, 
         Ok(())
     })?;
     if count == 0 {
-        return Err(geometry_error(path, "", "no geometry rows"));
+        return Err(geometry_error(
+            path,
+            Refusal::at_line(0, "no geometry rows".into()),
+        ));
     }
     table
         .notes
@@ -150,41 +161,37 @@ pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> Result<GeometryTable, 
 
 /// The angle columns of a header row, refusing duplicate names (which value would be meant?) and
 /// names of the Mueller elements that eval appends (the output would hold two m00 columns).
-fn geometry_columns(path: &Path, headers: &[String]) -> Result<GeometryColumns, AppError> {
-    for (index, name) in headers.iter().enumerate() {
-        let at = format!(":1:{}", index + 1);
-        if let Some(first) = headers[..index].iter().position(|h| h == name) {
-            return Err(geometry_error(
-                path,
-                at,
-                format!(
-                    "duplicate column '{}' (already column {})",
-                    shown(name),
-                    first + 1
-                ),
-            ));
+fn geometry_columns(
+    path: &Path,
+    line: u64,
+    header: &[Field<'_>],
+) -> Result<GeometryColumns, AppError> {
+    let headers: Vec<&str> = header.iter().map(|f| f.text.as_ref()).collect();
+    for (index, (&name, field)) in headers.iter().zip(header).enumerate() {
+        let refused =
+            |message: String| geometry_error(path, Refusal::new(line, field.column, message));
+        if let Some(first) = headers[..index].iter().position(|h| *h == name) {
+            return Err(refused(format!(
+                "duplicate column '{}' (already column {})",
+                shown(name),
+                first + 1
+            )));
         }
-        if MUELLER_ELEMENT_NAMES.contains(&name.as_str()) {
-            return Err(geometry_error(
-                path,
-                at,
-                format!(
-                    "column '{name}' clashes with the Mueller elements eval appends; rename it"
-                ),
-            ));
+        if MUELLER_ELEMENT_NAMES.contains(&name) {
+            return Err(refused(format!(
+                "column '{}' clashes with the Mueller elements eval appends; rename it",
+                shown(name)
+            )));
         }
     }
-    let column = |name: &str| headers.iter().position(|h| h == name);
+    let column = |name: &str| headers.iter().position(|h| *h == name);
     let required = |name: &str| {
         column(name).ok_or_else(|| {
-            geometry_error(
-                path,
-                ":1:1",
-                format!(
-                    "missing column '{name}' (have: {})",
-                    shown_at_most(&headers.join(","), HEADER_EXCERPT_CHARS)
-                ),
-            )
+            let message = format!(
+                "missing column '{name}' (have: {})",
+                shown_at_most(&headers.join(","), HEADER_EXCERPT_CHARS)
+            );
+            geometry_error(path, Refusal::new(line, 1, message))
         })
     };
     Ok(GeometryColumns {
@@ -195,30 +202,27 @@ fn geometry_columns(path: &Path, headers: &[String]) -> Result<GeometryColumns, 
     })
 }
 
-/// The geometry of one record, its angles checked.
+/// The geometry of one row (line `line`, its `fields`), its angles checked.
 fn record_geometry(
     path: &Path,
     headers: &[String],
     columns: GeometryColumns,
-    record: &csv::StringRecord,
+    (line, fields): (u64, &[Field<'_>]),
 ) -> Result<Geometry, AppError> {
-    let line = record.position().map_or(0, |p| p.line());
+    if fields.len() != headers.len() {
+        let message = format!("{} fields, the header has {}", fields.len(), headers.len());
+        return Err(geometry_error(path, Refusal::at_line(line, message)));
+    }
     let field = |index: usize| -> Result<f64, AppError> {
-        let text = &record[index];
-        text.parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| {
-                geometry_error(
-                    path,
-                    format!(":{line}:{}", index + 1),
-                    format!(
-                        "{} = '{}' is not a finite number",
-                        shown(&headers[index]),
-                        shown(text)
-                    ),
-                )
-            })
+        let text = fields[index].text.as_ref();
+        parse_finite(text).map_err(|_| {
+            let message = format!(
+                "{} = '{}' is not a finite number",
+                shown(&headers[index]),
+                shown(text)
+            );
+            geometry_error(path, Refusal::new(line, fields[index].column, message))
+        })
     };
     let geometry = Geometry {
         theta_i_deg: field(columns.theta_i)?,
@@ -228,7 +232,7 @@ fn record_geometry(
     };
     geometry
         .directions()
-        .map_err(|e| geometry_error(path, format!(":{line}"), e.to_string()))?;
+        .map_err(|e| geometry_error(path, Refusal::at_line(line, e.to_string())))?;
     Ok(geometry)
 }
 
@@ -241,26 +245,18 @@ impl GeometryTable {
         match &self.rows {
             Rows::File {
                 path,
-                bytes,
+                text,
                 columns,
             } => {
-                let mut reader = geometry_reader(bytes);
-                let mut record = csv::StringRecord::new();
-                loop {
-                    let more = reader.read_record(&mut record).map_err(|e| {
-                        geometry_error(
-                            path,
-                            "",
-                            shown_at_most(&e.to_string(), HEADER_EXCERPT_CHARS),
-                        )
-                    })?;
-                    if !more {
-                        return Ok(());
-                    }
-                    let geometry = record_geometry(path, &self.headers, *columns, &record)?;
-                    let fields: Vec<&str> = record.iter().collect();
-                    visit(&fields, &geometry)?;
+                // The header is the first line; every other one is a row.
+                for (number, line) in table_lines(text).skip(1) {
+                    let fields = fields_of(path, number, line)?;
+                    let geometry =
+                        record_geometry(path, &self.headers, *columns, (number, &fields))?;
+                    let texts: Vec<&str> = fields.iter().map(|f| f.text.as_ref()).collect();
+                    visit(&texts, &geometry)?;
                 }
+                Ok(())
             }
             Rows::Sweep {
                 theta_i,
@@ -487,9 +483,30 @@ mod tests {
     #[test]
     fn duplicate_and_clashing_columns_and_bad_text_are_refused() {
         let err = eval_file("theta_i_deg,theta_r_deg,theta_i_deg\n30,30,40\n").unwrap_err();
+        // The place is the text tables' one: line and character column of the field.
         assert!(err
             .to_string()
-            .contains(":1:3: duplicate column 'theta_i_deg' (already column 1)"));
+            .contains("g.csv:1:25: duplicate column 'theta_i_deg' (already column 1)"));
+        let err = eval_file("# a comment\ntheta_i_deg,theta_r_deg\n30, 3x0\n").unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("g.csv:3:5: theta_r_deg = '3x0' is not a finite number"),
+            "{err}"
+        );
+        let err = eval_file("theta_i_deg,theta_r_deg\n30,30\n\n30\n").unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("g.csv:4: 1 fields, the header has 2"),
+            "{err}"
+        );
+        let err = eval_file("theta_i_deg,theta_r_deg\n30,\"30\n").unwrap_err();
+        assert!(err.to_string().contains("g.csv:2:4: quoted field"), "{err}");
+        let err = eval_file("theta_i_deg;theta_r_deg\n30;30\n").unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("g.csv:1:12: fields are separated by ';'"),
+            "{err}"
+        );
         let err = eval_file("theta_i_deg,theta_r_deg,m00\n30,30,1\n").unwrap_err();
         assert!(err.to_string().contains("'m00' clashes"), "{err}");
         let junk = format!(
