@@ -113,14 +113,9 @@ pub enum AppError {
     /// A geometry CSV of `irpol eval`, refused at its line and column.
     #[error(transparent)]
     Geometry(crate::table_text::TableError<crate::table_text::Problem>),
-    /// A bad line of a `--times-file`.
-    #[error("{}:{line}", crate::text::path(path))]
-    TimesLine {
-        path: PathBuf,
-        line: usize,
-        #[source]
-        source: crate::emitter::SunError,
-    },
+    /// A bad line of a `--times-file`, refused as every text table is (`path:line: why`).
+    #[error(transparent)]
+    TimesLine(crate::table_text::TableError<crate::emitter::SunError>),
     #[error(
         "{}: no times (expected one RFC 3339 instant per line, e.g. 2026-06-21T10:00:00Z)",
         crate::text::path(.0)

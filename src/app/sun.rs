@@ -5,6 +5,7 @@
 
 use super::AppError;
 use crate::emitter::{format_time_utc, parse_time_utc, sun_position, SunPosition};
+use crate::table_text::{self, Refusal};
 use crate::weather::{simplified_solis, SolisAtmosphere};
 use chrono::{DateTime, Utc};
 use std::io::Write;
@@ -27,15 +28,13 @@ pub fn read_times_file(path: &Path) -> Result<Vec<DateTime<Utc>>, AppError> {
 /// [`read_times_file`] of a file's text; `path` names it in messages.
 pub fn parse_times(path: &Path, text: &str) -> Result<Vec<DateTime<Utc>>, AppError> {
     let mut times = Vec::new();
-    for (index, line) in text.lines().enumerate() {
+    for (number, line) in table_text::lines(text) {
         let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
+        if line.is_empty() || table_text::is_comment(line) {
             continue;
         }
-        let time = parse_time_utc(line).map_err(|source| AppError::TimesLine {
-            path: path.to_owned(),
-            line: index + 1,
-            source,
+        let time = parse_time_utc(line).map_err(|problem| {
+            AppError::TimesLine(Refusal::at_line(number, problem).in_file(path))
         })?;
         times.push(time);
     }
