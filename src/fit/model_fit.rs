@@ -114,11 +114,13 @@ impl ModelFit {
         data: &MeasurementData,
         options: &FitOptions,
     ) -> Result<Vec<Mueller>, FitError> {
-        let options = &self.effective_options(options);
-        let space = model_space(self.distribution, options)?;
-        Objective::new(data, &space, None)
-            .model_muellers(&self.parameter_values(options))
-            .ok_or_else(|| unevaluable(set, self.distribution, "Mueller matrices"))
+        self.evaluated(
+            set,
+            data,
+            options,
+            "Mueller matrices",
+            |objective, values| objective.model_muellers(values),
+        )
     }
 
     /// Normalized residuals (model − data)/σ at every observation of `data`, point-major,
@@ -129,11 +131,28 @@ impl ModelFit {
         data: &MeasurementData,
         options: &FitOptions,
     ) -> Result<Vec<f64>, FitError> {
+        self.evaluated(set, data, options, "residuals", |objective, values| {
+            objective.normalized_residuals(values)
+        })
+    }
+
+    /// `evaluate` of the fit's objective on `data` at the fitted values, refused as `what`
+    /// when the model cannot be evaluated there.
+    fn evaluated<T>(
+        &self,
+        set: &MeasurementSet,
+        data: &MeasurementData,
+        options: &FitOptions,
+        what: &str,
+        evaluate: impl FnOnce(&Objective, &ParameterValues) -> Option<T>,
+    ) -> Result<T, FitError> {
         let options = &self.effective_options(options);
         let space = model_space(self.distribution, options)?;
-        Objective::new(data, &space, None)
-            .normalized_residuals(&self.parameter_values(options))
-            .ok_or_else(|| unevaluable(set, self.distribution, "residuals"))
+        evaluate(
+            &Objective::new(data, &space, None),
+            &self.parameter_values(options),
+        )
+        .ok_or_else(|| unevaluable(set, self.distribution, what))
     }
 }
 
