@@ -16,7 +16,7 @@ use super::AppError;
 use crate::measure::MUELLER_ELEMENT_NAMES;
 use crate::pbrdf::{signed_zenith_note, Direction, HemisphereQuadrature, Pbrdf};
 use crate::table_text::{
-    self, decode_utf8, is_comment, parse_finite, split_fields, wrong_delimiter, Field, InvalidUtf8,
+    content_lines, decode_utf8, parse_finite, split_fields, wrong_delimiter, Field, InvalidUtf8,
     Problem, Refusal,
 };
 use crate::text::{shown, shown_at_most};
@@ -86,11 +86,6 @@ struct GeometryColumns {
     phi_r: Option<usize>,
 }
 
-/// The lines of a geometry CSV that hold a header or a row: not blank, not a `#` comment.
-fn table_lines(text: &str) -> impl Iterator<Item = (u64, &str)> {
-    table_text::lines(text).filter(|(_, line)| !line.trim().is_empty() && !is_comment(line))
-}
-
 /// The fields of line `number`, refused at the column of a malformed quote.
 fn fields_of<'a>(path: &Path, number: u64, line: &'a str) -> Result<Vec<Field<'a>>, AppError> {
     split_fields(number, line)
@@ -121,7 +116,7 @@ pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> Result<GeometryTable, 
         })?
         .to_owned();
     drop(bytes);
-    let (header_line, header) = match table_lines(&text).next() {
+    let (header_line, header) = match content_lines(&text).next() {
         Some((number, line)) => (number, fields_of(path, number, line)?),
         None => (1, Vec::new()),
     };
@@ -249,7 +244,7 @@ impl GeometryTable {
                 columns,
             } => {
                 // The header is the first line; every other one is a row.
-                for (number, line) in table_lines(text).skip(1) {
+                for (number, line) in content_lines(text).skip(1) {
                     let fields = fields_of(path, number, line)?;
                     let geometry =
                         record_geometry(path, &self.headers, *columns, (number, &fields))?;

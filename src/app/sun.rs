@@ -28,12 +28,8 @@ pub fn read_times_file(path: &Path) -> Result<Vec<DateTime<Utc>>, AppError> {
 /// [`read_times_file`] of a file's text; `path` names it in messages.
 pub fn parse_times(path: &Path, text: &str) -> Result<Vec<DateTime<Utc>>, AppError> {
     let mut times = Vec::new();
-    for (number, line) in table_text::lines(text) {
-        let line = line.trim();
-        if line.is_empty() || table_text::is_comment(line) {
-            continue;
-        }
-        let time = parse_time_utc(line).map_err(|problem| {
+    for (number, line) in table_text::content_lines(text) {
+        let time = parse_time_utc(line.trim()).map_err(|problem| {
             AppError::TimesLine(Refusal::at_line(number, problem).in_file(path))
         })?;
         times.push(time);

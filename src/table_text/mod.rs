@@ -32,6 +32,11 @@ pub fn is_comment(line: &str) -> bool {
     line.trim_start().starts_with('#')
 }
 
+/// The numbered [`lines`] that hold a header or a row: neither blank nor a `#` comment.
+pub fn content_lines(text: &str) -> impl Iterator<Item = (u64, &str)> {
+    lines(text).filter(|(_, line)| !line.trim().is_empty() && !is_comment(line))
+}
+
 /// The column just after the end of `line` (where a missing field would start).
 pub fn last_column(line: &str) -> u64 {
     line.chars().count() as u64 + 1

@@ -18,8 +18,8 @@ use super::{
 use crate::emitter::{format_time_utc, sun_direction, sun_position};
 use crate::optics::MAX_TEMPERATURE_K;
 use crate::table_text::{
-    self, is_comment, last_column, parse_finite, split_fields, ColumnMap, Field, HeaderProblem,
-    NumberProblem, Problem,
+    self, last_column, parse_finite, split_fields, ColumnMap, Field, HeaderProblem, NumberProblem,
+    Problem,
 };
 use crate::text::{number, shown};
 use nalgebra::Vector3;
@@ -102,8 +102,7 @@ fn parse_rows(bytes: &[u8], site: &Site) -> Result<Weather, Refusal> {
         let message = "invalid UTF-8: a weather CSV must be UTF-8 text";
         Refusal::new(refusal.line, 1, message.into())
     })?;
-    let mut lines =
-        table_text::lines(text).filter(|(_, line)| !line.trim().is_empty() && !is_comment(line));
+    let mut lines = table_text::content_lines(text);
     let Some((header_line, header)) = lines.next() else {
         let message = "no header row: the file is empty or only comments";
         return Err(Refusal::new(1, 1, message.into()));
