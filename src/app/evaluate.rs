@@ -109,13 +109,21 @@ fn geometry_error(path: &Path, refusal: Refusal<String>) -> AppError {
 
 /// [`read_geometry_csv`] of a file's bytes; `path` names it in messages.
 pub fn parse_geometry_csv(path: &Path, bytes: Vec<u8>) -> Result<GeometryTable, AppError> {
-    let text = decode_utf8(&bytes)
-        .map_err(|refusal| {
-            let problem = |k: InvalidUtf8| format!("byte 0x{:02X} is not UTF-8 text", k.byte);
-            geometry_error(path, refusal.map(problem))
-        })?
-        .to_owned();
-    drop(bytes);
+    // Checked (and its byte-order mark found) in place, then kept without a copy.
+    let bom = match decode_utf8(&bytes) {
+        Ok(text) => bytes.len() - text.len(),
+        Err(refusal) => {
+            let problem = |k: InvalidUtf8| {
+                format!(
+                    "invalid UTF-8 (byte 0x{:02X}): a geometry CSV must be UTF-8 text",
+                    k.byte
+                )
+            };
+            return Err(geometry_error(path, refusal.map(problem)));
+        }
+    };
+    let mut text = String::from_utf8(bytes).expect("checked above");
+    text.drain(..bom);
     let (header_line, header) = match content_lines(&text).next() {
         Some((number, line)) => (number, fields_of(path, number, line)?),
         None => (1, Vec::new()),
@@ -205,7 +213,11 @@ fn record_geometry(
     (line, fields): (u64, &[Field<'_>]),
 ) -> Result<Geometry, AppError> {
     if fields.len() != headers.len() {
-        let message = format!("{} fields, the header has {}", fields.len(), headers.len());
+        let message = format!(
+            "the row has {} fields, the header row has {}",
+            fields.len(),
+            headers.len()
+        );
         return Err(geometry_error(path, Refusal::at_line(line, message)));
     }
     let field = |index: usize| -> Result<f64, AppError> {
@@ -491,7 +503,7 @@ mod tests {
         let err = eval_file("theta_i_deg,theta_r_deg\n30,30\n\n30\n").unwrap_err();
         assert!(
             err.to_string()
-                .contains("g.csv:4: 1 fields, the header has 2"),
+                .contains("g.csv:4: the row has 1 fields, the header row has 2"),
             "{err}"
         );
         let err = eval_file("theta_i_deg,theta_r_deg\n30,\"30\n").unwrap_err();
