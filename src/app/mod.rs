@@ -249,8 +249,11 @@ impl ModelArgs {
 
     /// `--facet` and the lobes' flags applied to `model` (docs/design.md §1.10).
     fn with_volume_terms(&self, model: Pbrdf) -> Result<Pbrdf, ModelArgsError> {
-        let subsurface =
-            (self.lobes.0.lobes()).map_err(ModelArgsError::PolarizationWithoutSubsurface)?;
+        let subsurface = self
+            .lobes
+            .0
+            .lobes()
+            .map_err(ModelArgsError::PolarizationWithoutSubsurface)?;
         if self.facet.is_none() && subsurface.is_empty() {
             return Ok(model);
         }

@@ -29,7 +29,7 @@ use crate::atomic::write_atomically;
 use crate::optics::RefractiveIndex;
 use crate::pbrdf::{
     FacetSide, LobeKeys, ModelError, ModelTerms, Parameter, Pbrdf, Shadowing, SlopeDistribution,
-    Subsurface, Term,
+    Subsurface,
 };
 use crate::text::{number, shown, shown_at_most};
 use serde::{Deserialize, Serialize};
@@ -104,7 +104,7 @@ impl ModelSpec {
             Parameter::N => Some(self.n),
             Parameter::K => Some(self.k),
             Parameter::RhoD => Some(self.rho_d),
-            lobe if lobe.info().term.lobe().is_some() => self
+            lobe if lobe.is_lobe() => self
                 .subsurface_lobes()
                 .iter()
                 .find_map(|s| s.value(lobe, self.n)),
@@ -117,14 +117,10 @@ impl ModelSpec {
         ModelTerms::new(self.facet, self.lobe_keys.body())
     }
 
-    /// The subsurface lobes the model has (keys of a lobe without its ρ_s, refused by every
-    /// reader, describe none).
+    /// The subsurface lobes the model has ([`LobeKeys::lobes`]; keys of a lobe without its
+    /// ρ_s, refused by every reader, describe none).
     pub fn subsurface_lobes(&self) -> Vec<Subsurface> {
-        Term::ALL
-            .into_iter()
-            .filter_map(|t| Subsurface::from_keys(t, |p| self.lobe_keys.get(p).copied()).ok())
-            .flatten()
-            .collect()
+        self.lobe_keys.lobes().unwrap_or_default()
     }
 
     pub fn pbrdf(&self) -> Result<Pbrdf, ModelError> {

@@ -23,14 +23,9 @@ impl<V> Default for LobeKeys<V> {
     }
 }
 
-/// Whether `parameter` belongs to a lobe term (and so is stored in [`LobeKeys`]).
-fn is_lobe_parameter(parameter: Parameter) -> bool {
-    parameter.info().term.lobe().is_some()
-}
-
 /// The lobe parameters, in [`Parameter::ALL`] order.
 pub fn lobe_parameters() -> impl Iterator<Item = Parameter> {
-    Parameter::ALL.into_iter().filter(|&p| is_lobe_parameter(p))
+    Parameter::ALL.into_iter().filter(Parameter::is_lobe)
 }
 
 impl<V> LobeKeys<V> {
@@ -41,7 +36,7 @@ impl<V> LobeKeys<V> {
 
     /// Writes (`Some`) or removes (`None`) the value of a lobe parameter.
     pub fn set(&mut self, parameter: Parameter, value: Option<V>) {
-        debug_assert!(is_lobe_parameter(parameter), "{parameter} is no lobe's");
+        debug_assert!(parameter.is_lobe(), "{parameter} is no lobe's");
         self.values[parameter.index()] = value;
     }
 

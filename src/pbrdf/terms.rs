@@ -474,6 +474,12 @@ impl Parameter {
         *self as usize
     }
 
+    /// Whether the parameter belongs to a subsurface lobe ([`Term::lobe`]), whose keys a
+    /// material stores by parameter ([`super::LobeKeys`]).
+    pub fn is_lobe(&self) -> bool {
+        self.info().term.lobe().is_some()
+    }
+
     /// The values a model accepts ([`limits`]): (lowest, highest, whether the lowest itself is
     /// excluded).
     pub fn domain(&self) -> (f64, f64, bool) {

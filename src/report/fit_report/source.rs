@@ -72,9 +72,10 @@ fn verified_source(
 }
 
 /// Whether each of the fit's source files still holds the data that was fitted (the library
-/// index's check), each read as the fit read it — a spectral material's files may hold several
-/// wavelengths each — except that a file of the very bytes fitted is not read again. A dense scan is hundreds of megabytes of text
-/// and rows, which `irpol fit` would otherwise hold beside the fit it just made.
+/// index's check), each read as the fit read it (a spectral material's files may hold several
+/// wavelengths each), except that a file of the very bytes fitted is not read again: a dense
+/// scan is hundreds of megabytes of text and rows, which `irpol fit` would otherwise hold
+/// beside the fit it just made.
 pub(crate) fn source_unchanged(
     material_path: &Path,
     fit: &FitRecord,
