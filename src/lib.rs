@@ -102,7 +102,10 @@ pub use app::thermal::{run_thermal, run_thermal_and_render};
 pub use app::{AppError, ModelArgs};
 pub use fit::{fit_inputs, FitOptions, MaterialFit};
 pub use material::{Material, MaterialModel, ModelSpec, SpectralModel};
-pub use measure::{read_measurement_csv, read_measurement_sets, MeasurementPoint, MeasurementSet};
+pub use measure::{
+    read_measurement_csv, read_measurement_sets, MeasurementPoint, MeasurementRow, MeasurementRows,
+    MeasurementSet,
+};
 pub use optics::RefractiveIndex;
 pub use pbrdf::{DistributionKind, Pbrdf, Shadowing, SlopeDistribution};
 pub use progress::{Progress, Silent};

@@ -3,7 +3,7 @@
 use crate::errors::raised;
 use irpol::app::{MeasurementArgs, SelectionArgs};
 use irpol::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
-use numpy::{PyArray1, PyArray2};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -58,9 +58,8 @@ pub fn measurement_args(
 
 pub fn set_dict<'py>(py: Python<'py>, set: &MeasurementSet) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let column = |f: fn(&irpol::measure::MeasurementPoint) -> f64| {
-        PyArray1::from_vec(py, set.points.iter().map(f).collect())
-    };
+    let rows = &set.points;
+    let angle = |k: usize| PyArray1::from_iter(py, rows.angles().iter().map(|a| a[k]));
     d.set_item("material", &set.material)?;
     d.set_item("wavelength_um", set.wavelength_um)?;
     d.set_item("source", &set.source)?;
@@ -72,25 +71,20 @@ pub fn set_dict<'py>(py: Python<'py>, set: &MeasurementSet) -> PyResult<Bound<'p
         .map(|&e| MUELLER_ELEMENT_NAMES[e])
         .collect();
     d.set_item("elements", names)?;
-    d.set_item("theta_i_deg", column(|p| p.theta_i_deg))?;
-    d.set_item("phi_i_deg", column(|p| p.phi_i_deg))?;
-    d.set_item("theta_r_deg", column(|p| p.theta_r_deg))?;
-    d.set_item("phi_r_deg", column(|p| p.phi_r_deg))?;
-    let values: Vec<Vec<f64>> = set.points.iter().map(|p| p.values.clone()).collect();
-    let uncertainties: Vec<Vec<f64>> = set
-        .points
+    d.set_item("theta_i_deg", angle(0))?;
+    d.set_item("phi_i_deg", angle(1))?;
+    d.set_item("theta_r_deg", angle(2))?;
+    d.set_item("phi_r_deg", angle(3))?;
+    // The values block is point-major already: one copy, viewed as rows × elements.
+    let shape = [rows.len(), rows.width()];
+    let values = PyArray1::from_slice(py, rows.values()).reshape(shape)?;
+    let uncertainties = rows
         .iter()
-        .map(|p| {
-            p.uncertainties
-                .iter()
-                .map(|u| u.unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
-    d.set_item("values", PyArray2::from_vec2(py, &values)?)?;
-    d.set_item("uncertainties", PyArray2::from_vec2(py, &uncertainties)?)?;
-    let lines: Vec<u64> = set.points.iter().map(|p| p.line).collect();
-    d.set_item("line", PyArray1::from_vec(py, lines))?;
+        .flat_map(|p| p.uncertainties().map(|u| u.unwrap_or(f64::NAN)));
+    let uncertainties = PyArray1::from_iter(py, uncertainties).reshape(shape)?;
+    d.set_item("values", values)?;
+    d.set_item("uncertainties", uncertainties)?;
+    d.set_item("line", PyArray1::from_slice(py, rows.lines()))?;
     let merged: Vec<PathBuf> = set.merged.iter().map(|m| m.path.clone()).collect();
     d.set_item("merged", merged)?;
     d.set_item("notes", set.notes.clone())?;

@@ -226,7 +226,7 @@ pub fn fold_rows(rows: usize, k: usize, seed: u64) -> Vec<Vec<usize>> {
 /// The rows `rows` of `set`, as a set of their own.
 pub fn subset(set: &MeasurementSet, rows: &[usize]) -> MeasurementSet {
     MeasurementSet {
-        points: rows.iter().map(|&r| set.points[r].clone()).collect(),
+        points: set.points.select(rows),
         ..set.clone()
     }
 }
@@ -293,7 +293,7 @@ mod tests {
             wavelength_um: 10.0,
             metadata: Default::default(),
             elements: vec![0],
-            points: vec![point.clone(); n],
+            points: std::iter::repeat_n(point.clone(), n).collect(),
             merged: Vec::new(),
             notes: Vec::new(),
         };

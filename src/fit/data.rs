@@ -3,9 +3,10 @@
 //! with the same zenith angle, and one standard deviation per observation (the weights of the
 //! least-squares objective).
 
-use crate::measure::{MeasurementPoint, MeasurementSet, MUELLER_ELEMENT_NAMES};
+use crate::measure::{MeasurementRow, MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::pbrdf::{Direction, ScatteringGeometry};
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use super::FitError;
 
@@ -45,32 +46,32 @@ pub struct MeasurementData {
     pub(crate) zenith_cosines: Vec<f64>,
     /// Mueller (row, column) of each element present.
     pub(crate) elements: Vec<(usize, usize)>,
-    /// Measured values, point-major (`point * elements.len() + element`).
-    pub(crate) values: Vec<f64>,
+    /// Measured values, point-major (`point * elements.len() + element`): for the data of a
+    /// whole set, the set's own values block ([`crate::measure::MeasurementRows::shared_values`]),
+    /// not a copy.
+    pub(crate) values: Arc<Vec<f64>>,
     /// 1 / standard deviation, aligned with `values`.
     pub(crate) inverse_sigma: Vec<f64>,
     error_sources: Vec<ErrorSource>,
 }
 
 impl MeasurementData {
+    /// The set's data prepared, after checking every row; the values are the set's own block,
+    /// shared, so the prepared data adds only the geometry and 1/σ.
     pub fn new(set: &MeasurementSet) -> Result<MeasurementData, FitError> {
         let width = set.elements.len();
         let mut geometry = Vec::with_capacity(set.points.len());
-        let mut values = Vec::with_capacity(set.points.len() * width);
         let mut inverse_sigma = Vec::with_capacity(set.points.len() * width);
         let zeniths = visit_observations(
             set,
             |g| geometry.push(g),
-            |value, sigma| {
-                values.push(value);
-                inverse_sigma.push(1.0 / sigma);
-            },
+            |_, sigma| inverse_sigma.push(1.0 / sigma),
         )?;
         Ok(MeasurementData {
             geometry,
             zenith_cosines: zeniths.cosines,
             elements: set.elements.iter().map(|&e| (e / 4, e % 4)).collect(),
-            values,
+            values: set.points.shared_values(),
             inverse_sigma,
             error_sources: error_sources(set),
         })
@@ -159,7 +160,7 @@ impl MeasurementData {
             geometry,
             zenith_cosines: zeniths.cosines,
             elements: self.elements.clone(),
-            values,
+            values: Arc::new(values),
             inverse_sigma,
             error_sources: self.error_sources.clone(),
         }
@@ -185,22 +186,15 @@ fn visit_observations(
     mut observation: impl FnMut(f64, f64),
 ) -> Result<DistinctCosines, FitError> {
     check_elements(set)?;
-    let width = set.elements.len();
     let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
     let floor = default_floor(m00_max);
     let mut zeniths = DistinctCosines::default();
     for point in &set.points {
         let at_line = |what: String| refusal(set, format!("line {}: {what}", point.line));
-        if point.values.len() != width || point.uncertainties.len() != width {
-            return Err(at_line(format!(
-                "{} values for {width} elements",
-                point.values.len()
-            )));
-        }
         geometry(prepare_geometry(point, &mut zeniths, &at_line)?);
         let m00 = point.values[0];
         for (column, (&value, uncertainty)) in
-            point.values.iter().zip(&point.uncertainties).enumerate()
+            point.values.iter().zip(point.uncertainties()).enumerate()
         {
             let sigma = uncertainty.unwrap_or_else(|| default_sigma(column, m00, floor));
             if !(value.is_finite() && sigma.is_finite() && sigma > 0.0) {
@@ -239,10 +233,18 @@ fn refusal(set: &MeasurementSet, message: String) -> FitError {
     }
 }
 
-/// Refuses a set without rows, without m00 first, or with an index outside the 4×4 matrix.
+/// Refuses a set without rows, without m00 first, with an index outside the 4×4 matrix, or with
+/// rows of another number of values than it has elements.
 fn check_elements(set: &MeasurementSet) -> Result<(), FitError> {
     if set.points.is_empty() {
         return Err(refusal(set, "the file has no data rows".into()));
+    }
+    let (width, values) = (set.elements.len(), set.points.width());
+    if values != width {
+        return Err(refusal(
+            set,
+            format!("rows of {values} values for {width} elements"),
+        ));
     }
     if set.elements.first() != Some(&0) {
         return Err(refusal(
@@ -283,7 +285,7 @@ impl DistinctCosines {
 /// The scattering geometry of `point`, its zenith cosines entered in `zeniths`; `at_line` makes
 /// the refusal of an invalid direction.
 fn prepare_geometry(
-    point: &MeasurementPoint,
+    point: MeasurementRow<'_>,
     zeniths: &mut DistinctCosines,
     at_line: &impl Fn(String) -> FitError,
 ) -> Result<PreparedGeometry, FitError> {
@@ -302,14 +304,15 @@ fn prepare_geometry(
     })
 }
 
-/// Where each element's standard deviations come from, judged by the first row.
+/// Where each element's standard deviations come from: the same for every row, decided by the
+/// file's `u_` columns.
 fn error_sources(set: &MeasurementSet) -> Vec<ErrorSource> {
-    set.points[0]
-        .uncertainties
-        .iter()
-        .map(|u| match u {
-            Some(_) => ErrorSource::File,
-            None => ErrorSource::DefaultModel,
+    set.points
+        .has_uncertainty()
+        .into_iter()
+        .map(|has| match has {
+            true => ErrorSource::File,
+            false => ErrorSource::DefaultModel,
         })
         .collect()
 }
@@ -340,12 +343,14 @@ mod tests {
             wavelength_um: 10.0,
             metadata: Default::default(),
             elements: vec![0, 4],
-            points: vec![
+            points: [
                 point(10.0, 20.0, 4.0),
                 point(30.0, 20.0, 0.0),
                 point(50.0, 40.0, 0.5),
                 point(10.0, 60.0, 0.25),
-            ],
+            ]
+            .into_iter()
+            .collect(),
             merged: Vec::new(),
             notes: Vec::new(),
         };

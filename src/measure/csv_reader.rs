@@ -13,11 +13,11 @@ use super::columns::{parse_header_row, NativeColumns, Quantity};
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
 use super::metadata::{split_metadata_line, wavelength_in_range, HeaderWavelength, Metadata};
 use super::table_file::{
-    check_width, decode_utf8, fields_of, hex, material_of, measurement_point, parse_number,
-    read_bytes, row_wavelength, table_lines, wavelength_groups, FileFacts, RowWavelengths,
+    check_width, decode_utf8, fields_of, hex, material_of, parse_number, read_bytes,
+    row_wavelength, table_lines, FileFacts, WavelengthGroups,
 };
 use super::units::{check_degrees, converted_note, AngleReading};
-use super::{MeasurementPoint, MeasurementSet, MAX_MUELLER_SR, MIN_UNCERTAINTY_SR};
+use super::{MeasurementSet, MAX_MUELLER_SR, MIN_UNCERTAINTY_SR};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
 use crate::table_text::wrong_delimiter;
 use crate::text::shown;
@@ -76,15 +76,15 @@ fn parse_sets(
     let sha256 = hex(&Sha256::digest(bytes));
     let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
     let radians = angles == AngleReading::Radians;
-    let parsed = parse_text(text, radians).map_err(|r| r.in_file(source))?;
+    let parsed = parse_text(text, radians, spectral).map_err(|r| r.in_file(source))?;
     let file = source.display().to_string();
     let angle_note = if radians {
         Some(converted_note(&file))
     } else {
-        check_degrees(&file, &parsed.points, angles, PLAIN_FIX).map_err(|r| r.in_file(source))?
+        check_degrees(&file, parsed.groups.rows(), angles, PLAIN_FIX)
+            .map_err(|r| r.in_file(source))?
     };
-    let groups = wavelength_groups(parsed.points, parsed.wavelengths, spectral)
-        .map_err(|r| r.in_file(source))?;
+    let groups = parsed.groups.finish().map_err(|r| r.in_file(source))?;
     let facts = FileFacts {
         sha256,
         material: material_of(parsed.metadata.material.as_ref(), source),
@@ -106,10 +106,9 @@ fn parse_sets(
 struct ParsedText {
     metadata: Metadata,
     columns: NativeColumns,
-    points: Vec<MeasurementPoint>,
-    /// The file's wavelength (the header's) or each row's, for a wavelength_um column without a
-    /// header (which may hold several wavelengths).
-    wavelengths: RowWavelengths,
+    /// The rows by wavelength: the file's (the header's), or each row's for a wavelength_um
+    /// column without a header (which may hold several wavelengths).
+    groups: WavelengthGroups,
     /// Rows whose θ_r was negative.
     signed_rows: usize,
 }
@@ -118,7 +117,7 @@ struct ParsedText {
 const PLAIN_FIX: &str = "convert them to degrees, or pass --angles radians to convert them as \
      the file is read (--angles degrees if they are degrees)";
 
-fn parse_text(text: &str, radians: bool) -> Result<ParsedText, Refusal> {
+fn parse_text(text: &str, radians: bool, spectral: bool) -> Result<ParsedText, Refusal> {
     let lines = table_lines(text)?;
     let mut metadata = Metadata::default();
     for &(number, line) in &lines.comments {
@@ -132,21 +131,31 @@ fn parse_text(text: &str, radians: bool) -> Result<ParsedText, Refusal> {
     if metadata.wavelength.is_none() && !columns.has(Quantity::Wavelength) {
         return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength));
     }
-    let mut row_wavelengths = Vec::new();
+    let has_uncertainty = (columns.elements.iter())
+        .map(|&e| columns.has(Quantity::Uncertainty(e)))
+        .collect();
+    let header_wavelength = metadata.wavelength.as_ref();
+    let mut groups = WavelengthGroups::new(
+        header_wavelength,
+        spectral,
+        has_uncertainty,
+        lines.rows().len(),
+    );
     let mut signed_rows = 0;
-    let mut points = Vec::with_capacity(lines.rows().len());
+    // One row's values, reused for every row: each is copied into its group's columns.
+    let mut row = RowValues::new(columns.elements.len());
     for &(number, line) in lines.rows() {
-        let row = parse_row(number, line, &columns, &metadata, radians)?;
-        row_wavelengths.extend(row.wavelength);
-        signed_rows += usize::from(row.signed);
-        points.push(row.point);
+        let read = parse_row(number, line, &columns, &metadata, radians, &mut row)?;
+        signed_rows += usize::from(read.signed);
+        let (values, uncertainties) = (&row.values, &row.uncertainties);
+        groups.push(read.wavelength, read.angles, values, uncertainties, number);
     }
-    if points.is_empty() {
+    if groups.len() == 0 {
         return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
     }
     // A file of zeros has no lobe: every model with ρ_d = 0 and σ anywhere fits it perfectly, so
     // a "fit" would report arbitrary parameters with χ² = 0.
-    if points.iter().all(|p| p.values[0] == 0.0) {
+    if groups.rows().all(|p| p.values[0] == 0.0) {
         let m00_column = header_fields
             .iter()
             .zip(&columns.quantities)
@@ -158,52 +167,62 @@ fn parse_text(text: &str, radians: bool) -> Result<ParsedText, Refusal> {
             MeasureErrorKind::AllM00Zero,
         ));
     }
-    let wavelengths = match &metadata.wavelength {
-        Some(header) => RowWavelengths::Header(header.um),
-        None => RowWavelengths::PerRow(row_wavelengths),
-    };
     Ok(ParsedText {
         metadata,
         columns,
-        points,
-        wavelengths,
+        groups,
         signed_rows,
     })
 }
 
-/// One data row read: its point (θ_r < 0 read as the detector across the normal, (|θ_r|,
-/// φ_r + 180°), once all of the row's columns are known), its own wavelength if the file has no
-/// header one, and whether θ_r was negative.
+/// One data row read, besides its values (in [`RowValues`]): its angles (θ_r < 0 read as the
+/// detector across the normal, (|θ_r|, φ_r + 180°), once all of the row's columns are known),
+/// its own wavelength if the file has no header one, and whether θ_r was negative.
 struct Row {
-    point: MeasurementPoint,
+    angles: [f64; 4],
     wavelength: Option<(HeaderWavelength, u64)>,
     signed: bool,
 }
 
-/// A row's values as read, before they become a point.
+/// A row's values as read, aligned with the file's elements; one buffer serves every row.
 struct RowValues {
     angles: [f64; 4],
     values: Vec<f64>,
     uncertainties: Vec<Option<f64>>,
 }
 
+impl RowValues {
+    fn new(elements: usize) -> RowValues {
+        RowValues {
+            angles: [f64::NAN; 4],
+            values: vec![f64::NAN; elements],
+            uncertainties: vec![None; elements],
+        }
+    }
+
+    /// Back to a row with nothing read: the azimuths at their defaults.
+    fn clear(&mut self) {
+        self.angles = [f64::NAN, DEFAULT_PHI_I_DEG, f64::NAN, DEFAULT_PHI_R_DEG];
+        self.values.fill(f64::NAN);
+        self.uncertainties.fill(None);
+    }
+}
+
+/// Reads the row `line` (line `line_number`) into `row`.
 fn parse_row(
     line_number: u64,
     line: &str,
     columns: &NativeColumns,
     metadata: &Metadata,
     radians: bool,
+    row: &mut RowValues,
 ) -> Result<Row, Refusal> {
     let fields = fields_of(line_number, line)?;
     if let Some(refusal) = wrong_delimiter(line_number, &fields) {
         return Err(refusal.map(MeasureErrorKind::Token));
     }
     check_width(line_number, line, &fields, columns.quantities.len())?;
-    let mut row = RowValues {
-        angles: [f64::NAN, DEFAULT_PHI_I_DEG, f64::NAN, DEFAULT_PHI_R_DEG],
-        values: vec![f64::NAN; columns.elements.len()],
-        uncertainties: vec![None; columns.elements.len()],
-    };
+    row.clear();
     let mut wavelength = None;
     for ((field, &quantity), name) in fields.iter().zip(&columns.quantities).zip(&columns.names) {
         let refuse = |kind| Refusal::new(line_number, field.column, kind);
@@ -227,7 +246,7 @@ fn parse_row(
             let header = metadata.wavelength.as_ref();
             wavelength = row_wavelength(header, line_number, field.column, value, text)?;
         } else {
-            store_value(&mut row, columns, quantity, name, value, text).map_err(refuse)?;
+            store_value(row, columns, quantity, name, value, text).map_err(refuse)?;
         }
     }
     let [theta_i, phi_i, theta_r, phi_r] = row.angles;
@@ -236,9 +255,8 @@ fn parse_row(
         true => fold_signed_zenith(theta_r, phi_r),
         false => (theta_r, phi_r),
     };
-    let angles = [theta_i, phi_i, theta_r, phi_r];
     Ok(Row {
-        point: measurement_point(angles, row.values, row.uncertainties, line_number),
+        angles: [theta_i, phi_i, theta_r, phi_r],
         wavelength,
         signed,
     })
@@ -358,13 +376,17 @@ mod tests {
         assert_eq!(set.material, "sample");
         assert_eq!(set.wavelength_um, 10.6);
         assert_eq!(set.elements, vec![0]);
-        let p = &set.points[0];
+        let p = set.points.row(0);
         assert_eq!(
             (p.theta_i_deg, p.phi_i_deg, p.theta_r_deg, p.phi_r_deg),
             (30.0, 0.0, 40.0, 180.0)
         );
         assert_eq!(
-            (p.values.clone(), p.uncertainties.clone(), p.line),
+            (
+                p.values.to_vec(),
+                p.uncertainties().collect::<Vec<_>>(),
+                p.line
+            ),
             (vec![0.05], vec![None], 3)
         );
     }
@@ -376,8 +398,11 @@ mod tests {
         )
         .unwrap();
         assert_eq!(set.elements, vec![0, 10]);
-        assert_eq!(set.points[0].values, vec![0.05, -0.04]);
-        assert_eq!(set.points[0].uncertainties, vec![Some(0.001), None]);
+        assert_eq!(set.points.row(0).values, vec![0.05, -0.04]);
+        assert_eq!(
+            set.points.row(0).uncertainties().collect::<Vec<_>>(),
+            vec![Some(0.001), None]
+        );
         assert_eq!(set.wavelength_um, 9.925);
     }
 
@@ -435,7 +460,7 @@ mod tests {
     fn bare_carriage_returns_end_lines() {
         let set = parse("# wavelength_um: 8\rtheta_i_deg,theta_r_deg,m00\r10,20,0.5\r\r11,21,0.4")
             .unwrap();
-        assert_eq!(set.points[1].line, 5);
+        assert_eq!(set.points.row(1).line, 5);
         assert_eq!(
             message("# wavelength_um: 8\r\ntheta_i_deg,theta_r_deg,m00\r10,20,-0.5"),
             "mem/sample.csv:3:7: column 'm00': -0.5 is negative, but m00 (the unpolarized BRDF, sr⁻¹) is ≥ 0"
@@ -448,7 +473,7 @@ mod tests {
     fn bom_crlf_and_quoted_names_are_accepted() {
         let text = "\u{feff}\"theta_i_deg\",\"theta_r_deg\",\"m00\"\r\n# wavelength_um: 8\r\n10,20,0.5\r\n";
         let set = parse(text).unwrap();
-        assert_eq!(set.points[0].values, vec![0.5]);
+        assert_eq!(set.points.row(0).values, vec![0.5]);
         assert_eq!(set.wavelength_um, 8.0);
     }
 

@@ -5,7 +5,7 @@
 //! changed file be described ("data in rows 12–14 changed") without keeping the data.
 
 use super::table_file::hex;
-use super::{MeasurementPoint, MeasurementSet, MUELLER_ELEMENT_NAMES};
+use super::{MeasurementRow, MeasurementSet, MUELLER_ELEMENT_NAMES};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -41,14 +41,14 @@ impl MeasurementSet {
     pub fn source_data(&self, rows_per_digest: usize) -> SourceData {
         let merged_rows: usize = self.merged.iter().map(|file| file.rows).sum();
         let own = self.points.len().saturating_sub(merged_rows);
-        self.fingerprint(&self.points[..own], rows_per_digest)
+        self.fingerprint(own, rows_per_digest)
     }
 
-    /// The fingerprint of `points` (rows of this set) with this set's material, wavelength and
-    /// columns.
-    fn fingerprint(&self, points: &[MeasurementPoint], rows_per_digest: usize) -> SourceData {
+    /// The fingerprint of the first `rows` rows of this set with this set's material, wavelength
+    /// and columns.
+    fn fingerprint(&self, rows: usize, rows_per_digest: usize) -> SourceData {
         let rows_per_digest = match rows_per_digest {
-            0 => points.len().div_ceil(MAX_DIGESTS).max(1),
+            0 => rows.div_ceil(MAX_DIGESTS).max(1),
             given => given,
         };
         let columns = value_columns(self);
@@ -61,10 +61,11 @@ impl MeasurementSet {
             whole.update([0]);
         }
         let mut row_digests = String::new();
-        for group in points.chunks(rows_per_digest) {
+        let mut bytes = Vec::new();
+        for start in (0..rows).step_by(rows_per_digest) {
             let mut part = Sha256::new();
-            for point in group {
-                let bytes = row_bytes(point);
+            for index in start..(start + rows_per_digest).min(rows) {
+                row_bytes(self.points.row(index), &mut bytes);
                 whole.update(&bytes);
                 part.update(&bytes);
             }
@@ -75,7 +76,7 @@ impl MeasurementSet {
             material: self.material.clone(),
             wavelength_um: self.wavelength_um,
             columns,
-            rows: points.len(),
+            rows,
             rows_per_digest,
             row_digests,
         }
@@ -94,25 +95,22 @@ fn value_columns(set: &MeasurementSet) -> Vec<String> {
         .elements
         .iter()
         .enumerate()
-        .filter(|&(column, _)| first.is_some_and(|p| p.uncertainties[column].is_some()))
+        .filter(|&(column, _)| first.is_some_and(|p| p.uncertainty(column).is_some()))
         .map(|(_, &e)| format!("u_{}", MUELLER_ELEMENT_NAMES[e]));
     names.map(str::to_owned).chain(uncertain).collect()
 }
 
-fn row_bytes(point: &MeasurementPoint) -> Vec<u8> {
-    let geometry = [
-        point.theta_i_deg,
-        point.phi_i_deg,
-        point.theta_r_deg,
-        point.phi_r_deg,
-    ];
-    let uncertainties = point.uncertainties.iter().flatten();
-    geometry
-        .iter()
-        .chain(&point.values)
-        .chain(uncertainties)
-        .flat_map(|&v| canonical(v).to_le_bytes())
-        .collect()
+/// The bytes a row is hashed as, into `bytes`: its angles, values and uncertainties.
+fn row_bytes(point: MeasurementRow<'_>, bytes: &mut Vec<u8>) {
+    bytes.clear();
+    let geometry = point.angles();
+    let uncertainties = point.uncertainties().flatten();
+    let numbers = geometry.into_iter().chain(point.values.iter().copied());
+    bytes.extend(
+        numbers
+            .chain(uncertainties)
+            .flat_map(|v| canonical(v).to_le_bytes()),
+    );
 }
 
 impl SourceData {

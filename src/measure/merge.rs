@@ -43,7 +43,8 @@ pub fn merge_repeat_measurements(
             rows: set.points.len(),
             data: set.source_data(0),
         });
-        merged.points.append(&mut set.points);
+        // Taken out, so that each file's columns are freed once copied.
+        merged.points.append(&std::mem::take(&mut set.points));
         merged.notes.append(&mut set.notes);
     }
     let last = sources.pop().unwrap_or_default();
@@ -84,15 +85,15 @@ fn check_mergeable(first: &MeasurementSet, other: &MeasurementSet) -> Result<(),
         ));
     }
     let columns = |set: &MeasurementSet| -> String {
-        let with_u = set.points.first().map(|p| p.uncertainties.as_slice());
+        let first = set.points.first();
         set.elements
             .iter()
             .enumerate()
             .map(|(slot, &e)| {
                 let name = MUELLER_ELEMENT_NAMES[e];
-                match with_u.and_then(|u| u.get(slot)) {
-                    Some(Some(_)) => format!("{name} u_{name}"),
-                    _ => name.to_owned(),
+                match first.and_then(|p| p.uncertainty(slot)) {
+                    Some(_) => format!("{name} u_{name}"),
+                    None => name.to_owned(),
                 }
             })
             .collect::<Vec<_>>()
@@ -127,7 +128,7 @@ mod tests {
             .unwrap()
             .unwrap();
         assert_eq!(merged.points.len(), 3);
-        assert_eq!(merged.points[2], b.points[0]);
+        assert_eq!(merged.points.row(2), b.points.row(0));
         assert_eq!(
             (merged.source.clone(), merged.sha256.clone()),
             (a.source, a.sha256)

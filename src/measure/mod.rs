@@ -34,6 +34,7 @@ mod metadata;
 mod pbsdf;
 mod reading;
 mod realizability;
+mod rows;
 mod selection;
 mod table_file;
 mod units;
@@ -57,6 +58,7 @@ pub use reading::{
     parse_measurement_file, read_measurement_file, ReadError, ReadOptions, LAYOUT_KEY,
 };
 pub use realizability::{unrealizable_rows, Realizability};
+pub use rows::{MeasurementRow, MeasurementRows, Rows};
 pub use selection::{RowSelection, SelectionError, THETA_I_TOLERANCE_DEG};
 pub(crate) use table_file::hex;
 pub use units::{is_angle_note, AngleReading};
@@ -82,8 +84,10 @@ pub fn mueller_index(name: &str) -> Option<usize> {
     MUELLER_ELEMENT_NAMES.iter().position(|&m| m == name)
 }
 
-/// One measured geometry: the Mueller elements of [`MeasurementSet::elements`] at (θ_i, φ_i) →
-/// (θ_r, φ_r), directions pointing away from the surface (docs/design.md §1.1).
+/// One measured geometry, owned: the Mueller elements of [`MeasurementSet::elements`] at (θ_i, φ_i) →
+/// (θ_r, φ_r), directions pointing away from the surface (docs/design.md §1.1). A set stores its
+/// rows as columns ([`MeasurementRows`]); this is one of them taken out, or one to build a set
+/// from ([`MeasurementRows`] collects points).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasurementPoint {
     /// Incidence zenith angle, degrees, in [0, 90).
@@ -122,8 +126,9 @@ pub struct MeasurementSet {
     pub metadata: BTreeMap<String, String>,
     /// Mueller indices (r*4 + c) present in the file, ascending, so m00 (0) is always first.
     pub elements: Vec<usize>,
-    /// The data rows in file order (after merging, `source`'s rows first); never empty.
-    pub points: Vec<MeasurementPoint>,
+    /// The data rows in file order (after merging, `source`'s rows first), stored as columns
+    /// whose values and uncertainties are aligned with `elements`; never empty.
+    pub points: MeasurementRows,
     /// Further files of the same material and wavelength merged after `source` as repeat
     /// measurements ([`merge_repeat_measurements`]); empty for a set read from one file.
     pub merged: Vec<SourceFile>,

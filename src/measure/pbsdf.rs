@@ -17,7 +17,7 @@
 use crate::interop::convention::{node_directions, psps_from_table};
 use crate::interop::{PbsdfFile, TensorError};
 use crate::measure::{
-    MeasureError, MeasureErrorKind, MeasurementPoint, MeasurementSet, MAX_MUELLER_SR,
+    MeasureError, MeasureErrorKind, MeasurementRows, MeasurementSet, MAX_MUELLER_SR,
 };
 use crate::optics::Mueller;
 use sha2::{Digest, Sha256};
@@ -44,7 +44,7 @@ pub fn read_table_measurements(path: &Path) -> Result<Vec<MeasurementSet>, Measu
     let sha256 = file_sha256(path).map_err(table_error)?;
     let selection = NodeSelection::of(&file.grid);
     let (rows, skipped, nodes_read) = table_rows(&mut file, &selection).map_err(table_error)?;
-    if rows.iter().all(Vec::is_empty) {
+    if rows.iter().all(MeasurementRows::is_empty) {
         return Err(refuse(MeasureErrorKind::NoTableRows { skipped }));
     }
     let material = path
@@ -190,9 +190,10 @@ fn splitmix64(x: u64) -> u64 {
 fn table_rows<R: std::io::Read + std::io::Seek>(
     file: &mut PbsdfFile<R>,
     selection: &NodeSelection,
-) -> Result<(Vec<Vec<MeasurementPoint>>, usize, usize), TensorError> {
+) -> Result<(Vec<MeasurementRows>, usize, usize), TensorError> {
     let n_l = file.wavelengths_nm.len();
-    let mut rows: Vec<Vec<MeasurementPoint>> = vec![Vec::new(); n_l];
+    // All 16 elements, none with an uncertainty.
+    let mut rows = vec![MeasurementRows::with_capacity(&[false; 16], 0); n_l];
     let mut skipped = 0;
     let grid = file.grid.clone();
     let mut index = 0u64;
@@ -213,13 +214,8 @@ fn table_rows<R: std::io::Read + std::io::Seek>(
                         continue;
                     }
                     let table = Mueller::from_fn(|i, j| values[i * 4 + j]);
-                    match point(
-                        &psps_from_table(&table, &light, &view),
-                        &light,
-                        &view,
-                        index,
-                    ) {
-                        Some(point) => row.push(point),
+                    match point(&psps_from_table(&table, &light, &view), &light, &view) {
+                        Some((angles, values)) => row.push(angles, &values, &[None; 16], index),
                         None => skipped += 1,
                     }
                 }
@@ -230,15 +226,15 @@ fn table_rows<R: std::io::Read + std::io::Seek>(
     Ok((rows, skipped, nodes_read))
 }
 
-/// A measurement row of a psps matrix, or `None` when it cannot be one (m00 ≤ 0, a value not
-/// finite or beyond [`MAX_MUELLER_SR`]).
+/// A measurement row of a psps matrix, its angles (θ_i, φ_i, θ_r, φ_r) in degrees and its 16
+/// values, or `None` when it cannot be one (m00 ≤ 0, a value not finite or beyond
+/// [`MAX_MUELLER_SR`]).
 fn point(
     m: &Mueller,
     light: &nalgebra::Vector3<f64>,
     view: &nalgebra::Vector3<f64>,
-    line: u64,
-) -> Option<MeasurementPoint> {
-    let values: Vec<f64> = (0..16).map(|k| m[(k / 4, k % 4)]).collect();
+) -> Option<([f64; 4], [f64; 16])> {
+    let values: [f64; 16] = std::array::from_fn(|k| m[(k / 4, k % 4)]);
     let usable = |v: &f64| v.is_finite() && v.abs() <= MAX_MUELLER_SR;
     if values[0].is_nan() || values[0] <= 0.0 || !values.iter().all(usable) {
         return None;
@@ -250,13 +246,5 @@ fn point(
         )
     };
     let ((theta_i_deg, phi_i_deg), (theta_r_deg, phi_r_deg)) = (angles(light), angles(view));
-    Some(MeasurementPoint {
-        theta_i_deg,
-        phi_i_deg,
-        theta_r_deg,
-        phi_r_deg,
-        values,
-        uncertainties: vec![None; 16],
-        line,
-    })
+    Some(([theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg], values))
 }

@@ -36,13 +36,12 @@ pub fn unrealizable_rows(set: &MeasurementSet, sigmas: f64) -> Realizability {
     let mut unrealizable = Vec::new();
     for (row, point) in set.points.iter().enumerate() {
         let mut m = Mueller::zeros();
-        for (&index, &value) in set.elements.iter().zip(&point.values) {
+        for (&index, &value) in set.elements.iter().zip(point.values) {
             m[(index / 4, index % 4)] = value;
         }
         let noise = 0.5
             * point
-                .uncertainties
-                .iter()
+                .uncertainties()
                 .map(|u| u.unwrap_or(0.0).powi(2))
                 .sum::<f64>()
                 .sqrt();

@@ -2,15 +2,16 @@
 //! a table whose columns are §2.1's own, a layout's table as one whose columns the layout names;
 //! both are the same file underneath — UTF-8 lines, `# key: value` metadata wherever it stands,
 //! a header row (the first line that is neither blank nor `#`), then data rows — split by
-//! [`crate::table_text`] and grouped by wavelength here. The one place a row becomes a
-//! [`MeasurementPoint`] and rows become [`MeasurementSet`]s is here too.
+//! [`crate::table_text`] and grouped by wavelength here, each row pushed straight into the
+//! columns of its wavelength's [`MeasurementRows`]. The one place rows become
+//! [`MeasurementSet`]s is here too.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
 use super::metadata::HeaderWavelength;
-use super::{MeasurementPoint, MeasurementSet};
+use super::{MeasurementRow, MeasurementRows, MeasurementSet};
 use crate::table_text::{self, is_comment, last_column, Field};
 use crate::text::shown;
 
@@ -139,25 +140,6 @@ pub(crate) fn parse_number(column: &str, text: &str) -> Result<f64, MeasureError
     })
 }
 
-/// One row of a table in §2.1's meaning: the one place a row becomes a [`MeasurementPoint`].
-/// Angles in degrees with θ ≥ 0; `values` and `uncertainties` aligned with the set's elements.
-pub(crate) fn measurement_point(
-    [theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg]: [f64; 4],
-    values: Vec<f64>,
-    uncertainties: Vec<Option<f64>>,
-    line: u64,
-) -> MeasurementPoint {
-    MeasurementPoint {
-        theta_i_deg,
-        phi_i_deg,
-        theta_r_deg,
-        phi_r_deg,
-        values,
-        uncertainties,
-        line,
-    }
-}
-
 /// What every set read from one file shares.
 pub(crate) struct FileFacts {
     pub sha256: String,
@@ -173,7 +155,7 @@ impl FileFacts {
         &self,
         source: &Path,
         wavelength_um: f64,
-        points: Vec<MeasurementPoint>,
+        points: MeasurementRows,
         notes: Vec<String>,
     ) -> MeasurementSet {
         MeasurementSet {
@@ -201,37 +183,81 @@ pub(crate) fn material_of(named: Option<&String>, source: &Path) -> String {
     }
 }
 
-/// The rows' wavelengths: the `# wavelength_um:` line's for all, or each row's own, with the
-/// column it is in.
-pub(crate) enum RowWavelengths {
-    Header(f64),
-    PerRow(Vec<(HeaderWavelength, u64)>),
+/// The rows of a file by wavelength, filled as the rows are read (no list of the whole file's
+/// rows is made): all at the header's wavelength, or one group per distinct row wavelength
+/// (equal within [`WAVELENGTH_RELATIVE_TOLERANCE`], the group keeping its first row's value),
+/// rows in file order. Unless `spectral`, a second wavelength is refused at its first row, once
+/// every row has been read (the rows' own refusals come first, in file order).
+pub(crate) struct WavelengthGroups {
+    /// Each wavelength met and its rows, in order of first appearance.
+    groups: Vec<(HeaderWavelength, MeasurementRows)>,
+    /// Whether a row gives its own wavelength (no `# wavelength_um:` line).
+    per_row: bool,
+    spectral: bool,
+    /// The refusal of the first row of a second wavelength in a file read as one.
+    mixed: Option<Refusal>,
+    has_uncertainty: Vec<bool>,
+    /// Rows to reserve room for in the first group: the file's data rows.
+    capacity: usize,
 }
 
-/// The points by wavelength, ascending: all at the header's, or one group per distinct row
-/// wavelength (equal within [`WAVELENGTH_RELATIVE_TOLERANCE`], the group keeping its first row's
-/// value), rows in file order. Unless `spectral`, a second wavelength is refused at its first
-/// row.
-pub(crate) fn wavelength_groups(
-    points: Vec<MeasurementPoint>,
-    wavelengths: RowWavelengths,
-    spectral: bool,
-) -> Result<Vec<(f64, Vec<MeasurementPoint>)>, Refusal> {
-    let rows = match wavelengths {
-        RowWavelengths::Header(um) => return Ok(vec![(um, points)]),
-        RowWavelengths::PerRow(rows) => rows,
-    };
-    let mut groups: Vec<(HeaderWavelength, Vec<MeasurementPoint>)> = Vec::new();
-    for (point, (row, column)) in points.into_iter().zip(rows) {
-        match groups
+impl WavelengthGroups {
+    /// No rows yet of the elements whose uncertainty flags are `has_uncertainty`, at `header`'s
+    /// wavelength (a `# wavelength_um:` line) or each row's own; `capacity` data rows expected.
+    pub(crate) fn new(
+        header: Option<&HeaderWavelength>,
+        spectral: bool,
+        has_uncertainty: Vec<bool>,
+        capacity: usize,
+    ) -> WavelengthGroups {
+        let groups = header
+            .map(|h| {
+                let rows = MeasurementRows::with_capacity(&has_uncertainty, capacity);
+                vec![(h.clone(), rows)]
+            })
+            .unwrap_or_default();
+        WavelengthGroups {
+            groups,
+            per_row: header.is_none(),
+            spectral,
+            mixed: None,
+            has_uncertainty,
+            capacity,
+        }
+    }
+
+    /// Adds a row to its wavelength's group: `wavelength` is the row's own with its column
+    /// ([`row_wavelength`]; `None` under a header wavelength), the rest as
+    /// [`MeasurementRows::push`] takes it.
+    pub(crate) fn push(
+        &mut self,
+        wavelength: Option<(HeaderWavelength, u64)>,
+        angles: [f64; 4],
+        values: &[f64],
+        uncertainties: &[Option<f64>],
+        line: u64,
+    ) {
+        let group = match wavelength {
+            None => 0,
+            Some((row, column)) => self.group_of(row, column),
+        };
+        self.groups[group]
+            .1
+            .push(angles, values, uncertainties, line);
+    }
+
+    /// The group of a row at wavelength `row` (in `column`), made if it is the first there.
+    fn group_of(&mut self, row: HeaderWavelength, column: u64) -> usize {
+        if let Some(i) = self
+            .groups
             .iter()
             .position(|(w, _)| same_wavelength(w.um, row.um))
         {
-            Some(i) => groups[i].1.push(point),
-            None if groups.is_empty() || spectral => groups.push((row, vec![point])),
-            None => {
-                let first = &groups[0].0;
-                return Err(Refusal::new(
+            return i;
+        }
+        if let Some((first, _)) = self.groups.first().filter(|_| !self.spectral) {
+            self.mixed.get_or_insert_with(|| {
+                Refusal::new(
                     row.line,
                     column,
                     MeasureErrorKind::MixedWavelengths {
@@ -239,15 +265,46 @@ pub(crate) fn wavelength_groups(
                         first: shown(&first.text),
                         first_line: first.line,
                     },
-                ));
-            }
+                )
+            });
         }
+        // The first group gets the room of the whole file: one wavelength is the usual file.
+        let capacity = if self.groups.is_empty() {
+            self.capacity
+        } else {
+            0
+        };
+        let rows = MeasurementRows::with_capacity(&self.has_uncertainty, capacity);
+        self.groups.push((row, rows));
+        self.groups.len() - 1
     }
-    groups.sort_by(|a, b| a.0.um.total_cmp(&b.0.um));
-    Ok(groups
-        .into_iter()
-        .map(|(w, points)| (w.um, points))
-        .collect())
+
+    /// Every row read so far, group by group.
+    pub(crate) fn rows(&self) -> impl Iterator<Item = MeasurementRow<'_>> + Clone {
+        self.groups.iter().flat_map(|(_, rows)| rows.iter())
+    }
+
+    /// Number of rows read.
+    pub(crate) fn len(&self) -> usize {
+        self.groups.iter().map(|(_, rows)| rows.len()).sum()
+    }
+
+    /// The groups by wavelength, ascending, or the refusal of a second wavelength.
+    pub(crate) fn finish(mut self) -> Result<Vec<(f64, MeasurementRows)>, Refusal> {
+        if let Some(refusal) = self.mixed {
+            return Err(refusal);
+        }
+        if self.per_row && self.groups.len() > 1 {
+            // The first group reserved room for every row of the file.
+            self.groups[0].1.shrink_to_fit();
+        }
+        self.groups.sort_by(|a, b| a.0.um.total_cmp(&b.0.um));
+        Ok(self
+            .groups
+            .into_iter()
+            .map(|(w, rows)| (w.um, rows))
+            .collect())
+    }
 }
 
 /// A row's wavelength `um` (written `text` at `column` of line `line`): checked against the

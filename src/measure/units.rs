@@ -5,7 +5,7 @@
 //! the command says how to read its angles (`--angles`).
 
 use super::error::{MeasureErrorKind, Refusal};
-use super::MeasurementPoint;
+use super::MeasurementRow;
 use std::f64::consts::FRAC_PI_2;
 
 /// How a command reads the angle columns of its measurement files (`--angles`).
@@ -67,12 +67,13 @@ impl std::fmt::Display for RadiansEvidence {
     }
 }
 
-/// The evidence that `points`' zenith angles (as read, in what the file calls degrees) are
+/// The evidence that the zenith angles of `rows` (as read, in what the file calls degrees) are
 /// radians, if they look so.
-pub(crate) fn radians_evidence(points: &[MeasurementPoint]) -> Option<RadiansEvidence> {
+pub(crate) fn radians_evidence<'a>(
+    rows: impl Iterator<Item = MeasurementRow<'a>> + Clone,
+) -> Option<RadiansEvidence> {
     let zeniths = || {
-        points
-            .iter()
+        rows.clone()
             .flat_map(|p| [(p.theta_i_deg.abs(), p.line), (p.theta_r_deg.abs(), p.line)])
     };
     let largest = zeniths().map(|(theta, _)| theta).fold(0.0, f64::max);
@@ -80,7 +81,11 @@ pub(crate) fn radians_evidence(points: &[MeasurementPoint]) -> Option<RadiansEvi
         return None;
     }
     let whole = |theta: f64| (theta - theta.round()).abs() < 1e-9;
-    let (example, line) = zeniths().find(|&(theta, _)| !whole(theta))?;
+    // The first in the file (θ_i before θ_r on a line): the rows may come wavelength by
+    // wavelength, not in file order; min_by_key keeps the first of equal lines.
+    let (example, line) = zeniths()
+        .filter(|&(theta, _)| !whole(theta))
+        .min_by_key(|&(_, line)| line)?;
     Some(RadiansEvidence {
         largest,
         example,
@@ -92,13 +97,13 @@ pub(crate) fn radians_evidence(points: &[MeasurementPoint]) -> Option<RadiansEvi
 /// refusal at the line of the evidence (saying `fix`) when they look like radians and the
 /// command did not say how to read them; a note (for the caller to print before the fit, and
 /// with any fit error) when `--angles degrees` says they are degrees.
-pub(crate) fn check_degrees(
+pub(crate) fn check_degrees<'a>(
     file: &str,
-    points: &[MeasurementPoint],
+    rows: impl Iterator<Item = MeasurementRow<'a>> + Clone,
     reading: AngleReading,
     fix: &str,
 ) -> Result<Option<String>, Refusal> {
-    let Some(evidence) = radians_evidence(points) else {
+    let Some(evidence) = radians_evidence(rows) else {
         return Ok(None);
     };
     match reading {
@@ -129,8 +134,9 @@ pub fn is_angle_note(note: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::measure::{MeasurementPoint, MeasurementRows};
 
-    fn points(angles: &[(f64, f64)]) -> Vec<MeasurementPoint> {
+    fn points(angles: &[(f64, f64)]) -> MeasurementRows {
         angles
             .iter()
             .enumerate()
@@ -154,27 +160,43 @@ mod tests {
             (rad(30.0), rad(60.0)),
             (rad(60.0), rad(80.0)),
         ]);
-        let evidence = radians_evidence(&radians).unwrap();
+        let evidence = radians_evidence(radians.iter()).unwrap();
         assert_eq!((evidence.largest, evidence.line), (rad(80.0), 2));
         // Radians written with one decimal, as a coarse scan would be.
-        assert!(radians_evidence(&points(&[(0.5, 0.7), (1.0, 1.2)])).is_some());
+        assert!(radians_evidence(points(&[(0.5, 0.7), (1.0, 1.2)]).iter()).is_some());
         // Whole degrees within 1.6° of the normal.
-        assert_eq!(radians_evidence(&points(&[(0.0, 1.0), (1.0, 0.0)])), None);
+        assert_eq!(
+            radians_evidence(points(&[(0.0, 1.0), (1.0, 0.0)]).iter()),
+            None
+        );
         // Any angle beyond π/2, or all at the normal: degrees.
-        assert_eq!(radians_evidence(&points(&[(0.3, 60.0)])), None);
-        assert_eq!(radians_evidence(&points(&[(0.0, 0.0)])), None);
+        assert_eq!(radians_evidence(points(&[(0.3, 60.0)]).iter()), None);
+        assert_eq!(radians_evidence(points(&[(0.0, 0.0)]).iter()), None);
+    }
+
+    /// A spectral file's rows come wavelength by wavelength; the example is still the file's
+    /// first fractional angle.
+    #[test]
+    fn the_evidence_is_the_first_in_the_file_whatever_the_row_order() {
+        let mut later = points(&[(0.5, 1.5)]).to_points();
+        later[0].line = 9;
+        let later: MeasurementRows = later.into_iter().collect();
+        let earlier = points(&[(1.0, 0.25)]);
+        let evidence = radians_evidence(later.iter().chain(earlier.iter())).unwrap();
+        assert_eq!((evidence.example, evidence.line), (0.25, 2));
     }
 
     #[test]
     fn the_flag_turns_the_refusal_into_a_note() {
         let radians = points(&[(30f64.to_radians(), 0.5)]);
-        let refusal = check_degrees("f.csv", &radians, AngleReading::Auto, "FIX").unwrap_err();
+        let refusal =
+            check_degrees("f.csv", radians.iter(), AngleReading::Auto, "FIX").unwrap_err();
         assert!(
             refusal.kind.to_string().ends_with("FIX"),
             "{}",
             refusal.kind
         );
-        let note = check_degrees("f.csv", &radians, AngleReading::Degrees, "FIX").unwrap();
+        let note = check_degrees("f.csv", radians.iter(), AngleReading::Degrees, "FIX").unwrap();
         assert!(is_angle_note(&note.unwrap()));
         assert_eq!(AngleReading::parse("rad"), Some(AngleReading::Radians));
         assert_eq!(AngleReading::parse("grad"), None);

@@ -136,7 +136,7 @@ pub fn to_csv(set: &MeasurementSet, with_uncertainties: bool) -> String {
         ];
         row.extend(p.values.iter().map(|v| format!("{v:e}")));
         if with_uncertainties {
-            row.extend(p.uncertainties.iter().map(|u| format!("{:e}", u.unwrap())));
+            row.extend(p.uncertainties().map(|u| format!("{:e}", u.unwrap())));
         }
         text += &row.join(",");
         text.push('\n');

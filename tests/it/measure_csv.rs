@@ -161,7 +161,7 @@ fn full_file_parses_with_metadata_elements_and_provenance() {
         ["m00", "m01", "m02", "m10", "m11", "m12", "m20", "m21", "m22"]
     );
     assert_eq!(set.points.len(), 3);
-    let last = &set.points[2];
+    let last = set.points.row(2);
     assert_eq!(last.line, 11);
     assert_eq!(
         (
@@ -176,8 +176,8 @@ fn full_file_parses_with_metadata_elements_and_provenance() {
         last.values,
         [5.0e-02, 4.0e-03, -1.2e-03, 4.1e-03, 4.9e-02, 3e-04, 1.1e-03, -2e-04, -4.4e-02]
     );
-    assert!(last.uncertainties.iter().all(Option::is_none));
-    assert_eq!(set.points[0].values[0], 0.192);
+    assert!(last.uncertainties().all(|u| u.is_none()));
+    assert_eq!(set.points.row(0).values[0], 0.192);
 }
 
 #[test]
@@ -216,7 +216,7 @@ fn uncertainties_may_cover_a_subset_of_the_elements() {
     assert_eq!(set.elements, [0, 5, 10]);
     assert_eq!(set.wavelength_um, 8.5);
     assert_eq!(set.metadata["date"], "2024-05-01");
-    let second = &set.points[1];
+    let second = set.points.row(1);
     assert_eq!(second.line, 4);
     assert_eq!(
         (
@@ -228,11 +228,9 @@ fn uncertainties_may_cover_a_subset_of_the_elements() {
         (20.0, 0.0, 40.0, 190.5)
     );
     assert_eq!(second.values, [0.020, 0.019, -0.020]);
-    assert_eq!(second.uncertainties, [Some(0.0010), None, Some(0.0011)]);
-    assert_eq!(
-        set.points[0].uncertainties,
-        [Some(0.0012), None, Some(0.0009)]
-    );
+    let uncertainties = |row: usize| set.points.row(row).uncertainties().collect::<Vec<_>>();
+    assert_eq!(uncertainties(1), [Some(0.0010), None, Some(0.0011)]);
+    assert_eq!(uncertainties(0), [Some(0.0012), None, Some(0.0009)]);
 }
 
 #[test]
@@ -241,8 +239,8 @@ fn spreadsheet_export_with_bom_crlf_and_quoted_names_parses() {
     assert_eq!(set.material, "primer");
     assert_eq!(set.wavelength_um, 12.0);
     assert_eq!(set.elements, [0, 4]);
-    assert_eq!(set.points[0].values, [0.11, -0.02]);
-    assert_eq!(set.points[0].line, 4);
+    assert_eq!(set.points.row(0).values, [0.11, -0.02]);
+    assert_eq!(set.points.row(0).line, 4);
 }
 
 #[test]

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use irpol::measure::{
     parse_with_layout, read_measurement_file, read_measurement_sets, read_with_layout, Layout,
-    MeasurementSet, MUELLER_ELEMENT_NAMES,
+    MeasurementPoint, MeasurementSet, MUELLER_ELEMENT_NAMES,
 };
 
 const PTFE: &str = "data/ptfe/PTFE_351_1064.csv";
@@ -105,7 +105,7 @@ fn ptfe_rows_by_hand() -> Vec<ExpectedRow> {
 fn matrix_of(set: &MeasurementSet, point: usize) -> Matrix {
     let mut m = [[0.0; 4]; 4];
     for (slot, &index) in set.elements.iter().enumerate() {
-        m[index / 4][index % 4] = set.points[point].values[slot];
+        m[index / 4][index % 4] = set.points.row(point).values[slot];
     }
     m
 }
@@ -141,10 +141,7 @@ fn the_shipped_ptfe_table_equals_an_independent_conversion() {
                 worst = worst.max(error);
                 largest_rotation = largest_rotation.max((m[r][c] - row.xyxy[r][c]).abs());
             }
-            assert!(point
-                .uncertainties
-                .iter()
-                .all(|u| u.is_some_and(|u| u > 0.0)));
+            assert!(point.uncertainties().all(|u| u.is_some_and(|u| u > 0.0)));
         }
         assert_eq!(set.metadata["uncertainty_model"], "estimate (mirror pairs)");
         // The fit takes the set as it takes a file of docs/design.md §2.1.
@@ -207,8 +204,8 @@ fn the_good_example_reads() {
     let layout = Layout::parse(Path::new("mem/layout.toml"), GOOD_LAYOUT).unwrap();
     let sets = parse_with_layout(Path::new("t.csv"), GOOD_TABLE.as_bytes(), &layout).unwrap();
     assert_eq!(sets[0].elements, [0, 1, 4]);
-    assert_eq!(sets[0].points[0].values, [0.5, 0.1, 0.2]);
-    assert_eq!(sets[0].points[0].uncertainties, [None, None, None]);
+    assert_eq!(sets[0].points.row(0).values, [0.5, 0.1, 0.2]);
+    assert!(sets[0].points.row(0).uncertainties().all(|u| u.is_none()));
     assert_eq!(sets[0].metadata["uncertainty_model"], "fixed");
     assert!(sets[0].notes.iter().all(|n| !n.contains("radians")));
     // Radians declared as degrees are refused at the row that shows it, saying what to fix.
@@ -366,7 +363,7 @@ fn the_xyxy_basis_needs_the_elements_it_mixes_and_a_header_that_agrees() {
         "# mueller_convention: XYXY\n# wavelength_um: 10\nti,tr,pr,M11,M14\n30,20,0,1,0.5\n";
     let sets = parse_with_layout(Path::new("t.csv"), table.as_bytes(), &layout).unwrap();
     assert_eq!(sets[0].metadata["mueller_convention"], "XYXY");
-    assert_eq!(sets[0].points[0].values, [1.0, 0.5]);
+    assert_eq!(sets[0].points.row(0).values, [1.0, 0.5]);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -381,7 +378,7 @@ fn geometry_values(set: &MeasurementSet) -> Vec<([f64; 4], Vec<f64>)> {
         .map(|p| {
             (
                 [p.theta_i_deg, p.phi_i_deg, p.theta_r_deg, p.phi_r_deg],
-                p.values.clone(),
+                p.values.to_vec(),
             )
         })
         .collect()
@@ -491,11 +488,11 @@ fn a_design_2_1_file_written_in_an_instruments_conventions_reads_back() {
                 p.phi_r_deg,
                 q.phi_r_deg
             );
-            for (slot, (x, y)) in p.values.iter().zip(&q.values).enumerate() {
+            for (slot, (x, y)) in p.values.iter().zip(q.values).enumerate() {
                 let name = MUELLER_ELEMENT_NAMES[a.elements[slot]];
                 assert!((x - y).abs() <= 1e-12, "line {} {name}: {x} vs {y}", q.line);
             }
-            assert!(q.uncertainties.iter().all(|u| u.is_some_and(|u| u > 0.0)));
+            assert!(q.uncertainties().all(|u| u.is_some_and(|u| u > 0.0)));
         }
     }
     let rows_across = own.iter().map(|s| s.points.len() / 2).sum::<usize>();
@@ -670,7 +667,7 @@ fn a_file_naming_its_layout_is_read_through_it_and_a_different_layout_is_refused
         assert_eq!(a.points.len(), b.points.len());
         for (p, q) in a.points.iter().zip(&b.points) {
             assert_eq!(p.values, q.values);
-            assert_eq!(p.uncertainties, q.uncertainties);
+            assert!(p.uncertainties().eq(q.uncertainties()));
         }
     }
     // The same layout given again (another path, same content) is no disagreement.
@@ -935,9 +932,13 @@ fn rows_are_flagged_unrealizable_only_beyond_their_noise() {
         (&[2][..], 3)
     );
     let mut noisy = set.clone();
-    for point in &mut noisy.points {
-        point.uncertainties = vec![Some(0.2); 16]; // noise 0.4: −½ is within 2σ
-    }
+    // noise 0.4: −½ is within 2σ
+    noisy.points = (noisy.points.iter())
+        .map(|row| MeasurementPoint {
+            uncertainties: vec![Some(0.2); 16],
+            ..row.to_point()
+        })
+        .collect();
     assert!(irpol::measure::unrealizable_rows(&noisy, 2.0)
         .unrealizable
         .is_empty());
@@ -1012,7 +1013,7 @@ fn layout_values_meet_the_limit_of_every_table_reader() {
         &layout,
     )
     .unwrap();
-    assert_eq!(sets[0].points[0].values, [10.0, 1e12]);
+    assert_eq!(sets[0].points.row(0).values, [10.0, 1e12]);
 }
 
 /// One column named for two roles is refused at the second role's value, naming both roles and

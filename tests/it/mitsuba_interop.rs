@@ -362,8 +362,8 @@ fn a_dense_table_is_read_at_an_even_share_of_its_nodes() {
     // Spread: every decile of θ_i and of φ_r − φ_i holds about a tenth of the rows.
     let points = &sets[0].points;
     for angle in [
-        |p: &irpol::MeasurementPoint| p.theta_i_deg / 90.0,
-        |p: &irpol::MeasurementPoint| (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0) / 360.0,
+        |p: irpol::MeasurementRow| p.theta_i_deg / 90.0,
+        |p: irpol::MeasurementRow| (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0) / 360.0,
     ] {
         let mut deciles = [0usize; 10];
         for p in points {

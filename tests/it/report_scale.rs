@@ -212,7 +212,7 @@ fn a_dense_scan_is_drawn_thinned_but_its_statistics_use_every_row() {
             );
             LINEAR_ELEMENTS
                 .iter()
-                .zip(p.values.iter().zip(&p.uncertainties))
+                .zip(p.values.iter().zip(p.uncertainties()))
                 .map(|(&e, (v, u))| ((m[(e / 4, e % 4)] - v) / u.unwrap()).powi(2))
                 .sum::<f64>()
         })

@@ -14,11 +14,11 @@ use crate::measure::csv_reader::{element_value_refusal, wavelength_refusal};
 use crate::measure::error::{MeasureError, MeasureErrorKind, Refusal};
 use crate::measure::metadata::{split_metadata_line, HeaderWavelength, Metadata};
 use crate::measure::table_file::{
-    check_width, decode_utf8, fields_of, hex, material_of, measurement_point, parse_number,
-    row_wavelength, table_lines, wavelength_groups, FileFacts, RowWavelengths,
+    check_width, decode_utf8, fields_of, hex, material_of, parse_number, row_wavelength,
+    table_lines, FileFacts, WavelengthGroups,
 };
 use crate::measure::units::{check_degrees, AngleReading};
-use crate::measure::{MeasurementPoint, MeasurementSet, MUELLER_ELEMENT_NAMES};
+use crate::measure::{MeasurementRow, MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
 use crate::table_text::{wrong_delimiter, Field};
 use crate::text::shown;
@@ -44,8 +44,8 @@ struct Resolved {
 struct ParsedTable {
     metadata: Metadata,
     elements: Vec<usize>,
-    points: Vec<MeasurementPoint>,
-    wavelengths: RowWavelengths,
+    /// The rows by wavelength (the header's, or each row's own).
+    groups: WavelengthGroups,
     folded_incident: usize,
     folded_detector: usize,
     unused_columns: Vec<String>,
@@ -60,7 +60,7 @@ pub(super) fn parse_table(
     let sha256 = hex(&Sha256::digest(bytes));
     let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
     let parsed = parse_text(text, layout).map_err(|r| r.in_file(source))?;
-    let angle_note = check_layout_angles(source, &parsed.points, layout, angles)
+    let angle_note = check_layout_angles(source, parsed.groups.rows(), layout, angles)
         .map_err(|r| r.in_file(source))?;
     build_sets(source, sha256, parsed, layout, angle_note).map_err(|r| r.in_file(source))
 }
@@ -68,9 +68,9 @@ pub(super) fn parse_table(
 /// The table's angles against the layout's `angle_unit` and `--angles`: radians declared as
 /// degrees are refused unless `--angles degrees` says they are degrees (then a note); a layout
 /// states its unit, so `--angles` naming the other one is refused.
-fn check_layout_angles(
+fn check_layout_angles<'a>(
     source: &Path,
-    points: &[MeasurementPoint],
+    rows: impl Iterator<Item = MeasurementRow<'a>> + Clone,
     layout: &Layout,
     angles: AngleReading,
 ) -> Result<Option<String>, Refusal> {
@@ -98,7 +98,7 @@ fn check_layout_angles(
         "set angle_unit = \"rad\" in the layout {layout_file} (--angles degrees if they are \
          degrees)"
     );
-    check_degrees(&source.display().to_string(), points, angles, &fix)
+    check_degrees(&source.display().to_string(), rows, angles, &fix)
 }
 
 fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
@@ -113,8 +113,14 @@ fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
     if resolved.wavelength.is_none() && metadata.wavelength.is_none() {
         return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength));
     }
-    let mut points = Vec::new();
-    let mut row_wavelengths = Vec::new();
+    // A layout's table has no uncertainty columns: its model gives them once the rows are in.
+    let no_uncertainties = vec![None; resolved.elements.len()];
+    let mut groups = WavelengthGroups::new(
+        metadata.wavelength.as_ref(),
+        true,
+        vec![false; resolved.elements.len()],
+        lines.rows().len(),
+    );
     let (mut folded_incident, mut folded_detector) = (0, 0);
     for &(number, line) in lines.rows() {
         let row = parse_row(
@@ -126,13 +132,13 @@ fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
         )?;
         folded_incident += usize::from(row.folded.0);
         folded_detector += usize::from(row.folded.1);
-        points.push(row.point);
-        row_wavelengths.extend(row.wavelength);
+        let (angles, values) = (row.angles, &row.values);
+        groups.push(row.wavelength, angles, values, &no_uncertainties, number);
     }
-    if points.is_empty() {
+    if groups.len() == 0 {
         return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
     }
-    if points.iter().all(|p| p.values[0] == 0.0) {
+    if groups.rows().all(|p| p.values[0] == 0.0) {
         let m00_column = header_fields[resolved.elements[0].1].column;
         return Err(Refusal::new(
             header_line,
@@ -145,15 +151,10 @@ fn parse_text(text: &str, layout: &Layout) -> Result<ParsedTable, Refusal> {
         .filter(|i| !used.contains(i))
         .map(|i| resolved.names[i].clone())
         .collect();
-    let wavelengths = match &metadata.wavelength {
-        Some(header) => RowWavelengths::Header(header.um),
-        None => RowWavelengths::PerRow(row_wavelengths),
-    };
     Ok(ParsedTable {
         metadata,
         elements: resolved.elements.iter().map(|&(index, _)| index).collect(),
-        points,
-        wavelengths,
+        groups,
         folded_incident,
         folded_detector,
         unused_columns,
@@ -307,9 +308,10 @@ fn used_fields(resolved: &Resolved) -> Vec<usize> {
     used
 }
 
-/// One converted row.
+/// One converted row: (θ_i, φ_i, θ_r, φ_r) in degrees, the values of the layout's elements.
 struct Row {
-    point: MeasurementPoint,
+    angles: [f64; 4],
+    values: Vec<f64>,
     wavelength: Option<(HeaderWavelength, u64)>,
     /// Whether θ_i and θ_r were negative (read across the normal).
     folded: (bool, bool),
@@ -351,10 +353,9 @@ fn parse_row(
     let (theta_i_deg, phi_i_deg) = fold_signed_zenith(theta_i, phi_i);
     let (theta_r_deg, phi_r_deg) = fold_signed_zenith(theta_r, phi_r);
     let values = cells.elements(resolved, layout, phi_i_deg, phi_r_deg)?;
-    let uncertainties = vec![None; values.len()];
-    let angles = [theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg];
     Ok(Row {
-        point: measurement_point(angles, values, uncertainties, number),
+        angles: [theta_i_deg, phi_i_deg, theta_r_deg, phi_r_deg],
+        values,
         wavelength,
         folded: (theta_i < 0.0, theta_r < 0.0),
     })
@@ -509,7 +510,7 @@ fn build_sets(
     facts
         .metadata
         .insert("layout".to_string(), layout.source.display().to_string());
-    let groups = wavelength_groups(parsed.points, parsed.wavelengths, true)?;
+    let groups = parsed.groups.finish()?;
     let mut sets = Vec::with_capacity(groups.len());
     for (wavelength_um, mut points) in groups {
         let applied = apply_uncertainty_model(layout.uncertainty, &mut points, &facts.elements);

@@ -17,7 +17,7 @@
 use std::collections::HashMap;
 
 use super::UncertaintyModel;
-use crate::measure::MeasurementPoint;
+use crate::measure::{MeasurementRow, MeasurementRows};
 
 /// Fewest mirror pairs or θ_r triples an estimate is made from.
 const MIN_SAMPLES: usize = 8;
@@ -40,7 +40,7 @@ pub(super) struct Applied {
 /// Sets the uncertainties of `points` (whose values follow `elements`) under `model`.
 pub(super) fn apply_uncertainty_model(
     model: UncertaintyModel,
-    points: &mut [MeasurementPoint],
+    points: &mut MeasurementRows,
     elements: &[usize],
 ) -> Applied {
     let estimated = match model {
@@ -71,13 +71,10 @@ pub(super) fn apply_uncertainty_model(
         .collect();
     let m00_max = points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
     let floor = ABSOLUTE_FLOOR * m00_max.max(f64::MIN_POSITIVE);
-    for point in points.iter_mut() {
+    points.set_uncertainties(|point| {
         let m00 = point.values[0];
-        point.uncertainties = relative
-            .iter()
-            .map(|r| Some((r * m00).max(floor)))
-            .collect();
-    }
+        relative.iter().map(|r| (r * m00).max(floor)).collect()
+    });
     Applied {
         label: format!("estimate ({method})"),
         note: estimate_note(&relative, method, scatter.samples),
@@ -121,7 +118,7 @@ fn angle_key(degrees: f64) -> i64 {
 }
 
 /// The relative azimuth Δ = φ_r − φ_i − 180° in [0°, 360°).
-fn relative_azimuth(point: &MeasurementPoint) -> f64 {
+fn relative_azimuth(point: MeasurementRow<'_>) -> f64 {
     (point.phi_r_deg - point.phi_i_deg - 180.0).rem_euclid(360.0)
 }
 
@@ -130,9 +127,9 @@ fn mirror_odd(index: usize) -> bool {
     (index / 4 >= 2) != (index % 4 >= 2)
 }
 
-fn mirror_scatter(points: &[MeasurementPoint], elements: &[usize]) -> Option<Scatter> {
+fn mirror_scatter(points: &MeasurementRows, elements: &[usize]) -> Option<Scatter> {
     let full_turn = angle_key(360.0);
-    let key = |p: &MeasurementPoint, azimuth_key: i64| {
+    let key = |p: MeasurementRow<'_>, azimuth_key: i64| {
         (
             angle_key(p.theta_i_deg),
             angle_key(p.phi_i_deg.rem_euclid(360.0)),
@@ -158,7 +155,7 @@ fn mirror_scatter(points: &[MeasurementPoint], elements: &[usize]) -> Option<Sca
         let Some(&other) = by_geometry.get(&key(point, mirrored)) else {
             continue;
         };
-        let other = &points[other];
+        let other = points.row(other);
         let mean_m00 = 0.5 * (point.values[0] + other.values[0]);
         if mean_m00 <= 0.0 {
             continue;
@@ -177,7 +174,7 @@ fn mirror_scatter(points: &[MeasurementPoint], elements: &[usize]) -> Option<Sca
     })
 }
 
-fn smoothness_scatter(points: &[MeasurementPoint]) -> Option<Scatter> {
+fn smoothness_scatter(points: &MeasurementRows) -> Option<Scatter> {
     let mut scans: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
     for (index, p) in points.iter().enumerate() {
         let scan = (
@@ -191,9 +188,12 @@ fn smoothness_scatter(points: &[MeasurementPoint]) -> Option<Scatter> {
     let mut residuals = vec![Vec::new(); width];
     let mut triples = 0;
     for scan in scans.values_mut() {
-        scan.sort_by(|&a, &b| points[a].theta_r_deg.total_cmp(&points[b].theta_r_deg));
+        scan.sort_by(|&a, &b| {
+            let theta_r = |i: usize| points.row(i).theta_r_deg;
+            theta_r(a).total_cmp(&theta_r(b))
+        });
         for window in scan.windows(3) {
-            let [a, b, c] = [&points[window[0]], &points[window[1]], &points[window[2]]];
+            let [a, b, c] = [window[0], window[1], window[2]].map(|i| points.row(i));
             let span = c.theta_r_deg - a.theta_r_deg;
             if !(span > 0.0 && b.values[0] > 0.0) {
                 continue;
@@ -229,6 +229,7 @@ fn robust_sigma(absolute: &mut [f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::measure::MeasurementPoint;
 
     fn point(theta_r: f64, phi_r: f64, values: Vec<f64>) -> MeasurementPoint {
         MeasurementPoint {
@@ -246,12 +247,13 @@ mod tests {
     fn mirror_pairs_see_only_the_difference_and_odd_elements_flip() {
         // m00 and m02 (odd): pairs at Δ = ±40° with m02 of opposite sign are noise-free except
         // for m00, which differs by 2 % between the two rows of every pair.
-        let mut points = Vec::new();
+        let mut pairs = Vec::new();
         for k in 0..10 {
             let theta = 10.0 + k as f64;
-            points.push(point(theta, 220.0, vec![1.01, 0.3]));
-            points.push(point(theta, 140.0, vec![0.99, -0.3]));
+            pairs.push(point(theta, 220.0, vec![1.01, 0.3]));
+            pairs.push(point(theta, 140.0, vec![0.99, -0.3]));
         }
+        let mut points: MeasurementRows = pairs.into_iter().collect();
         let scatter = mirror_scatter(&points, &[0, 2]).unwrap();
         assert_eq!(scatter.samples, 10);
         let expected = 0.02 / std::f64::consts::SQRT_2 / MEDIAN_ABS_PER_SIGMA;
@@ -261,20 +263,20 @@ mod tests {
         let applied = apply_uncertainty_model(UncertaintyModel::Estimate, &mut points, &[0, 2]);
         assert_eq!(applied.label, "estimate (mirror pairs)");
         // The zero scatter of m02 is raised to the floor.
-        assert_eq!(points[0].uncertainties[1], Some(RELATIVE_FLOOR * 1.01));
+        assert_eq!(points.row(0).uncertainty(1), Some(RELATIVE_FLOOR * 1.01));
     }
 
     #[test]
     fn without_pairs_a_smooth_scan_falls_back_to_neighbours_then_to_the_fixed_rule() {
-        let line: Vec<MeasurementPoint> = (0..12)
+        let line: MeasurementRows = (0..12)
             .map(|k| point(5.0 * k as f64, 180.0, vec![1.0 + 0.01 * k as f64]))
             .collect();
         let scatter = smoothness_scatter(&line).unwrap();
         assert_eq!(scatter.samples, 10);
         assert!(scatter.relative[0] < 1e-12);
-        let mut few = line[..4].to_vec();
+        let mut few = line.select(&[0, 1, 2, 3]);
         let applied = apply_uncertainty_model(UncertaintyModel::Estimate, &mut few, &[0]);
         assert_eq!(applied.label, "fixed");
-        assert!(few.iter().all(|p| p.uncertainties == vec![None]));
+        assert!(few.iter().all(|p| p.uncertainty(0).is_none()));
     }
 }

@@ -361,7 +361,7 @@ fn find_rings(
     let mut rings = Vec::with_capacity(kept.len());
     for (index, group) in kept.iter().enumerate() {
         let incidence = points[group[0]].incidence;
-        let theta_r_deg = set.points[group[0]].theta_r_deg;
+        let theta_r_deg = set.points.row(group[0]).theta_r_deg;
         for &i in group.iter() {
             points[i].ring = Some(index);
         }
@@ -386,7 +386,7 @@ fn find_rings(
 /// Indices of the points sorted by incidence angle, then detector zenith θ_r.
 fn setting_order(points: &[PointView], set: &MeasurementSet) -> Vec<usize> {
     let mut order: Vec<usize> = (0..points.len()).collect();
-    let theta_r = |i: usize| set.points[i].theta_r_deg;
+    let theta_r = |i: usize| set.points.row(i).theta_r_deg;
     order.sort_by(|&a, &b| {
         points[a]
             .incidence
@@ -403,7 +403,7 @@ fn settings<'o>(
     points: &[PointView],
     set: &MeasurementSet,
 ) -> Vec<&'o [usize]> {
-    let theta_r = |i: usize| set.points[i].theta_r_deg;
+    let theta_r = |i: usize| set.points.row(i).theta_r_deg;
     let mut groups: Vec<&[usize]> = Vec::new();
     let mut start = 0;
     for end in 1..=order.len() {
@@ -628,7 +628,8 @@ mod tests {
     fn model_set(geometry: &[(f64, f64, f64, f64)], elements: &[usize]) -> MeasurementSet {
         let mut set = set_of(geometry, exact, [None, None]);
         let model = material(false).grey_model().unwrap().pbrdf().unwrap();
-        for p in &mut set.points {
+        let mut points = set.points.to_points();
+        for p in &mut points {
             let m = model.mueller(
                 &Direction::from_angles(p.theta_i_deg.to_radians(), p.phi_i_deg.to_radians()),
                 &Direction::from_angles(p.theta_r_deg.to_radians(), p.phi_r_deg.to_radians()),
@@ -636,6 +637,7 @@ mod tests {
             p.values = elements.iter().map(|&e| m[(e / 4, e % 4)]).collect();
             p.uncertainties = vec![Some(1e-4); elements.len()];
         }
+        set.points = points.into_iter().collect();
         set.elements = elements.to_vec();
         set
     }
@@ -858,7 +860,7 @@ mod tests {
         // Unturned, the rows disagree with the curve: m10 flips sign at 90°, and at 135° the
         // polarization sits in m20, which the in-plane model has none of.
         let raw = |point: usize, e: usize| {
-            set.points[point].values[linear.iter().position(|&x| x == e).unwrap()]
+            set.points.row(point).values[linear.iter().position(|&x| x == e).unwrap()]
         };
         assert!((raw(0, 4) + curve[(1, 0)]).abs() < 1e-12 * m00);
         assert!(raw(1, 4).abs() < 1e-12 * m00 && raw(1, 8).abs() > 0.05 * m00);
@@ -877,7 +879,7 @@ mod tests {
         let curve = in_plane_curve_at_normal(&data);
         let quarter = data.points[0].drawn.as_deref().unwrap();
         let m10 = quarter.readings[4].unwrap();
-        assert_eq!(m10.value, -set.points[0].values[1]);
+        assert_eq!(m10.value, -set.points.row(0).values[1]);
         assert!(
             (m10.value / quarter.readings[0].unwrap().value - curve[(1, 0)] / curve[(0, 0)]).abs()
                 < 1e-12
@@ -887,7 +889,7 @@ mod tests {
         assert_eq!(eighth.readings[4], None);
         assert_eq!(
             eighth.readings[0].map(|r| r.value),
-            Some(set.points[1].values[0])
+            Some(set.points.row(1).values[0])
         );
         let (series, _) = profile_series(&data, Quantity::Ratio(4), Domain::InPlane);
         assert_eq!(

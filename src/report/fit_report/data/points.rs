@@ -52,7 +52,7 @@ fn own_frame(
     point: usize,
     chosen: &ModelCurveSource,
 ) -> Result<([Option<Reading>; 16], Mueller), ReportError> {
-    let p = &set.points[point];
+    let p = set.points.row(point);
     let incident = checked_direction("theta_i_deg", p.theta_i_deg, p.phi_i_deg)?;
     let scattered = checked_direction("theta_r_deg", p.theta_r_deg, p.phi_r_deg)?;
     let width = set.elements.len();
@@ -78,7 +78,7 @@ pub(super) fn add_drawn(
         if !(in_plane || view.ring.is_some()) {
             continue;
         }
-        let p = &set.points[point];
+        let p = set.points.row(point);
         let (readings, model) = own_frame(set, sigmas, point, chosen)?;
         let (readings, model) = if at_normal(p.theta_r_deg) {
             in_plane_frame_at_normal(&readings, &model, p.phi_i_deg, p.phi_r_deg)
