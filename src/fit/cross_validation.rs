@@ -15,6 +15,7 @@
 
 use super::admissible::why_inadmissible;
 use super::data::MeasurementData;
+use super::data_view::PointSubset;
 use super::levenberg_marquardt::LevenbergMarquardtSettings;
 use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
@@ -253,18 +254,17 @@ fn cross_validate(
         let training: Vec<usize> = (0..set.points.len())
             .filter(|r| held_out.binary_search(r).is_err())
             .collect();
-        // The fold's rows as prepared data (no copy of the set's rows); errors name the file.
-        let refit = fit_model(set, &data.rows(&training), fit.distribution, &options)?;
+        // The fold's rows read in place from the prepared data; errors name the file.
+        let training = PointSubset::new(data, &training);
+        let refit = fit_model(set, training.view(data), fit.distribution, &options)?;
         let effective = refit.effective_options(&options);
         let space = model_space(fit.distribution, &effective)?;
-        let test_data = data.rows(&held_out);
-        let residuals = Objective::new(&test_data, &space, None)
-            .normalized_residuals(&refit.parameter_values(&effective))
-            .unwrap_or_default();
-        folds.push((
-            residuals.iter().map(|r| r * r).sum::<f64>(),
-            residuals.len(),
-        ));
+        let held_out = PointSubset::new(data, &held_out);
+        // An invalid model adds nothing: the sum of no residuals.
+        let held_out_chi2 = Objective::over(held_out.view(data), &space, None)
+            .chi2(&refit.parameter_values(&effective))
+            .unwrap_or((-0.0, 0));
+        folds.push(held_out_chi2);
     }
     Ok(folds)
 }

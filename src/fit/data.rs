@@ -107,44 +107,21 @@ impl MeasurementData {
         (self.values[index], 1.0 / self.inverse_sigma[index])
     }
 
-    /// The points `rows` (ascending), exactly as [`MeasurementData::new`] prepares a set of
-    /// those rows alone (a cross-validation fold): the default noise model's floor is the
-    /// subset's, the zenith list that of its points. No copy of the set's rows is made.
-    pub(crate) fn rows(&self, rows: &[usize]) -> MeasurementData {
-        let width = self.elements.len();
-        let m00_max = rows
-            .iter()
-            .map(|&p| self.values[p * width])
-            .fold(0.0, f64::max);
-        let floor = default_floor(m00_max);
-        let mut subset = self.with_points(rows.iter().copied(), rows.len());
-        for (point, chunk) in subset.inverse_sigma.chunks_mut(width).enumerate() {
-            let m00 = subset.values[point * width];
-            for (column, inverse) in chunk.iter_mut().enumerate() {
-                if self.error_sources[column] == ErrorSource::DefaultModel {
-                    *inverse = 1.0 / default_sigma(column, m00, floor);
-                }
-            }
-        }
-        subset
-    }
-
-    /// Every `stride`-th point, from the first, with the same standard deviations (the default
-    /// noise model's floor stays the whole file's) and the zenith list of those points only, so
-    /// that an evaluation costs what the subsample holds.
-    pub(crate) fn every_nth(&self, stride: usize) -> MeasurementData {
-        let count = self.points().div_ceil(stride);
-        self.with_points((0..self.points()).step_by(stride), count)
-    }
-
-    /// The points `points` (`count` of them, ascending) with their standard deviations as they
-    /// are, and the zenith list of those points only.
-    fn with_points(&self, points: impl Iterator<Item = usize>, count: usize) -> MeasurementData {
+    /// The points `points` (`count` of them, ascending) with the reciprocal standard deviation
+    /// `inverse_sigma(start, element)` of each element of the point whose first observation is
+    /// `start`, and the zenith list of those points only (a subsample,
+    /// [`super::data_view::DataView::every_nth`]).
+    pub(super) fn with_points(
+        &self,
+        points: impl Iterator<Item = usize>,
+        count: usize,
+        inverse_sigma: impl Fn(usize, usize) -> f64,
+    ) -> MeasurementData {
         let width = self.elements.len();
         let mut zeniths = DistinctCosines::default();
         let mut geometry = Vec::with_capacity(count);
         let mut values = Vec::with_capacity(count * width);
-        let mut inverse_sigma = Vec::with_capacity(count * width);
+        let mut inverse_sigmas = Vec::with_capacity(count * width);
         for point in points {
             let g = &self.geometry[point];
             geometry.push(PreparedGeometry {
@@ -152,16 +129,16 @@ impl MeasurementData {
                 incident_zenith: zeniths.index(self.zenith_cosines[g.incident_zenith]),
                 scattered_zenith: zeniths.index(self.zenith_cosines[g.scattered_zenith]),
             });
-            let rows = point * width..(point + 1) * width;
-            values.extend_from_slice(&self.values[rows.clone()]);
-            inverse_sigma.extend_from_slice(&self.inverse_sigma[rows]);
+            let start = point * width;
+            values.extend_from_slice(&self.values[start..start + width]);
+            inverse_sigmas.extend((0..width).map(|element| inverse_sigma(start, element)));
         }
         MeasurementData {
             geometry,
             zenith_cosines: zeniths.cosines,
             elements: self.elements.clone(),
             values: Arc::new(values),
-            inverse_sigma,
+            inverse_sigma: inverse_sigmas,
             error_sources: self.error_sources.clone(),
         }
     }
@@ -211,7 +188,7 @@ fn visit_observations(
 
 /// The default noise model's standard deviation of element `column` (0: m00) of a point whose
 /// m00 is `m00`, at least `floor`.
-fn default_sigma(column: usize, m00: f64, floor: f64) -> f64 {
+pub(super) fn default_sigma(column: usize, m00: f64, floor: f64) -> f64 {
     let relative = if column == 0 {
         DEFAULT_M00_RELATIVE_ERROR
     } else {
@@ -221,7 +198,7 @@ fn default_sigma(column: usize, m00: f64, floor: f64) -> f64 {
 }
 
 /// The default noise model's floor for a set whose largest m00 is `m00_max`.
-fn default_floor(m00_max: f64) -> f64 {
+pub(super) fn default_floor(m00_max: f64) -> f64 {
     DEFAULT_ERROR_FLOOR * m00_max.max(f64::MIN_POSITIVE)
 }
 
@@ -315,61 +292,4 @@ fn error_sources(set: &MeasurementSet) -> Vec<ErrorSource> {
             false => ErrorSource::DefaultModel,
         })
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::measure::MeasurementPoint;
-
-    /// A fold prepared from the whole set's data is what preparing the fold's rows alone gives:
-    /// the default noise model's floor follows the fold's largest m00 (here a row with m00 = 0
-    /// sits on it), the file's uncertainties stay, the zenith list is the fold's own.
-    #[test]
-    fn rows_of_the_prepared_data_are_the_rows_prepared_alone() {
-        let point = |theta_i: f64, theta_r: f64, m00: f64| MeasurementPoint {
-            theta_i_deg: theta_i,
-            phi_i_deg: 0.0,
-            theta_r_deg: theta_r,
-            phi_r_deg: 180.0,
-            values: vec![m00, 0.1 * m00],
-            uncertainties: vec![None, Some(2e-3)],
-            line: 0,
-        };
-        let set = MeasurementSet {
-            source: "fold.csv".into(),
-            sha256: String::new(),
-            material: "fold".into(),
-            wavelength_um: 10.0,
-            metadata: Default::default(),
-            elements: vec![0, 4],
-            points: [
-                point(10.0, 20.0, 4.0),
-                point(30.0, 20.0, 0.0),
-                point(50.0, 40.0, 0.5),
-                point(10.0, 60.0, 0.25),
-            ]
-            .into_iter()
-            .collect(),
-            merged: Vec::new(),
-            notes: Vec::new(),
-        };
-        let whole = MeasurementData::new(&set).unwrap();
-        let rows = [1, 2, 3];
-        let fold = whole.rows(&rows);
-        let alone = MeasurementData::new(&super::super::subset(&set, &rows)).unwrap();
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&fold.values), bits(&alone.values));
-        assert_eq!(bits(&fold.inverse_sigma), bits(&alone.inverse_sigma));
-        assert_eq!(bits(&fold.zenith_cosines), bits(&alone.zenith_cosines));
-        let zeniths = |d: &MeasurementData| {
-            d.geometry
-                .iter()
-                .map(|g| (g.incident_zenith, g.scattered_zenith))
-                .collect::<Vec<_>>()
-        };
-        assert_eq!(zeniths(&fold), zeniths(&alone));
-        // The whole file's floor (1e-6 × 4) is not the fold's (1e-6 × 0.5).
-        assert_ne!(whole.inverse_sigma[2], fold.inverse_sigma[0]);
-    }
 }

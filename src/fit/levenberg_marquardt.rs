@@ -35,9 +35,17 @@ pub(crate) trait LeastSquares: Sync {
     fn lower(&self) -> &[f64];
     /// Upper corner of the search box.
     fn upper(&self) -> &[f64];
-    /// Residuals (whose squares sum to the cost) at search coordinates `s`; `None` where the
-    /// model is invalid.
-    fn residuals(&self, s: &[f64]) -> Option<DVector<f64>>;
+    /// Size of the residual vector.
+    fn residual_count(&self) -> usize;
+    /// Writes the residuals (whose squares sum to the cost) at search coordinates `s` into
+    /// `out` (of [`LeastSquares::residual_count`]); false where the model is invalid (`out`
+    /// then holds nothing of use).
+    fn residuals_into(&self, s: &[f64], out: &mut DVector<f64>) -> bool;
+    /// The residuals at `s` in a vector of their own; `None` where the model is invalid.
+    fn residuals(&self, s: &[f64]) -> Option<DVector<f64>> {
+        let mut r = DVector::zeros(self.residual_count());
+        self.residuals_into(s, &mut r).then_some(r)
+    }
     /// Residual vectors one Jacobian costs (for the evaluation count).
     fn jacobian_evaluations(&self) -> u64 {
         self.lower().len() as u64
@@ -89,6 +97,11 @@ impl Damping {
 /// The iterate of a Levenberg–Marquardt run and its record.
 struct Iterate {
     s: Vec<f64>,
+    /// The residuals at `s` until a step is rejected, then the rejected trial's: the one
+    /// residual vector of the run (at 2e5 rows of 9 elements 14 MB, which a vector per trial
+    /// made a new allocation each step and two alive at once). Only the normal equations read
+    /// it, and after a rejection they are reused, not evaluated again, so `s`'s own residuals
+    /// are never needed once a trial has overwritten them.
     r: DVector<f64>,
     cost: f64,
     /// The normal equations (JᵀJ, Jᵀr) of the Jacobian J = ∂r/∂s at `s`, evaluated again after
@@ -112,10 +125,11 @@ pub(crate) fn levenberg_marquardt(
         evaluations: 0,
         termination: String::new(),
     };
-    let Some(r) = problem.residuals(&s) else {
+    let mut r = DVector::zeros(problem.residual_count());
+    if !problem.residuals_into(&s, &mut r) {
         history.termination = "invalid starting point".to_owned();
         return (s, history);
-    };
+    }
     let cost = r.norm_squared();
     history.best_cost.push(cost);
     history.evaluations = 1;
@@ -191,11 +205,14 @@ impl Iterate {
         predicted: f64,
         settings: &LevenbergMarquardtSettings,
     ) -> Option<&'static str> {
-        let trial_residuals = problem.residuals(&trial);
+        // The trial's residuals overwrite `s`'s ([`Iterate::r`]).
+        let valid = problem.residuals_into(&trial, &mut self.r);
         self.history.evaluations += 1;
-        let trial_cost = trial_residuals
-            .as_ref()
-            .map_or(f64::INFINITY, |r| r.norm_squared());
+        let trial_cost = if valid {
+            self.r.norm_squared()
+        } else {
+            f64::INFINITY
+        };
         if trial_cost < self.cost {
             let decrease = self.cost - trial_cost;
             let gain = if predicted > 0.0 {
@@ -205,9 +222,6 @@ impl Iterate {
             };
             self.damping.relax(gain);
             self.s = trial;
-            if let Some(r) = trial_residuals {
-                self.r = r;
-            }
             self.cost = trial_cost;
             self.normal_equations = None;
             self.history.best_cost.push(self.cost);

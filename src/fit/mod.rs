@@ -18,6 +18,7 @@ mod comparison;
 pub mod cost;
 mod cross_validation;
 mod data;
+mod data_view;
 mod energy;
 mod error;
 mod files;

@@ -2,6 +2,7 @@
 
 use super::comparison::{aic, bic, Candidate};
 use super::data::MeasurementData;
+use super::data_view::DataView;
 use super::energy::{check_energy, EnergyCheck, ENERGY_TOLERANCE};
 use super::objective::Objective;
 use super::optimize::minimize;
@@ -244,7 +245,7 @@ const ENERGY_ROUNDS: usize = 4;
 /// the largest value that conserves energy and the rest refitted by the local stages.
 pub(crate) fn fit_model(
     set: &MeasurementSet,
-    data: &MeasurementData,
+    data: DataView,
     kind: DistributionKind,
     options: &FitOptions,
 ) -> Result<ModelFit, FitError> {
@@ -304,7 +305,7 @@ fn local_stages(optimizer: &Optimizer) -> Optimizer {
 /// Fits the `kind` family to a prepared measurement, without the energy constraint.
 fn fit_model_unconstrained(
     set: &MeasurementSet,
-    data: &MeasurementData,
+    data: DataView,
     kind: DistributionKind,
     options: &FitOptions,
 ) -> Result<ModelFit, FitError> {
@@ -319,7 +320,7 @@ fn fit_model_unconstrained(
             ),
         });
     }
-    let objective = Objective::new(data, &space, options.robust);
+    let objective = Objective::over(data, &space, options.robust);
     let start = space.search(&starting_values(&space, options)?);
     let (best, history) = minimize(
         &objective,
@@ -334,10 +335,8 @@ fn fit_model_unconstrained(
         message: error.to_string(),
     })?;
     let values = space.values(&best);
-    let residuals = objective
-        .normalized_residuals(&values)
-        .ok_or_else(|| unevaluable(set, kind, "residuals"))?;
-    let chi2: f64 = residuals.iter().map(|r| r * r).sum();
+    let (chi2, rmse) =
+        residual_sums(set, &objective, &values).ok_or_else(|| unevaluable(set, kind, "residuals"))?;
     let free_count = space.dimension();
     let degrees_of_freedom = observations - free_count;
     let reduced_chi2 = chi2 / degrees_of_freedom as f64;
@@ -355,7 +354,7 @@ fn fit_model_unconstrained(
         reduced_chi2,
         aic: aic(chi2, free_count),
         bic: bic(chi2, free_count, observations),
-        rmse: rmse_per_element(set, data, &residuals),
+        rmse,
         uncertainty,
         history,
         evaluations: objective.evaluations(),
@@ -364,28 +363,38 @@ fn fit_model_unconstrained(
     })
 }
 
-/// RMS of (model − data) in sr⁻¹ per element, from the normalized residuals and the σ's.
-fn rmse_per_element(
+/// χ² = Σ r² of the normalized residuals at `values`, and the RMS of (model − data) in sr⁻¹
+/// per element (from the residuals and the σ's), each summed in observation order as
+/// `Iterator::sum` sums (from −0.0), without holding the residuals; `None` for an invalid
+/// model.
+fn residual_sums(
     set: &MeasurementSet,
-    data: &MeasurementData,
-    residuals: &[f64],
-) -> BTreeMap<String, f64> {
+    objective: &Objective,
+    values: &ParameterValues,
+) -> Option<(f64, BTreeMap<String, f64>)> {
+    let data = objective.data();
     let width = set.elements.len();
-    set.elements
+    let mut chi2 = -0.0;
+    let mut squares = vec![-0.0; width];
+    let mut next = 0;
+    let valid = objective.visit_normalized_residuals(values, |block| {
+        for (i, r) in (next..).zip(block) {
+            chi2 += r * r;
+            let (_, sigma) = data.observation(i);
+            squares[i % width] += (r * sigma).powi(2);
+        }
+        next += block.len();
+    });
+    let rmse = set
+        .elements
         .iter()
-        .enumerate()
-        .map(|(e, &index)| {
-            let sum: f64 = (0..data.points())
-                .map(|p| {
-                    let i = p * width + e;
-                    let (_, sigma) = data.observation(i);
-                    (residuals[i] * sigma).powi(2)
-                })
-                .sum();
+        .zip(squares)
+        .map(|(&index, sum)| {
             (
                 MUELLER_ELEMENT_NAMES[index].to_owned(),
                 (sum / data.points() as f64).sqrt(),
             )
         })
-        .collect()
+        .collect();
+    valid.then_some((chi2, rmse))
 }

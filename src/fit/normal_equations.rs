@@ -28,10 +28,11 @@ impl LeastSquares for Objective<'_> {
     fn upper(&self) -> &[f64] {
         self.space().upper()
     }
-    fn residuals(&self, s: &[f64]) -> Option<DVector<f64>> {
-        let mut r = DVector::zeros(self.observations());
-        self.residuals_at(&self.space().values(s), r.as_mut_slice())
-            .then_some(r)
+    fn residual_count(&self) -> usize {
+        self.observations()
+    }
+    fn residuals_into(&self, s: &[f64], out: &mut DVector<f64>) -> bool {
+        self.residuals_at(&self.space().values(s), out.as_mut_slice())
     }
     /// Block by block of points, never holding J ([`normal_equations`]).
     fn normal_equations(

@@ -5,6 +5,7 @@
 //! per distinct zenith angle and one Mueller matrix per point, in parallel over blocks of points.
 
 use super::data::MeasurementData;
+use super::data_view::DataView;
 use super::parameters::ParameterValues;
 use super::robust::RobustLoss;
 use super::space::ModelSpace;
@@ -21,10 +22,15 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// ([`super::normal_equations`]).
 pub(crate) const CHUNK_POINTS: usize = 4096;
 
+/// Blocks of points whose residuals [`Objective::visit_normalized_residuals`] evaluates in one
+/// parallel pass before handing them on in order: enough tasks for the threads, 2.4 MB of a
+/// 9-element file's residuals.
+const BLOCKS_PER_PASS: usize = 8;
+
 /// The objective of one model family on one measurement, as a function of search coordinates
 /// ([`ModelSpace`]). Thread-safe: the genetic stage evaluates it in parallel.
 pub struct Objective<'a> {
-    data: &'a MeasurementData,
+    data: DataView<'a>,
     space: &'a ModelSpace,
     robust: Option<RobustLoss>,
     evaluations: AtomicU64,
@@ -33,6 +39,15 @@ pub struct Objective<'a> {
 impl<'a> Objective<'a> {
     pub fn new(
         data: &'a MeasurementData,
+        space: &'a ModelSpace,
+        robust: Option<RobustLoss>,
+    ) -> Objective<'a> {
+        Objective::over(data.into(), space, robust)
+    }
+
+    /// The objective over the points of `data` (all of a measurement's, or a fold's).
+    pub(crate) fn over(
+        data: DataView<'a>,
         space: &'a ModelSpace,
         robust: Option<RobustLoss>,
     ) -> Objective<'a> {
@@ -47,7 +62,7 @@ impl<'a> Objective<'a> {
     pub fn space(&self) -> &ModelSpace {
         self.space
     }
-    pub fn data(&self) -> &MeasurementData {
+    pub(crate) fn data(&self) -> DataView<'a> {
         self.data
     }
     pub fn robust(&self) -> Option<RobustLoss> {
@@ -77,7 +92,7 @@ impl<'a> Objective<'a> {
 
     fn masking_factors(&self, pbrdf: &Pbrdf) -> Vec<f64> {
         self.data
-            .zenith_cosines
+            .zenith_cosines()
             .iter()
             .map(|&c| pbrdf.masking_without_table(c))
             .collect()
@@ -92,32 +107,53 @@ impl<'a> Objective<'a> {
         point: usize,
         mut visit: impl FnMut(usize, f64),
     ) {
-        let g = &self.data.geometry[point];
-        let m = pbrdf.mueller_for_geometry(
-            &g.scattering,
-            masking[g.incident_zenith],
-            masking[g.scattered_zenith],
-        );
-        let start = point * self.data.elements.len();
-        for (offset, &(row, column)) in self.data.elements.iter().enumerate() {
-            let i = start + offset;
+        let whole = self.data.whole;
+        let at = self.data.whole_point(point);
+        let m = self.model_at(pbrdf, masking, at);
+        let start = at * whole.elements.len();
+        for (offset, &(row, column)) in whole.elements.iter().enumerate() {
             visit(
                 offset,
-                (m[(row, column)] - self.data.values[i]) * self.data.inverse_sigma[i],
+                (m[(row, column)] - whole.values[start + offset])
+                    * self.data.inverse_sigma(start, offset),
             );
         }
+    }
+
+    /// The model's Mueller matrix at point `at` of the whole data.
+    #[inline]
+    fn model_at(&self, pbrdf: &Pbrdf, masking: &[f64], at: usize) -> Mueller {
+        let g = &self.data.whole.geometry[at];
+        pbrdf.mueller_for_geometry(
+            &g.scattering,
+            masking[self.data.zenith(g.incident_zenith)],
+            masking[self.data.zenith(g.scattered_zenith)],
+        )
     }
 
     /// Writes `map(r)` of every normalized residual of the model `pbrdf` into `out`, in parallel
     /// over blocks of [`CHUNK_POINTS`] points (each value is the same whatever the threads).
     fn fill_residuals(&self, pbrdf: &Pbrdf, out: &mut [f64], map: impl Fn(f64) -> f64 + Sync) {
         let masking = self.masking(pbrdf);
-        let width = self.data.elements.len();
+        self.fill_points(pbrdf, &masking, 0, out, &map);
+    }
+
+    /// Writes `map(r)` of the points from `first` on into `out` (whole points), in parallel over
+    /// blocks of [`CHUNK_POINTS`] points.
+    fn fill_points(
+        &self,
+        pbrdf: &Pbrdf,
+        masking: &[f64],
+        first: usize,
+        out: &mut [f64],
+        map: &(impl Fn(f64) -> f64 + Sync),
+    ) {
+        let width = self.data.element_count();
         let fill = |(chunk, block): (usize, &mut [f64])| {
-            self.fill_block(pbrdf, &masking, chunk * CHUNK_POINTS, block, &map);
+            self.fill_block(pbrdf, masking, first + chunk * CHUNK_POINTS, block, map);
         };
         // One block (every shipped file) runs on the calling thread: no task to hand out.
-        if self.data.points() <= CHUNK_POINTS {
+        if out.len() <= CHUNK_POINTS * width {
             fill((0, out));
         } else {
             out.par_chunks_mut(CHUNK_POINTS * width)
@@ -136,7 +172,7 @@ impl<'a> Objective<'a> {
         block: &mut [f64],
         map: &impl Fn(f64) -> f64,
     ) {
-        let width = self.data.elements.len();
+        let width = self.data.element_count();
         for (p, values) in block.chunks_mut(width).enumerate() {
             self.point_residuals(pbrdf, masking, first + p, |e, r| values[e] = map(r));
         }
@@ -242,21 +278,52 @@ impl<'a> Objective<'a> {
         Some(out)
     }
 
+    /// Calls `visit` with the plain normalized residuals at `values`, whatever the loss, a pass
+    /// of [`BLOCKS_PER_PASS`] blocks of points at a time, in order: the values of
+    /// [`Objective::normalized_residuals`] (counting one evaluation), for a sum over them in
+    /// order without holding them all (14 MB at 2e5 rows of 9 elements). Returns false for an
+    /// invalid model.
+    pub(crate) fn visit_normalized_residuals(
+        &self,
+        values: &ParameterValues,
+        mut visit: impl FnMut(&[f64]),
+    ) -> bool {
+        let Some(pbrdf) = self.model(values) else {
+            return false;
+        };
+        let masking = self.masking(&pbrdf);
+        let (points, width) = (self.data.points(), self.data.element_count());
+        let pass_points = BLOCKS_PER_PASS * CHUNK_POINTS;
+        let mut pass = vec![0.0; points.min(pass_points) * width];
+        for first in (0..points).step_by(pass_points) {
+            let block = &mut pass[..(points - first).min(pass_points) * width];
+            self.fill_points(&pbrdf, &masking, first, block, &|r| r);
+            visit(block);
+        }
+        true
+    }
+
+    /// Σ r² of the plain normalized residuals at `values`, summed in order as `Iterator::sum`
+    /// sums [`Objective::normalized_residuals`], and their number; `None` for an invalid model.
+    pub(crate) fn chi2(&self, values: &ParameterValues) -> Option<(f64, usize)> {
+        // −0.0: where `Iterator::sum` of f64 starts.
+        let mut chi2 = -0.0;
+        self.visit_normalized_residuals(values, |block| {
+            for r in block {
+                chi2 += r * r;
+            }
+        })
+        .then_some((chi2, self.observations()))
+    }
+
     /// The model's full Mueller matrix (sr⁻¹) at every point.
     pub fn model_muellers(&self, values: &ParameterValues) -> Option<Vec<Mueller>> {
         let pbrdf = self.model(values)?;
         let masking = self.masking_factors(&pbrdf);
         Some(
-            self.data
-                .geometry
-                .par_iter()
-                .map(|g| {
-                    pbrdf.mueller_for_geometry(
-                        &g.scattering,
-                        masking[g.incident_zenith],
-                        masking[g.scattered_zenith],
-                    )
-                })
+            (0..self.data.points())
+                .into_par_iter()
+                .map(|point| self.model_at(&pbrdf, &masking, self.data.whole_point(point)))
                 .collect(),
         )
     }

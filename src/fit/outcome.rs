@@ -78,7 +78,7 @@ pub(super) fn fit_distributions(
     let mut fits = options
         .distributions()
         .into_par_iter()
-        .map(|kind| fit_model(set, data, kind, options))
+        .map(|kind| fit_model(set, data.into(), kind, options))
         .collect::<Vec<_>>()
         .into_iter()
         .collect::<Result<Vec<ModelFit>, FitError>>()?;

@@ -74,16 +74,13 @@ impl Profile<'_, '_> {
             };
             // Plain least squares, whatever loss the fit used: the bound is a χ² statement.
             // Levenberg–Marquardt's last cost is Σ r² at its result: no evaluation more.
-            let objective = Objective::new(self.objective.data(), &reduced, None);
+            let objective = Objective::over(self.objective.data(), &reduced, None);
             let start = reduced.search(&values);
             let (best, history) = levenberg_marquardt(&objective, &start, self.settings);
             values = reduced.values(&best);
             return self.remember(values, history.best_cost.last().copied());
         }
-        let chi2 = self
-            .objective
-            .normalized_residuals(&values)
-            .map(|residuals| residuals.iter().map(|r| r * r).sum());
+        let chi2 = self.objective.chi2(&values).map(|(chi2, _)| chi2);
         self.remember(values, chi2)
     }
 

@@ -177,24 +177,27 @@ impl LeastSquares for JointProblem<'_> {
     fn upper(&self) -> &[f64] {
         &self.upper
     }
-    /// Every wavelength's residuals, in parallel, in wavelength order.
-    fn residuals(&self, s: &[f64]) -> Option<DVector<f64>> {
-        let parts: Option<Vec<Vec<f64>>> = self
-            .blocks
-            .par_iter()
+    fn residual_count(&self) -> usize {
+        self.observations
+    }
+    /// Every wavelength's residuals, in parallel, each written into its rows.
+    fn residuals_into(&self, s: &[f64], out: &mut DVector<f64>) -> bool {
+        let mut parts = Vec::with_capacity(self.blocks.len());
+        let mut rest = out.as_mut_slice();
+        for block in &self.blocks {
+            let (part, tail) = rest.split_at_mut(block.rows.len());
+            parts.push(part);
+            rest = tail;
+        }
+        parts
+            .into_par_iter()
             .enumerate()
-            .map(|(j, block)| {
-                let mut r = vec![0.0; block.rows.len()];
-                block
+            .map(|(j, part)| {
+                self.blocks[j]
                     .objective
-                    .residuals_at(&self.block_values(s, j), &mut r)
-                    .then_some(r)
+                    .residuals_at(&self.block_values(s, j), part)
             })
-            .collect();
-        Some(DVector::from_iterator(
-            self.observations,
-            parts?.into_iter().flatten(),
-        ))
+            .reduce(|| true, |a, b| a && b)
     }
     /// J by forward differences, one evaluation per shared coordinate (a full column) and one
     /// per family (every wavelength's member shifted at once, each column nonzero on its own
@@ -257,7 +260,12 @@ impl JointProblem<'_> {
                 for &(c, h) in &steps {
                     shifted[c] += h;
                 }
-                Some((steps, self.residuals(&shifted)? - r))
+                let mut change = DVector::zeros(self.observations);
+                if !self.residuals_into(&shifted, &mut change) {
+                    return None;
+                }
+                change -= r;
+                Some((steps, change))
             })
             .collect()
     }

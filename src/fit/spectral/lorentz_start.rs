@@ -120,14 +120,21 @@ impl LeastSquares for PermittivityFit<'_> {
     fn upper(&self) -> &[f64] {
         &self.upper
     }
-    fn residuals(&self, s: &[f64]) -> Option<DVector<f64>> {
+    fn residual_count(&self) -> usize {
+        2 * self.wavelengths.len()
+    }
+    fn residuals_into(&self, s: &[f64], out: &mut DVector<f64>) -> bool {
         let law = law_of(s);
-        let values = self.wavelengths.iter().zip(self.eps).flat_map(|(&w, e)| {
+        for ((&w, e), pair) in self
+            .wavelengths
+            .iter()
+            .zip(self.eps)
+            .zip(out.as_mut_slice().chunks_exact_mut(2))
+        {
             let d = law.permittivity(w) - e;
-            [d.re, d.im]
-        });
-        let r = DVector::from_iterator(2 * self.wavelengths.len(), values);
-        r.iter().all(|x| x.is_finite()).then_some(r)
+            pair.copy_from_slice(&[d.re, d.im]);
+        }
+        out.iter().all(|x| x.is_finite())
     }
     /// From J by forward differences (a few columns of 2 × wavelengths rows).
     fn normal_equations(

@@ -209,7 +209,7 @@ pub(crate) fn fit_spectral_from(
                 None => sets
                     .par_iter()
                     .zip(&data)
-                    .map(|(set, data)| fit_model(set, data, kind, options))
+                    .map(|(set, data)| fit_model(set, data.into(), kind, options))
                     .collect::<Result<Vec<_>, _>>()?,
             };
             let joint = fit_table(&sets, &data, kind, options, &alone)?;
