@@ -95,8 +95,8 @@ impl<'a> Objective<'a> {
         let g = &self.data.geometry[point];
         let m = pbrdf.mueller_for_geometry(
             &g.scattering,
-            masking[g.incident_zenith],
-            masking[g.scattered_zenith],
+            masking[g.incident_zenith()],
+            masking[g.scattered_zenith()],
         );
         let start = point * self.data.elements.len();
         for (offset, &(row, column)) in self.data.elements.iter().enumerate() {
@@ -253,8 +253,8 @@ impl<'a> Objective<'a> {
                 .map(|g| {
                     pbrdf.mueller_for_geometry(
                         &g.scattering,
-                        masking[g.incident_zenith],
-                        masking[g.scattered_zenith],
+                        masking[g.incident_zenith()],
+                        masking[g.scattered_zenith()],
                     )
                 })
                 .collect(),
