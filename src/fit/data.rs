@@ -30,12 +30,24 @@ pub enum ErrorSource {
 }
 
 /// One measured geometry, and its zenith angles' positions in
-/// [`MeasurementData::zenith_cosines`].
+/// [`MeasurementData::zenith_cosines`] (u32: 72 B a point, not 80; a set of 2³¹ rows would not
+/// fit in memory anyway).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PreparedGeometry {
     pub scattering: ScatteringGeometry,
-    pub incident_zenith: usize,
-    pub scattered_zenith: usize,
+    incident_zenith: u32,
+    scattered_zenith: u32,
+}
+
+impl PreparedGeometry {
+    /// Position of cos θ_i in [`MeasurementData::zenith_cosines`].
+    pub fn incident_zenith(&self) -> usize {
+        self.incident_zenith as usize
+    }
+    /// Position of cos θ_r in [`MeasurementData::zenith_cosines`].
+    pub fn scattered_zenith(&self) -> usize {
+        self.scattered_zenith as usize
+    }
 }
 
 /// The measurement in the form the objective consumes.
@@ -126,8 +138,8 @@ impl MeasurementData {
             let g = &self.geometry[point];
             geometry.push(PreparedGeometry {
                 scattering: g.scattering,
-                incident_zenith: zeniths.index(self.zenith_cosines[g.incident_zenith]),
-                scattered_zenith: zeniths.index(self.zenith_cosines[g.scattered_zenith]),
+                incident_zenith: zeniths.index(self.zenith_cosines[g.incident_zenith()]),
+                scattered_zenith: zeniths.index(self.zenith_cosines[g.scattered_zenith()]),
             });
             let start = point * width;
             values.extend_from_slice(&self.values[start..start + width]);
@@ -243,18 +255,18 @@ fn check_elements(set: &MeasurementSet) -> Result<(), FitError> {
 #[derive(Default)]
 struct DistinctCosines {
     cosines: Vec<f64>,
-    positions: HashMap<u64, usize>,
+    positions: HashMap<u64, u32>,
 }
 
 impl DistinctCosines {
     /// Position of `cos` in the list, added if new.
-    fn index(&mut self, cos: f64) -> usize {
+    fn index(&mut self, cos: f64) -> u32 {
         // == on floats: +0 and −0 are one key (the cosines are finite).
         let key = if cos == 0.0 { 0 } else { cos.to_bits() };
         let cosines = &mut self.cosines;
         *self.positions.entry(key).or_insert_with(|| {
             cosines.push(cos);
-            cosines.len() - 1
+            u32::try_from(cosines.len() - 1).expect("fewer than 2³² distinct zenith angles")
         })
     }
 }

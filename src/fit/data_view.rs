@@ -39,8 +39,8 @@ impl PointSubset {
         };
         for &p in rows {
             let g = &whole.geometry[p];
-            slot(g.incident_zenith);
-            slot(g.scattered_zenith);
+            slot(g.incident_zenith());
+            slot(g.scattered_zenith());
         }
         PointSubset {
             points: rows.iter().map(|&p| index_u32(p)).collect(),

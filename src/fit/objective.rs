@@ -126,8 +126,8 @@ impl<'a> Objective<'a> {
         let g = &self.data.whole.geometry[at];
         pbrdf.mueller_for_geometry(
             &g.scattering,
-            masking[self.data.zenith(g.incident_zenith)],
-            masking[self.data.zenith(g.scattered_zenith)],
+            masking[self.data.zenith(g.incident_zenith())],
+            masking[self.data.zenith(g.scattered_zenith())],
         )
     }
 

@@ -965,7 +965,7 @@ fn the_shipped_ptfe_rows_are_all_realizable() {
             .points
             .iter()
             .map(|p| {
-                let m = irpol::optics::Mueller::from_row_slice(&p.values);
+                let m = irpol::optics::Mueller::from_row_slice(p.values);
                 irpol::optics::coherency_eigenvalues(&m)[0] / p.values[0]
             })
             .fold(f64::INFINITY, f64::min);
