@@ -13,7 +13,7 @@
 //! data made by §1.3's model come back as §1.3's model), or the lowest AIC without folds. Both
 //! are reported side by side.
 
-use super::admissible::why_inadmissible;
+use super::admissible::{why_inadmissible, why_inadmissible_where};
 use super::data::MeasurementData;
 use super::data_view::PointSubset;
 use super::levenberg_marquardt::LevenbergMarquardtSettings;
@@ -156,7 +156,7 @@ pub(super) fn score_terms(
         Some(k) => cross_validate(set, data, options, fit, k)?,
         None => Vec::new(),
     };
-    let muellers = fit.model_muellers(set, data, options)?;
+    let first_unrealizable = fit.first_unrealizable_point(set, data, options)?;
     let score = TermsScore {
         terms: options.terms,
         distribution: fit.distribution,
@@ -164,7 +164,7 @@ pub(super) fn score_terms(
         reduced_chi2: fit.reduced_chi2,
         aic: fit.aic,
         folds,
-        inadmissible: why_inadmissible(&[&fit.model], &[&muellers]),
+        inadmissible: why_inadmissible_where(&[&fit.model], |_| first_unrealizable),
     };
     Ok((fitted, score))
 }
