@@ -21,9 +21,29 @@ const REALIZABILITY_ROUNDING: f64 = 1e-9;
 /// Why `models` (one per wavelength of one material, with their Mueller matrices at the
 /// measured geometries) are not admissible, or `None` when they are.
 pub fn why_inadmissible(models: &[&ModelSpec], muellers: &[&[Mueller]]) -> Option<String> {
+    why_inadmissible_where(models, |j| {
+        muellers
+            .get(j)
+            .and_then(|rows| rows.iter().position(unrealizable))
+    })
+}
+
+/// [`why_inadmissible`] with the first row whose model matrix is not realizable
+/// ([`unrealizable`]) of each model `j` given by `first_unrealizable(j)`, for a caller that
+/// finds it without holding every matrix (a dense scan's are 128 B a row).
+pub(super) fn why_inadmissible_where(
+    models: &[&ModelSpec],
+    first_unrealizable: impl Fn(usize) -> Option<usize>,
+) -> Option<String> {
     index_problem(models)
         .or_else(|| energy_problem(models))
-        .or_else(|| realizability_problem(models, muellers))
+        .or_else(|| realizability_problem(models, first_unrealizable))
+}
+
+/// Whether a model matrix's coherency matrix has a negative eigenvalue (Cloude), beyond
+/// rounding.
+pub(super) fn unrealizable(matrix: &Mueller) -> bool {
+    coherency_eigenvalues(matrix)[0] < -REALIZABILITY_ROUNDING * matrix.norm()
 }
 
 /// n < 1 without strong absorption anywhere in the material's wavelengths.
@@ -57,12 +77,14 @@ fn energy_problem(models: &[&ModelSpec]) -> Option<String> {
     })
 }
 
-/// A model matrix whose coherency matrix has a negative eigenvalue (Cloude).
-fn realizability_problem(models: &[&ModelSpec], muellers: &[&[Mueller]]) -> Option<String> {
-    models.iter().zip(muellers).find_map(|(m, rows)| {
-        let row = rows.iter().position(|matrix| {
-            coherency_eigenvalues(matrix)[0] < -REALIZABILITY_ROUNDING * matrix.norm()
-        })?;
+/// A model matrix whose coherency matrix has a negative eigenvalue (Cloude), the first row of
+/// model `j` with one being `first_unrealizable(j)`.
+fn realizability_problem(
+    models: &[&ModelSpec],
+    first_unrealizable: impl Fn(usize) -> Option<usize>,
+) -> Option<String> {
+    models.iter().enumerate().find_map(|(j, m)| {
+        let row = first_unrealizable(j)?;
         Some(format!(
             "model matrix not realizable at row {} ({} µm)",
             row + 1,

@@ -13,14 +13,14 @@
 //! data made by §1.3's model come back as §1.3's model), or the lowest AIC without folds. Both
 //! are reported side by side.
 
-use super::admissible::why_inadmissible;
+use super::admissible::{why_inadmissible, why_inadmissible_where};
 use super::data::MeasurementData;
 use super::data_view::PointSubset;
 use super::levenberg_marquardt::LevenbergMarquardtSettings;
 use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
 use super::options::FitOptions;
-use super::outcome::{finish, fit_distributions, fit_measurement, FitOutcome, Fitted};
+use super::outcome::{finish, fit_distributions, fit_measurement_set, FitOutcome, Fitted};
 use super::stages::Optimizer;
 pub use super::terms_choice::{TermsChoice, TermsScore};
 use super::FitError;
@@ -28,6 +28,7 @@ use crate::measure::MeasurementSet;
 use crate::pbrdf::ModelTerms;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
+use std::borrow::Cow;
 
 /// The local stage of a fold's refit: it starts at the whole-data optimum, a few Gauss–Newton
 /// steps from the fold's own, and a score good to 1e-6 relatively is all the choice needs (the
@@ -51,11 +52,21 @@ pub const MIN_ROWS_PER_FOLD: usize = 10;
 /// Fits one grey measurement as `options` ask: its `terms` alone, or choosing among
 /// `term_candidates` (by cross-validation with `cv_folds`, else by AIC).
 pub fn fit_grey(set: &MeasurementSet, options: &FitOptions) -> Result<FitOutcome, FitError> {
+    fit_grey_set(Cow::Borrowed(set), options)
+}
+
+/// [`fit_grey`] of a set lent or given: a given set becomes the outcome's
+/// [`FitOutcome::measurement`] as it is, a lent one is copied into it once the fit's prepared
+/// data are gone (a dense scan's rows are the largest thing a fit holds).
+pub(crate) fn fit_grey_set(
+    set: Cow<'_, MeasurementSet>,
+    options: &FitOptions,
+) -> Result<FitOutcome, FitError> {
     if options.term_candidates.is_empty() && options.cv_folds.is_none() {
-        return fit_measurement(set, options);
+        return fit_measurement_set(set, options);
     }
-    let (mut outcome, choice) =
-        fit_choosing_terms(set, options, &candidates(options), folds_for(set, options)?)?;
+    let folds = folds_for(&set, options)?;
+    let (mut outcome, choice) = choosing_terms(set, options, &candidates(options), folds)?;
     outcome.terms_choice = Some(choice);
     Ok(outcome)
 }
@@ -99,18 +110,28 @@ pub fn fit_choosing_terms(
     candidates: &[ModelTerms],
     folds: Option<usize>,
 ) -> Result<(FitOutcome, TermsChoice), FitError> {
-    let data = MeasurementData::new(set)?;
+    choosing_terms(Cow::Borrowed(set), options, candidates, folds)
+}
+
+/// [`fit_choosing_terms`] of a set lent or given ([`fit_grey_set`]).
+fn choosing_terms(
+    set: Cow<'_, MeasurementSet>,
+    options: &FitOptions,
+    candidates: &[ModelTerms],
+    folds: Option<usize>,
+) -> Result<(FitOutcome, TermsChoice), FitError> {
+    let data = MeasurementData::new(&set)?;
     let mut fitted = Vec::new();
     let mut scores = Vec::new();
     for &terms in candidates {
         let options = options.with_terms(terms);
-        let (fit, score) = score_terms(set, &data, &options, folds)?;
+        let (fit, score) = score_terms(&set, &data, &options, folds)?;
         fitted.push(fit);
         scores.push(score);
     }
     let chosen = TermsChoice::choose(&scores, folds.is_some());
     let options = options.with_terms(candidates[chosen]);
-    let outcome = finish(set, &data, &options, fitted.swap_remove(chosen))?;
+    let outcome = finish(set, data, &options, fitted.swap_remove(chosen))?;
     Ok((
         outcome,
         TermsChoice {
@@ -135,7 +156,7 @@ pub(super) fn score_terms(
         Some(k) => cross_validate(set, data, options, fit, k)?,
         None => Vec::new(),
     };
-    let muellers = fit.model_muellers(set, data, options)?;
+    let first_unrealizable = fit.first_unrealizable_point(set, data, options)?;
     let score = TermsScore {
         terms: options.terms,
         distribution: fit.distribution,
@@ -143,7 +164,7 @@ pub(super) fn score_terms(
         reduced_chi2: fit.reduced_chi2,
         aic: fit.aic,
         folds,
-        inadmissible: why_inadmissible(&[&fit.model], &[&muellers]),
+        inadmissible: why_inadmissible_where(&[&fit.model], |_| first_unrealizable),
     };
     Ok((fitted, score))
 }

@@ -110,7 +110,8 @@ impl DataView<'_> {
     /// The position in [`DataView::zenith_cosines`] of the whole data's zenith `zenith`.
     #[inline]
     pub fn zenith(&self, zenith: usize) -> usize {
-        self.subset.map_or(zenith, |s| s.zenith_slots[zenith] as usize)
+        self.subset
+            .map_or(zenith, |s| s.zenith_slots[zenith] as usize)
     }
     /// 1/σ of element `element` of the point whose first observation in the whole data is
     /// `start`: the whole data's, or for an element of the default noise model the subset's
@@ -145,10 +146,9 @@ impl DataView<'_> {
         let points = (0..self.points())
             .step_by(stride)
             .map(|p| self.whole_point(p));
-        self.whole
-            .with_points(points, count, |start, element| {
-                self.inverse_sigma(start, element)
-            })
+        self.whole.with_points(points, count, |start, element| {
+            self.inverse_sigma(start, element)
+        })
     }
 }
 

@@ -13,6 +13,7 @@ use crate::measure::{
     ReadOptions, SAME_WAVELENGTH_UM,
 };
 use crate::progress::Progress;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 /// One material's fit: of one wavelength, or jointly of several (a spectral set, docs/design.md §1.9).
@@ -140,10 +141,12 @@ pub fn fit_read_inputs(
 
     progress.begin("fitting", materials.len() as u64);
     let mut outcomes = Vec::with_capacity(materials.len());
-    for sets in materials {
+    for mut sets in materials {
         progress.message(&sets[0].material);
         let outcome = if sets.len() == 1 {
-            super::cross_validation::fit_grey(&sets[0], options)
+            // The set becomes the outcome's: no copy of its rows.
+            let set = sets.pop().expect("one set");
+            super::cross_validation::fit_grey_set(Cow::Owned(set), options)
                 .map(|o| MaterialFit::Grey(Box::new(o)))
         } else {
             fit_spectral_choosing_terms(sets, options).map(|o| MaterialFit::Spectral(Box::new(o)))

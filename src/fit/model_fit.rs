@@ -1,5 +1,6 @@
 //! One model family fitted to one measurement: optimization, goodness of fit and uncertainties.
 
+use super::admissible::unrealizable;
 use super::comparison::{aic, bic, Candidate};
 use super::data::MeasurementData;
 use super::data_view::DataView;
@@ -121,6 +122,24 @@ impl ModelFit {
             options,
             "Mueller matrices",
             |objective, values| objective.model_muellers(values),
+        )
+    }
+
+    /// The first point of `data` where the model's matrix is not realizable
+    /// ([`super::admissible::unrealizable`]), found without holding the matrices; `options`
+    /// are those the fit was given.
+    pub(crate) fn first_unrealizable_point(
+        &self,
+        set: &MeasurementSet,
+        data: &MeasurementData,
+        options: &FitOptions,
+    ) -> Result<Option<usize>, FitError> {
+        self.evaluated(
+            set,
+            data,
+            options,
+            "Mueller matrices",
+            |objective, values| objective.first_point_where(values, unrealizable),
         )
     }
 
@@ -335,8 +354,8 @@ fn fit_model_unconstrained(
         message: error.to_string(),
     })?;
     let values = space.values(&best);
-    let (chi2, rmse) =
-        residual_sums(set, &objective, &values).ok_or_else(|| unevaluable(set, kind, "residuals"))?;
+    let (chi2, rmse) = residual_sums(set, &objective, &values)
+        .ok_or_else(|| unevaluable(set, kind, "residuals"))?;
     let free_count = space.dimension();
     let degrees_of_freedom = observations - free_count;
     let reduced_chi2 = chi2 / degrees_of_freedom as f64;

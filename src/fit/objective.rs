@@ -316,6 +316,24 @@ impl<'a> Objective<'a> {
         .then_some((chi2, self.observations()))
     }
 
+    /// The first point where the model's Mueller matrix (sr⁻¹) at `values` satisfies
+    /// `predicate`, in parallel and without holding the matrices; `None` for an invalid model.
+    pub(crate) fn first_point_where(
+        &self,
+        values: &ParameterValues,
+        predicate: impl Fn(&Mueller) -> bool + Sync,
+    ) -> Option<Option<usize>> {
+        let pbrdf = self.model(values)?;
+        let masking = self.masking_factors(&pbrdf);
+        Some(
+            (0..self.data.points())
+                .into_par_iter()
+                .position_first(|point| {
+                    predicate(&self.model_at(&pbrdf, &masking, self.data.whole_point(point)))
+                }),
+        )
+    }
+
     /// The model's full Mueller matrix (sr⁻¹) at every point.
     pub fn model_muellers(&self, values: &ParameterValues) -> Option<Vec<Mueller>> {
         let pbrdf = self.model(values)?;

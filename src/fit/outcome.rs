@@ -11,6 +11,7 @@ use crate::material::{pinned_at_bound, AlternativeFit, FitRecord, Material, Merg
 use crate::measure::{MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::optics::Mueller;
 use crate::pbrdf::{DistributionKind, Parameter};
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 /// Everything a fit report needs about one measurement.
@@ -52,9 +53,17 @@ impl FitOutcome {
 /// `options.distribution` is `None`), keeps the one with the lower AIC and records the other as
 /// the alternative. Deterministic for a given `options.seed`.
 pub fn fit_measurement(set: &MeasurementSet, options: &FitOptions) -> Result<FitOutcome, FitError> {
-    let data = MeasurementData::new(set)?;
-    let fitted = fit_distributions(set, &data, options)?;
-    finish(set, &data, options, fitted)
+    fit_measurement_set(Cow::Borrowed(set), options)
+}
+
+/// [`fit_measurement`] of a set lent or given (see [`finish`]).
+pub(super) fn fit_measurement_set(
+    set: Cow<'_, MeasurementSet>,
+    options: &FitOptions,
+) -> Result<FitOutcome, FitError> {
+    let data = MeasurementData::new(&set)?;
+    let fitted = fit_distributions(&set, &data, options)?;
+    finish(set, data, options, fitted)
 }
 
 /// The fits of one measurement before the profile bounds: the kept distribution's, the other's
@@ -105,10 +114,12 @@ pub(super) fn fit_distributions(
 }
 
 /// The outcome of the `fitted` model that is kept: its profile bounds (each costs dozens of
-/// local fits, so only the kept fit gets them) and its library entry.
+/// local fits, so only the kept fit gets them) and its library entry. The outcome keeps `set`:
+/// a given set as it is, a lent one copied after `data` are dropped, so that the rows are
+/// never held three times (set, prepared data, copy).
 pub(super) fn finish(
-    set: &MeasurementSet,
-    data: &MeasurementData,
+    set: Cow<'_, MeasurementSet>,
+    data: MeasurementData,
     options: &FitOptions,
     fitted: Fitted,
 ) -> Result<FitOutcome, FitError> {
@@ -117,7 +128,7 @@ pub(super) fn finish(
         alternative,
         comparison,
     } = fitted;
-    chosen.add_profile_bounds(data, options)?;
+    chosen.add_profile_bounds(&data, options)?;
     let given = options.clone();
     let options = &chosen.effective_options(options);
     let material = Material {
@@ -125,16 +136,17 @@ pub(super) fn finish(
         tool_version: format!("irpol {}", env!("CARGO_PKG_VERSION")),
         model: crate::material::MaterialModel::Grey(chosen.model.clone()),
         fit: Some(fit_record(
-            set,
-            data,
+            &set,
+            &data,
             options,
             &chosen,
             alternative.as_ref(),
             comparison.as_ref(),
         )),
     };
+    drop(data);
     Ok(FitOutcome {
-        measurement: set.clone(),
+        measurement: set.into_owned(),
         material,
         chosen,
         alternative,

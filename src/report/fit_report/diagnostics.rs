@@ -22,11 +22,11 @@ const BIN_WIDTH: f64 = 0.25;
 const HISTOGRAM_LIMIT: f64 = 5.0;
 
 /// Counts per bin of `values` over ±[`HISTOGRAM_LIMIT`], and how many fall outside.
-pub fn histogram(values: &[f64]) -> (Vec<usize>, usize) {
+pub fn histogram(values: impl IntoIterator<Item = f64>) -> (Vec<usize>, usize) {
     let bins = (2.0 * HISTOGRAM_LIMIT / BIN_WIDTH).round() as usize;
     let mut counts = vec![0; bins];
     let mut outside = 0;
-    for &v in values {
+    for v in values {
         let bin = ((v + HISTOGRAM_LIMIT) / BIN_WIDTH).floor();
         if bin >= 0.0 && (bin as usize) < bins {
             counts[bin as usize] += 1;
@@ -40,17 +40,20 @@ pub fn histogram(values: &[f64]) -> (Vec<usize>, usize) {
 /// Histogram of the normalized residuals against the standard normal they should follow.
 pub fn draw_histogram<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) -> DrawResult<DB> {
     let caption = "(h) Residual distribution";
-    let values: Vec<f64> = data
-        .residuals
-        .iter()
-        .map(|r| r.value)
-        .filter(|v| v.is_finite())
-        .collect();
-    if values.is_empty() {
+    // The finite residuals, read in place each time they are needed rather than copied (a
+    // dense scan has millions, and the report's panels are drawn in parallel).
+    let values = || {
+        data.residuals
+            .iter()
+            .map(|r| r.value)
+            .filter(|v| v.is_finite())
+    };
+    let count = values().count();
+    if count == 0 {
         return draw_note(area, caption, "no residuals");
     }
-    let (counts, outside) = histogram(&values);
-    let n = values.len() as f64;
+    let (counts, outside) = histogram(values());
+    let n = count as f64;
     let top = counts.iter().copied().max().unwrap_or(0) as f64;
     // At least a few counts high, so that the integer tick labels stay distinct.
     let high = (top.max(expected_count(n, 0.0)) * 1.3).max(5.0);
@@ -86,7 +89,7 @@ pub fn draw_histogram<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
     let (x, y) = chart.plotting_area().get_pixel_range();
     draw_legend_column(
         area,
-        &histogram_legend(&values, outside),
+        &histogram_legend(values, count, outside),
         (
             x.start - area.get_base_pixel().0 + 8,
             y.start - area.get_base_pixel().1 + 6,
@@ -105,15 +108,20 @@ fn expected_count(n: f64, x: f64) -> f64 {
 
 /// The histogram's key: the bars, the normal curve, the residuals' mean and standard deviation,
 /// and how many fell outside the bins.
-fn histogram_legend(values: &[f64], outside: usize) -> Vec<LegendEntry> {
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let sd = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+/// `values` gives the `count` residuals anew on each call.
+fn histogram_legend<I: Iterator<Item = f64>>(
+    values: impl Fn() -> I,
+    count: usize,
+    outside: usize,
+) -> Vec<LegendEntry> {
+    let n = count as f64;
+    let mean = values().sum::<f64>() / n;
+    let sd = (values().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
     // Printed to two decimals: keep a tiny negative mean from showing as "-0.00".
     let mean = if mean.abs() < 0.005 { 0.0 } else { mean };
     let mut entries = vec![
         LegendEntry::line(
-            format!("residuals, N = {}", values.len()),
+            format!("residuals, N = {count}"),
             HISTOGRAM_BAR,
             LineKind::Patch,
         ),
@@ -393,7 +401,7 @@ mod tests {
 
     #[test]
     fn histogram_bins_are_quarter_sigma_and_count_the_overflow() {
-        let (counts, outside) = histogram(&[-5.0, -0.1, 0.0, 0.1, 0.26, 4.99, 5.0, -7.0, f64::NAN]);
+        let (counts, outside) = histogram([-5.0, -0.1, 0.0, 0.1, 0.26, 4.99, 5.0, -7.0, f64::NAN]);
         assert_eq!(counts.len(), 40);
         assert_eq!(counts[0], 1, "−5 opens the first bin");
         assert_eq!(
