@@ -5,21 +5,25 @@
 //! header row (the first line that is neither blank nor `#`), then the data rows top to bottom,
 //! fields left to right. The first problem found is reported.
 
+use std::borrow::Cow;
+use std::io::BufRead;
 use std::path::Path;
 
-use sha2::{Digest, Sha256};
-
-use super::columns::{parse_header_row, NativeColumns, Quantity};
+use super::columns::{HeaderRow, NativeColumns, Quantity};
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
-use super::metadata::{split_metadata_line, wavelength_in_range, HeaderWavelength, Metadata};
+use super::metadata::{wavelength_in_range, HeaderWavelength, Metadata};
+use super::streaming::{
+    line_text, next_line, open_table, same_file, scan_file, scan_table, stream_lines,
+    StreamedLines, TableScan,
+};
 use super::table_file::{
-    check_width, decode_utf8, fields_of, hex, material_of, measurement_point, parse_number,
-    read_bytes, row_wavelength, table_lines, wavelength_groups, FileFacts, RowWavelengths,
+    check_width, fields_of, material_of, measurement_point, parse_number, row_wavelength,
+    wavelength_groups, FileFacts, RowWavelengths,
 };
 use super::units::{check_degrees, converted_note, AngleReading};
 use super::{MeasurementPoint, MeasurementSet, MAX_MUELLER_SR, MIN_UNCERTAINTY_SR};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
-use crate::table_text::wrong_delimiter;
+use crate::table_text::{is_comment, wrong_delimiter};
 use crate::text::shown;
 
 /// Default azimuths when the columns are absent: the plane of incidence, with the receiver on
@@ -29,8 +33,8 @@ const DEFAULT_PHI_R_DEG: f64 = 180.0;
 
 /// Reads and validates one measurement CSV. `path` is quoted as given in every message.
 pub fn read_measurement_csv(path: &Path) -> Result<MeasurementSet, MeasureError> {
-    let bytes = read_bytes(path)?;
-    parse_measurement_csv(path, &bytes)
+    let mut sets = read_sets(path, scan_file(path)?, false, AngleReading::Auto)?;
+    Ok(sets.remove(0))
 }
 
 /// Parses the bytes of a measurement CSV of one wavelength; `source` names it in messages and in
@@ -45,8 +49,7 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
 /// Reads one measurement CSV as one set per wavelength, ascending (a spectral file, docs/design.md
 /// §1.9, holds several in its wavelength_um column; most files hold one).
 pub fn read_measurement_sets(path: &Path) -> Result<Vec<MeasurementSet>, MeasureError> {
-    let bytes = read_bytes(path)?;
-    parse_sets(path, &bytes, true, AngleReading::Auto)
+    read_sets(path, scan_file(path)?, true, AngleReading::Auto)
 }
 
 /// [`read_measurement_sets`] of bytes; `source` names them.
@@ -67,16 +70,49 @@ pub(crate) fn parse_sets_reading(
     parse_sets(source, bytes, true, angles)
 }
 
+/// [`read_measurement_sets`] of the file at `path` whose first pass is `scan`, with the angles
+/// read as `angles` says.
+pub(crate) fn read_scanned_sets(
+    path: &Path,
+    scan: TableScan,
+    angles: AngleReading,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    read_sets(path, scan, true, angles)
+}
+
+/// The second pass over the file at `path`, reopened (the module doc of `streaming` says why).
+fn read_sets(
+    path: &Path,
+    scan: TableScan,
+    spectral: bool,
+    angles: AngleReading,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    sets_of(path, scan, open_table(path)?, spectral, angles)
+}
+
 fn parse_sets(
     source: &Path,
     bytes: &[u8],
     spectral: bool,
     angles: AngleReading,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
-    let sha256 = hex(&Sha256::digest(bytes));
-    let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
+    let scan = scan_table(bytes).map_err(|r| r.in_file(source))?;
+    sets_of(source, scan, bytes, spectral, angles)
+}
+
+/// The sets of a table read a second time from `reader`, after its first pass `scan`.
+fn sets_of(
+    source: &Path,
+    mut scan: TableScan,
+    reader: impl BufRead,
+    spectral: bool,
+    angles: AngleReading,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    let metadata = scan.metadata().map_err(|r| r.in_file(source))?;
     let radians = angles == AngleReading::Radians;
-    let parsed = parse_text(text, radians).map_err(|r| r.in_file(source))?;
+    let mut lines = stream_lines(reader);
+    let parsed = parse_text(&mut lines, metadata, scan.rows, radians);
+    let parsed = same_file(lines, &scan.fingerprint, parsed).map_err(|r| r.in_file(source))?;
     let file = source.display().to_string();
     let angle_note = if radians {
         Some(converted_note(&file))
@@ -86,7 +122,7 @@ fn parse_sets(
     let groups = wavelength_groups(parsed.points, parsed.wavelengths, spectral)
         .map_err(|r| r.in_file(source))?;
     let facts = FileFacts {
-        sha256,
+        sha256: scan.sha256(),
         material: material_of(parsed.metadata.material.as_ref(), source),
         metadata: parsed.metadata.entries,
         elements: parsed.columns.elements,
@@ -118,43 +154,52 @@ struct ParsedText {
 const PLAIN_FIX: &str = "convert them to degrees, or pass --angles radians to convert them as \
      the file is read (--angles degrees if they are degrees)";
 
-fn parse_text(text: &str, radians: bool) -> Result<ParsedText, Refusal> {
-    let lines = table_lines(text)?;
-    let mut metadata = Metadata::default();
-    for &(number, line) in &lines.comments {
-        if let Some((key, value, column)) = split_metadata_line(line) {
-            metadata.add(number, key, value, column)?;
-        }
-    }
-    let (header_line, header) = lines.header()?;
-    let header_fields = fields_of(header_line, header)?;
-    let columns = parse_header_row(header_line, &header_fields)?;
-    if metadata.wavelength.is_none() && !columns.has(Quantity::Wavelength) {
-        return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength));
-    }
+/// The header row and the `rows` data rows (as the first pass counted them) of `lines`, read
+/// top to bottom with `metadata` (all of the file's, checked by the first pass).
+fn parse_text<R: BufRead>(
+    lines: &mut StreamedLines<R>,
+    metadata: Metadata,
+    rows: usize,
+    radians: bool,
+) -> Result<ParsedText, Refusal> {
+    let mut header: Option<HeaderRow> = None;
     let mut row_wavelengths = Vec::new();
     let mut signed_rows = 0;
-    let mut points = Vec::with_capacity(lines.rows().len());
-    for &(number, line) in lines.rows() {
-        let row = parse_row(number, line, &columns, &metadata, radians)?;
-        row_wavelengths.extend(row.wavelength);
-        signed_rows += usize::from(row.signed);
-        points.push(row.point);
+    let mut points = Vec::with_capacity(rows);
+    while next_line(lines)? {
+        let number = lines.number();
+        let line = line_text(lines)?;
+        if line.trim().is_empty() || is_comment(line) {
+            continue;
+        }
+        match &header {
+            None => {
+                header = Some(HeaderRow::parse(
+                    number,
+                    line,
+                    metadata.wavelength.is_some(),
+                )?)
+            }
+            Some(header) => {
+                let row = parse_row(number, line, &header.columns, &metadata, radians)?;
+                row_wavelengths.extend(row.wavelength);
+                signed_rows += usize::from(row.signed);
+                points.push(row.point);
+            }
+        }
     }
+    // The first pass found a header row: only a file changed since lacks one, and is refused
+    // as such.
+    let header = header.ok_or_else(|| Refusal::new(1, 1, MeasureErrorKind::NoHeader))?;
     if points.is_empty() {
-        return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
+        return Err(Refusal::new(header.line, 1, MeasureErrorKind::NoDataRows));
     }
     // A file of zeros has no lobe: every model with ρ_d = 0 and σ anywhere fits it perfectly, so
     // a "fit" would report arbitrary parameters with χ² = 0.
     if points.iter().all(|p| p.values[0] == 0.0) {
-        let m00_column = header_fields
-            .iter()
-            .zip(&columns.quantities)
-            .find(|(_, q)| **q == Quantity::Element(0))
-            .map_or(1, |(field, _)| field.column);
         return Err(Refusal::new(
-            header_line,
-            m00_column,
+            header.line,
+            header.m00_column,
             MeasureErrorKind::AllM00Zero,
         ));
     }
@@ -164,7 +209,7 @@ fn parse_text(text: &str, radians: bool) -> Result<ParsedText, Refusal> {
     };
     Ok(ParsedText {
         metadata,
-        columns,
+        columns: header.columns,
         points,
         wavelengths,
         signed_rows,
@@ -213,13 +258,14 @@ fn parse_row(
             quantity,
             Quantity::ThetaI | Quantity::ThetaR | Quantity::PhiI | Quantity::PhiR
         );
+        // Quoted as read, with the unit the flag gave it.
         let text = if radians && is_angle {
             value = value.to_degrees();
-            format!("{text} rad")
+            Cow::Owned(format!("{text} rad"))
         } else {
-            text.to_owned()
+            Cow::Borrowed(text)
         };
-        let text = text.as_str();
+        let text = text.as_ref();
         if quantity == Quantity::Wavelength {
             if let Some(kind) = wavelength_refusal(value, text) {
                 return Err(refuse(kind));
@@ -486,6 +532,34 @@ mod tests {
             message("# wavelength_um: 10\ntheta_i_deg,theta_r_deg,m00\n-1,30,0.1\n")
                 .contains("column 'theta_i_deg': -1 is outside [0°, 90°)")
         );
+    }
+
+    /// Bytes that change between the two passes are refused as such, whatever the second pass
+    /// would have found in them: never a set mixing two versions of a file.
+    #[test]
+    fn a_file_changed_between_the_passes_is_refused() {
+        let first = "# wavelength_um: 10\ntheta_i_deg,theta_r_deg,m00\n30,40,0.5\n";
+        for second in [
+            first.replace("0.5", "0.6"),
+            first.replace("0.5", "-0.5"),
+            first.replace("30,40,0.5\n", ""),
+            format!("{first}31,41,0.4\n"),
+        ] {
+            let scan = scan_table(first.as_bytes()).unwrap();
+            let err = sets_of(
+                Path::new("x.csv"),
+                scan,
+                second.as_bytes(),
+                true,
+                AngleReading::Auto,
+            )
+            .unwrap_err();
+            assert_eq!(
+                err.to_string(),
+                "x.csv: the file changed while it was read (its bytes differ between the \
+                 reader's two passes): read it again once it is no longer being written"
+            );
+        }
     }
 
     #[test]

@@ -35,6 +35,7 @@ mod pbsdf;
 mod reading;
 mod realizability;
 mod selection;
+mod streaming;
 mod table_file;
 mod units;
 

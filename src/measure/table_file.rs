@@ -28,6 +28,15 @@ pub(crate) fn hex(bytes: &[u8]) -> String {
 
 /// The bytes of a measurement file, refused with a message if it cannot be read.
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, MeasureError> {
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(&mut open_file(path)?, &mut bytes)
+        .map_err(|e| unreadable(e).in_file(path))?;
+    Ok(bytes)
+}
+
+/// A measurement file opened for reading, or refused as a whole (missing, a folder,
+/// unreadable).
+pub(crate) fn open_file(path: &Path) -> Result<std::fs::File, MeasureError> {
     let whole_file = |kind| Refusal::new(1, 1, kind).in_file(path);
     match std::fs::metadata(path) {
         Ok(meta) if meta.is_dir() => return Err(whole_file(MeasureErrorKind::IsDirectory)),
@@ -36,11 +45,18 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, MeasureError> {
         }
         _ => {}
     }
-    std::fs::read(path).map_err(|e| {
-        whole_file(MeasureErrorKind::Unreadable {
-            reason: e.to_string(),
-        })
-    })
+    std::fs::File::open(path).map_err(|e| unreadable(e).in_file(path))
+}
+
+/// The refusal of a file the system could not read, as a whole.
+pub(crate) fn unreadable(error: std::io::Error) -> Refusal {
+    Refusal::new(
+        1,
+        1,
+        MeasureErrorKind::Unreadable {
+            reason: error.to_string(),
+        },
+    )
 }
 
 /// The text of the file without a leading byte-order mark, or its first byte that is not UTF-8.
