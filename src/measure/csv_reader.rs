@@ -33,7 +33,8 @@ const DEFAULT_PHI_R_DEG: f64 = 180.0;
 
 /// Reads and validates one measurement CSV. `path` is quoted as given in every message.
 pub fn read_measurement_csv(path: &Path) -> Result<MeasurementSet, MeasureError> {
-    let mut sets = read_sets(path, scan_file(path)?, false, AngleReading::Auto)?;
+    let scan = scan_file(path)?;
+    let mut sets = sets_of(path, scan, open_table(path)?, false, AngleReading::Auto)?;
     Ok(sets.remove(0))
 }
 
@@ -49,7 +50,7 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
 /// Reads one measurement CSV as one set per wavelength, ascending (a spectral file, docs/design.md
 /// §1.9, holds several in its wavelength_um column; most files hold one).
 pub fn read_measurement_sets(path: &Path) -> Result<Vec<MeasurementSet>, MeasureError> {
-    read_sets(path, scan_file(path)?, true, AngleReading::Auto)
+    read_scanned_sets(path, scan_file(path)?, AngleReading::Auto)
 }
 
 /// [`read_measurement_sets`] of bytes; `source` names them.
@@ -71,23 +72,13 @@ pub(crate) fn parse_sets_reading(
 }
 
 /// [`read_measurement_sets`] of the file at `path` whose first pass is `scan`, with the angles
-/// read as `angles` says.
+/// read as `angles` says; the file is reopened for the second pass.
 pub(crate) fn read_scanned_sets(
     path: &Path,
     scan: TableScan,
     angles: AngleReading,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
-    read_sets(path, scan, true, angles)
-}
-
-/// The second pass over the file at `path`, reopened (the module doc of `streaming` says why).
-fn read_sets(
-    path: &Path,
-    scan: TableScan,
-    spectral: bool,
-    angles: AngleReading,
-) -> Result<Vec<MeasurementSet>, MeasureError> {
-    sets_of(path, scan, open_table(path)?, spectral, angles)
+    sets_of(path, scan, open_table(path)?, true, angles)
 }
 
 fn parse_sets(
