@@ -3,6 +3,7 @@
 //! m01…m33 and their uncertainties u_m00…u_m33. Names are case-sensitive.
 
 use super::error::{MeasureErrorKind, Refusal};
+use super::table_file::fields_of;
 use super::MUELLER_ELEMENT_NAMES;
 use crate::table_text::{ColumnMap, Field, HeaderProblem};
 use crate::text::shown;
@@ -86,6 +87,35 @@ pub(crate) fn parse_header_row(line: u64, fields: &[Field<'_>]) -> Result<Native
         names: map.names().to_vec(),
         elements,
     })
+}
+
+/// The header row: its line, its columns and the column where m00 stands.
+pub(crate) struct HeaderRow {
+    pub line: u64,
+    pub columns: NativeColumns,
+    pub m00_column: u64,
+}
+
+impl HeaderRow {
+    /// The header row `line` (line `number`) of a file whose metadata gives its wavelength or
+    /// not (`header_wavelength`): without it, the columns must.
+    pub(crate) fn parse(number: u64, line: &str, header_wavelength: bool) -> Result<Self, Refusal> {
+        let fields = fields_of(number, line)?;
+        let columns = parse_header_row(number, &fields)?;
+        if !header_wavelength && !columns.has(Quantity::Wavelength) {
+            return Err(Refusal::new(number, 1, MeasureErrorKind::NoWavelength));
+        }
+        let m00_column = fields
+            .iter()
+            .zip(&columns.quantities)
+            .find(|(_, q)| **q == Quantity::Element(0))
+            .map_or(1, |(field, _)| field.column);
+        Ok(Self {
+            line: number,
+            columns,
+            m00_column,
+        })
+    }
 }
 
 /// A header problem in §2.1's words.

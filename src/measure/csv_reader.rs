@@ -5,21 +5,25 @@
 //! header row (the first line that is neither blank nor `#`), then the data rows top to bottom,
 //! fields left to right. The first problem found is reported.
 
+use std::borrow::Cow;
+use std::io::BufRead;
 use std::path::Path;
 
-use sha2::{Digest, Sha256};
-
-use super::columns::{parse_header_row, NativeColumns, Quantity};
+use super::columns::{HeaderRow, NativeColumns, Quantity};
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
-use super::metadata::{split_metadata_line, wavelength_in_range, HeaderWavelength, Metadata};
+use super::metadata::{HeaderWavelength, Metadata};
+use super::streaming::{
+    line_text, next_line, open_table, same_file, scan_file, scan_table, stream_lines,
+    StreamedLines, TableScan,
+};
 use super::table_file::{
-    check_width, decode_utf8, fields_of, hex, material_of, parse_number, read_bytes,
-    row_wavelength, table_lines, FileFacts, WavelengthGroups,
+    check_width, element_value_refusal, fields_of, material_of, parse_number, row_wavelength,
+    wavelength_refusal, FileFacts, WavelengthGroups,
 };
 use super::units::{check_degrees, converted_note, AngleReading};
 use super::{MeasurementSet, MAX_MUELLER_SR, MIN_UNCERTAINTY_SR};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
-use crate::table_text::wrong_delimiter;
+use crate::table_text::{is_comment, wrong_delimiter};
 use crate::text::shown;
 
 /// Default azimuths when the columns are absent: the plane of incidence, with the receiver on
@@ -29,8 +33,9 @@ const DEFAULT_PHI_R_DEG: f64 = 180.0;
 
 /// Reads and validates one measurement CSV. `path` is quoted as given in every message.
 pub fn read_measurement_csv(path: &Path) -> Result<MeasurementSet, MeasureError> {
-    let bytes = read_bytes(path)?;
-    parse_measurement_csv(path, &bytes)
+    let scan = scan_file(path)?;
+    let mut sets = sets_of(path, scan, open_table(path)?, false, AngleReading::Auto)?;
+    Ok(sets.remove(0))
 }
 
 /// Parses the bytes of a measurement CSV of one wavelength; `source` names it in messages and in
@@ -45,8 +50,7 @@ pub fn parse_measurement_csv(source: &Path, bytes: &[u8]) -> Result<MeasurementS
 /// Reads one measurement CSV as one set per wavelength, ascending (a spectral file, docs/design.md
 /// §1.9, holds several in its wavelength_um column; most files hold one).
 pub fn read_measurement_sets(path: &Path) -> Result<Vec<MeasurementSet>, MeasureError> {
-    let bytes = read_bytes(path)?;
-    parse_sets(path, &bytes, true, AngleReading::Auto)
+    read_scanned_sets(path, scan_file(path)?, AngleReading::Auto)
 }
 
 /// [`read_measurement_sets`] of bytes; `source` names them.
@@ -67,16 +71,39 @@ pub(crate) fn parse_sets_reading(
     parse_sets(source, bytes, true, angles)
 }
 
+/// [`read_measurement_sets`] of the file at `path` whose first pass is `scan`, with the angles
+/// read as `angles` says; the file is reopened for the second pass.
+pub(crate) fn read_scanned_sets(
+    path: &Path,
+    scan: TableScan,
+    angles: AngleReading,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    sets_of(path, scan, open_table(path)?, true, angles)
+}
+
 fn parse_sets(
     source: &Path,
     bytes: &[u8],
     spectral: bool,
     angles: AngleReading,
 ) -> Result<Vec<MeasurementSet>, MeasureError> {
-    let sha256 = hex(&Sha256::digest(bytes));
-    let text = decode_utf8(bytes).map_err(|r| r.in_file(source))?;
+    let scan = scan_table(bytes).map_err(|r| r.in_file(source))?;
+    sets_of(source, scan, bytes, spectral, angles)
+}
+
+/// The sets of a table read a second time from `reader`, after its first pass `scan`.
+fn sets_of(
+    source: &Path,
+    mut scan: TableScan,
+    reader: impl BufRead,
+    spectral: bool,
+    angles: AngleReading,
+) -> Result<Vec<MeasurementSet>, MeasureError> {
+    let metadata = scan.metadata().map_err(|r| r.in_file(source))?;
     let radians = angles == AngleReading::Radians;
-    let parsed = parse_text(text, radians, spectral).map_err(|r| r.in_file(source))?;
+    let mut lines = stream_lines(reader);
+    let parsed = parse_text(&mut lines, metadata, scan.rows, radians, spectral);
+    let parsed = same_file(lines, &scan.fingerprint, parsed).map_err(|r| r.in_file(source))?;
     let file = source.display().to_string();
     let angle_note = if radians {
         Some(converted_note(&file))
@@ -86,7 +113,7 @@ fn parse_sets(
     };
     let groups = parsed.groups.finish().map_err(|r| r.in_file(source))?;
     let facts = FileFacts {
-        sha256,
+        sha256: scan.sha256(),
         material: material_of(parsed.metadata.material.as_ref(), source),
         metadata: parsed.metadata.entries,
         elements: parsed.columns.elements,
@@ -117,59 +144,61 @@ struct ParsedText {
 const PLAIN_FIX: &str = "convert them to degrees, or pass --angles radians to convert them as \
      the file is read (--angles degrees if they are degrees)";
 
-fn parse_text(text: &str, radians: bool, spectral: bool) -> Result<ParsedText, Refusal> {
-    let lines = table_lines(text)?;
-    let mut metadata = Metadata::default();
-    for &(number, line) in &lines.comments {
-        if let Some((key, value, column)) = split_metadata_line(line) {
-            metadata.add(number, key, value, column)?;
-        }
-    }
-    let (header_line, header) = lines.header()?;
-    let header_fields = fields_of(header_line, header)?;
-    let columns = parse_header_row(header_line, &header_fields)?;
-    if metadata.wavelength.is_none() && !columns.has(Quantity::Wavelength) {
-        return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoWavelength));
-    }
-    let has_uncertainty = (columns.elements.iter())
-        .map(|&e| columns.has(Quantity::Uncertainty(e)))
-        .collect();
-    let header_wavelength = metadata.wavelength.as_ref();
-    let mut groups = WavelengthGroups::new(
-        header_wavelength,
-        spectral,
-        has_uncertainty,
-        lines.rows().len(),
-    );
+/// The header row and the `rows` data rows (as the first pass counted them) of `lines`, read
+/// top to bottom with `metadata` (all of the file's, checked by the first pass), each row pushed
+/// into its wavelength's columns.
+fn parse_text<R: BufRead>(
+    lines: &mut StreamedLines<R>,
+    metadata: Metadata,
+    rows: usize,
+    radians: bool,
+    spectral: bool,
+) -> Result<ParsedText, Refusal> {
+    let mut table: Option<(HeaderRow, WavelengthGroups, RowValues)> = None;
     let mut signed_rows = 0;
-    // One row's values, reused for every row: each is copied into its group's columns.
-    let mut row = RowValues::new(columns.elements.len());
-    for &(number, line) in lines.rows() {
-        let read = parse_row(number, line, &columns, &metadata, radians, &mut row)?;
+    while next_line(lines)? {
+        let number = lines.number();
+        let line = line_text(lines)?;
+        if line.trim().is_empty() || is_comment(line) {
+            continue;
+        }
+        let Some((header, groups, row)) = &mut table else {
+            let header = HeaderRow::parse(number, line, metadata.wavelength.is_some())?;
+            let columns = &header.columns;
+            let has_uncertainty = (columns.elements.iter())
+                .map(|&e| columns.has(Quantity::Uncertainty(e)))
+                .collect();
+            let header_wavelength = metadata.wavelength.as_ref();
+            let groups = WavelengthGroups::new(header_wavelength, spectral, has_uncertainty, rows);
+            // One row's values, reused for every row: each is copied into its group's columns.
+            let row = RowValues::new(columns.elements.len());
+            table = Some((header, groups, row));
+            continue;
+        };
+        let read = parse_row(number, line, &header.columns, &metadata, radians, row)?;
         signed_rows += usize::from(read.signed);
         let (values, uncertainties) = (&row.values, &row.uncertainties);
         groups.push(read.wavelength, read.angles, values, uncertainties, number);
     }
+    // The first pass found a header row: only a file changed since lacks one, and is refused
+    // as such.
+    let (header, groups, _) =
+        table.ok_or_else(|| Refusal::new(1, 1, MeasureErrorKind::NoHeader))?;
     if groups.len() == 0 {
-        return Err(Refusal::new(header_line, 1, MeasureErrorKind::NoDataRows));
+        return Err(Refusal::new(header.line, 1, MeasureErrorKind::NoDataRows));
     }
     // A file of zeros has no lobe: every model with ρ_d = 0 and σ anywhere fits it perfectly, so
     // a "fit" would report arbitrary parameters with χ² = 0.
     if groups.rows().all(|p| p.values[0] == 0.0) {
-        let m00_column = header_fields
-            .iter()
-            .zip(&columns.quantities)
-            .find(|(_, q)| **q == Quantity::Element(0))
-            .map_or(1, |(field, _)| field.column);
         return Err(Refusal::new(
-            header_line,
-            m00_column,
+            header.line,
+            header.m00_column,
             MeasureErrorKind::AllM00Zero,
         ));
     }
     Ok(ParsedText {
         metadata,
-        columns,
+        columns: header.columns,
         groups,
         signed_rows,
     })
@@ -232,13 +261,14 @@ fn parse_row(
             quantity,
             Quantity::ThetaI | Quantity::ThetaR | Quantity::PhiI | Quantity::PhiR
         );
+        // Quoted as read, with the unit the flag gave it.
         let text = if radians && is_angle {
             value = value.to_degrees();
-            format!("{text} rad")
+            Cow::Owned(format!("{text} rad"))
         } else {
-            text.to_owned()
+            Cow::Borrowed(text)
         };
-        let text = text.as_str();
+        let text = text.as_ref();
         if quantity == Quantity::Wavelength {
             if let Some(kind) = wavelength_refusal(value, text) {
                 return Err(refuse(kind));
@@ -325,36 +355,6 @@ fn store_value(
         }
     }
     Ok(())
-}
-
-/// Why a Mueller element of `value` sr⁻¹ (read from column `name` as `text`) cannot be measured
-/// data, if it cannot: beyond ±[`MAX_MUELLER_SR`]. Every table reader (§2.1 files and layouts,
-/// whose normalized elements are checked once multiplied by m00) refuses through this one check.
-pub(crate) fn element_value_refusal(
-    name: &str,
-    value: f64,
-    text: &str,
-) -> Option<MeasureErrorKind> {
-    (!value.is_finite() || value.abs() > MAX_MUELLER_SR).then(|| {
-        MeasureErrorKind::ElementTooLarge {
-            column: name.to_owned(),
-            value: shown(text),
-        }
-    })
-}
-
-/// Why a wavelength_um field's (finite) value is not a wavelength irpol models, if it is not.
-pub(crate) fn wavelength_refusal(value: f64, text: &str) -> Option<MeasureErrorKind> {
-    if value <= 0.0 {
-        Some(MeasureErrorKind::NonPositiveWavelength { value: shown(text) })
-    } else if !wavelength_in_range(value) {
-        Some(MeasureErrorKind::WavelengthOutOfRange {
-            place: "column 'wavelength_um'".to_string(),
-            value: shown(text),
-        })
-    } else {
-        None
-    }
 }
 
 #[cfg(test)]
@@ -511,6 +511,34 @@ mod tests {
             message("# wavelength_um: 10\ntheta_i_deg,theta_r_deg,m00\n-1,30,0.1\n")
                 .contains("column 'theta_i_deg': -1 is outside [0°, 90°)")
         );
+    }
+
+    /// Bytes that change between the two passes are refused as such, whatever the second pass
+    /// would have found in them: never a set mixing two versions of a file.
+    #[test]
+    fn a_file_changed_between_the_passes_is_refused() {
+        let first = "# wavelength_um: 10\ntheta_i_deg,theta_r_deg,m00\n30,40,0.5\n";
+        for second in [
+            first.replace("0.5", "0.6"),
+            first.replace("0.5", "-0.5"),
+            first.replace("30,40,0.5\n", ""),
+            format!("{first}31,41,0.4\n"),
+        ] {
+            let scan = scan_table(first.as_bytes()).unwrap();
+            let err = sets_of(
+                Path::new("x.csv"),
+                scan,
+                second.as_bytes(),
+                true,
+                AngleReading::Auto,
+            )
+            .unwrap_err();
+            assert_eq!(
+                err.to_string(),
+                "x.csv: the file changed while it was read (its bytes differ between the \
+                 reader's two passes): read it again once it is no longer being written"
+            );
+        }
     }
 
     #[test]

@@ -55,6 +55,8 @@ pub enum MeasureErrorKind {
     NoHeader,
     #[error("a header row but no data rows")]
     NoDataRows,
+    #[error("the file changed while it was read (its bytes differ between the reader's two passes): read it again once it is no longer being written")]
+    ChangedWhileRead,
 
     // --- field splitting ---
     #[error("{0}")]

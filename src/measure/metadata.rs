@@ -12,6 +12,9 @@ const MATERIAL: &str = "material";
 const WAVELENGTH: &str = "wavelength_um";
 const CONVENTION: &str = "mueller_convention";
 
+/// The metadata key by which a measurement file names its layout (docs/design.md §2.8).
+pub const LAYOUT_KEY: &str = "layout";
+
 /// The wavelength given by a `# wavelength_um:` line, with its text and line for messages.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct HeaderWavelength {

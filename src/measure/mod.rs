@@ -36,6 +36,7 @@ mod reading;
 mod realizability;
 mod rows;
 mod selection;
+mod streaming;
 mod table_file;
 mod units;
 

@@ -4,18 +4,19 @@
 
 use std::path::{Path, PathBuf};
 
-use super::csv_reader::parse_sets_reading;
+use super::csv_reader::{parse_sets_reading, read_scanned_sets};
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
 use super::layout::{parse_with_layout_reading, Layout};
 use super::metadata::split_metadata_line;
 use super::selection::{RowSelection, SelectionError};
-use super::table_file::{decode_utf8, numbered_lines, read_bytes};
+use super::streaming::scan_file;
+use super::table_file::{decode_utf8, read_bytes};
 use super::units::AngleReading;
 use super::MeasurementSet;
+use crate::table_text;
 use crate::text::shown;
 
-/// The metadata key by which a measurement file names its layout.
-pub const LAYOUT_KEY: &str = "layout";
+pub use super::metadata::LAYOUT_KEY;
 
 /// Reads one measurement file as one set per wavelength, ascending: through `layout` if given,
 /// else through the layout its `# layout:` line names, else as a docs/design.md §2.1 file. A
@@ -56,6 +57,13 @@ fn read_file(
             .in_file(path));
         }
         return super::pbsdf::read_table_measurements(path);
+    }
+    if layout.is_none() {
+        // A §2.1 file is read as a stream; a table read through a layout, whole.
+        let scan = scan_file(path)?;
+        if scan.layout.is_none() {
+            return read_scanned_sets(path, scan, angles);
+        }
     }
     let bytes = read_bytes(path)?;
     parse_file(path, &bytes, layout, angles)
@@ -131,10 +139,7 @@ fn named_layout<'a>(
     let Ok(text) = decode_utf8(bytes) else {
         return Ok(None);
     };
-    let Ok(lines) = numbered_lines(text) else {
-        return Ok(None);
-    };
-    let found = lines.iter().find_map(|&(number, line)| {
+    let found = table_text::lines(text).find_map(|(number, line)| {
         split_metadata_line(line)
             .filter(|(key, _, _)| *key == LAYOUT_KEY)
             .map(|(_, value, column)| (number, value, column))

@@ -10,8 +10,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::error::{MeasureError, MeasureErrorKind, Refusal};
-use super::metadata::HeaderWavelength;
-use super::{MeasurementRow, MeasurementRows, MeasurementSet};
+use super::metadata::{wavelength_in_range, HeaderWavelength};
+use super::{MeasurementRow, MeasurementRows, MeasurementSet, MAX_MUELLER_SR};
 use crate::table_text::{self, is_comment, last_column, Field};
 use crate::text::shown;
 
@@ -29,6 +29,15 @@ pub(crate) fn hex(bytes: &[u8]) -> String {
 
 /// The bytes of a measurement file, refused with a message if it cannot be read.
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, MeasureError> {
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(&mut open_file(path)?, &mut bytes)
+        .map_err(|e| unreadable(e).in_file(path))?;
+    Ok(bytes)
+}
+
+/// A measurement file opened for reading, or refused as a whole (missing, a folder,
+/// unreadable).
+pub(crate) fn open_file(path: &Path) -> Result<std::fs::File, MeasureError> {
     let whole_file = |kind| Refusal::new(1, 1, kind).in_file(path);
     match std::fs::metadata(path) {
         Ok(meta) if meta.is_dir() => return Err(whole_file(MeasureErrorKind::IsDirectory)),
@@ -37,11 +46,18 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, MeasureError> {
         }
         _ => {}
     }
-    std::fs::read(path).map_err(|e| {
-        whole_file(MeasureErrorKind::Unreadable {
-            reason: e.to_string(),
-        })
-    })
+    std::fs::File::open(path).map_err(|e| unreadable(e).in_file(path))
+}
+
+/// The refusal of a file the system could not read, as a whole.
+pub(crate) fn unreadable(error: std::io::Error) -> Refusal {
+    Refusal::new(
+        1,
+        1,
+        MeasureErrorKind::Unreadable {
+            reason: error.to_string(),
+        },
+    )
 }
 
 /// The text of the file without a leading byte-order mark, or its first byte that is not UTF-8.
@@ -335,5 +351,34 @@ pub(crate) fn row_wavelength(
             },
             column,
         ))),
+    }
+}
+/// Why a Mueller element of `value` sr⁻¹ (read from column `name` as `text`) cannot be measured
+/// data, if it cannot: beyond ±[`MAX_MUELLER_SR`]. Every table reader (§2.1 files and layouts,
+/// whose normalized elements are checked once multiplied by m00) refuses through this one check.
+pub(crate) fn element_value_refusal(
+    name: &str,
+    value: f64,
+    text: &str,
+) -> Option<MeasureErrorKind> {
+    (!value.is_finite() || value.abs() > MAX_MUELLER_SR).then(|| {
+        MeasureErrorKind::ElementTooLarge {
+            column: name.to_owned(),
+            value: shown(text),
+        }
+    })
+}
+
+/// Why a wavelength_um field's (finite) value is not a wavelength irpol models, if it is not.
+pub(crate) fn wavelength_refusal(value: f64, text: &str) -> Option<MeasureErrorKind> {
+    if value <= 0.0 {
+        Some(MeasureErrorKind::NonPositiveWavelength { value: shown(text) })
+    } else if !wavelength_in_range(value) {
+        Some(MeasureErrorKind::WavelengthOutOfRange {
+            place: "column 'wavelength_um'".to_string(),
+            value: shown(text),
+        })
+    } else {
+        None
     }
 }

@@ -3,6 +3,7 @@
 //! table, a weather CSV, an EPW or TMY3 file — goes through the same pieces:
 //! - [`lines`]: the text's lines, numbered from 1 ("\r\n", "\n" and a bare "\r" each end one),
 //!   after [`decode_utf8`] has refused bytes that are not UTF-8 at their line and column;
+//!   [`LineReader`] reads the same lines from a stream, one at a time;
 //! - [`split_fields`]: the one tokenizer, fields that remember their column;
 //! - [`ColumnMap`]: a header row's names mapped onto the columns a reader knows;
 //! - [`Refusal`] / [`TableError`]: the one "refused at file:line:column: what is wrong and
@@ -13,10 +14,12 @@
 mod columns;
 mod fields;
 mod refusal;
+mod stream;
 
 pub use columns::{ColumnMap, HeaderProblem};
 pub use fields::{field_delimiter, split_fields, wrong_delimiter, Delimiter, Field, TokenProblem};
 pub use refusal::{Problem, Refusal, TableError};
+pub use stream::LineReader;
 
 /// The lines of a text without their terminators, numbered from 1: "\r\n", "\n", or a bare
 /// "\r" (old Mac spreadsheet exports) each end a line.

@@ -362,3 +362,65 @@ fn a_material_name_too_long_for_a_file_is_refused_at_its_header_line() {
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(!dir.path().join("fits").exists() && !dir.path().join("reports").exists());
 }
+
+/// Where the reader's buffer of the file ends (it reads 64 KiB at a time).
+const READ_BUFFER: usize = 1 << 16;
+
+/// `text` extended with a comment line that ends just before byte `offset`, then `end`.
+fn pad_to(text: &mut String, offset: usize, end: &str) {
+    let pad = offset - text.len() - 1;
+    text.push('#');
+    text.push_str(&"x".repeat(pad));
+    text.push_str(end);
+}
+
+/// `text` extended with rows (each ended by `terminator`) until within 64 bytes of `offset`.
+fn rows_until(text: &mut String, offset: usize, terminator: &str) {
+    let mut row = text.len();
+    while text.len() + 64 < offset {
+        text.push_str(&format!(
+            "{},{},0.{}{terminator}",
+            row % 80,
+            row % 70,
+            row % 997 + 1
+        ));
+        row += 1;
+    }
+}
+
+/// A file several buffers long, whose lines span the buffers' ends, with a bare '\r' as the
+/// last byte of one buffer and a two-byte character split between two, is read from disk as
+/// its bytes are parsed in memory, rows and line numbers included, and refused at the same
+/// place when a row past the buffers' ends is wrong.
+#[test]
+fn a_file_longer_than_the_read_buffer_streams_as_its_bytes_parse() {
+    let mut text = "# wavelength_um: 10\ntheta_i_deg,theta_r_deg,m00\n".to_string();
+    rows_until(&mut text, READ_BUFFER, "\r\n");
+    pad_to(&mut text, READ_BUFFER - 1, "\r");
+    rows_until(&mut text, 2 * READ_BUFFER, "\r");
+    pad_to(&mut text, 2 * READ_BUFFER - 1, "\u{b5}\n");
+    rows_until(&mut text, 3 * READ_BUFFER + 700, "\n");
+    let bytes = text.as_bytes();
+    assert!(bytes[READ_BUFFER - 1] == b'\r' && bytes[READ_BUFFER].is_ascii_digit());
+    assert_eq!(&bytes[2 * READ_BUFFER - 1..][..2], "\u{b5}".as_bytes());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("long.csv");
+    std::fs::write(&path, &text).unwrap();
+    let streamed = read_measurement_csv(&path).unwrap();
+    let parsed = parse_measurement_csv(&path, text.as_bytes()).unwrap();
+    assert_eq!(streamed, parsed);
+    let lines = text.split(['\r', '\n']).filter(|l| !l.is_empty()).count();
+    assert_eq!(streamed.points.len(), lines - 4);
+    let last = text.trim_end().rfind('\n').unwrap() + 1;
+    let wrong = format!("{}1,1,-1\n", &text[..last]);
+    std::fs::write(&path, &wrong).unwrap();
+    let refused = read_measurement_csv(&path).unwrap_err();
+    assert_eq!(
+        refused,
+        parse_measurement_csv(&path, wrong.as_bytes()).unwrap_err()
+    );
+    assert_eq!(
+        (refused.line, refused.column),
+        (streamed.points.last().unwrap().line, 5)
+    );
+}

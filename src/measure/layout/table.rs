@@ -10,13 +10,13 @@ use sha2::{Digest, Sha256};
 use super::basis::{mixed_with, xyxy_to_psps};
 use super::uncertainty::apply_uncertainty_model;
 use super::{AngleUnit, Layout, MuellerBasis, SpecularAzimuth};
-use crate::measure::csv_reader::{element_value_refusal, wavelength_refusal};
 use crate::measure::error::{MeasureError, MeasureErrorKind, Refusal};
 use crate::measure::metadata::{split_metadata_line, HeaderWavelength, Metadata};
 use crate::measure::table_file::{
     check_width, decode_utf8, fields_of, hex, material_of, parse_number, row_wavelength,
     table_lines, FileFacts, WavelengthGroups,
 };
+use crate::measure::table_file::{element_value_refusal, wavelength_refusal};
 use crate::measure::units::{check_degrees, AngleReading};
 use crate::measure::{MeasurementRow, MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::pbrdf::{fold_signed_zenith, signed_zenith_note};
