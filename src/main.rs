@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    cli::allocator::return_large_blocks_when_freed();
     let cli = Cli::parse();
     // One interrupt handler for every command that writes (validate, report, figure, scene
     // init as well as fit, render, thermal and demo): it removes what the library staged.

@@ -9,6 +9,7 @@ macro_rules! say {
     };
 }
 
+pub mod allocator;
 pub mod args;
 pub mod demo;
 pub mod fit_summary;
