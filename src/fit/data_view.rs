@@ -211,7 +211,10 @@ mod tests {
             (0..d.points())
                 .map(|p| {
                     let g = &d.whole.geometry[d.whole_point(p)];
-                    (d.zenith(g.incident_zenith), d.zenith(g.scattered_zenith))
+                    (
+                        d.zenith(g.incident_zenith()),
+                        d.zenith(g.scattered_zenith()),
+                    )
                 })
                 .collect::<Vec<_>>()
         };
