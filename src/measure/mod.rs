@@ -61,7 +61,8 @@ pub use reading::{
 pub use realizability::{unrealizable_rows, Realizability};
 pub use rows::{MeasurementRow, MeasurementRows, Rows};
 pub use selection::{RowSelection, SelectionError, THETA_I_TOLERANCE_DEG};
-pub(crate) use table_file::hex;
+pub(crate) use streaming::file_sha256;
+pub(crate) use table_file::{hex, read_bytes};
 pub use units::{is_angle_note, AngleReading};
 
 /// Largest |Mueller element| and uncertainty a measurement file may hold (sr⁻¹): far above the

@@ -193,6 +193,15 @@ pub(crate) fn scan_file(path: &Path) -> Result<TableScan, MeasureError> {
     scan_table(open_table(path)?).map_err(|r| r.in_file(path))
 }
 
+/// Hex SHA-256 of the bytes of the file at `path`, read as a stream (the check of a fit's
+/// source against its record, which needs no more of the file).
+pub(crate) fn file_sha256(path: &Path) -> Result<String, MeasureError> {
+    let fingerprint = Digesting::new(open_table(path)?).finish();
+    Ok(hex(&fingerprint
+        .map_err(|e| unreadable(e).in_file(path))?
+        .sha256))
+}
+
 /// The outcome of a second pass over `lines` that began where the first did: `parsed` unless
 /// the bytes (read to their end) differ from those `first` fingerprinted.
 pub(crate) fn same_file<R: BufRead, T>(

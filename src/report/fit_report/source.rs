@@ -6,7 +6,7 @@ use super::write_fit_report;
 use crate::fit::FitError;
 use crate::material::{FitRecord, Material};
 use crate::measure::{
-    hex, merge_repeat_measurements, parse_measurement_csv, Layout, MeasureError, MeasureErrorKind,
+    file_sha256, hex, merge_repeat_measurements, parse_measurement_csv, read_bytes, Layout,
     MeasurementSet, ReadOptions, SourceData, LAYOUT_KEY,
 };
 use sha2::{Digest, Sha256};
@@ -191,21 +191,13 @@ fn verified_file(
     let candidates = source_candidates(material_path, source);
     let mut first_changed = None;
     for csv in candidates.iter().filter(|p| p.is_file()) {
-        let unreadable = |e: std::io::Error| MeasureError {
-            file: csv.clone(),
-            line: 1,
-            column: 1,
-            kind: MeasureErrorKind::Unreadable {
-                reason: e.to_string(),
-            },
-        };
         let recorded_bytes = |sha256: String| sha256.eq_ignore_ascii_case(recorded_sha256.trim());
         // The verdict on the very bytes needs only their hash: `irpol fit` asks it of a file it
         // has just parsed, and must not hold a second copy of it (83 MB for a 2e5-row scan).
-        if wanted == Wanted::Verdict && recorded_bytes(file_sha256(csv).map_err(unreadable)?) {
+        if wanted == Wanted::Verdict && recorded_bytes(file_sha256(csv)?) {
             return Ok(Vec::new());
         }
-        let bytes = std::fs::read(csv).map_err(unreadable)?;
+        let bytes = read_bytes(csv)?;
         let same_bytes = recorded_bytes(hex(&Sha256::digest(&bytes)));
         let error = match (recorded_data, same_bytes) {
             (_, true) => return parse(csv, &bytes),
@@ -248,13 +240,6 @@ fn verified_file(
             .collect::<Vec<_>>()
             .join(", "),
     }))
-}
-
-/// Lower-case hex SHA-256 of the file at `path`, read in pieces rather than whole.
-fn file_sha256(path: &Path) -> std::io::Result<String> {
-    let mut hasher = Sha256::new();
-    std::io::copy(&mut std::fs::File::open(path)?, &mut hasher)?;
-    Ok(hex(&hasher.finalize()))
 }
 
 #[cfg(test)]
