@@ -12,10 +12,17 @@
 //! parameters whose score is within one standard error of the best (the one-standard-error rule:
 //! data made by §1.3's model come back as §1.3's model), or the lowest AIC without folds. Both
 //! are reported side by side.
+//!
+//! A set of more than [`CHOICE_POINTS`] points is compared on every n-th of its points (at most
+//! that many) and the kept terms are then fitted to every point, exactly as a fit of those terms
+//! alone: ranking a few candidates needs the surface's shape, which 50 000 points of a dense scan
+//! show as well as a million, while the losing candidates' fits and every fold's refit were most
+//! of a dense fit's time. What the fit writes (parameters, χ², uncertainties) is the fit of
+//! every point; the printed table says the scores are the subsample's.
 
 use super::admissible::{why_inadmissible, why_inadmissible_where};
 use super::data::MeasurementData;
-use super::data_view::PointSubset;
+use super::data_view::{DataView, PointSubset};
 use super::levenberg_marquardt::LevenbergMarquardtSettings;
 use super::model_fit::{fit_model, model_space, ModelFit};
 use super::objective::Objective;
@@ -48,6 +55,76 @@ pub const DEFAULT_FOLDS: usize = 5;
 /// Fewest rows per fold for the default choice to cross-validate; a smaller set is compared by
 /// AIC (docs/design.md §1.10).
 pub const MIN_ROWS_PER_FOLD: usize = 10;
+
+/// Most points the choice of terms compares its candidates on (module docs).
+pub const CHOICE_POINTS: usize = 50_000;
+
+/// Every how many points the choice of terms of a set of `points` points uses: 1 up to
+/// [`CHOICE_POINTS`].
+fn choice_stride(points: usize) -> usize {
+    points.div_ceil(CHOICE_POINTS).max(1)
+}
+
+/// The points the candidates are compared on: all of a set's prepared data, or every n-th
+/// point of a dense one ([`choice_stride`]) with the whole data's standard deviations.
+struct ChoicePoints<'a> {
+    whole: &'a MeasurementData,
+    sample: Option<MeasurementData>,
+    stride: usize,
+}
+
+impl<'a> ChoicePoints<'a> {
+    fn of(whole: &'a MeasurementData) -> ChoicePoints<'a> {
+        let stride = choice_stride(whole.points());
+        let sample = (stride > 1).then(|| DataView::from(whole).every_nth(stride));
+        ChoicePoints {
+            whole,
+            sample,
+            stride,
+        }
+    }
+
+    fn data(&self) -> &MeasurementData {
+        self.sample.as_ref().unwrap_or(self.whole)
+    }
+
+    /// The position in the whole data of point `point` of [`ChoicePoints::data`].
+    fn whole_point(&self, point: usize) -> usize {
+        point * self.stride
+    }
+
+    /// The options a candidate is compared with: `options`, with the stopping rule of a fold's
+    /// refit (a score good to 1e-6) when the comparison takes a subsample, whose fits are
+    /// thrown away (the kept terms are fitted anew to every point with `options` themselves).
+    fn comparison_options(&self, options: &FitOptions) -> FitOptions {
+        let mut options = options.clone();
+        if self.sample.is_some() {
+            options.settings.levenberg_marquardt.relative_tolerance = FOLD_REFIT.relative_tolerance;
+        }
+        options
+    }
+
+    /// (points compared, points of the set), when the comparison took a subsample.
+    fn sampled(&self) -> Option<(usize, usize)> {
+        let sample = self.sample.as_ref()?;
+        Some((sample.points(), self.whole.points()))
+    }
+
+    /// The kept candidate's fits of every point: those of the comparison when it compared every
+    /// point, else the kept terms fitted anew to the whole data ([`fit_distributions`], the
+    /// fit of those terms alone).
+    fn whole_data_fits(
+        &self,
+        set: &MeasurementSet,
+        options: &FitOptions,
+        compared: Fitted,
+    ) -> Result<Fitted, FitError> {
+        match self.sample {
+            None => Ok(compared),
+            Some(_) => fit_distributions(set, self.whole, options),
+        }
+    }
+}
 
 /// Fits one grey measurement as `options` ask: its `terms` alone, or choosing among
 /// `term_candidates` (by cross-validation with `cv_folds`, else by AIC).
@@ -121,42 +198,57 @@ fn choosing_terms(
     folds: Option<usize>,
 ) -> Result<(FitOutcome, TermsChoice), FitError> {
     let data = MeasurementData::new(&set)?;
+    let points = ChoicePoints::of(&data);
     let mut fitted = Vec::new();
     let mut scores = Vec::new();
     for &terms in candidates {
-        let options = options.with_terms(terms);
-        let (fit, score) = score_terms(&set, &data, &options, folds)?;
+        let options = points.comparison_options(&options.with_terms(terms));
+        let (fit, score) = score_terms(&set, &points, &options, folds)?;
         fitted.push(fit);
         scores.push(score);
     }
     let chosen = TermsChoice::choose(&scores, folds.is_some());
     let options = options.with_terms(candidates[chosen]);
-    let outcome = finish(set, data, &options, fitted.swap_remove(chosen))?;
-    Ok((
-        outcome,
-        TermsChoice {
-            scores,
-            chosen,
-            folds,
-        },
-    ))
+    let kept = points.whole_data_fits(&set, &options, fitted.swap_remove(chosen))?;
+    let sampled = points.sampled();
+    drop(points);
+    if sampled.is_some() {
+        // The verdict on the model written is that of every point.
+        let first_unrealizable = kept
+            .chosen
+            .first_unrealizable_point(&set, &data, &options)?;
+        scores[chosen].inadmissible =
+            why_inadmissible_where(&[&kept.chosen.model], |_| first_unrealizable);
+    }
+    let mut outcome = finish(set, data, &options, kept)?;
+    let choice = TermsChoice {
+        scores,
+        chosen,
+        folds,
+        sampled,
+    };
+    choice.note_sample(&mut outcome.material);
+    Ok((outcome, choice))
 }
 
 /// One candidate's fits (`options.terms`) and scores: χ², AIC, the folds' held-out residuals
 /// when `folds` are asked for, and whether the model is admissible.
-pub(super) fn score_terms(
+fn score_terms(
     set: &MeasurementSet,
-    data: &MeasurementData,
+    points: &ChoicePoints,
     options: &FitOptions,
     folds: Option<usize>,
 ) -> Result<(Fitted, TermsScore), FitError> {
+    let data = points.data();
     let fitted = fit_distributions(set, data, options)?;
     let fit = &fitted.chosen;
     let folds = match folds {
         Some(k) => cross_validate(set, data, options, fit, k)?,
         None => Vec::new(),
     };
-    let first_unrealizable = fit.first_unrealizable_point(set, data, options)?;
+    let first_unrealizable = fit
+        .first_unrealizable_point(set, data, options)?
+        .map(|point| points.whole_point(point));
     let score = TermsScore {
         terms: options.terms,
         distribution: fit.distribution,
@@ -188,20 +280,21 @@ pub(super) fn choose_spectral_terms(
         .iter()
         .map(MeasurementData::new)
         .collect::<Result<Vec<_>, _>>()?;
+    let points: Vec<ChoicePoints> = data.iter().map(ChoicePoints::of).collect();
     let mut scores = Vec::new();
     let mut fits = Vec::new();
     for terms in candidates(options) {
         let options = options.with_terms(terms);
         let parts = sets
             .iter()
-            .zip(&data)
-            .map(|(set, data)| score_terms(set, data, &options, folds))
+            .zip(&points)
+            .map(|(set, points)| score_terms(set, points, &options, folds))
             .collect::<Result<Vec<_>, _>>()?;
         let models: Vec<_> = parts.iter().map(|p| &p.0.chosen.model).collect();
         let muellers = parts
             .iter()
-            .zip(sets.iter().zip(&data))
-            .map(|(p, (set, data))| p.0.chosen.model_muellers(set, data, &options))
+            .zip(sets.iter().zip(&points))
+            .map(|(p, (set, points))| p.0.chosen.model_muellers(set, points.data(), &options))
             .collect::<Result<Vec<_>, _>>()?;
         let muellers: Vec<_> = muellers.iter().map(Vec::as_slice).collect();
         let inadmissible = why_inadmissible(&models, &muellers);
@@ -210,12 +303,18 @@ pub(super) fn choose_spectral_terms(
         fits.push(fitted);
     }
     let chosen = TermsChoice::choose(&scores, folds.is_some());
+    let kept_options = options.with_terms(scores[chosen].terms);
+    let kept = fits
+        .swap_remove(chosen)
+        .into_iter()
+        .zip(sets.iter().zip(&points))
+        .map(|(fitted, (set, points))| points.whole_data_fits(set, &kept_options, fitted))
+        .collect::<Result<Vec<_>, _>>()?;
     let by_distribution = options
         .distributions()
         .into_iter()
         .map(|kind| {
-            fits[chosen]
-                .iter()
+            kept.iter()
                 .map(|f| match &f.alternative {
                     Some(other) if other.distribution == kind => other.clone(),
                     _ => f.chosen.clone(),
@@ -223,10 +322,29 @@ pub(super) fn choose_spectral_terms(
                 .collect()
         })
         .collect();
+    let sampled = points
+        .iter()
+        .map(|p| {
+            p.sampled()
+                .unwrap_or((p.data().points(), p.data().points()))
+        })
+        .reduce(|a, b| (a.0 + b.0, a.1 + b.1))
+        .filter(|(compared, all)| compared < all);
+    if sampled.is_some() {
+        // The verdict on the models written is that of every point of every wavelength.
+        let first_unrealizable = kept
+            .iter()
+            .zip(sets.iter().zip(&data))
+            .map(|(f, (set, data))| f.chosen.first_unrealizable_point(set, data, &kept_options))
+            .collect::<Result<Vec<_>, _>>()?;
+        let models: Vec<_> = kept.iter().map(|f| &f.chosen.model).collect();
+        scores[chosen].inadmissible = why_inadmissible_where(&models, |j| first_unrealizable[j]);
+    }
     let choice = TermsChoice {
         scores,
         chosen,
         folds,
+        sampled,
     };
     Ok((choice, by_distribution))
 }
@@ -271,8 +389,8 @@ fn cross_validate(
     };
     options.settings.levenberg_marquardt = FOLD_REFIT;
     let mut folds = Vec::with_capacity(k);
-    for held_out in fold_rows(set.points.len(), k, options.seed) {
-        let training: Vec<usize> = (0..set.points.len())
+    for held_out in fold_rows(data.points(), k, options.seed) {
+        let training: Vec<usize> = (0..data.points())
             .filter(|r| held_out.binary_search(r).is_err())
             .collect();
         // The fold's rows read in place from the prepared data; errors name the file.

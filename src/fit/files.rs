@@ -172,6 +172,7 @@ fn fit_spectral_choosing_terms(
     let (choice, alone) = super::cross_validation::choose_spectral_terms(&sets, options)?;
     let options = options.with_terms(choice.scores[choice.chosen].terms);
     let mut outcome = fit_spectral_from(sets, &options, options.dispersion, Some(alone))?;
+    choice.note_sample(&mut outcome.material);
     outcome.terms_choice = Some(choice);
     Ok(outcome)
 }

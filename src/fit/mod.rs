@@ -46,8 +46,8 @@ mod validation;
 pub use admissible::{why_inadmissible, STRONG_ABSORPTION_K};
 pub use comparison::{aic, bic, Candidate, ModelComparison};
 pub use cross_validation::{
-    fit_choosing_terms, fit_grey, fold_rows, subset, TermsChoice, TermsScore, DEFAULT_FOLDS,
-    MAX_FOLDS,
+    fit_choosing_terms, fit_grey, fold_rows, subset, TermsChoice, TermsScore, CHOICE_POINTS,
+    DEFAULT_FOLDS, MAX_FOLDS,
 };
 pub use data::{
     observation_sigmas, ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR,

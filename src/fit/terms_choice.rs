@@ -70,6 +70,9 @@ pub struct TermsChoice {
     pub chosen: usize,
     /// K, when the choice was made by K-fold cross-validation.
     pub folds: Option<usize>,
+    /// (rows compared, rows measured) when the candidates were compared on every n-th row of a
+    /// dense set and the kept terms then fitted to every row ([`super::cross_validation`]).
+    pub sampled: Option<(usize, usize)>,
 }
 
 impl TermsChoice {
@@ -118,12 +121,36 @@ impl TermsChoice {
         } else {
             "no set is admissible: kept the best of all, which is not physical"
         };
-        match self.folds {
+        let rule = match self.folds {
             Some(k) => format!(
                 "  kept: the fewest parameters whose {k}-fold CV score is within one standard \
                  error of the best, {among}"
             ),
             None => format!("  kept: the lowest AIC, {among}"),
+        };
+        match self.sample_clause() {
+            Some(clause) => format!("{rule}\n  {clause}"),
+            None => rule,
+        }
+    }
+
+    /// How the candidates' rows were sampled, when they were.
+    fn sample_clause(&self) -> Option<String> {
+        let (compared, measured) = self.sampled?;
+        Some(format!(
+            "scores from every n-th row, {compared} of the {measured} rows; the kept terms then \
+             fitted to every row"
+        ))
+    }
+
+    /// Adds to `material`'s fit settings that its terms were chosen on a subsample of its rows,
+    /// when they were: the record says how the fit was made.
+    pub(super) fn note_sample(&self, material: &mut crate::material::Material) {
+        let (Some(clause), Some(record)) = (self.sample_clause(), material.fit.as_mut()) else {
+            return;
+        };
+        if let Some(setting) = record.settings.get_mut("terms_choice") {
+            setting.push_str(&format!("; {clause}"));
         }
     }
 

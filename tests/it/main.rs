@@ -13,6 +13,7 @@ mod atmosphere_table;
 mod cli;
 mod docs_examples;
 mod dofp_demosaic;
+mod fit_dense_choice;
 mod fit_files;
 mod fit_quality;
 mod fit_shipped;
