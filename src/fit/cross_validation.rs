@@ -288,7 +288,9 @@ pub(super) fn choose_spectral_terms(
         let parts = sets
             .iter()
             .zip(&points)
-            .map(|(set, points)| score_terms(set, points, &options, folds))
+            .map(|(set, points)| {
+                score_terms(set, points, &points.comparison_options(&options), folds)
+            })
             .collect::<Result<Vec<_>, _>>()?;
         let models: Vec<_> = parts.iter().map(|p| &p.0.chosen.model).collect();
         let muellers = parts
