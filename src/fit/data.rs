@@ -1,9 +1,7 @@
 //! A measurement prepared for fast repeated model evaluation: the model-independent scattering
 //! geometry of every point built once, the per-direction shadowing factors shared between points
 //! with the same zenith angle, and one standard deviation per observation (the weights of the
-//! least-squares objective), read from the set's own blocks of values and uncertainties rather
-//! than copied: 1/σ costs a division per observation, a copy 8 B per observation (72 MB a
-//! million rows of 9 elements).
+//! least-squares objective).
 
 use crate::measure::{MeasurementRow, MeasurementSet, MUELLER_ELEMENT_NAMES};
 use crate::pbrdf::{Direction, ScatteringGeometry};
@@ -64,16 +62,8 @@ pub struct MeasurementData {
     /// whole set, the set's own values block ([`crate::measure::MeasurementRows::shared_values`]),
     /// not a copy.
     pub(crate) values: Arc<Vec<f64>>,
-    /// The uncertainties of the elements with a `u_` column, point-major (`point * slots +
-    /// slot`): the set's own block ([`crate::measure::MeasurementRows::shared_uncertainties`]).
-    uncertainties: Arc<Vec<f64>>,
-    /// Each element's position among a point's uncertainties; `None`: the default noise model.
-    uncertainty_slots: Vec<Option<usize>>,
-    /// Uncertainties per point: the elements with a slot.
-    slots_per_point: usize,
-    /// The default noise model's floor: from the largest m00 of the set, or for a subsample that
-    /// of the data it was taken from ([`MeasurementData::with_points`]).
-    default_floor: f64,
+    /// 1 / standard deviation, aligned with `values`.
+    pub(crate) inverse_sigma: Vec<f64>,
     error_sources: Vec<ErrorSource>,
 }
 
@@ -81,17 +71,20 @@ impl MeasurementData {
     /// The set's data prepared, after checking every row; the values are the set's own block,
     /// shared, so the prepared data adds only the geometry and 1/σ.
     pub fn new(set: &MeasurementSet) -> Result<MeasurementData, FitError> {
+        let width = set.elements.len();
         let mut geometry = Vec::with_capacity(set.points.len());
-        let (zeniths, default_floor) = visit_observations(set, |g| geometry.push(g), |_, _| {})?;
+        let mut inverse_sigma = Vec::with_capacity(set.points.len() * width);
+        let zeniths = visit_observations(
+            set,
+            |g| geometry.push(g),
+            |_, sigma| inverse_sigma.push(1.0 / sigma),
+        )?;
         Ok(MeasurementData {
             geometry,
             zenith_cosines: zeniths.cosines,
             elements: set.elements.iter().map(|&e| (e / 4, e % 4)).collect(),
             values: set.points.shared_values(),
-            uncertainties: set.points.shared_uncertainties(),
-            uncertainty_slots: set.points.uncertainty_slots().to_vec(),
-            slots_per_point: set.points.uncertainty_slots().iter().flatten().count(),
-            default_floor,
+            inverse_sigma,
             error_sources: error_sources(set),
         })
     }
@@ -121,54 +114,26 @@ impl MeasurementData {
     pub fn error_sources(&self) -> &[ErrorSource] {
         &self.error_sources
     }
-    /// Measured value and standard deviation of observation `index` (point-major), the
-    /// standard deviation as the fit weighs it, 1/(1/σ).
+    /// Measured value and standard deviation of observation `index` (point-major).
     pub fn observation(&self, index: usize) -> (f64, f64) {
-        let width = self.elements.len();
-        let (point, element) = (index / width, index % width);
-        (
-            self.values[index],
-            1.0 / self.inverse_sigma(point, element, self.default_floor),
-        )
+        (self.values[index], 1.0 / self.inverse_sigma[index])
     }
 
-    /// 1/σ of element `element` of point `point`: its `u_` column's, or the default noise
-    /// model's with the floor `default_floor` (the data's own, or a subset's,
-    /// [`super::data_view::DataView::inverse_sigma`]).
-    #[inline]
-    pub(super) fn inverse_sigma(&self, point: usize, element: usize, default_floor: f64) -> f64 {
-        let sigma = match self.uncertainty_slots[element] {
-            Some(slot) => self.uncertainties[point * self.slots_per_point + slot],
-            None => default_sigma(
-                element,
-                self.values[point * self.elements.len()],
-                default_floor,
-            ),
-        };
-        1.0 / sigma
-    }
-
-    /// The default noise model's floor of these data.
-    pub(super) fn default_floor(&self) -> f64 {
-        self.default_floor
-    }
-
-    /// The points `points` (`count` of them, ascending), their values and uncertainties copied,
-    /// weighed by the default noise model with `default_floor` (that of the data they are
-    /// taken from), and the zenith list of those points only (a subsample,
+    /// The points `points` (`count` of them, ascending) with the reciprocal standard deviation
+    /// `inverse_sigma(start, element)` of each element of the point whose first observation is
+    /// `start`, and the zenith list of those points only (a subsample,
     /// [`super::data_view::DataView::every_nth`]).
     pub(super) fn with_points(
         &self,
         points: impl Iterator<Item = usize>,
         count: usize,
-        default_floor: f64,
+        inverse_sigma: impl Fn(usize, usize) -> f64,
     ) -> MeasurementData {
         let width = self.elements.len();
-        let slots = self.slots_per_point;
         let mut zeniths = DistinctCosines::default();
         let mut geometry = Vec::with_capacity(count);
         let mut values = Vec::with_capacity(count * width);
-        let mut uncertainties = Vec::with_capacity(count * slots);
+        let mut inverse_sigmas = Vec::with_capacity(count * width);
         for point in points {
             let g = &self.geometry[point];
             geometry.push(PreparedGeometry {
@@ -176,19 +141,16 @@ impl MeasurementData {
                 incident_zenith: zeniths.index(self.zenith_cosines[g.incident_zenith()]),
                 scattered_zenith: zeniths.index(self.zenith_cosines[g.scattered_zenith()]),
             });
-            values.extend_from_slice(&self.values[point * width..(point + 1) * width]);
-            uncertainties
-                .extend_from_slice(&self.uncertainties[point * slots..(point + 1) * slots]);
+            let start = point * width;
+            values.extend_from_slice(&self.values[start..start + width]);
+            inverse_sigmas.extend((0..width).map(|element| inverse_sigma(start, element)));
         }
         MeasurementData {
             geometry,
             zenith_cosines: zeniths.cosines,
             elements: self.elements.clone(),
             values: Arc::new(values),
-            uncertainties: Arc::new(uncertainties),
-            uncertainty_slots: self.uncertainty_slots.clone(),
-            slots_per_point: slots,
-            default_floor,
+            inverse_sigma: inverse_sigmas,
             error_sources: self.error_sources.clone(),
         }
     }
@@ -206,12 +168,12 @@ pub fn observation_sigmas(set: &MeasurementSet) -> Result<Vec<f64>, FitError> {
 
 /// Checks every point of `set` and hands its prepared geometry to `geometry` and each of its
 /// observations, value and standard deviation, to `observation`; returns the distinct zenith
-/// cosines the geometries index and the default noise model's floor.
+/// cosines the geometries index.
 fn visit_observations(
     set: &MeasurementSet,
     mut geometry: impl FnMut(PreparedGeometry),
     mut observation: impl FnMut(f64, f64),
-) -> Result<(DistinctCosines, f64), FitError> {
+) -> Result<DistinctCosines, FitError> {
     check_elements(set)?;
     let m00_max = set.points.iter().map(|p| p.values[0]).fold(0.0, f64::max);
     let floor = default_floor(m00_max);
@@ -233,7 +195,7 @@ fn visit_observations(
             observation(value, sigma);
         }
     }
-    Ok((zeniths, floor))
+    Ok(zeniths)
 }
 
 /// The default noise model's standard deviation of element `column` (0: m00) of a point whose

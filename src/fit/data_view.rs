@@ -3,7 +3,7 @@
 //! a dense scan is most of the file, and a copy of its prepared points (geometry, values and
 //! 1/σ, 224 B a row of a 9-element file) was the largest thing the choice of terms held.
 
-use super::data::{default_floor, MeasurementData};
+use super::data::{default_floor, default_sigma, ErrorSource, MeasurementData};
 
 /// Some points of a [`MeasurementData`] as [`MeasurementData::new`] prepares a set of those
 /// rows alone, without copying them: the same points in the same order, their own zenith list
@@ -113,30 +113,28 @@ impl DataView<'_> {
         self.subset
             .map_or(zenith, |s| s.zenith_slots[zenith] as usize)
     }
-    /// 1/σ of element `element` of point `point` of the whole data: the file's, or the
-    /// default noise model's with the floor of the points viewed (the subset's own, as
-    /// [`MeasurementData::new`] of its rows alone would give it).
+    /// 1/σ of element `element` of the point whose first observation in the whole data is
+    /// `start`: the whole data's, or for an element of the default noise model the subset's
+    /// own, 1/σ with the subset's floor, computed as [`MeasurementData::new`] computes it.
     #[inline]
-    pub fn inverse_sigma(&self, point: usize, element: usize) -> f64 {
-        self.whole
-            .inverse_sigma(point, element, self.default_floor())
-    }
-
-    /// The default noise model's floor of the points viewed.
-    #[inline]
-    fn default_floor(&self) -> f64 {
-        self.subset
-            .map_or(self.whole.default_floor(), |s| s.default_floor)
+    pub fn inverse_sigma(&self, start: usize, element: usize) -> f64 {
+        match self.subset {
+            Some(s) if self.whole.error_sources()[element] == ErrorSource::DefaultModel => {
+                1.0 / default_sigma(element, self.whole.values[start], s.default_floor)
+            }
+            _ => self.whole.inverse_sigma[start + element],
+        }
     }
 
     /// Measured value and standard deviation of observation `index` (point-major), as
     /// [`MeasurementData::observation`] gives them.
     pub fn observation(&self, index: usize) -> (f64, f64) {
         let width = self.element_count();
-        let (point, element) = (self.whole_point(index / width), index % width);
+        let start = self.whole_point(index / width) * width;
+        let element = index % width;
         (
-            self.whole.values[point * width + element],
-            1.0 / self.inverse_sigma(point, element),
+            self.whole.values[start + element],
+            1.0 / self.inverse_sigma(start, element),
         )
     }
 
@@ -148,7 +146,9 @@ impl DataView<'_> {
         let points = (0..self.points())
             .step_by(stride)
             .map(|p| self.whole_point(p));
-        self.whole.with_points(points, count, self.default_floor())
+        self.whole.with_points(points, count, |start, element| {
+            self.inverse_sigma(start, element)
+        })
     }
 }
 

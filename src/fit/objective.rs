@@ -115,7 +115,7 @@ impl<'a> Objective<'a> {
             visit(
                 offset,
                 (m[(row, column)] - whole.values[start + offset])
-                    * self.data.inverse_sigma(at, offset),
+                    * self.data.inverse_sigma(start, offset),
             );
         }
     }

@@ -19,9 +19,8 @@ pub struct MeasurementRows {
     values: Arc<Vec<f64>>,
     /// Each element's position among a row's uncertainties, `None` for an element without one.
     uncertainty_slots: Vec<Option<usize>>,
-    /// Uncertainties of the elements with a slot, point-major (`row * slots + slot`), shared
-    /// with the fit.
-    uncertainties: Arc<Vec<f64>>,
+    /// Uncertainties of the elements with a slot, point-major (`row * slots + slot`).
+    uncertainties: Vec<f64>,
     /// 1-based line of each row in its file.
     lines: Vec<u64>,
 }
@@ -100,7 +99,7 @@ impl MeasurementRows {
             angles: Vec::with_capacity(capacity),
             values: Arc::new(Vec::with_capacity(capacity * width)),
             uncertainty_slots,
-            uncertainties: Arc::new(Vec::with_capacity(capacity * count)),
+            uncertainties: Vec::with_capacity(capacity * count),
             lines: Vec::with_capacity(capacity),
         }
     }
@@ -140,7 +139,7 @@ impl MeasurementRows {
         }
         self.angles.push(angles);
         Arc::make_mut(&mut self.values).extend_from_slice(values);
-        Arc::make_mut(&mut self.uncertainties).extend(uncertainties.iter().flatten());
+        self.uncertainties.extend(uncertainties.iter().flatten());
         self.lines.push(line);
     }
 
@@ -234,17 +233,6 @@ impl MeasurementRows {
         &self.uncertainties
     }
 
-    /// The uncertainties block itself ([`MeasurementRows::shared_values`]).
-    pub fn shared_uncertainties(&self) -> Arc<Vec<f64>> {
-        Arc::clone(&self.uncertainties)
-    }
-
-    /// Each element's position among a row's uncertainties ([`MeasurementRows::uncertainty_block`]),
-    /// `None` for an element without one.
-    pub fn uncertainty_slots(&self) -> &[Option<usize>] {
-        &self.uncertainty_slots
-    }
-
     /// Every row's file line.
     pub fn lines(&self) -> &[u64] {
         &self.lines
@@ -278,7 +266,7 @@ impl MeasurementRows {
         );
         self.angles.extend_from_slice(&other.angles);
         Arc::make_mut(&mut self.values).extend_from_slice(&other.values);
-        Arc::make_mut(&mut self.uncertainties).extend_from_slice(&other.uncertainties);
+        self.uncertainties.extend_from_slice(&other.uncertainties);
         self.lines.extend_from_slice(&other.lines);
     }
 
@@ -295,21 +283,21 @@ impl MeasurementRows {
             block.extend(row_sigma);
         }
         self.uncertainty_slots = (0..width).map(Some).collect();
-        self.uncertainties = Arc::new(block);
+        self.uncertainties = block;
     }
 
     /// Frees capacity beyond the rows held (after a reader reserved for more).
     pub(crate) fn shrink_to_fit(&mut self) {
         self.angles.shrink_to_fit();
         Arc::make_mut(&mut self.values).shrink_to_fit();
-        Arc::make_mut(&mut self.uncertainties).shrink_to_fit();
+        self.uncertainties.shrink_to_fit();
         self.lines.shrink_to_fit();
     }
 
     fn push_row(&mut self, row: MeasurementRow<'_>) {
         self.angles.push(row.angles());
         Arc::make_mut(&mut self.values).extend_from_slice(row.values);
-        Arc::make_mut(&mut self.uncertainties).extend_from_slice(row.uncertainties);
+        self.uncertainties.extend_from_slice(row.uncertainties);
         self.lines.push(row.line);
     }
 
