@@ -4,6 +4,7 @@
 use super::comparison::ModelComparison;
 use super::data::{ErrorSource, MeasurementData, DEFAULT_M00_RELATIVE_ERROR};
 use super::model_fit::{fit_model, ModelFit};
+use super::optimize::COARSE_POINTS;
 use super::options::FitOptions;
 use super::stages::Stage;
 use super::FitError;
@@ -84,11 +85,17 @@ pub(super) fn fit_distributions(
     options: &FitOptions,
 ) -> Result<Fitted, FitError> {
     use rayon::prelude::*;
-    let mut fits = options
-        .distributions()
-        .into_par_iter()
-        .map(|kind| fit_model(set, data.into(), kind, options))
-        .collect::<Vec<_>>()
+    let fit = |kind| fit_model(set, data.into(), kind, options);
+    let kinds = options.distributions();
+    // A dense set's laws are fitted one after the other: each evaluation already runs in
+    // parallel over blocks of points, and two fits at once would hold two residual vectors
+    // (72 MB each a million rows of 9 elements).
+    let fits = if data.points() > COARSE_POINTS {
+        kinds.into_iter().map(fit).collect::<Vec<_>>()
+    } else {
+        kinds.into_par_iter().map(fit).collect::<Vec<_>>()
+    };
+    let mut fits = fits
         .into_iter()
         .collect::<Result<Vec<ModelFit>, FitError>>()?;
     let candidates: Vec<_> = fits.iter().map(ModelFit::candidate).collect();
