@@ -12,7 +12,12 @@ use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
 use super::super::ReportError;
 
 mod points;
+mod residuals;
 use points::{add_drawn, point_views};
+pub use residuals::{
+    Residual, ResidualDensity, ResidualSummary, BIN_WIDTH, DENSITY_X_DEG, DENSITY_Y_SIGMA,
+    HISTOGRAM_LIMIT,
+};
 
 /// Two angles are the same goniometer setting when they agree to a microdegree.
 const SAME_ANGLE_DEG: f64 = 1e-6;
@@ -80,16 +85,6 @@ pub struct Ring {
     pub sweep: ModelSweep,
 }
 
-/// One normalized residual (data − model)/σ, both in the measured row's own psps frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Residual {
-    /// θ_r signed by hemisphere: + when the detector is on the forward (specular) half,
-    /// 90° ≤ φ_r − φ_i ≤ 270°. Equals the point's signed zenith in the plane.
-    pub forward_zenith: f64,
-    pub element: usize,
-    pub value: f64,
-}
-
 /// ε0 and ε1 against emission angle for the chosen and the competing model.
 #[derive(Clone, Debug)]
 pub struct EmissivityCurves {
@@ -119,7 +114,8 @@ pub struct ReportData {
     /// the plane).
     pub in_plane: Vec<Option<ModelSweep>>,
     pub rings: Vec<Ring>,
-    pub residuals: Vec<Residual>,
+    /// The normalized residuals of every measured element, summarized for panels (g) and (h).
+    pub residuals: ResidualSummary,
     pub emissivity: EmissivityCurves,
     pub chosen_label: String,
     pub alternative_label: Option<String>,
@@ -134,7 +130,8 @@ impl ReportData {
         // The standard deviations the fit weighted by (the file's u_ columns or the fit's
         // default noise model), so that report residuals are the ones the optimizer minimized.
         let sigmas = observation_sigmas(set)?;
-        let (mut points, residuals) = point_views(set, &sigmas, &incidences, &chosen)?;
+        let residuals = ResidualSummary::new(set, &sigmas, &chosen)?;
+        let mut points = point_views(set, &incidences);
         let shown = representatives(&incidences, MAX_CURVE_INCIDENCES);
         let mut slot = vec![None; incidences.len()];
         for (position, &incidence) in shown.iter().enumerate() {
@@ -541,7 +538,7 @@ fn emissivity_curves(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::points::normal_detector_turn;
     use super::*;
     use crate::material::{AlternativeFit, ModelSpec};
@@ -564,7 +561,7 @@ mod tests {
         }
     }
 
-    fn material(with_alternative: bool) -> Material {
+    pub(super) fn material(with_alternative: bool) -> Material {
         let model = spec(SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 });
         let fit = with_alternative.then(|| {
             let alternative = AlternativeFit {
@@ -585,7 +582,7 @@ mod tests {
     }
 
     /// A set of m00 and m10 at the given (θ_i, φ_i, θ_r, φ_r), valued by `value(m)`.
-    fn set_of(
+    pub(super) fn set_of(
         geometry: &[(f64, f64, f64, f64)],
         value: impl Fn(&Mueller) -> [f64; 2],
         uncertainties: [Option<f64>; 2],
@@ -682,6 +679,7 @@ mod tests {
         // Two residuals (m00, m10) per point, each at the point's hemisphere-signed θ_r.
         let forward: Vec<f64> = data
             .residuals
+            .each
             .iter()
             .step_by(2)
             .map(|r| r.forward_zenith)
@@ -732,8 +730,8 @@ mod tests {
         let geometry = [(40.0, 0.0, 40.0, 180.0), (40.0, 0.0, 20.0, 0.0)];
         let exact_set = set_of(&geometry, exact, [None, None]);
         let data = ReportData::new(&material(false), &exact_set).unwrap();
-        assert_eq!(data.residuals.len(), 4);
-        assert!(data.residuals.iter().all(|r| r.value.abs() < 1e-12));
+        assert_eq!(data.residuals.count, 4);
+        assert!(data.residuals.each.iter().all(|r| r.value.abs() < 1e-12));
 
         // Without u_ columns: σ(m00) = 3 % and σ(m10) = 1 % of the measured m00 (the fit's noise
         // model), so a reading 3 % high is 1/1.03 σ off.
@@ -743,7 +741,7 @@ mod tests {
             [None, None],
         );
         let data = ReportData::new(&material(false), &shifted).unwrap();
-        let values: Vec<f64> = data.residuals.iter().map(|r| r.value).collect();
+        let values: Vec<f64> = data.residuals.each.iter().map(|r| r.value).collect();
         let (up, down) = (1.0 / 1.03, -2.0 / 1.03);
         for (got, want) in values.iter().zip([up, down, up, down]) {
             assert!((got - want).abs() < 1e-9, "{values:?}");
@@ -755,9 +753,9 @@ mod tests {
             [Some(0.002), Some(1.0)],
         );
         let data = ReportData::new(&material(false), &with_u).unwrap();
-        assert!((data.residuals[0].value - 2.0).abs() < 1e-9);
-        assert_eq!(data.residuals[0].forward_zenith, 40.0);
-        assert_eq!(data.residuals[2].forward_zenith, -20.0);
+        assert!((data.residuals.each[0].value - 2.0).abs() < 1e-9);
+        assert_eq!(data.residuals.each[0].forward_zenith, 40.0);
+        assert_eq!(data.residuals.each[2].forward_zenith, -20.0);
     }
 
     #[test]
@@ -866,8 +864,8 @@ mod tests {
         assert!(raw(1, 4).abs() < 1e-12 * m00 && raw(1, 8).abs() > 0.05 * m00);
         assert!(curve[(2, 0)].abs() < 1e-15 * m00);
         // Residuals stay data − model in the row's own frame: zero for the model's own values.
-        assert!(data.residuals.iter().all(|r| r.value.abs() < 1e-9));
-        assert_eq!(data.residuals.len(), geometry.len() * linear.len());
+        assert!(data.residuals.each.iter().all(|r| r.value.abs() < 1e-9));
+        assert_eq!(data.residuals.count, geometry.len() * linear.len());
     }
 
     #[test]
@@ -900,7 +898,7 @@ mod tests {
         let (series, _) = profile_series(&data, Quantity::M00, Domain::InPlane);
         assert_eq!(series[0].points.len(), 2);
         // Both rows keep their residuals in their own frames.
-        assert_eq!(data.residuals.len(), 4);
+        assert_eq!(data.residuals.count, 4);
     }
 
     #[test]
@@ -914,7 +912,7 @@ mod tests {
         assert!(data.points[0].drawn.is_some());
         assert!(data.points[1].drawn.is_none());
         assert_eq!(data.off_ring_points(), 1);
-        assert_eq!(data.residuals.len(), 4, "every row keeps its residuals");
+        assert_eq!(data.residuals.count, 4, "every row keeps its residuals");
     }
 
     #[test]
