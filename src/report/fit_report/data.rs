@@ -13,7 +13,7 @@ use super::super::ReportError;
 
 mod points;
 mod residuals;
-use points::{add_drawn, point_views};
+use points::{drawn_points, point_views, shown_views};
 pub use residuals::{
     Residual, ResidualDensity, ResidualSummary, BIN_WIDTH, DENSITY_X_DEG, DENSITY_Y_SIGMA,
     HISTOGRAM_LIMIT,
@@ -47,15 +47,13 @@ pub struct PointView {
     pub ring: Option<usize>,
     /// φ_r − φ_i in [0°, 360°).
     pub relative_azimuth: f64,
-    /// What the profile panels draw of a point they show (in the plane of incidence at an angle
-    /// with curves, or on a drawn ring); `None` for the others, which appear only among the
-    /// residuals: a dense scan's rows are mostly such, and these are 0.5 KB a row.
-    pub drawn: Option<Box<DrawnPoint>>,
 }
 
-/// The measured elements and the model of a point the profile panels show.
+/// A point the profile panels show (in the plane of incidence at an angle with curves, or on a
+/// drawn ring): where it lies, its measured elements and the model.
 #[derive(Clone, Debug)]
 pub struct DrawnPoint {
+    pub place: PointView,
     /// The measured elements by Mueller index r*4 + c, in the psps frame the point is drawn in: its
     /// own, except at the normal (θ_r = 0), where they are turned into the in-plane profile's
     /// frame (`points::in_plane_frame_at_normal`); elements that cannot be turned are `None`
@@ -109,7 +107,9 @@ pub struct ReportData {
     pub unshown_ring_points: usize,
     /// Mueller indices present in the measurement, ascending.
     pub elements: Vec<usize>,
-    pub points: Vec<PointView>,
+    /// The points the profile panels show, in the order of the file; the others (most of a
+    /// dense scan's) appear only among the residuals.
+    pub drawn: Vec<DrawnPoint>,
     /// In-plane model sweeps, one per entry of `shown` (`None` when no point of that angle lies in
     /// the plane).
     pub in_plane: Vec<Option<ModelSweep>>,
@@ -127,10 +127,6 @@ impl ReportData {
     pub fn new(material: &Material, set: &MeasurementSet) -> Result<ReportData, ReportError> {
         let (chosen, alternative) = curve_sources(material)?;
         let incidences = distinct_sorted(set.points.iter().map(|p| p.theta_i_deg));
-        // The standard deviations the fit weighted by (the file's u_ columns or the fit's
-        // default noise model), so that report residuals are the ones the optimizer minimized.
-        let sigmas = observation_sigmas(set)?;
-        let residuals = ResidualSummary::new(set, &sigmas, &chosen)?;
         let mut points = point_views(set, &incidences);
         let shown = representatives(&incidences, MAX_CURVE_INCIDENCES);
         let mut slot = vec![None; incidences.len()];
@@ -146,7 +142,14 @@ impl ReportData {
             alternative.as_ref(),
         );
         let in_plane = in_plane_sweeps(&points, &incidences, &shown, &chosen, alternative.as_ref());
-        add_drawn(&mut points, set, &sigmas, &slot, &chosen)?;
+        // Every point's view is freed before the standard deviations (as many as observations)
+        // are taken: the report's peak is one of them, not both.
+        let shown_points = shown_views(points, &slot);
+        // The standard deviations the fit weighted by (the file's u_ columns or the fit's
+        // default noise model), so that report residuals are the ones the optimizer minimized.
+        let sigmas = observation_sigmas(set)?;
+        let residuals = ResidualSummary::new(set, &sigmas, &chosen)?;
+        let drawn = drawn_points(shown_points, set, &sigmas, &chosen)?;
         let emissivity = emissivity_curves(&chosen, alternative.as_ref());
 
         Ok(ReportData {
@@ -156,7 +159,7 @@ impl ReportData {
             raster_points: found.raster_points,
             unshown_ring_points: found.unshown_points,
             elements: set.elements.clone(),
-            points,
+            drawn,
             in_plane,
             rings: found.rings,
             residuals,
@@ -660,20 +663,24 @@ pub(super) mod tests {
         let set = set_of(&geometry, exact, [None, None]);
         let data = ReportData::new(&material(false), &set).unwrap();
         assert_eq!(data.incidences, [20.0, 60.0]);
-        let signed: Vec<Option<f64>> = data.points.iter().map(|p| p.signed_zenith).collect();
+        // The points the profiles show, in the order of the file, with their signed zenith in
+        // the plane and their ring: the plane's three, the ring's three and its in-plane member;
+        // not the raster (58°) nor the lone 20° point, which are only among the residuals.
+        let placed: Vec<(Option<f64>, Option<usize>)> = data
+            .drawn
+            .iter()
+            .map(|p| (p.place.signed_zenith, p.place.ring))
+            .collect();
         assert_eq!(
-            signed,
+            placed,
             [
-                Some(30.0),
-                Some(-30.0),
-                Some(0.0),
-                None,
-                None,
-                None,
-                Some(45.0),
-                None,
-                None,
-                None
+                (Some(30.0), None),
+                (Some(-30.0), None),
+                (Some(0.0), None),
+                (None, Some(0)),
+                (None, Some(0)),
+                (None, Some(0)),
+                (Some(45.0), Some(0)),
             ]
         );
         // Two residuals (m00, m10) per point, each at the point's hemisphere-signed θ_r.
@@ -693,11 +700,6 @@ pub(super) mod tests {
         assert_eq!(
             (data.rings[0].incidence, data.rings[0].theta_r_deg),
             (1, 45.0)
-        );
-        let on_ring: Vec<bool> = data.points.iter().map(|p| p.ring == Some(0)).collect();
-        assert_eq!(
-            on_ring,
-            [false, false, false, true, true, true, true, false, false, false]
         );
         assert_eq!(data.off_ring_points(), 3);
         // Only θi = 60° has in-plane points, so only it gets an in-plane model sweep.
@@ -832,9 +834,13 @@ pub(super) mod tests {
         let curve = in_plane_curve_at_normal(&data);
         let m00 = curve[(0, 0)];
         assert!(curve[(1, 0)].abs() > 0.05 * m00, "a polarizing model");
-        for (view, row) in data.points.iter().zip(&set.points) {
-            assert_eq!(view.signed_zenith, Some(0.0));
-            let p = view.drawn.as_deref().expect("an in-plane point is drawn");
+        assert_eq!(
+            data.drawn.len(),
+            geometry.len(),
+            "in-plane points are drawn"
+        );
+        for (p, row) in data.drawn.iter().zip(&set.points) {
+            assert_eq!(p.place.signed_zenith, Some(0.0));
             let measured = p.readings[0].unwrap().value;
             assert_eq!(measured, row.values[0], "m00 does not turn");
             for &e in &linear {
@@ -875,7 +881,7 @@ pub(super) mod tests {
         let set = model_set(&[(40.0, 0.0, 0.0, 90.0), (40.0, 0.0, 0.0, 135.0)], &[0, 4]);
         let data = ReportData::new(&material(false), &set).unwrap();
         let curve = in_plane_curve_at_normal(&data);
-        let quarter = data.points[0].drawn.as_deref().unwrap();
+        let quarter = &data.drawn[0];
         let m10 = quarter.readings[4].unwrap();
         assert_eq!(m10.value, -set.points.row(0).values[1]);
         assert!(
@@ -883,7 +889,7 @@ pub(super) mod tests {
                 < 1e-12
         );
         assert!((m10.sigma - 1e-4).abs() < 1e-18);
-        let eighth = data.points[1].drawn.as_deref().unwrap();
+        let eighth = &data.drawn[1];
         assert_eq!(eighth.readings[4], None);
         assert_eq!(
             eighth.readings[0].map(|r| r.value),
@@ -909,8 +915,8 @@ pub(super) mod tests {
             &[0, 4],
         );
         let data = ReportData::new(&material(false), &set).unwrap();
-        assert!(data.points[0].drawn.is_some());
-        assert!(data.points[1].drawn.is_none());
+        assert_eq!(data.drawn.len(), 1);
+        assert_eq!(data.drawn[0].place.signed_zenith, Some(30.0));
         assert_eq!(data.off_ring_points(), 1);
         assert_eq!(data.residuals.count, 4, "every row keeps its residuals");
     }

@@ -22,7 +22,6 @@ pub(super) fn point_views(set: &MeasurementSet, incidences: &[f64]) -> Vec<Point
                 signed_zenith: in_plane_zenith(p.theta_r_deg, relative_azimuth),
                 ring: None,
                 relative_azimuth,
-                drawn: None,
             }
         })
         .collect()
@@ -66,30 +65,48 @@ pub(super) fn own_frame(
     Ok((readings, chosen.pbrdf.mueller(&incident, &scattered)))
 }
 
-/// Fills [`PointView::drawn`] of the points the profile panels show: in the plane of incidence
-/// at an angle with curves (`slot`), or on a drawn ring.
-pub(super) fn add_drawn(
-    points: &mut [PointView],
+/// The points the profile panels show, with their row indices: in the plane of incidence at
+/// an angle with curves (`slot`), or on a drawn ring. A dense scan's rows are mostly neither;
+/// those appear only among the residuals, and their views need not outlive the placing.
+pub(super) fn shown_views(
+    points: Vec<PointView>,
+    slot: &[Option<usize>],
+) -> Vec<(usize, PointView)> {
+    points
+        .into_iter()
+        .enumerate()
+        .filter(|(_, view)| {
+            let in_plane = slot[view.incidence].is_some() && view.signed_zenith.is_some();
+            in_plane || view.ring.is_some()
+        })
+        .collect()
+}
+
+/// What the profile panels draw of each of the `shown` points (row index and place in `set`,
+/// standard deviations `sigmas`).
+pub(super) fn drawn_points(
+    shown: Vec<(usize, PointView)>,
     set: &MeasurementSet,
     sigmas: &[f64],
-    slot: &[Option<usize>],
     chosen: &ModelCurveSource,
-) -> Result<(), ReportError> {
-    for (point, view) in points.iter_mut().enumerate() {
-        let in_plane = slot[view.incidence].is_some() && view.signed_zenith.is_some();
-        if !(in_plane || view.ring.is_some()) {
-            continue;
-        }
-        let p = set.points.row(point);
-        let (readings, model) = own_frame(set, sigmas, point, chosen)?;
-        let (readings, model) = if at_normal(p.theta_r_deg) {
-            in_plane_frame_at_normal(&readings, &model, p.phi_i_deg, p.phi_r_deg)
-        } else {
-            (readings, model)
-        };
-        view.drawn = Some(Box::new(DrawnPoint { readings, model }));
-    }
-    Ok(())
+) -> Result<Vec<DrawnPoint>, ReportError> {
+    shown
+        .into_iter()
+        .map(|(point, place)| {
+            let p = set.points.row(point);
+            let (readings, model) = own_frame(set, sigmas, point, chosen)?;
+            let (readings, model) = if at_normal(p.theta_r_deg) {
+                in_plane_frame_at_normal(&readings, &model, p.phi_i_deg, p.phi_r_deg)
+            } else {
+                (readings, model)
+            };
+            Ok(DrawnPoint {
+                place,
+                readings,
+                model,
+            })
+        })
+        .collect()
 }
 
 fn checked_direction(name: &'static str, theta: f64, phi: f64) -> Result<Direction, ReportError> {
