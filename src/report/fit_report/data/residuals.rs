@@ -202,10 +202,43 @@ fn normalized_residuals<'a>(
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{material, set_of};
+    use super::super::tests::{exact, material, set_of};
     use super::super::ReportData;
     use super::*;
     use crate::fit::observation_sigmas;
+
+    #[test]
+    fn residuals_are_data_minus_model_over_sigma() {
+        let geometry = [(40.0, 0.0, 40.0, 180.0), (40.0, 0.0, 20.0, 0.0)];
+        let exact_set = set_of(&geometry, exact, [None, None]);
+        let data = ReportData::new(&material(false), &exact_set).unwrap();
+        assert_eq!(data.residuals.count, 4);
+        assert!(data.residuals.each.iter().all(|r| r.value.abs() < 1e-12));
+
+        // Without u_ columns: σ(m00) = 3 % and σ(m10) = 1 % of the measured m00 (the fit's noise
+        // model), so a reading 3 % high is 1/1.03 σ off.
+        let shifted = set_of(
+            &geometry,
+            |m| [1.03 * m[(0, 0)], m[(1, 0)] - 0.02 * m[(0, 0)]],
+            [None, None],
+        );
+        let data = ReportData::new(&material(false), &shifted).unwrap();
+        let values: Vec<f64> = data.residuals.each.iter().map(|r| r.value).collect();
+        let (up, down) = (1.0 / 1.03, -2.0 / 1.03);
+        for (got, want) in values.iter().zip([up, down, up, down]) {
+            assert!((got - want).abs() < 1e-9, "{values:?}");
+        }
+        // With them, the file's σ is used as is.
+        let with_u = set_of(
+            &geometry,
+            |m| [m[(0, 0)] + 0.004, m[(1, 0)]],
+            [Some(0.002), Some(1.0)],
+        );
+        let data = ReportData::new(&material(false), &with_u).unwrap();
+        assert!((data.residuals.each[0].value - 2.0).abs() < 1e-9);
+        assert_eq!(data.residuals.each[0].forward_zenith, 40.0);
+        assert_eq!(data.residuals.each[2].forward_zenith, -20.0);
+    }
 
     #[test]
     fn a_dense_summary_is_that_of_every_residual_kept() {
