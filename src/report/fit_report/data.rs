@@ -12,7 +12,12 @@ use crate::pbrdf::{Direction, HemisphereQuadrature, Pbrdf};
 use super::super::ReportError;
 
 mod points;
-use points::{add_drawn, point_views};
+mod residuals;
+use points::{drawn_points, point_views, shown_views};
+pub use residuals::{
+    Residual, ResidualDensity, ResidualSummary, BIN_WIDTH, DENSITY_X_DEG, DENSITY_Y_SIGMA,
+    HISTOGRAM_LIMIT,
+};
 
 /// Two angles are the same goniometer setting when they agree to a microdegree.
 const SAME_ANGLE_DEG: f64 = 1e-6;
@@ -42,15 +47,13 @@ pub struct PointView {
     pub ring: Option<usize>,
     /// φ_r − φ_i in [0°, 360°).
     pub relative_azimuth: f64,
-    /// What the profile panels draw of a point they show (in the plane of incidence at an angle
-    /// with curves, or on a drawn ring); `None` for the others, which appear only among the
-    /// residuals: a dense scan's rows are mostly such, and these are 0.5 KB a row.
-    pub drawn: Option<Box<DrawnPoint>>,
 }
 
-/// The measured elements and the model of a point the profile panels show.
+/// A point the profile panels show (in the plane of incidence at an angle with curves, or on a
+/// drawn ring): where it lies, its measured elements and the model.
 #[derive(Clone, Debug)]
 pub struct DrawnPoint {
+    pub place: PointView,
     /// The measured elements by Mueller index r*4 + c, in the psps frame the point is drawn in: its
     /// own, except at the normal (θ_r = 0), where they are turned into the in-plane profile's
     /// frame (`points::in_plane_frame_at_normal`); elements that cannot be turned are `None`
@@ -80,16 +83,6 @@ pub struct Ring {
     pub sweep: ModelSweep,
 }
 
-/// One normalized residual (data − model)/σ, both in the measured row's own psps frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Residual {
-    /// θ_r signed by hemisphere: + when the detector is on the forward (specular) half,
-    /// 90° ≤ φ_r − φ_i ≤ 270°. Equals the point's signed zenith in the plane.
-    pub forward_zenith: f64,
-    pub element: usize,
-    pub value: f64,
-}
-
 /// ε0 and ε1 against emission angle for the chosen and the competing model.
 #[derive(Clone, Debug)]
 pub struct EmissivityCurves {
@@ -114,12 +107,15 @@ pub struct ReportData {
     pub unshown_ring_points: usize,
     /// Mueller indices present in the measurement, ascending.
     pub elements: Vec<usize>,
-    pub points: Vec<PointView>,
+    /// The points the profile panels show, in the order of the file; the others (most of a
+    /// dense scan's) appear only among the residuals.
+    pub drawn: Vec<DrawnPoint>,
     /// In-plane model sweeps, one per entry of `shown` (`None` when no point of that angle lies in
     /// the plane).
     pub in_plane: Vec<Option<ModelSweep>>,
     pub rings: Vec<Ring>,
-    pub residuals: Vec<Residual>,
+    /// The normalized residuals of every measured element, summarized for panels (g) and (h).
+    pub residuals: ResidualSummary,
     pub emissivity: EmissivityCurves,
     pub chosen_label: String,
     pub alternative_label: Option<String>,
@@ -131,10 +127,7 @@ impl ReportData {
     pub fn new(material: &Material, set: &MeasurementSet) -> Result<ReportData, ReportError> {
         let (chosen, alternative) = curve_sources(material)?;
         let incidences = distinct_sorted(set.points.iter().map(|p| p.theta_i_deg));
-        // The standard deviations the fit weighted by (the file's u_ columns or the fit's
-        // default noise model), so that report residuals are the ones the optimizer minimized.
-        let sigmas = observation_sigmas(set)?;
-        let (mut points, residuals) = point_views(set, &sigmas, &incidences, &chosen)?;
+        let mut points = point_views(set, &incidences);
         let shown = representatives(&incidences, MAX_CURVE_INCIDENCES);
         let mut slot = vec![None; incidences.len()];
         for (position, &incidence) in shown.iter().enumerate() {
@@ -149,7 +142,13 @@ impl ReportData {
             alternative.as_ref(),
         );
         let in_plane = in_plane_sweeps(&points, &incidences, &shown, &chosen, alternative.as_ref());
-        add_drawn(&mut points, set, &sigmas, &slot, &chosen)?;
+        // Every point's view is freed before the sigmas (one per observation) are taken.
+        let shown_points = shown_views(points, &slot);
+        // The standard deviations the fit weighted by (the file's u_ columns or the fit's
+        // default noise model), so that report residuals are the ones the optimizer minimized.
+        let sigmas = observation_sigmas(set)?;
+        let residuals = ResidualSummary::new(set, &sigmas, &chosen)?;
+        let drawn = drawn_points(shown_points, set, &sigmas, &chosen)?;
         let emissivity = emissivity_curves(&chosen, alternative.as_ref());
 
         Ok(ReportData {
@@ -159,7 +158,7 @@ impl ReportData {
             raster_points: found.raster_points,
             unshown_ring_points: found.unshown_points,
             elements: set.elements.clone(),
-            points,
+            drawn,
             in_plane,
             rings: found.rings,
             residuals,
@@ -541,7 +540,7 @@ fn emissivity_curves(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::points::normal_detector_turn;
     use super::*;
     use crate::material::{AlternativeFit, ModelSpec};
@@ -564,7 +563,7 @@ mod tests {
         }
     }
 
-    fn material(with_alternative: bool) -> Material {
+    pub(super) fn material(with_alternative: bool) -> Material {
         let model = spec(SlopeDistribution::Cauchy { sigma: 0.2, q: 2.5 });
         let fit = with_alternative.then(|| {
             let alternative = AlternativeFit {
@@ -585,7 +584,7 @@ mod tests {
     }
 
     /// A set of m00 and m10 at the given (θ_i, φ_i, θ_r, φ_r), valued by `value(m)`.
-    fn set_of(
+    pub(super) fn set_of(
         geometry: &[(f64, f64, f64, f64)],
         value: impl Fn(&Mueller) -> [f64; 2],
         uncertainties: [Option<f64>; 2],
@@ -642,7 +641,7 @@ mod tests {
         set
     }
 
-    fn exact(m: &Mueller) -> [f64; 2] {
+    pub(super) fn exact(m: &Mueller) -> [f64; 2] {
         [m[(0, 0)], m[(1, 0)]]
     }
 
@@ -663,25 +662,30 @@ mod tests {
         let set = set_of(&geometry, exact, [None, None]);
         let data = ReportData::new(&material(false), &set).unwrap();
         assert_eq!(data.incidences, [20.0, 60.0]);
-        let signed: Vec<Option<f64>> = data.points.iter().map(|p| p.signed_zenith).collect();
+        // The points the profiles show, in the order of the file, with their signed zenith in
+        // the plane and their ring: the plane's three, the ring's three and its in-plane member;
+        // not the raster (58°) nor the lone 20° point, which are only among the residuals.
+        let placed: Vec<(Option<f64>, Option<usize>)> = data
+            .drawn
+            .iter()
+            .map(|p| (p.place.signed_zenith, p.place.ring))
+            .collect();
         assert_eq!(
-            signed,
+            placed,
             [
-                Some(30.0),
-                Some(-30.0),
-                Some(0.0),
-                None,
-                None,
-                None,
-                Some(45.0),
-                None,
-                None,
-                None
+                (Some(30.0), None),
+                (Some(-30.0), None),
+                (Some(0.0), None),
+                (None, Some(0)),
+                (None, Some(0)),
+                (None, Some(0)),
+                (Some(45.0), Some(0)),
             ]
         );
         // Two residuals (m00, m10) per point, each at the point's hemisphere-signed θ_r.
         let forward: Vec<f64> = data
             .residuals
+            .each
             .iter()
             .step_by(2)
             .map(|r| r.forward_zenith)
@@ -695,11 +699,6 @@ mod tests {
         assert_eq!(
             (data.rings[0].incidence, data.rings[0].theta_r_deg),
             (1, 45.0)
-        );
-        let on_ring: Vec<bool> = data.points.iter().map(|p| p.ring == Some(0)).collect();
-        assert_eq!(
-            on_ring,
-            [false, false, false, true, true, true, true, false, false, false]
         );
         assert_eq!(data.off_ring_points(), 3);
         // Only θi = 60° has in-plane points, so only it gets an in-plane model sweep.
@@ -725,39 +724,6 @@ mod tests {
         assert_eq!(evenly(200, 18)[17], 199);
         assert_eq!(evenly(5, 18), [0, 1, 2, 3, 4]);
         assert_eq!(position_of(&many, 5.0 + 0.07 * 500.0), 500);
-    }
-
-    #[test]
-    fn residuals_are_data_minus_model_over_sigma() {
-        let geometry = [(40.0, 0.0, 40.0, 180.0), (40.0, 0.0, 20.0, 0.0)];
-        let exact_set = set_of(&geometry, exact, [None, None]);
-        let data = ReportData::new(&material(false), &exact_set).unwrap();
-        assert_eq!(data.residuals.len(), 4);
-        assert!(data.residuals.iter().all(|r| r.value.abs() < 1e-12));
-
-        // Without u_ columns: σ(m00) = 3 % and σ(m10) = 1 % of the measured m00 (the fit's noise
-        // model), so a reading 3 % high is 1/1.03 σ off.
-        let shifted = set_of(
-            &geometry,
-            |m| [1.03 * m[(0, 0)], m[(1, 0)] - 0.02 * m[(0, 0)]],
-            [None, None],
-        );
-        let data = ReportData::new(&material(false), &shifted).unwrap();
-        let values: Vec<f64> = data.residuals.iter().map(|r| r.value).collect();
-        let (up, down) = (1.0 / 1.03, -2.0 / 1.03);
-        for (got, want) in values.iter().zip([up, down, up, down]) {
-            assert!((got - want).abs() < 1e-9, "{values:?}");
-        }
-        // With them, the file's σ is used as is.
-        let with_u = set_of(
-            &geometry,
-            |m| [m[(0, 0)] + 0.004, m[(1, 0)]],
-            [Some(0.002), Some(1.0)],
-        );
-        let data = ReportData::new(&material(false), &with_u).unwrap();
-        assert!((data.residuals[0].value - 2.0).abs() < 1e-9);
-        assert_eq!(data.residuals[0].forward_zenith, 40.0);
-        assert_eq!(data.residuals[2].forward_zenith, -20.0);
     }
 
     #[test]
@@ -834,9 +800,13 @@ mod tests {
         let curve = in_plane_curve_at_normal(&data);
         let m00 = curve[(0, 0)];
         assert!(curve[(1, 0)].abs() > 0.05 * m00, "a polarizing model");
-        for (view, row) in data.points.iter().zip(&set.points) {
-            assert_eq!(view.signed_zenith, Some(0.0));
-            let p = view.drawn.as_deref().expect("an in-plane point is drawn");
+        assert_eq!(
+            data.drawn.len(),
+            geometry.len(),
+            "in-plane points are drawn"
+        );
+        for (p, row) in data.drawn.iter().zip(&set.points) {
+            assert_eq!(p.place.signed_zenith, Some(0.0));
             let measured = p.readings[0].unwrap().value;
             assert_eq!(measured, row.values[0], "m00 does not turn");
             for &e in &linear {
@@ -866,8 +836,8 @@ mod tests {
         assert!(raw(1, 4).abs() < 1e-12 * m00 && raw(1, 8).abs() > 0.05 * m00);
         assert!(curve[(2, 0)].abs() < 1e-15 * m00);
         // Residuals stay data − model in the row's own frame: zero for the model's own values.
-        assert!(data.residuals.iter().all(|r| r.value.abs() < 1e-9));
-        assert_eq!(data.residuals.len(), geometry.len() * linear.len());
+        assert!(data.residuals.each.iter().all(|r| r.value.abs() < 1e-9));
+        assert_eq!(data.residuals.count, geometry.len() * linear.len());
     }
 
     #[test]
@@ -877,7 +847,7 @@ mod tests {
         let set = model_set(&[(40.0, 0.0, 0.0, 90.0), (40.0, 0.0, 0.0, 135.0)], &[0, 4]);
         let data = ReportData::new(&material(false), &set).unwrap();
         let curve = in_plane_curve_at_normal(&data);
-        let quarter = data.points[0].drawn.as_deref().unwrap();
+        let quarter = &data.drawn[0];
         let m10 = quarter.readings[4].unwrap();
         assert_eq!(m10.value, -set.points.row(0).values[1]);
         assert!(
@@ -885,7 +855,7 @@ mod tests {
                 < 1e-12
         );
         assert!((m10.sigma - 1e-4).abs() < 1e-18);
-        let eighth = data.points[1].drawn.as_deref().unwrap();
+        let eighth = &data.drawn[1];
         assert_eq!(eighth.readings[4], None);
         assert_eq!(
             eighth.readings[0].map(|r| r.value),
@@ -900,7 +870,7 @@ mod tests {
         let (series, _) = profile_series(&data, Quantity::M00, Domain::InPlane);
         assert_eq!(series[0].points.len(), 2);
         // Both rows keep their residuals in their own frames.
-        assert_eq!(data.residuals.len(), 4);
+        assert_eq!(data.residuals.count, 4);
     }
 
     #[test]
@@ -911,10 +881,10 @@ mod tests {
             &[0, 4],
         );
         let data = ReportData::new(&material(false), &set).unwrap();
-        assert!(data.points[0].drawn.is_some());
-        assert!(data.points[1].drawn.is_none());
+        assert_eq!(data.drawn.len(), 1);
+        assert_eq!(data.drawn[0].place.signed_zenith, Some(30.0));
         assert_eq!(data.off_ring_points(), 1);
-        assert_eq!(data.residuals.len(), 4, "every row keeps its residuals");
+        assert_eq!(data.residuals.count, 4, "every row keeps its residuals");
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The fit's diagnostic panels: the histogram of the normalized residuals (the residuals
 //! themselves are [`super::residuals`]), the optimizer's convergence, and the polarized emissivity the fit implies (docs/design.md §1.4).
 
-use super::data::{EmissivityCurves, ReportData};
+use super::data::{EmissivityCurves, ReportData, ResidualSummary, BIN_WIDTH, HISTOGRAM_LIMIT};
 use super::style::{
     draw_legend_column, draw_legend_top_right, draw_note, log_tick, panel_chart, report_mesh_style,
     sane_log_range, DrawResult, LegendEntry, LineKind, AXIS_DESC_SIZE, GREY, LEGEND_SIZE,
@@ -17,42 +17,15 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 pub(super) type Area<DB> = DrawingArea<DB, Shift>;
 
-/// Bins of the residual histogram: 0.25σ wide over ±5σ.
-const BIN_WIDTH: f64 = 0.25;
-const HISTOGRAM_LIMIT: f64 = 5.0;
-
-/// Counts per bin of `values` over ±[`HISTOGRAM_LIMIT`], and how many fall outside.
-pub fn histogram(values: impl IntoIterator<Item = f64>) -> (Vec<usize>, usize) {
-    let bins = (2.0 * HISTOGRAM_LIMIT / BIN_WIDTH).round() as usize;
-    let mut counts = vec![0; bins];
-    let mut outside = 0;
-    for v in values {
-        let bin = ((v + HISTOGRAM_LIMIT) / BIN_WIDTH).floor();
-        if bin >= 0.0 && (bin as usize) < bins {
-            counts[bin as usize] += 1;
-        } else {
-            outside += 1;
-        }
-    }
-    (counts, outside)
-}
-
 /// Histogram of the normalized residuals against the standard normal they should follow.
 pub fn draw_histogram<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) -> DrawResult<DB> {
     let caption = "(h) Residual distribution";
-    // The finite residuals, read in place each time they are needed rather than copied (a
-    // dense scan has millions, and the report's panels are drawn in parallel).
-    let values = || {
-        data.residuals
-            .iter()
-            .map(|r| r.value)
-            .filter(|v| v.is_finite())
-    };
-    let count = values().count();
+    let residuals = &data.residuals;
+    let count = residuals.finite;
     if count == 0 {
         return draw_note(area, caption, "no residuals");
     }
-    let (counts, outside) = histogram(values());
+    let counts = &residuals.histogram.counts;
     let n = count as f64;
     let top = counts.iter().copied().max().unwrap_or(0) as f64;
     // At least a few counts high, so that the integer tick labels stay distinct.
@@ -89,7 +62,7 @@ pub fn draw_histogram<DB: DrawingBackend>(area: &Area<DB>, data: &ReportData) ->
     let (x, y) = chart.plotting_area().get_pixel_range();
     draw_legend_column(
         area,
-        &histogram_legend(values, count, outside),
+        &histogram_legend(residuals),
         (
             x.start - area.get_base_pixel().0 + 8,
             y.start - area.get_base_pixel().1 + 6,
@@ -106,19 +79,17 @@ fn expected_count(n: f64, x: f64) -> f64 {
     n * BIN_WIDTH * (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt()
 }
 
-/// The histogram's key: the bars, the normal curve, the residuals' mean and standard deviation,
-/// and how many fell outside the bins.
-/// `values` gives the `count` residuals anew on each call.
-fn histogram_legend<I: Iterator<Item = f64>>(
-    values: impl Fn() -> I,
-    count: usize,
-    outside: usize,
-) -> Vec<LegendEntry> {
-    let n = count as f64;
-    let mean = values().sum::<f64>() / n;
-    let sd = (values().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+/// The histogram's key: the bars, the normal curve, the finite residuals' mean and standard
+/// deviation, and how many fell outside the bins.
+fn histogram_legend(residuals: &ResidualSummary) -> Vec<LegendEntry> {
+    let (count, outside) = (residuals.finite, residuals.histogram.outside);
     // Printed to two decimals: keep a tiny negative mean from showing as "-0.00".
-    let mean = if mean.abs() < 0.005 { 0.0 } else { mean };
+    let mean = if residuals.mean.abs() < 0.005 {
+        0.0
+    } else {
+        residuals.mean
+    };
+    let sd = residuals.standard_deviation;
     let mut entries = vec![
         LegendEntry::line(
             format!("residuals, N = {count}"),
@@ -393,22 +364,4 @@ fn emissivity_legend(data: &ReportData, e0_low: f64) -> Vec<LegendEntry> {
 /// `value` rounded down to a multiple of `step`.
 fn floor_to(value: f64, step: f64) -> f64 {
     (value / step).floor() * step
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn histogram_bins_are_quarter_sigma_and_count_the_overflow() {
-        let (counts, outside) = histogram([-5.0, -0.1, 0.0, 0.1, 0.26, 4.99, 5.0, -7.0, f64::NAN]);
-        assert_eq!(counts.len(), 40);
-        assert_eq!(counts[0], 1, "−5 opens the first bin");
-        assert_eq!(
-            (counts[19], counts[20], counts[21], counts[39]),
-            (1, 2, 1, 1)
-        );
-        assert_eq!(outside, 3, "5.0, −7 and NaN");
-        assert_eq!(counts.iter().sum::<usize>() + outside, 9);
-    }
 }

@@ -6,7 +6,7 @@ mod axes;
 
 pub use axes::{flat_floor, linear_axis, log_axis, DegreeAxis, Domain, FLOOR_LABEL};
 
-use super::data::{DrawnPoint, ModelSweep, PointView, ReportData};
+use super::data::{DrawnPoint, ModelSweep, ReportData};
 use super::style::{
     incidence_color, log_tick, report_mesh_style, DrawResult, Marker, YAxis, AXIS_DESC_SIZE,
     CAPTION_SIZE, GREY, LEGEND_SIZE, SMALL_CAPTION_SIZE, SMALL_TICK_SIZE, TICK_SIZE,
@@ -174,8 +174,7 @@ pub fn profile_series(
 /// [`ReportData::in_plane`] or per ring, in one pass over the points (a file may hold as many
 /// groups as points).
 fn profile_points(data: &ReportData, quantity: Quantity, domain: Domain) -> Vec<Vec<ProfilePoint>> {
-    let measured = |p: &PointView, x: f64| {
-        let p = p.drawn.as_deref()?;
+    let measured = |p: &DrawnPoint, x: f64| {
         quantity.of_point(p).map(|(value, sigma)| ProfilePoint {
             x,
             value,
@@ -188,10 +187,11 @@ fn profile_points(data: &ReportData, quantity: Quantity, domain: Domain) -> Vec<
         Domain::Rings => data.rings.len(),
     };
     let mut buckets: Vec<Vec<ProfilePoint>> = vec![Vec::new(); groups];
-    for p in &data.points {
+    for p in &data.drawn {
+        let place = &p.place;
         let placed = match domain {
-            Domain::InPlane => data.slot[p.incidence].zip(p.signed_zenith),
-            Domain::Rings => p.ring.map(|ring| (ring, p.relative_azimuth)),
+            Domain::InPlane => data.slot[place.incidence].zip(place.signed_zenith),
+            Domain::Rings => place.ring.map(|ring| (ring, place.relative_azimuth)),
         };
         if let Some(point) = placed.and_then(|(group, x)| Some((group, measured(p, x)?))) {
             buckets[point.0].push(point.1);
@@ -365,7 +365,7 @@ fn draw_series<DB: DrawingBackend, Y: Ranged<ValueType = f64> + ValueFormatter<f
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::fit_report::data::Reading;
+    use crate::report::fit_report::data::{PointView, Reading};
 
     fn point(readings: &[(usize, f64, f64)]) -> DrawnPoint {
         let mut all = [None; 16];
@@ -373,6 +373,12 @@ mod tests {
             all[e] = Some(Reading { value, sigma });
         }
         DrawnPoint {
+            place: PointView {
+                incidence: 0,
+                signed_zenith: Some(0.0),
+                ring: None,
+                relative_azimuth: 180.0,
+            },
             readings: all,
             model: Mueller::zeros(),
         }

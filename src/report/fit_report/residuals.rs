@@ -2,7 +2,7 @@
 //! signed detector zenith, coloured by the kind of element, as points or, when there are too many,
 //! as a density histogram.
 
-use super::data::{ReportData, Residual};
+use super::data::{ReportData, Residual, ResidualDensity, DENSITY_X_DEG, DENSITY_Y_SIGMA};
 use super::diagnostics::Area;
 use super::style::{
     draw_legend_top_right, draw_note, panel_chart, report_mesh_style, Chart2d, DrawResult,
@@ -37,36 +37,27 @@ pub fn draw_residuals<DB: DrawingBackend>(
     raster: bool,
 ) -> DrawResult<DB> {
     let caption = "(g) Normalized residuals (data − model)/σ, chosen model";
-    if data.residuals.is_empty() {
+    let residuals = &data.residuals;
+    if residuals.count == 0 {
         return draw_note(area, caption, "no residuals");
     }
-    let largest = data
-        .residuals
-        .iter()
-        .map(|r| r.value.abs())
-        .filter(|v| v.is_finite())
-        .fold(0.0, f64::max);
-    let bound = (largest * 1.1).clamp(4.0, 12.0);
-    let hidden = data
-        .residuals
-        .iter()
-        .filter(|r| r.value.is_nan() || r.value.abs() > bound)
-        .count();
+    let (bound, hidden) = (residuals.bound, residuals.hidden);
     let mut chart =
         panel_chart(area, caption, 22).build_cartesian_2d(-90.0..90.0, -bound..bound)?;
     residual_mesh(&mut chart)?;
     draw_residual_guides(&mut chart)?;
-    if data.residuals.len() > MAX_RESIDUAL_POINTS {
-        return draw_residual_density(area, &mut chart, data, bound, hidden);
+    if let Some(density) = &residuals.density {
+        return draw_residual_density(area, &mut chart, density, residuals.count, bound, hidden);
     }
-    if raster && data.residuals.len() > RASTER_SCATTER_POINTS {
+    if raster && residuals.count > RASTER_SCATTER_POINTS {
         draw_scatter_as_image(area, &chart, data, bound)?;
     } else {
         draw_residual_scatter(&mut chart, data, bound)?;
     }
     let mut entries: Vec<LegendEntry> = (0..3)
         .filter(|&class| {
-            data.residuals
+            residuals
+                .each
                 .iter()
                 .any(|r| element_class(r.element) == class)
         })
@@ -102,6 +93,7 @@ fn draw_residual_scatter<DB: DrawingBackend>(
     for class in [2, 1, 0] {
         let points: Vec<&Residual> = data
             .residuals
+            .each
             .iter()
             .filter(|r| element_class(r.element) == class && r.value.abs() <= bound)
             .collect();
@@ -142,31 +134,6 @@ fn draw_scatter_as_image<DB: DrawingBackend>(
     area.draw(&image)
 }
 
-/// Most residuals panel (g) draws one by one; beyond it, it draws their density as a 2-D
-/// histogram ([`DENSITY_X_DEG`] × [`DENSITY_Y_SIGMA`] cells), whose size does not grow with the
-/// file.
-pub const MAX_RESIDUAL_POINTS: usize = 20_000;
-const DENSITY_X_DEG: f64 = 2.0;
-const DENSITY_Y_SIGMA: f64 = 0.25;
-
-/// Counts of `residuals` within ±`bound` in cells of [`DENSITY_X_DEG`] × [`DENSITY_Y_SIGMA`]
-/// over −90…90° × ±`bound`, one run of y bins per x bin; and the number of y bins.
-pub fn residual_density(residuals: &[Residual], bound: f64) -> (Vec<usize>, usize) {
-    let columns = (180.0 / DENSITY_X_DEG).round() as usize;
-    let rows = ((2.0 * bound / DENSITY_Y_SIGMA).ceil() as usize).max(1);
-    let mut counts = vec![0; columns * rows];
-    for r in residuals {
-        if !(r.value.abs() <= bound && r.forward_zenith.is_finite()) {
-            continue;
-        }
-        let column = (((r.forward_zenith + 90.0) / DENSITY_X_DEG).floor().max(0.0) as usize)
-            .min(columns - 1);
-        let row = (((r.value + bound) / DENSITY_Y_SIGMA).floor().max(0.0) as usize).min(rows - 1);
-        counts[column * rows + row] += 1;
-    }
-    (counts, rows)
-}
-
 /// Cell colour for `count` of at most `most`: light to dark blue on a log scale.
 fn density_color(count: usize, most: usize) -> RGBColor {
     let t = if most > 1 {
@@ -178,7 +145,6 @@ fn density_color(count: usize, most: usize) -> RGBColor {
     RGBColor(mix(198, 8), mix(219, 48), mix(239, 107))
 }
 
-/// Panel (g) for many residuals: their density over (detector zenith, residual).
 /// A residual panel's legend: `entries`, then a note of the points beyond ±`bound` σ, if any.
 fn residual_legend<DB: DrawingBackend>(
     area: &Area<DB>,
@@ -225,14 +191,16 @@ fn draw_residual_guides<DB: DrawingBackend>(chart: &mut Chart2d<'_, DB>) -> Draw
     Ok(())
 }
 
+/// Panel (g) for many residuals (`count`): their density over (detector zenith, residual).
 fn draw_residual_density<DB: DrawingBackend>(
     area: &Area<DB>,
     chart: &mut Chart2d<'_, DB>,
-    data: &ReportData,
+    density: &ResidualDensity,
+    count: usize,
     bound: f64,
     hidden: usize,
 ) -> DrawResult<DB> {
-    let (counts, rows) = residual_density(&data.residuals, bound);
+    let (counts, rows) = (&density.counts, density.rows);
     let most = counts.iter().copied().max().unwrap_or(0);
     chart.draw_series(counts.iter().enumerate().filter(|(_, &c)| c > 0).map(
         |(cell, &count)| {
@@ -250,8 +218,7 @@ fn draw_residual_density<DB: DrawingBackend>(
     let entries = vec![
         LegendEntry::line(
             format!(
-                "{} residuals, all elements: count per {DENSITY_X_DEG}° × {DENSITY_Y_SIGMA}σ cell",
-                data.residuals.len()
+                "{count} residuals, all elements: count per {DENSITY_X_DEG}° × {DENSITY_Y_SIGMA}σ cell"
             ),
             density_color(1, most.max(2)),
             LineKind::Patch,
@@ -275,37 +242,6 @@ fn draw_residual_density<DB: DrawingBackend>(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn residual_density_counts_cells_of_two_degrees_and_a_quarter_sigma() {
-        let at = |forward_zenith, value| Residual {
-            forward_zenith,
-            element: 0,
-            value,
-        };
-        let residuals = [
-            at(-90.0, -4.0),
-            at(-89.0, -3.9),
-            at(0.5, 0.1),
-            at(90.0, 3.99),
-            at(10.0, 4.5),
-            at(10.0, f64::NAN),
-        ];
-        let (counts, rows) = residual_density(&residuals, 4.0);
-        assert_eq!((counts.len(), rows), (90 * 32, 32));
-        assert_eq!(counts[0], 2, "the first cell holds both corner points");
-        assert_eq!(counts[45 * rows + 16], 1, "0.5°, +0.1σ");
-        assert_eq!(
-            counts[89 * rows + 31],
-            1,
-            "the top edge closes the last cell"
-        );
-        assert_eq!(
-            counts.iter().sum::<usize>(),
-            4,
-            "beyond the bound or NaN: not counted"
-        );
-    }
 
     #[test]
     fn element_classes_split_intensity_linear_and_circular() {

@@ -1,52 +1,53 @@
-//! The measured points of a fit report: where each lies, its residuals, and what the profile
+//! The measured points of a fit report: where each lies, each row's elements and model in its own
+//! frame (from which [`super::residuals`] takes the residuals), and what the profile
 //! panels draw of the points they show (docs/design.md §1.3 for the frames).
 
 use super::{
     at_normal, in_plane_relative_azimuth, in_plane_zenith, position_of, DrawnPoint,
-    ModelCurveSource, PointView, Reading, ReportError, Residual,
+    ModelCurveSource, PointView, Reading, ReportError,
 };
-use crate::measure::MeasurementSet;
+use crate::measure::{MeasurementRow, MeasurementSet};
 use crate::optics::{rotation_between_frames, FrameTurn, Mueller};
 use crate::pbrdf::Direction;
 
-/// Every measured point as the report sees it (not yet on a ring, nothing drawn yet), and the
-/// normalized residuals of all of them, in the order of the file.
-pub(super) fn point_views(
-    set: &MeasurementSet,
-    sigmas: &[f64],
-    incidences: &[f64],
-    chosen: &ModelCurveSource,
-) -> Result<(Vec<PointView>, Vec<Residual>), ReportError> {
-    let mut points = Vec::with_capacity(set.points.len());
-    let mut residuals = Vec::with_capacity(set.points.len() * set.elements.len());
-    for (point, p) in set.points.iter().enumerate() {
-        let relative_azimuth = (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0);
-        let signed_zenith = in_plane_zenith(p.theta_r_deg, relative_azimuth);
-        let forward_zenith = signed_zenith.unwrap_or({
-            if (90.0..=270.0).contains(&relative_azimuth) {
-                p.theta_r_deg
-            } else {
-                -p.theta_r_deg
+/// Every measured point as the report sees it (not yet on a ring, nothing drawn yet), in the
+/// order of the file.
+pub(super) fn point_views(set: &MeasurementSet, incidences: &[f64]) -> Vec<PointView> {
+    set.points
+        .iter()
+        .map(|p| {
+            let relative_azimuth = relative_azimuth(&p);
+            PointView {
+                incidence: position_of(incidences, p.theta_i_deg),
+                signed_zenith: in_plane_zenith(p.theta_r_deg, relative_azimuth),
+                ring: None,
+                relative_azimuth,
             }
-        });
-        // Residuals in the row's own frame: the model is evaluated at the row's own φ_r, as
-        // the fit compared them.
-        let (readings, model) = own_frame(set, sigmas, point, chosen)?;
-        residuals.extend(normalized_residuals(&readings, &model, forward_zenith));
-        points.push(PointView {
-            incidence: position_of(incidences, p.theta_i_deg),
-            signed_zenith,
-            ring: None,
-            relative_azimuth,
-            drawn: None,
-        });
-    }
-    Ok((points, residuals))
+        })
+        .collect()
+}
+
+/// φ_r − φ_i of a row in [0°, 360°).
+fn relative_azimuth(p: &MeasurementRow<'_>) -> f64 {
+    (p.phi_r_deg - p.phi_i_deg).rem_euclid(360.0)
+}
+
+/// The detector zenith a row's residuals are drawn at: θ_r signed by hemisphere, + on the
+/// forward (specular) half 90° ≤ φ_r − φ_i ≤ 270°; in the plane of incidence, its signed zenith.
+pub(super) fn residual_zenith(p: MeasurementRow<'_>) -> f64 {
+    let relative_azimuth = relative_azimuth(&p);
+    in_plane_zenith(p.theta_r_deg, relative_azimuth).unwrap_or({
+        if (90.0..=270.0).contains(&relative_azimuth) {
+            p.theta_r_deg
+        } else {
+            -p.theta_r_deg
+        }
+    })
 }
 
 /// The measured elements of row `point` of `set` (standard deviations `sigmas`) and the chosen
 /// model there, both in the row's own psps frame.
-fn own_frame(
+pub(super) fn own_frame(
     set: &MeasurementSet,
     sigmas: &[f64],
     point: usize,
@@ -64,49 +65,52 @@ fn own_frame(
     Ok((readings, chosen.pbrdf.mueller(&incident, &scattered)))
 }
 
-/// Fills [`PointView::drawn`] of the points the profile panels show: in the plane of incidence
-/// at an angle with curves (`slot`), or on a drawn ring.
-pub(super) fn add_drawn(
-    points: &mut [PointView],
+/// The points the profile panels show, with their row indices: in the plane of incidence at
+/// an angle with curves (`slot`), or on a drawn ring. A dense scan's rows are mostly neither;
+/// those appear only among the residuals, and their views need not outlive the placing.
+pub(super) fn shown_views(
+    points: Vec<PointView>,
+    slot: &[Option<usize>],
+) -> Vec<(usize, PointView)> {
+    points
+        .into_iter()
+        .enumerate()
+        .filter(|(_, view)| {
+            let in_plane = slot[view.incidence].is_some() && view.signed_zenith.is_some();
+            in_plane || view.ring.is_some()
+        })
+        .collect()
+}
+
+/// What the profile panels draw of each of the `shown` points (row index and place in `set`,
+/// standard deviations `sigmas`).
+pub(super) fn drawn_points(
+    shown: Vec<(usize, PointView)>,
     set: &MeasurementSet,
     sigmas: &[f64],
-    slot: &[Option<usize>],
     chosen: &ModelCurveSource,
-) -> Result<(), ReportError> {
-    for (point, view) in points.iter_mut().enumerate() {
-        let in_plane = slot[view.incidence].is_some() && view.signed_zenith.is_some();
-        if !(in_plane || view.ring.is_some()) {
-            continue;
-        }
-        let p = set.points.row(point);
-        let (readings, model) = own_frame(set, sigmas, point, chosen)?;
-        let (readings, model) = if at_normal(p.theta_r_deg) {
-            in_plane_frame_at_normal(&readings, &model, p.phi_i_deg, p.phi_r_deg)
-        } else {
-            (readings, model)
-        };
-        view.drawn = Some(Box::new(DrawnPoint { readings, model }));
-    }
-    Ok(())
+) -> Result<Vec<DrawnPoint>, ReportError> {
+    shown
+        .into_iter()
+        .map(|(point, place)| {
+            let p = set.points.row(point);
+            let (readings, model) = own_frame(set, sigmas, point, chosen)?;
+            let (readings, model) = if at_normal(p.theta_r_deg) {
+                in_plane_frame_at_normal(&readings, &model, p.phi_i_deg, p.phi_r_deg)
+            } else {
+                (readings, model)
+            };
+            Ok(DrawnPoint {
+                place,
+                readings,
+                model,
+            })
+        })
+        .collect()
 }
 
 fn checked_direction(name: &'static str, theta: f64, phi: f64) -> Result<Direction, ReportError> {
     Ok(Direction::from_degrees_checked(name, theta, phi)?)
-}
-
-/// (data − model)/σ for each measured element, in the frame both are given in.
-fn normalized_residuals<'a>(
-    readings: &'a [Option<Reading>; 16],
-    model: &'a Mueller,
-    forward_zenith: f64,
-) -> impl Iterator<Item = Residual> + 'a {
-    readings.iter().enumerate().filter_map(move |(element, r)| {
-        r.map(|r| Residual {
-            forward_zenith,
-            element,
-            value: (r.value - model[(element / 4, element % 4)]) / r.sigma,
-        })
-    })
 }
 
 /// Largest |mixing weight| of the frame turn of [`in_plane_frame_at_normal`] treated as zero:
