@@ -312,26 +312,8 @@ pub(super) fn choose_spectral_terms(
         .zip(sets.iter().zip(&points))
         .map(|(fitted, (set, points))| points.whole_data_fits(set, &kept_options, fitted))
         .collect::<Result<Vec<_>, _>>()?;
-    let by_distribution = options
-        .distributions()
-        .into_iter()
-        .map(|kind| {
-            kept.iter()
-                .map(|f| match &f.alternative {
-                    Some(other) if other.distribution == kind => other.clone(),
-                    _ => f.chosen.clone(),
-                })
-                .collect()
-        })
-        .collect();
-    let sampled = points
-        .iter()
-        .map(|p| {
-            p.sampled()
-                .unwrap_or((p.data().points(), p.data().points()))
-        })
-        .reduce(|a, b| (a.0 + b.0, a.1 + b.1))
-        .filter(|(compared, all)| compared < all);
+    let by_distribution = fits_by_distribution(options, &kept);
+    let sampled = sampled_rows(&points);
     if sampled.is_some() {
         // The verdict on the models written is that of every point of every wavelength.
         let first_unrealizable = kept
@@ -349,6 +331,34 @@ pub(super) fn choose_spectral_terms(
         sampled,
     };
     Ok((choice, by_distribution))
+}
+
+/// The fits of each wavelength, per distribution (in `options.distributions()` order).
+fn fits_by_distribution(options: &FitOptions, fits: &[Fitted]) -> Vec<Vec<ModelFit>> {
+    options
+        .distributions()
+        .into_iter()
+        .map(|kind| {
+            fits.iter()
+                .map(|f| match &f.alternative {
+                    Some(other) if other.distribution == kind => other.clone(),
+                    _ => f.chosen.clone(),
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// (rows compared, rows measured) over the wavelengths, when any took a subsample.
+fn sampled_rows(points: &[ChoicePoints]) -> Option<(usize, usize)> {
+    points
+        .iter()
+        .map(|p| {
+            p.sampled()
+                .unwrap_or((p.data().points(), p.data().points()))
+        })
+        .reduce(|a, b| (a.0 + b.0, a.1 + b.1))
+        .filter(|(compared, all)| compared < all)
 }
 
 /// The rows of each of `k` folds: a seeded shuffle dealt round-robin.
