@@ -168,21 +168,60 @@ impl ResidualSummary {
     }
 }
 
+/// Rows whose residuals one thread computes at a time ([`for_each_residual`]).
+const ROWS_PER_BLOCK: usize = 2048;
+
 /// Hands every normalized residual of `set` to `visit`, row by row in the order of the file,
 /// within a row by Mueller index; the model is evaluated at the row's own geometry and both are
-/// in the row's own frame, as the fit compared them.
+/// in the row's own frame, as the fit compared them. The rows are evaluated a block per thread
+/// at a time, in parallel, and their residuals handed on in order: the same values in the same
+/// order as one row after the other, holding a few blocks' residuals, not the file's.
 pub(in crate::report::fit_report) fn for_each_residual(
     set: &MeasurementSet,
     sigmas: &[f64],
     chosen: &ModelCurveSource,
     mut visit: impl FnMut(Residual),
 ) -> Result<(), ReportError> {
-    for point in 0..set.points.len() {
-        let forward_zenith = residual_zenith(set.points.row(point));
-        let (readings, model) = own_frame(set, sigmas, point, chosen)?;
-        normalized_residuals(&readings, &model, forward_zenith).for_each(&mut visit);
+    use rayon::prelude::*;
+    let rows = set.points.len();
+    let wave = ROWS_PER_BLOCK * rayon::current_num_threads();
+    for start in (0..rows).step_by(wave) {
+        let end = (start + wave).min(rows);
+        let blocks: Vec<_> = (start..end)
+            .step_by(ROWS_PER_BLOCK)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(|first| {
+                block_residuals(
+                    set,
+                    sigmas,
+                    chosen,
+                    first..(first + ROWS_PER_BLOCK).min(end),
+                )
+            })
+            .collect();
+        // The first refusal in file order, whichever thread met it first.
+        for block in blocks {
+            block?.into_iter().for_each(&mut visit);
+        }
     }
     Ok(())
+}
+
+/// The normalized residuals of rows `rows` of `set`, in order.
+fn block_residuals(
+    set: &MeasurementSet,
+    sigmas: &[f64],
+    chosen: &ModelCurveSource,
+    rows: std::ops::Range<usize>,
+) -> Result<Vec<Residual>, ReportError> {
+    let mut residuals = Vec::with_capacity(rows.len() * set.elements.len());
+    for point in rows {
+        let forward_zenith = residual_zenith(set.points.row(point));
+        let (readings, model) = own_frame(set, sigmas, point, chosen)?;
+        residuals.extend(normalized_residuals(&readings, &model, forward_zenith));
+    }
+    Ok(residuals)
 }
 
 /// (data − model)/σ for each measured element, in the frame both are given in.
