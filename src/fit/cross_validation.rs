@@ -20,7 +20,7 @@
 //! of a dense fit's time. What the fit writes (parameters, χ², uncertainties) is the fit of
 //! every point; the printed table says the scores are the subsample's.
 
-use super::admissible::{why_inadmissible, why_inadmissible_where};
+use super::admissible::why_inadmissible_where;
 use super::data::MeasurementData;
 use super::data_view::{DataView, PointSubset};
 use super::levenberg_marquardt::LevenbergMarquardtSettings;
@@ -203,7 +203,9 @@ fn choosing_terms(
     let mut scores = Vec::new();
     for &terms in candidates {
         let options = points.comparison_options(&options.with_terms(terms));
-        let (fit, score) = score_terms(&set, &points, &options, folds)?;
+        let (fit, mut score) = score_terms(&set, &points, &options, folds)?;
+        score.inadmissible =
+            why_fits_inadmissible([(&fit.chosen, &*set, &points)], &options, false)?;
         fitted.push(fit);
         scores.push(score);
     }
@@ -211,15 +213,12 @@ fn choosing_terms(
     let options = options.with_terms(candidates[chosen]);
     let kept = points.whole_data_fits(&set, &options, fitted.swap_remove(chosen))?;
     let sampled = points.sampled();
-    drop(points);
     if sampled.is_some() {
         // The verdict on the model written is that of every point.
-        let first_unrealizable = kept
-            .chosen
-            .first_unrealizable_point(&set, &data, &options)?;
         scores[chosen].inadmissible =
-            why_inadmissible_where(&[&kept.chosen.model], |_| first_unrealizable);
+            why_fits_inadmissible([(&kept.chosen, &*set, &points)], &options, true)?;
     }
+    drop(points);
     let mut outcome = finish(set, data, &options, kept)?;
     let choice = TermsChoice {
         scores,
@@ -231,8 +230,9 @@ fn choosing_terms(
     Ok((outcome, choice))
 }
 
-/// One candidate's fits (`options.terms`) and scores: χ², AIC, the folds' held-out residuals
-/// when `folds` are asked for, and whether the model is admissible.
+/// One candidate's fits (`options.terms`) and scores: χ², AIC and the folds' held-out residuals
+/// when `folds` are asked for. Whether it is admissible is the caller's to judge
+/// ([`why_fits_inadmissible`]), on one wavelength or all of a material's.
 fn score_terms(
     set: &MeasurementSet,
     points: &ChoicePoints,
@@ -246,9 +246,6 @@ fn score_terms(
         Some(k) => cross_validate(set, data, options, fit, k)?,
         None => Vec::new(),
     };
-    let first_unrealizable = fit
-        .first_unrealizable_point(set, data, options)?
-        .map(|point| points.whole_point(point));
     let score = TermsScore {
         terms: options.terms,
         distribution: fit.distribution,
@@ -256,9 +253,34 @@ fn score_terms(
         reduced_chi2: fit.reduced_chi2,
         aic: fit.aic,
         folds,
-        inadmissible: why_inadmissible_where(&[&fit.model], |_| first_unrealizable),
+        inadmissible: None,
     };
     Ok((fitted, score))
+}
+
+/// Why the fits of one material (one per wavelength, each with its set and the points it was
+/// compared on) are not admissible ([`why_inadmissible_where`]), judged on the points compared
+/// or, with `every_point`, on all of them; a row named is a row of the whole set.
+fn why_fits_inadmissible<'a>(
+    judged: impl IntoIterator<Item = (&'a ModelFit, &'a MeasurementSet, &'a ChoicePoints<'a>)>,
+    options: &FitOptions,
+    every_point: bool,
+) -> Result<Option<String>, FitError> {
+    let (mut models, mut first_unrealizable) = (Vec::new(), Vec::new());
+    for (fit, set, points) in judged {
+        let data = if every_point {
+            points.whole
+        } else {
+            points.data()
+        };
+        let first = fit.first_unrealizable_point(set, data, options)?;
+        models.push(&fit.model);
+        first_unrealizable.push(first.map(|point| match every_point {
+            true => point,
+            false => points.whole_point(point),
+        }));
+    }
+    Ok(why_inadmissible_where(&models, |j| first_unrealizable[j]))
 }
 
 /// Chooses the terms of a material measured at several wavelengths as one (docs/design.md
@@ -292,14 +314,12 @@ pub(super) fn choose_spectral_terms(
                 score_terms(set, points, &points.comparison_options(&options), folds)
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let models: Vec<_> = parts.iter().map(|p| &p.0.chosen.model).collect();
-        let muellers = parts
-            .iter()
-            .zip(sets.iter().zip(&points))
-            .map(|(p, (set, points))| p.0.chosen.model_muellers(set, points.data(), &options))
-            .collect::<Result<Vec<_>, _>>()?;
-        let muellers: Vec<_> = muellers.iter().map(Vec::as_slice).collect();
-        let inadmissible = why_inadmissible(&models, &muellers);
+        let judged = parts.iter().zip(sets.iter().zip(&points));
+        let inadmissible = why_fits_inadmissible(
+            judged.map(|(p, (set, points))| (&p.0.chosen, set, points)),
+            &options,
+            false,
+        )?;
         let (fitted, part_scores): (Vec<Fitted>, Vec<TermsScore>) = parts.into_iter().unzip();
         scores.push(TermsScore::combined(&part_scores, inadmissible));
         fits.push(fitted);
@@ -316,13 +336,12 @@ pub(super) fn choose_spectral_terms(
     let sampled = sampled_rows(&points);
     if sampled.is_some() {
         // The verdict on the models written is that of every point of every wavelength.
-        let first_unrealizable = kept
-            .iter()
-            .zip(sets.iter().zip(&data))
-            .map(|(f, (set, data))| f.chosen.first_unrealizable_point(set, data, &kept_options))
-            .collect::<Result<Vec<_>, _>>()?;
-        let models: Vec<_> = kept.iter().map(|f| &f.chosen.model).collect();
-        scores[chosen].inadmissible = why_inadmissible_where(&models, |j| first_unrealizable[j]);
+        let judged = kept.iter().zip(sets.iter().zip(&points));
+        scores[chosen].inadmissible = why_fits_inadmissible(
+            judged.map(|(f, (set, points))| (&f.chosen, set, points)),
+            &kept_options,
+            true,
+        )?;
     }
     let choice = TermsChoice {
         scores,
